@@ -1,0 +1,39 @@
+#pragma once
+/// Host-side construction of device state: particles, walls and facet meshes from plain vectors.
+#include <vector>
+
+#include "kernels/particles.hpp"
+#include "kernels/walls.hpp"
+
+namespace dem {
+
+/// One ball on the host. Mass and inertia follow from radius and density (solid sphere).
+struct BallSpec {
+  Vec3 x, v, w;
+  Real radius = 0;       ///< m
+  Real density = 2500;   ///< kg/m^3
+  int material = 0;
+  int specimen = 0;
+};
+
+/// One analytic wall on the host (see WallKind).
+struct WallSpec {
+  int kind = kPlane;
+  Vec3 point, normal, velocity;
+  Real radius = 0;
+  int material = 0;
+};
+
+/// Particles with gids 0..n-1 in the given order.
+Particles make_particles(const std::vector<BallSpec>& balls);
+WallSet make_walls(const std::vector<WallSpec>& walls);
+/// nodes: n*3 coordinates (m); tris: m*3 node indices.
+FacetMesh make_mesh(const std::vector<Real>& nodes, const std::vector<int>& tris, int material);
+
+/// Copies of particle state to the host, indexed by gid (independent of the current sort order).
+struct HostParticles {
+  std::vector<Vec3> x, v, w, f, m;
+};
+HostParticles to_host_by_gid(const Particles& p);
+
+}  // namespace dem

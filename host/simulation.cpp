@@ -1,0 +1,202 @@
+#include "simulation.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "kernels/history_remap.hpp"
+#include "kernels/reduce.hpp"
+
+namespace dem {
+
+namespace {
+double seconds_since(Kokkos::Timer& t) {
+  Kokkos::fence();
+  const double s = t.seconds();
+  t.reset();
+  return s;
+}
+}  // namespace
+
+Simulation::Simulation(Particles particles, WallSet walls, FacetMesh mesh, const std::vector<ContactParams>& table,
+                       int nmat, SimParams prm)
+    : p_(std::move(particles)), walls_(std::move(walls)), mesh_(std::move(mesh)), prm_(prm) {
+  if (static_cast<int>(table.size()) != nmat * nmat)
+    throw std::invalid_argument("contact parameter table must have nmat^2 entries");
+  params_ = ParamTableView("dem::sim::params", nmat, nmat);
+  auto hp = Kokkos::create_mirror_view(params_);
+  for (int a = 0; a < nmat; ++a)
+    for (int b = 0; b < nmat; ++b) hp(a, b) = table[a * nmat + b];
+  Kokkos::deep_copy(params_, hp);
+  if (walls_.n == 0) walls_ = WallSet(0);
+  hwall_point_ = Kokkos::create_mirror_view_and_copy(HostSpace(), walls_.point);
+  hwall_vel_ = Kokkos::create_mirror_view_and_copy(HostSpace(), walls_.velocity);
+  auto r = p_.radius;
+  Kokkos::parallel_reduce("dem::sim::rmax", RangePolicy(0, p_.n),
+      KOKKOS_LAMBDA(const int i, Real& acc) { acc = r(i) > acc ? r(i) : acc; }, Kokkos::Max<Real>(rmax_));
+  if (prm_.skin <= 0) throw std::invalid_argument("Verlet skin must be > 0");
+}
+
+Real Simulation::critical_dt() const {
+  auto m = p_.mass, in = p_.inertia, r = p_.radius;
+  auto mat = p_.material;
+  auto params = params_;
+  Real dt = 0;
+  Kokkos::parallel_reduce("dem::sim::critical_dt", RangePolicy(0, p_.n),
+      KOKKOS_LAMBDA(const int i, Real& acc) {
+        for (int b = 0; b < static_cast<int>(params.extent(1)); ++b) {
+          const ContactParams& cp = params(mat(i), b);
+          const Real kn = NormalLinear::stiffness(cp, r(i), 0);  // ball-wall: the stiffest contact
+          const Real ks = kn / cp.kratio;
+          const Real krot = ks * r(i) * r(i) + ks * r(i) * r(i);  // shear lever + rolling spring (Rbar = R)
+          const Real t = kc::min(kc::sqrt(m(i) / kn), kc::sqrt(in(i) / krot));
+          acc = t < acc ? t : acc;
+        }
+      }, Kokkos::Min<Real>(dt));
+  return dt * std::sqrt(prm_.integ.mass_scale);
+}
+
+bool Simulation::rebuild_due() const {
+  if (fresh_) return true;
+  const Real d = std::sqrt(stats_.max_disp2);
+  return 2 * d > prm_.skin || d + wall_disp_ > prm_.skin;
+}
+
+void Simulation::rebuild() {
+  bin_particles(p_, prm_.domain, 2 * rmax_ + prm_.skin, cells_);
+  const IndexView g2l = gid_to_local(p_);
+  balls_ = remap_history(detect_pairs(p_, prm_.domain, cells_, prm_.skin), balls_, g2l, true);
+  FacetBins fb;
+  if (mesh_.ntri > 0) fb = bin_facets(mesh_, cells_.grid, rmax_ + prm_.skin);
+  wall_c_ = remap_history(detect_wall_pairs(p_, walls_, mesh_, fb, cells_, prm_.skin), wall_c_, g2l, false);
+  adj_balls_ = build_adjacency(p_.n, balls_, true);
+  adj_walls_ = build_adjacency(p_.n, wall_c_, false);
+  obj_offsets_ = object_offsets(wall_c_, walls_.n + mesh_.ntri);
+  Kokkos::deep_copy(p_.x_ref, p_.x);
+  wall_disp_ = 0;
+  fresh_ = false;
+  ++times_.rebuilds;
+}
+
+void Simulation::step() {
+  Kokkos::Timer t;
+  if (rebuild_due()) rebuild();
+  times_.rebuild += seconds_since(t);
+  const Real dt = prm_.integ.dt;
+  const OverlapStat ob = compute_ball_forces(p_, balls_, params_, prm_.domain, dt);
+  const OverlapStat ow = compute_wall_forces(p_, wall_c_, adj_walls_, walls_, mesh_, params_, dt);
+  times_.forces += seconds_since(t);
+  gather_forces(p_, balls_, adj_balls_, wall_c_, adj_walls_);
+  times_.gather += seconds_since(t);
+  check_blowup(ob, ow);
+  stats_ = integrate(p_, prm_.integ);
+  times_.integrate += seconds_since(t);
+  if (stats_.bad >= 0) check_blowup(ob, ow);
+  move_boundaries();
+  times_.boundaries += seconds_since(t);
+  time_ += dt;
+  ++step_;
+}
+
+void Simulation::move_boundaries() {
+  const Real dt = prm_.integ.dt;
+  Real vmax = 0;
+  for (int w = 0; w < walls_.n; ++w) {
+    const Vec3 v = load(hwall_vel_, w);
+    if (norm2(v) == 0) continue;
+    store(hwall_point_, w, load(hwall_point_, w) + dt * v);
+    vmax = std::max(vmax, norm(v));
+  }
+  if (vmax > 0) Kokkos::deep_copy(walls_.point, hwall_point_);
+  if (mesh_.ntri > 0) {
+    auto nx = mesh_.node_x, nv = mesh_.node_v;
+    Real nmax = 0;
+    Kokkos::parallel_reduce("dem::sim::move_mesh", RangePolicy(0, mesh_.nnode),
+        KOKKOS_LAMBDA(const int k, Real& acc) {
+          const Vec3 v = load(nv, k);
+          store(nx, k, load(nx, k) + dt * v);
+          acc = norm(v) > acc ? norm(v) : acc;
+        }, Kokkos::Max<Real>(nmax));
+    vmax = std::max(vmax, nmax);
+  }
+  wall_disp_ += vmax * dt;
+}
+
+void Simulation::check_blowup(const OverlapStat& ob, const OverlapStat& ow) const {
+  std::ostringstream msg;
+  auto gid_of = [&](const ContactList& c, int k) {
+    auto hi = Kokkos::create_mirror_view_and_copy(HostSpace(), Kokkos::subview(c.i, std::make_pair(k, k + 1)));
+    auto hg = Kokkos::create_mirror_view_and_copy(HostSpace(), Kokkos::subview(p_.gid, std::make_pair(hi(0), hi(0) + 1)));
+    return hg(0);
+  };
+  if (stats_.bad >= 0) {
+    auto hg = Kokkos::create_mirror_view_and_copy(HostSpace(), p_.gid);
+    msg << "blow-up at step " << step_ << ": particle " << hg(stats_.bad)
+        << " has a non-finite position. Likely cause: time step above the critical one or a servo gain too high; "
+           "suggested fix: lower [solver] dt_safety (now dt = "
+        << prm_.integ.dt << " s, critical " << critical_dt() << " s)";
+    throw BlowUp(msg.str());
+  }
+  const OverlapStat& worst = ob.ratio >= ow.ratio ? ob : ow;
+  if (worst.ratio > prm_.overlap_limit) {
+    const bool wall = ow.ratio > ob.ratio;
+    msg << "blow-up at step " << step_ << ": particle " << gid_of(wall ? wall_c_ : balls_, worst.contact)
+        << " overlaps " << (wall ? "a wall" : "another particle") << " by " << worst.ratio * 100
+        << "% of its radius (limit " << prm_.overlap_limit * 100
+        << "%). Likely cause: stiffness too low for the load, a wall or servo moving too fast, or too large a time "
+           "step; suggested fix: raise emod, lower the wall speed or servo gain, or lower [solver] dt_safety";
+    throw BlowUp(msg.str());
+  }
+}
+
+void Simulation::set_wall_velocity(int w, const Vec3& v) {
+  store(hwall_vel_, w, v);
+  Kokkos::deep_copy(walls_.velocity, hwall_vel_);
+}
+
+Vec3 Simulation::wall_point(int w) const { return load(hwall_point_, w); }
+
+void Simulation::set_wall_point(int w, const Vec3& p) {
+  const Real moved = norm(p - load(hwall_point_, w));
+  store(hwall_point_, w, p);
+  Kokkos::deep_copy(walls_.point, hwall_point_);
+  wall_disp_ += moved;
+}
+
+std::vector<Vec3> Simulation::wall_forces() {
+  if (fresh_) return std::vector<Vec3>(walls_.n + mesh_.ntri);
+  wall_forces_into(wall_c_, obj_offsets_, wall_force_);
+  auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), wall_force_);
+  std::vector<Vec3> out(h.extent(0));
+  for (std::size_t k = 0; k < out.size(); ++k) out[k] = load(h, static_cast<int>(k));
+  return out;
+}
+
+Real Simulation::unbalanced_ratio() const {
+  if (p_.n == 0) return 0;
+  Real s[2];
+  const ContactList b = balls_, w = wall_c_;
+  const int nb = b.n;
+  deterministic_sum<2>("dem::sim::contact_force_sum", b.n + w.n, KOKKOS_LAMBDA(const int k, Real* v) {
+    const Vec3 f = k < nb ? load(b.fc, k) : load(w.fc, k - nb);
+    const Real fn = k < nb ? b.fn(k) : w.fn(k - nb);
+    v[0] = norm(f);
+    v[1] = fn > 0 ? Real(1) : Real(0);
+  }, s);
+  if (s[1] == 0) return 1;
+  return (stats_.unbalanced / p_.n) / (s[0] / s[1]);
+}
+
+std::array<long, 2> Simulation::touching() const {
+  std::array<long, 2> out{};
+  const ContactList* lists[2] = {&balls_, &wall_c_};
+  for (int q = 0; q < 2; ++q) {
+    auto fn = lists[q]->fn;
+    long c = 0;
+    Kokkos::parallel_reduce("dem::sim::touching", RangePolicy(0, lists[q]->n),
+        KOKKOS_LAMBDA(const int k, long& acc) { acc += fn(k) > 0 ? 1 : 0; }, c);
+    out[q] = c;
+  }
+  return out;
+}
+
+}  // namespace dem

@@ -1,0 +1,96 @@
+#pragma once
+/// One DEM system and its time loop: named stages (rebuild, forces, gather, integrate, boundaries),
+/// each timed. Boundary control (servos, membrane) steers it from outside through the wall setters.
+#include <array>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "kernels/accumulate.hpp"
+#include "kernels/binning.hpp"
+#include "kernels/contact_detect.hpp"
+#include "kernels/contact_force.hpp"
+#include "kernels/integrate.hpp"
+
+namespace dem {
+
+/// A run stopped because the state became unphysical. what() names the step, particle and a fix.
+struct BlowUp : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct SimParams {
+  Domain domain;
+  IntegrateParams integ;        ///< dt must be set (see critical_dt)
+  Real skin = 0;                ///< Verlet skin (m)
+  Real overlap_limit = 0.1;     ///< stop when an overlap exceeds this fraction of the radius
+};
+
+/// Wall-clock seconds spent per stage.
+struct StageTimes {
+  double rebuild = 0, forces = 0, gather = 0, integrate = 0, boundaries = 0;
+  long rebuilds = 0;
+};
+
+class Simulation {
+ public:
+  /// table: nmat x nmat contact parameters (row-major); walls and mesh may be empty.
+  Simulation(Particles particles, WallSet walls, FacetMesh mesh, const std::vector<ContactParams>& table, int nmat,
+             SimParams prm);
+
+  void step();
+  void run(long nsteps) { for (long s = 0; s < nsteps; ++s) step(); }
+
+  Particles& particles() { return p_; }
+  const ContactList& ball_contacts() const { return balls_; }
+  const ContactList& wall_contacts() const { return wall_c_; }
+  const StepStats& stats() const { return stats_; }
+  const StageTimes& times() const { return times_; }
+  const SimParams& params() const { return prm_; }
+  long step_count() const { return step_; }
+  Real time() const { return time_; }
+  int num_walls() const { return walls_.n; }
+
+  /// Largest stable time step estimate (s): min over particles of sqrt(m/kn) and sqrt(I/k_rot) for the
+  /// stiffest (ball-wall) contact; the caller multiplies by a safety factor.
+  Real critical_dt() const;
+  void set_dt(Real dt) { prm_.integ.dt = dt; }
+
+  /// Rigid wall velocity (m/s) and position (m) control.
+  void set_wall_velocity(int w, const Vec3& v);
+  Vec3 wall_point(int w) const;
+  void set_wall_point(int w, const Vec3& p);
+  /// Force exerted by the balls on wall object `obj` (analytic walls first, then facets), N.
+  std::vector<Vec3> wall_forces();
+
+  /// Mean unbalanced force over mean contact force (YADE/PFC definition); 1 when there are no contacts.
+  Real unbalanced_ratio() const;
+  /// Number of touching contacts (ball-ball, ball-wall).
+  std::array<long, 2> touching() const;
+
+ private:
+  Particles p_;
+  WallSet walls_;
+  decltype(Kokkos::create_mirror_view(WallSet().point)) hwall_point_, hwall_vel_;
+  FacetMesh mesh_;
+  ParamTableView params_;
+  SimParams prm_;
+  CellList cells_;
+  ContactList balls_, wall_c_;
+  Adjacency adj_balls_, adj_walls_;
+  IndexView obj_offsets_;
+  Vec3View wall_force_;
+  StepStats stats_;
+  StageTimes times_;
+  Real rmax_ = 0, wall_disp_ = 0;
+  long step_ = 0;
+  Real time_ = 0;
+  bool fresh_ = true;
+
+  bool rebuild_due() const;
+  void rebuild();
+  void move_boundaries();
+  void check_blowup(const OverlapStat& ob, const OverlapStat& ow) const;
+};
+
+}  // namespace dem

@@ -1,0 +1,45 @@
+#pragma once
+/// Cell list by counting sort. Particles are re-sorted by cell (memory locality), ties broken by
+/// global id so that the order, and everything computed from it, is the same for any thread count.
+#include "domain.hpp"
+#include "particles.hpp"
+
+namespace dem {
+
+/// Uniform grid over the particles' bounding box (periodic axes: over the cell).
+struct CellGrid {
+  Real lo[3] = {0, 0, 0};
+  Real h[3] = {1, 1, 1};   ///< cell edge (m), >= the contact cut-off
+  int nc[3] = {1, 1, 1};
+  bool periodic[3] = {false, false, false};
+
+  KOKKOS_INLINE_FUNCTION int ncell() const { return nc[0] * nc[1] * nc[2]; }
+  KOKKOS_INLINE_FUNCTION int coord(int d, Real x) const {
+    int c = static_cast<int>(kc::floor((x - lo[d]) / h[d]));
+    if (periodic[d]) { c %= nc[d]; if (c < 0) c += nc[d]; return c; }
+    return c < 0 ? 0 : (c >= nc[d] ? nc[d] - 1 : c);
+  }
+  KOKKOS_INLINE_FUNCTION int index(int cx, int cy, int cz) const { return cx + nc[0] * (cy + nc[1] * cz); }
+  KOKKOS_INLINE_FUNCTION int cell_of(const Vec3& x) const {
+    return index(coord(0, x.x), coord(1, x.y), coord(2, x.z));
+  }
+  /// Neighbour cell coordinate c + off along axis d; -1 when it falls off a non-periodic edge.
+  KOKKOS_INLINE_FUNCTION int shift(int d, int c, int off) const {
+    int s = c + off;
+    if (periodic[d]) return (s + nc[d]) % nc[d];
+    return (s < 0 || s >= nc[d]) ? -1 : s;
+  }
+};
+
+/// The binned particles: cell_start(c) .. cell_start(c+1) are the particles of cell c, in sorted order.
+struct CellList {
+  CellGrid grid;
+  IndexView cell_start;
+};
+
+/// Wraps periodic coordinates, builds a grid with cells of at least `cell_min`, sorts the particles by
+/// cell (permuting every per-particle View) and fills the cell list. Throws std::runtime_error when a
+/// periodic length holds fewer than 3 cells (the minimum image would then be ambiguous).
+void bin_particles(Particles& p, const Domain& dom, Real cell_min, CellList& cells);
+
+}  // namespace dem

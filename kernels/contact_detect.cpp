@@ -1,0 +1,182 @@
+#include "contact_detect.hpp"
+
+#include <Kokkos_Sort.hpp>
+#include <algorithm>
+#include <vector>
+
+namespace dem {
+
+namespace {
+
+/// Exclusive scan of per-particle counts into offsets (n + 1 entries); returns the total.
+int scan_counts(const IndexView& count, IndexView& offset) {
+  const int n = static_cast<int>(count.extent(0));
+  offset = IndexView("dem::detect::offset", n + 1);
+  auto off = offset;
+  int total = 0;
+  Kokkos::parallel_scan("dem::detect::scan", RangePolicy(0, n + 1),
+      KOKKOS_LAMBDA(const int i, int& acc, const bool final) {
+        const int c = i < n ? count(i) : 0;
+        if (final) off(i) = acc;
+        acc += c;
+      }, total);
+  return total;
+}
+
+/// Ball-ball search over the 27 neighbour cells; each pair found once, from its lower local index.
+struct PairSearch {
+  struct TagCount {};
+  struct TagFill {};
+  ConstVec3View x;
+  ConstScalarView radius;
+  GidView gid;
+  IndexView cell_start, count, offset;
+  PairKeyView keys;
+  CellGrid g;
+  Domain dom;
+  Real skin;
+
+  template <class Visit>
+  KOKKOS_INLINE_FUNCTION void visit(const int i, Visit&& f) const {
+    const Vec3 xi = load(x, i);
+    const int c[3] = {g.coord(0, xi.x), g.coord(1, xi.y), g.coord(2, xi.z)};
+    for (int dz = -1; dz <= 1; ++dz) {
+      const int cz = g.shift(2, c[2], dz);
+      if (cz < 0) continue;
+      for (int dy = -1; dy <= 1; ++dy) {
+        const int cy = g.shift(1, c[1], dy);
+        if (cy < 0) continue;
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int cx = g.shift(0, c[0], dx);
+          if (cx < 0) continue;
+          const int cell = g.index(cx, cy, cz);
+          for (int j = cell_start(cell); j < cell_start(cell + 1); ++j) {
+            if (j <= i) continue;
+            const Real reach = radius(i) + radius(j) + skin;
+            if (norm2(dom.min_image(load(x, j) - xi)) < reach * reach) f(j);
+          }
+        }
+      }
+    }
+  }
+  KOKKOS_INLINE_FUNCTION void operator()(TagCount, const int i) const {
+    int n = 0;
+    visit(i, [&](int) { ++n; });
+    count(i) = n;
+  }
+  KOKKOS_INLINE_FUNCTION void operator()(TagFill, const int i) const {
+    int k = offset(i);
+    visit(i, [&](int j) { keys(k++) = pair_key(gid(i), gid(j)); });
+  }
+};
+
+/// Ball-wall search: every analytic wall, plus the facets binned into the ball's cell.
+struct WallSearch {
+  struct TagCount {};
+  struct TagFill {};
+  ConstVec3View x;
+  ConstScalarView radius;
+  GidView gid;
+  WallSet walls;
+  FacetMesh mesh;
+  IndexView fstart, ffacet;
+  IndexView count, offset;
+  PairKeyView keys;
+  CellGrid g;
+  Real skin;
+
+  template <class Visit>
+  KOKKOS_INLINE_FUNCTION void visit(const int i, Visit&& f) const {
+    const Vec3 xi = load(x, i);
+    const Real reach = radius(i) + skin;
+    for (int w = 0; w < walls.n; ++w) {
+      Vec3 n, cp;
+      Real dist;
+      if (wall_contact(walls.kind(w), load(walls.point, w), load(walls.normal, w), walls.radius(w), xi, n, dist, cp) &&
+          dist < reach)
+        f(w);
+    }
+    if (mesh.ntri == 0) return;
+    const int cell = g.cell_of(xi);
+    for (int k = fstart(cell); k < fstart(cell + 1); ++k) {
+      const int t = ffacet(k);
+      if (norm2(facet_hit(mesh, t, xi).cp - xi) < reach * reach) f(walls.n + t);
+    }
+  }
+  KOKKOS_INLINE_FUNCTION void operator()(TagCount, const int i) const {
+    int n = 0;
+    visit(i, [&](int) { ++n; });
+    count(i) = n;
+  }
+  KOKKOS_INLINE_FUNCTION void operator()(TagFill, const int i) const {
+    int k = offset(i);
+    visit(i, [&](int obj) { keys(k++) = wall_key(obj, gid(i)); });
+  }
+};
+
+template <class Search>
+PairKeyView run_search(Search s, int n, const char* label) {
+  s.count = IndexView("dem::detect::count", n);
+  Kokkos::parallel_for(label, Kokkos::RangePolicy<ExecSpace, typename Search::TagCount>(0, n), s);
+  const int total = scan_counts(s.count, s.offset);
+  s.keys = PairKeyView("dem::detect::keys", total);
+  Kokkos::parallel_for(label, Kokkos::RangePolicy<ExecSpace, typename Search::TagFill>(0, n), s);
+  if (total > 1) Kokkos::sort(s.keys);
+  return s.keys;
+}
+
+}  // namespace
+
+FacetBins bin_facets(const FacetMesh& mesh, const CellGrid& g, Real reach) {
+  const int nc = g.ncell();
+  auto hx = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.node_x);
+  auto ht = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.tri);
+  std::vector<std::pair<int, int>> entries;  // (cell, facet)
+  for (int t = 0; t < mesh.ntri; ++t) {
+    int lo[3], hi[3];
+    bool outside = false;
+    for (int d = 0; d < 3; ++d) {
+      Real a = hx(ht(t, 0), d), b = a;
+      for (int v = 1; v < 3; ++v) { a = std::min(a, hx(ht(t, v), d)); b = std::max(b, hx(ht(t, v), d)); }
+      a -= reach; b += reach;
+      const Real glo = g.lo[d], ghi = g.lo[d] + g.h[d] * g.nc[d];
+      if (!g.periodic[d] && (b < glo || a > ghi)) outside = true;
+      lo[d] = g.coord(d, a);
+      hi[d] = g.coord(d, b);
+      if (g.periodic[d] && (b - a >= g.h[d] * g.nc[d] || hi[d] < lo[d])) { lo[d] = 0; hi[d] = g.nc[d] - 1; }
+    }
+    if (outside) continue;
+    for (int cz = lo[2]; cz <= hi[2]; ++cz)
+      for (int cy = lo[1]; cy <= hi[1]; ++cy)
+        for (int cx = lo[0]; cx <= hi[0]; ++cx) entries.emplace_back(g.index(cx, cy, cz), t);
+  }
+  std::sort(entries.begin(), entries.end());
+  FacetBins b{IndexView("dem::detect::facet_start", nc + 1), IndexView("dem::detect::facet", entries.size())};
+  auto hs = Kokkos::create_mirror_view(b.start);
+  auto hf = Kokkos::create_mirror_view(b.facet);
+  std::size_t k = 0;
+  for (int c = 0; c <= nc; ++c) {
+    hs(c) = static_cast<int>(k);
+    while (k < entries.size() && entries[k].first == c) { hf(k) = entries[k].second; ++k; }
+  }
+  Kokkos::deep_copy(b.start, hs);
+  Kokkos::deep_copy(b.facet, hf);
+  return b;
+}
+
+PairKeyView detect_pairs(const Particles& p, const Domain& dom, const CellList& cells, Real skin) {
+  PairSearch s;
+  s.x = p.x; s.radius = p.radius; s.gid = p.gid; s.cell_start = cells.cell_start;
+  s.g = cells.grid; s.dom = dom; s.skin = skin;
+  return run_search(s, p.n, "dem::detect::pairs");
+}
+
+PairKeyView detect_wall_pairs(const Particles& p, const WallSet& walls, const FacetMesh& mesh,
+                              const FacetBins& bins, const CellList& cells, Real skin) {
+  WallSearch s;
+  s.x = p.x; s.radius = p.radius; s.gid = p.gid; s.walls = walls; s.mesh = mesh;
+  s.fstart = bins.start; s.ffacet = bins.facet; s.g = cells.grid; s.skin = skin;
+  return run_search(s, p.n, "dem::detect::walls");
+}
+
+}  // namespace dem

@@ -1,0 +1,33 @@
+#pragma once
+/// Candidate contacts by count -> exclusive scan -> fill -> sort: no guessed capacity, no retry loop,
+/// and the sorted keys make the order independent of threads.
+#include "binning.hpp"
+#include "contact_list.hpp"
+#include "walls.hpp"
+
+namespace dem {
+
+/// Facets listed per particle cell: a facet appears in every cell its bounding box, grown by
+/// `reach` (largest radius + skin), overlaps, so a ball only looks in its own cell.
+struct FacetBins {
+  IndexView start;   ///< ncell + 1 offsets
+  IndexView facet;
+};
+
+/// Bins the mesh's facets into the cells of `grid` (on the host: a membrane has a few thousand facets).
+FacetBins bin_facets(const FacetMesh& mesh, const CellGrid& grid, Real reach);
+
+/// Keys of all ball-ball pairs whose centres are closer than r_i + r_j + skin, sorted.
+PairKeyView detect_pairs(const Particles& p, const Domain& dom, const CellList& cells, Real skin);
+
+/// Keys of all ball-wall pairs (analytic walls, then facets as objects walls.n + f) within skin, sorted.
+PairKeyView detect_wall_pairs(const Particles& p, const WallSet& walls, const FacetMesh& mesh,
+                              const FacetBins& bins, const CellList& cells, Real skin);
+
+/// Centre-to-surface distance of a ball to facet f (closest point on the triangle).
+KOKKOS_INLINE_FUNCTION FacetHit facet_hit(const FacetMesh& mesh, int f, const Vec3& x) {
+  return closest_on_triangle(x, load(mesh.node_x, mesh.tri(f, 0)), load(mesh.node_x, mesh.tri(f, 1)),
+                             load(mesh.node_x, mesh.tri(f, 2)));
+}
+
+}  // namespace dem

@@ -1,0 +1,39 @@
+#pragma once
+/// Candidate contacts (pairs within the Verlet skin) with their history, one record per physical
+/// contact, sorted by key. Ball-ball key: min_gid << 32 | max_gid. Ball-wall key: object << 32 | gid,
+/// where object numbers the analytic walls first, then the facets; sorting by it groups each wall's
+/// contacts, so wall forces are summed in a fixed order.
+#include "types.hpp"
+
+namespace dem {
+
+KOKKOS_INLINE_FUNCTION std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) {
+  return a < b ? (std::uint64_t(a) << 32) | b : (std::uint64_t(b) << 32) | a;
+}
+KOKKOS_INLINE_FUNCTION std::uint64_t wall_key(int object, std::uint32_t gid) {
+  return (std::uint64_t(object) << 32) | gid;
+}
+KOKKOS_INLINE_FUNCTION std::uint32_t key_hi(std::uint64_t k) { return static_cast<std::uint32_t>(k >> 32); }
+KOKKOS_INLINE_FUNCTION std::uint32_t key_lo(std::uint64_t k) { return static_cast<std::uint32_t>(k & 0xffffffffu); }
+
+struct ContactList {
+  PairKeyView key;
+  IndexView i;            ///< local index of particle 1
+  IndexView j;            ///< local index of particle 2, or wall object number
+  // history (survives rebuilds through history_remap)
+  Vec3View fs;            ///< shear force on particle 1 (N)
+  Vec3View mr;            ///< rolling moment on particle 1 (N m)
+  FlagView flags;
+  // results of the current step
+  Vec3View fc;            ///< total contact force on particle 1 (N)
+  Vec3View m1, m2;        ///< moments on particle 1 and 2 (N m); m2 unused for walls
+  Vec3View normal;        ///< unit normal from 1 to 2
+  Vec3View point;         ///< contact point (m)
+  ScalarView fn;          ///< linear normal force (N), 0 when not touching
+  int n = 0;
+
+  ContactList() = default;
+  ContactList(int count, bool two_sided);
+};
+
+}  // namespace dem

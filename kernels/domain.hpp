@@ -1,0 +1,38 @@
+#pragma once
+/// The simulation box: bounds and which axes are periodic. Non-periodic axes are open (walls confine).
+#include "vec3.hpp"
+
+namespace dem {
+
+struct Domain {
+  Real lo[3] = {0, 0, 0};   ///< m
+  Real hi[3] = {0, 0, 0};   ///< m
+  bool periodic[3] = {false, false, false};
+
+  KOKKOS_INLINE_FUNCTION Real length(int d) const { return hi[d] - lo[d]; }
+
+  /// Minimum-image separation for periodic axes (orthorhombic cell).
+  KOKKOS_INLINE_FUNCTION Vec3 min_image(Vec3 d) const {
+    Real c[3] = {d.x, d.y, d.z};
+    for (int k = 0; k < 3; ++k) {
+      if (!periodic[k]) continue;
+      const Real L = length(k);
+      c[k] -= L * kc::floor(c[k] / L + Real(0.5));
+    }
+    return Vec3(c[0], c[1], c[2]);
+  }
+
+  /// Maps a position into the primary cell along periodic axes.
+  KOKKOS_INLINE_FUNCTION Vec3 wrap(Vec3 p) const {
+    Real c[3] = {p.x, p.y, p.z};
+    for (int k = 0; k < 3; ++k) {
+      if (!periodic[k]) continue;
+      const Real L = length(k);
+      c[k] -= L * kc::floor((c[k] - lo[k]) / L);
+      if (c[k] >= hi[k]) c[k] -= L;  // guards the rounding case (c - lo)/L == 1 - eps
+    }
+    return Vec3(c[0], c[1], c[2]);
+  }
+};
+
+}  // namespace dem

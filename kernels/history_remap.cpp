@@ -1,0 +1,54 @@
+#include "history_remap.hpp"
+
+namespace dem {
+
+IndexView gid_to_local(const Particles& p) {
+  IndexView map("dem::remap::gid2local", p.gid_bound());
+  Kokkos::deep_copy(map, -1);
+  auto gid = p.gid;
+  Kokkos::parallel_for("dem::remap::gid2local", RangePolicy(0, p.n), KOKKOS_LAMBDA(const int i) { map(gid(i)) = i; });
+  return map;
+}
+
+namespace {
+
+KOKKOS_INLINE_FUNCTION int find_key(const PairKeyView& keys, int n, std::uint64_t k) {
+  int lo = 0, hi = n;
+  while (lo < hi) {
+    const int mid = (lo + hi) / 2;
+    if (keys(mid) < k) lo = mid + 1; else hi = mid;
+  }
+  return (lo < n && keys(lo) == k) ? lo : -1;
+}
+
+}  // namespace
+
+ContactList remap_history(const PairKeyView& keys, const ContactList& old, const IndexView& gid2local,
+                          bool ball_ball) {
+  const int n = static_cast<int>(keys.extent(0));
+  ContactList c(n, ball_ball);
+  c.key = keys;
+  const int nold = old.n;
+  auto okey = old.key;
+  auto ofs = old.fs, omr = old.mr;
+  auto oflags = old.flags;
+  Kokkos::parallel_for("dem::remap::history", RangePolicy(0, n), KOKKOS_LAMBDA(const int k) {
+    const std::uint64_t key = keys(k);
+    if (ball_ball) {
+      c.i(k) = gid2local(key_hi(key));
+      c.j(k) = gid2local(key_lo(key));
+    } else {
+      c.i(k) = gid2local(key_lo(key));
+      c.j(k) = static_cast<int>(key_hi(key));
+    }
+    const int o = nold > 0 ? find_key(okey, nold, key) : -1;
+    for (int d = 0; d < 3; ++d) {
+      c.fs(k, d) = o >= 0 ? ofs(o, d) : Real(0);
+      c.mr(k, d) = o >= 0 ? omr(o, d) : Real(0);
+    }
+    c.flags(k) = o >= 0 ? oflags(o) : std::uint8_t(0);
+  });
+  return c;
+}
+
+}  // namespace dem

@@ -1,0 +1,17 @@
+#pragma once
+/// Carries contact history across a rebuild: each new key looks itself up among the previous sorted
+/// keys (binary search) and takes that contact's shear force, rolling moment and flags; new contacts
+/// start from zero. Keys are global ids, so re-sorting particles never loses history.
+#include "contact_list.hpp"
+#include "particles.hpp"
+
+namespace dem {
+
+/// gid -> current local index (-1 for unused gids).
+IndexView gid_to_local(const Particles& p);
+
+/// A contact list over `keys` with local indices resolved through gid2local and history from `old`.
+ContactList remap_history(const PairKeyView& keys, const ContactList& old, const IndexView& gid2local,
+                          bool ball_ball);
+
+}  // namespace dem

@@ -1,0 +1,67 @@
+#include "integrate.hpp"
+
+#include "reduce.hpp"
+
+namespace dem {
+
+namespace {
+
+struct Leapfrog {
+  Vec3View x, v, w;
+  ConstVec3View f, m;
+  ConstScalarView mass, inertia;
+  IntegrateParams prm;
+
+  /// Advances particle i; vals = {|F + m g|, kinetic energy, non-finite flag}.
+  KOKKOS_INLINE_FUNCTION void operator()(const int i, Real* vals) const {
+    const Real mi = mass(i), ii = inertia(i);
+    const Vec3 force = load(f, i) + mi * prm.gravity;
+    const Vec3 moment = load(m, i);
+    Vec3 vi = load(v, i), wi = load(w, i);
+    const Real a = prm.dt / (mi * prm.mass_scale), b = prm.dt / (ii * prm.mass_scale);
+    vi = vi + a * Vec3(force.x + local_damping(force.x, vi.x, prm.alpha), force.y + local_damping(force.y, vi.y, prm.alpha),
+                       force.z + local_damping(force.z, vi.z, prm.alpha));
+    wi = wi + b * Vec3(moment.x + local_damping(moment.x, wi.x, prm.alpha),
+                       moment.y + local_damping(moment.y, wi.y, prm.alpha),
+                       moment.z + local_damping(moment.z, wi.z, prm.alpha));
+    const Vec3 xi = load(x, i) + prm.dt * vi;
+    store(v, i, vi);
+    store(w, i, wi);
+    store(x, i, xi);
+    vals[0] = norm(force);
+    vals[1] = Real(0.5) * (mi * norm2(vi) + ii * norm2(wi));
+    vals[2] = (kc::isfinite(xi.x) && kc::isfinite(xi.y) && kc::isfinite(xi.z)) ? Real(0) : Real(1);
+  }
+};
+
+}  // namespace
+
+StepStats integrate(Particles& p, const IntegrateParams& prm) {
+  const Leapfrog lf{p.x, p.v, p.w, p.f, p.m, p.mass, p.inertia, prm};
+  Real sums[3];
+  deterministic_sum<3>("dem::integrate::leapfrog", p.n,
+                       KOKKOS_LAMBDA(const int i, Real* vals) { lf(i, vals); }, sums);
+  StepStats st;
+  st.unbalanced = sums[0];
+  st.kinetic = sums[1];
+  auto x = p.x, xr = p.x_ref;
+  Real mx = 0;
+  Kokkos::parallel_reduce("dem::integrate::max_disp", RangePolicy(0, p.n),
+      KOKKOS_LAMBDA(const int i, Real& acc) {
+        const Real d2 = norm2(load(x, i) - load(xr, i));
+        acc = d2 > acc ? d2 : acc;
+      }, Kokkos::Max<Real>(mx));
+  st.max_disp2 = mx;
+  if (sums[2] > 0) {
+    int bad = -1;
+    Kokkos::parallel_reduce("dem::integrate::find_bad", RangePolicy(0, p.n),
+        KOKKOS_LAMBDA(const int i, int& acc) {
+          const Vec3 xi = load(x, i);
+          if (!(kc::isfinite(xi.x) && kc::isfinite(xi.y) && kc::isfinite(xi.z)) && i > acc) acc = i;
+        }, Kokkos::Max<int>(bad));
+    st.bad = bad;
+  }
+  return st;
+}
+
+}  // namespace dem

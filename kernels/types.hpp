@@ -1,0 +1,40 @@
+#pragma once
+/// All device-side types of triaxdem, in one place. No other file spells out Kokkos::View template
+/// arguments: a change of layout or precision happens here and is measured in perf/.
+#include <Kokkos_Core.hpp>
+#include <cstdint>
+
+namespace dem {
+
+using Real = double;                                   ///< SI units everywhere inside the engine
+using ExecSpace = Kokkos::DefaultExecutionSpace;
+using MemSpace = ExecSpace::memory_space;
+using HostSpace = Kokkos::HostSpace;
+using Layout = Kokkos::LayoutLeft;                      ///< SoA: x(i,0..2) components in separate runs
+
+using Vec3View = Kokkos::View<Real* [3], Layout, MemSpace>;          ///< per-item 3-vector (m, m/s, N, ...)
+using ConstVec3View = Kokkos::View<const Real* [3], Layout, MemSpace>;
+using ScalarView = Kokkos::View<Real*, MemSpace>;                    ///< per-item scalar (m, kg, kg m^2, ...)
+using ConstScalarView = Kokkos::View<const Real*, MemSpace>;
+using IndexView = Kokkos::View<int*, MemSpace>;                      ///< local indices, counts, offsets
+using ConstIndexView = Kokkos::View<const int*, MemSpace>;
+using GidView = Kokkos::View<std::uint32_t*, MemSpace>;             ///< global particle id (stable across sorts)
+using PairKeyView = Kokkos::View<std::uint64_t*, MemSpace>;         ///< sorted contact key (see contact_list.hpp)
+using FlagView = Kokkos::View<std::uint8_t*, MemSpace>;             ///< per-contact state bits
+using Index2View = Kokkos::View<int* [2], Layout, MemSpace>;         ///< pair of local indices
+using Index3View = Kokkos::View<int* [3], Layout, MemSpace>;         ///< facet vertex indices
+
+struct ContactParams;
+/// Contact parameters per pair of material indices (contact_law.hpp).
+using ParamTableView = Kokkos::View<ContactParams**, MemSpace>;
+
+using RangePolicy = Kokkos::RangePolicy<ExecSpace>;
+
+/// Contact flags (bits of FlagView).
+enum ContactFlag : std::uint8_t {
+  kTouching = 1u << 0,  ///< overlapping this step
+  kSliding = 1u << 1,   ///< shear force at the Coulomb cap
+  kRolling = 1u << 2,   ///< rolling moment at its cap
+};
+
+}  // namespace dem
