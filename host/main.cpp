@@ -1,1 +1,50 @@
-int main() { return 0; }
+/// triaxdem command line.
+#include <CLI/CLI.hpp>
+#include <Kokkos_Core.hpp>
+
+#include <cstdio>
+#include <iostream>
+
+#include "host/config.hpp"
+#include "host/job.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"triaxdem: DEM laboratory for triaxial tests on granular materials"};
+  app.require_subcommand(1);
+  std::string config_path, output;
+  long steps = -1;
+
+  auto* run = app.add_subcommand("run", "run the job a config describes");
+  run->add_option("config", config_path, "TOML config file")->required()->check(CLI::ExistingFile);
+  run->add_option("-o,--output", output, "output folder (overrides [run] output)");
+  run->add_option("-n,--steps", steps, "number of steps (overrides [run] steps)")->check(CLI::NonNegativeNumber);
+
+  auto* check = app.add_subcommand("check", "validate a config and print the derived time step");
+  check->add_option("config", config_path, "TOML config file")->required()->check(CLI::ExistingFile);
+
+  auto* info = app.add_subcommand("info", "print the Kokkos build in use");
+
+  CLI11_PARSE(app, argc, argv);
+  Kokkos::ScopeGuard guard(argc, argv);
+  try {
+    if (info->parsed()) {
+      Kokkos::print_configuration(std::cout, false);
+      return 0;
+    }
+    dem::Config cfg = dem::load_config(config_path);
+    if (!output.empty()) cfg.run.output = output;
+    if (steps >= 0) cfg.run.steps = steps;
+    if (check->parsed()) {
+      dem::build_simulation(cfg, true);
+      std::printf("%s: OK\n", config_path.c_str());
+      return 0;
+    }
+    return dem::run_job(cfg);
+  } catch (const dem::ConfigError& e) {
+    std::fprintf(stderr, "triaxdem: config error: %s\n", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "triaxdem: error: %s\n", e.what());
+    return 1;
+  }
+}

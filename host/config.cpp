@@ -1,0 +1,186 @@
+#include "config.hpp"
+
+#include <toml++/toml.h>
+
+#include <cmath>
+#include <set>
+#include <sstream>
+
+namespace dem {
+
+namespace {
+
+/// Reads one table, remembering which keys were used so that leftovers (typos) are refused.
+class TableReader {
+ public:
+  TableReader(const std::string& file, const std::string& name, const toml::table* t)
+      : file_(file), name_(name), t_(t) {}
+
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
+    std::ostringstream s;
+    s << file_ << ": [" << name_ << "] " << key << ": " << what;
+    throw ConfigError(s.str());
+  }
+
+  /// A number in [lo, hi]; `scale` converts the file's unit to SI.
+  void number(const std::string& key, Real& out, Real lo, Real hi, Real scale = 1, bool open_lo = false) {
+    const toml::node* n = get(key);
+    if (!n) return;
+    double v;
+    if (auto d = n->value<double>()) v = *d;
+    else fail(key, "expected a number");
+    if (!std::isfinite(v) || v < lo || v > hi || (open_lo && v == lo)) {
+      std::ostringstream r;
+      r << "value " << v << " out of range (allowed: " << (open_lo ? "(" : "[") << lo << ", " << hi << "])";
+      fail(key, r.str());
+    }
+    out = v * scale;
+  }
+  void integer(const std::string& key, long& out, long lo, long hi) {
+    const toml::node* n = get(key);
+    if (!n) return;
+    auto v = n->value_exact<int64_t>();
+    if (!v) fail(key, "expected an integer");
+    if (*v < lo || *v > hi)
+      fail(key, "value " + std::to_string(*v) + " out of range (allowed: [" + std::to_string(lo) + ", " +
+                    std::to_string(hi) + "])");
+    out = static_cast<long>(*v);
+  }
+  void boolean(const std::string& key, bool& out) {
+    const toml::node* n = get(key);
+    if (!n) return;
+    auto v = n->value_exact<bool>();
+    if (!v) fail(key, "expected true or false");
+    out = *v;
+  }
+  void string(const std::string& key, std::string& out, const std::set<std::string>& allowed = {}) {
+    const toml::node* n = get(key);
+    if (!n) return;
+    auto v = n->value_exact<std::string>();
+    if (!v) fail(key, "expected a string");
+    if (!allowed.empty() && !allowed.count(*v)) {
+      std::string list;
+      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+      fail(key, "'" + *v + "' is not allowed (allowed: " + list + ")");
+    }
+    out = *v;
+  }
+  template <class T, class F>
+  void triple(const std::string& key, std::array<T, 3>& out, F&& element) {
+    const toml::node* n = get(key);
+    if (!n) return;
+    const toml::array* a = n->as_array();
+    if (!a || a->size() != 3) fail(key, "expected an array of 3 values (x, y, z)");
+    for (int d = 0; d < 3; ++d) element((*a)[d], out[d]);
+  }
+  /// Refuses keys that were never read.
+  void finish() const {
+    if (!t_) return;
+    for (const auto& [k, v] : *t_)
+      if (!used_.count(std::string(k.str()))) fail(std::string(k.str()), "unknown key (check the spelling)");
+  }
+
+ private:
+  std::string file_, name_;
+  const toml::table* t_;
+  std::set<std::string> used_;
+  const toml::node* get(const std::string& key) {
+    if (!t_) return nullptr;
+    used_.insert(key);
+    return t_->get(key);
+  }
+};
+
+void read_contact(TableReader& r, ContactParams& c) {
+  r.number("emod_Pa", c.emod, 0, 1e13, 1, true);
+  r.number("kratio", c.kratio, 0, 1e3, 1, true);
+  r.number("mu_s", c.mu_s, 0, 10);
+  r.number("mu_r", c.mu_r, 0, 10);
+  r.number("beta_n", c.beta_n, 0, 1);
+  r.finish();
+}
+
+}  // namespace
+
+Config load_config(const std::string& path) {
+  Config c;
+  c.path = path;
+  toml::table root;
+  try {
+    root = toml::parse_file(path);
+  } catch (const toml::parse_error& e) {
+    std::ostringstream s;
+    s << path << ":" << e.source().begin.line << ":" << e.source().begin.column << ": " << e.description();
+    throw ConfigError(s.str());
+  }
+  static const std::set<std::string> tables = {"run", "particles", "box", "material", "wall_material", "solver"};
+  for (const auto& [k, v] : root) {
+    if (!tables.count(std::string(k.str())) || !v.is_table())
+      throw ConfigError(path + ": [" + std::string(k.str()) +
+                        "]: unknown table (allowed: run, particles, box, material, wall_material, solver)");
+  }
+  auto table = [&](const char* name) { return TableReader(path, name, root[name].as_table()); };
+
+  TableReader run = table("run");
+  run.string("name", c.run.name);
+  run.integer("steps", c.run.steps, 0, 1000000000L);
+  run.string("output", c.run.output);
+  run.integer("series_every", c.run.series_every, 1, 1000000000L);
+  run.integer("snapshot_every", c.run.snapshot_every, 0, 1000000000L);
+  long seed = c.run.seed;
+  run.integer("seed", seed, 0, 4294967295L);
+  run.number("stop_ratio", c.run.stop_ratio, 0, 1);
+  c.run.seed = static_cast<unsigned>(seed);
+  run.finish();
+
+  TableReader pt = table("particles");
+  pt.integer("count", c.particles.count, 1, 2000000000L);
+  pt.number("diameter_mm", c.particles.diameter, 1e-6, 1e6, 1e-3, true);
+  pt.number("diameter_ratio", c.particles.diameter_ratio, 1, 10);
+  pt.number("density_kg_m3", c.particles.density, 0, 1e6, 1, true);
+  pt.finish();
+
+  TableReader box = table("box");
+  box.triple("size_mm", c.box.size, [&](const toml::node& n, Real& out) {
+    auto v = n.value<double>();
+    if (!v || !(*v > 0)) box.fail("size_mm", "each size must be a number > 0 (mm)");
+    out = *v * 1e-3;
+  });
+  box.triple("periodic", c.box.periodic, [&](const toml::node& n, bool& out) {
+    auto v = n.value_exact<bool>();
+    if (!v) box.fail("periodic", "expected [true|false, true|false, true|false]");
+    out = *v;
+  });
+  box.boolean("walls", c.box.walls);
+  box.string("fill", c.box.fill, {"random", "lattice"});
+  box.number("lattice_spacing", c.box.lattice_spacing, 0.9, 2.0);
+  box.finish();
+
+  TableReader mat = table("material");
+  read_contact(mat, c.ball);
+  c.wall = c.ball;
+  TableReader wmat = table("wall_material");
+  read_contact(wmat, c.wall);
+
+  TableReader sv = table("solver");
+  sv.number("damping", c.solver.damping, 0, 0.99);
+  sv.triple("gravity", c.solver.gravity, [&](const toml::node& n, Real& out) {
+    auto v = n.value<double>();
+    if (!v || std::fabs(*v) > 1e4) sv.fail("gravity", "expected 3 numbers in m/s^2 with |g| <= 1e4");
+    out = *v;
+  });
+  sv.number("dt_safety", c.solver.dt_safety, 0, 1, 1, true);
+  sv.number("dt_s", c.solver.dt, 0, 1);
+  sv.number("mass_scale", c.solver.mass_scale, 1, 1e12);
+  sv.number("skin", c.solver.skin, 0, 2, 1, true);
+  sv.number("overlap_limit", c.solver.overlap_limit, 0, 1, 1, true);
+  sv.finish();
+
+  for (int d = 0; d < 3; ++d)
+    if (c.box.size[d] < 3 * c.particles.diameter)
+      throw ConfigError(path + ": [box] size_mm: every side must be at least 3 diameters (" +
+                        std::to_string(3e3 * c.particles.diameter) + " mm)");
+  return c;
+}
+
+}  // namespace dem

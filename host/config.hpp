@@ -1,0 +1,67 @@
+#pragma once
+/// Run configuration: TOML (toml++) read into plain structs. SI inside; the file speaks the units
+/// researchers use (mm, kPa, kg/m^3), named in each key. Unknown keys, wrong types and values out of
+/// range are refused with the file, the key and the allowed range.
+#include <array>
+#include <stdexcept>
+#include <string>
+
+#include "kernels/contact_law.hpp"
+
+namespace dem {
+
+/// A config error: what() reads "<file>: [table] key: problem (allowed: range)".
+struct ConfigError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct RunConfig {
+  std::string name = "run";
+  long steps = 20000;            ///< time steps of the run
+  std::string output = "out";    ///< output folder
+  long series_every = 100;       ///< steps between time-series rows
+  long snapshot_every = 5000;    ///< steps between particle snapshots (0 = first and last only)
+  unsigned seed = 1;             ///< random generator seed (packing)
+  Real stop_ratio = 0;           ///< stop early once the unbalanced-force ratio is below this (0 = never)
+};
+
+struct ParticleConfig {
+  long count = 2000;
+  Real diameter = 2e-3;          ///< m (file: diameter_mm)
+  Real diameter_ratio = 1.0;     ///< largest / smallest diameter, uniform in between
+  Real density = 2500;           ///< kg/m^3
+};
+
+/// Box holding the particles at the start; its non-periodic faces carry plane walls when `walls`.
+struct BoxConfig {
+  std::array<Real, 3> size{0.03, 0.03, 0.06};  ///< m (file: size_mm)
+  std::array<bool, 3> periodic{false, false, false};
+  bool walls = true;
+  std::string fill = "random";   ///< "random" (sequential insertion) or "lattice" (jittered cubic)
+  Real lattice_spacing = 1.0;    ///< lattice pitch / largest diameter (< 1 presses neighbours together)
+};
+
+struct SolverConfig {
+  Real damping = 0.7;                       ///< local damping alpha
+  std::array<Real, 3> gravity{0, 0, -9.81}; ///< m/s^2
+  Real dt_safety = 0.2;                     ///< dt = dt_safety * critical dt
+  Real dt = 0;                              ///< s; > 0 overrides dt_safety
+  Real mass_scale = 1;                      ///< density scaling (quasi-static runs only)
+  Real skin = 0.2;                          ///< Verlet skin / mean diameter
+  Real overlap_limit = 0.1;                 ///< blow-up threshold: overlap / radius
+};
+
+struct Config {
+  std::string path;  ///< file it came from (for messages)
+  RunConfig run;
+  ParticleConfig particles;
+  BoxConfig box;
+  ContactParams ball;   ///< ball-ball contact law
+  ContactParams wall;   ///< ball-wall contact law (defaults to ball)
+  SolverConfig solver;
+};
+
+/// Reads and validates a config file. Throws ConfigError.
+Config load_config(const std::string& path);
+
+}  // namespace dem

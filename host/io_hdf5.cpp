@@ -1,0 +1,368 @@
+#include "host/io_hdf5.hpp"
+
+#include <hdf5.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <charconv>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <numeric>
+#include <set>
+#include <stdexcept>
+#include <tuple>
+#include <utility>
+
+namespace dem::io {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+static_assert(sizeof(int) == 4, "specimen and triangle datasets are written as 32-bit integers");
+
+[[noreturn]] void fail(const std::string& path, const std::string& what) {
+  throw std::runtime_error("cannot write '" + path + "': " + what);
+}
+
+std::string in_folder(const std::string& folder, const std::string& name) {
+  return (fs::path(folder) / name).string();
+}
+
+std::string join(const std::vector<std::string>& parts, char sep) {
+  std::string out;
+  for (std::size_t i = 0; i < parts.size(); ++i) out += (i ? std::string(1, sep) : "") + parts[i];
+  return out;
+}
+
+/// HDF5 reads '/' as a group separator, so it cannot appear in a dataset name.
+std::string dataset_name(std::string name) {
+  std::replace(name.begin(), name.end(), '/', '_');
+  return name;
+}
+
+/// Names become dataset names, CSV header fields and comma-joined attributes: reject the ones that would
+/// collide or make those ambiguous now, rather than leave a file that reads back wrong.
+void check_names(const std::vector<std::string>& names, std::set<std::string> taken, const std::string& context) {
+  for (const std::string& name : names) {
+    const std::string ds = dataset_name(name);
+    if (name.empty() || ds == "." || name.find_first_of(",\"\r\n") != std::string::npos)
+      throw std::invalid_argument(context + ": name '" + name + "' is empty, '.', or has a comma, quote or newline");
+    if (!taken.insert(ds).second)
+      throw std::invalid_argument(context + ": name '" + name + "' clashes with another or a reserved name");
+  }
+}
+
+/// Writes through "<path>.tmp" so that a crash or a concurrent reader never sees a half-written file under
+/// the final name, and the previous complete version stays in place until the new one is.
+template <class Write>
+void replace_atomically(const std::string& path, Write write) {
+  const std::string tmp = path + ".tmp";
+  std::error_code ec;
+  try {
+    write(tmp);
+    fs::rename(tmp, path, ec);
+    if (ec) fail(path, "rename from '" + tmp + "': " + ec.message());
+  } catch (...) {
+    fs::remove(tmp, ec);
+    throw;
+  }
+}
+
+/// Owns one HDF5 identifier, so that every exit path, exceptions included, releases it.
+class Handle {
+ public:
+  using Closer = herr_t (*)(hid_t);
+  Handle(hid_t id, Closer closer) : id_(id), closer_(closer) {}
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+  ~Handle() { if (id_ >= 0) closer_(id_); }
+  hid_t get() const { return id_; }
+  /// For files, closing is the final flush: its failure must be reported, not ignored as in the destructor.
+  bool close() { return closer_(std::exchange(id_, H5I_INVALID_HID)) >= 0; }
+
+ private:
+  hid_t id_;
+  Closer closer_;
+};
+
+/// One HDF5 file being written under its temporary name; errors name the final path.
+class H5Writer {
+ public:
+  H5Writer(const std::string& tmp, std::string path)
+      : path_(std::move(path)),
+        file_(check(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), "create '" + tmp + "'"),
+              H5Fclose) {}
+
+  hid_t root() const { return file_.get(); }
+
+  hid_t check(hid_t id, const std::string& what) const {
+    if (id < 0) fail(path_, "HDF5 cannot " + what);
+    return id;
+  }
+
+  void dataset(hid_t loc, const std::string& name, hid_t type, const void* data, const std::vector<hsize_t>& d) {
+    Handle space(check(H5Screate_simple(int(d.size()), d.data(), nullptr), "create dataspace for " + name), H5Sclose);
+    const hid_t id = H5Dcreate2(loc, name.c_str(), type, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    Handle set(check(id, "create dataset '" + name + "'"), H5Dclose);
+    // HDF5 refuses a null buffer (an empty vector's data()) even when there is nothing to write.
+    const bool empty = std::find(d.begin(), d.end(), hsize_t(0)) != d.end();
+    if (!empty && H5Dwrite(set.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0)
+      fail(path_, "HDF5 cannot write dataset '" + name + "'");
+  }
+
+  /// Scalar attribute on the object at `object` ("." for the root group).
+  void attribute(const std::string& object, const std::string& name, hid_t type, const void* value) {
+    const std::string what = "attribute '" + name + "' on '" + object + "'";
+    Handle space(check(H5Screate(H5S_SCALAR), "create dataspace for " + what), H5Sclose);
+    const hid_t id = H5Acreate_by_name(root(), object.c_str(), name.c_str(), type, space.get(), H5P_DEFAULT,
+                                       H5P_DEFAULT, H5P_DEFAULT);
+    Handle attr(check(id, "create " + what), H5Aclose);
+    if (H5Awrite(attr.get(), type, value) < 0) fail(path_, "HDF5 cannot write " + what);
+  }
+
+  /// Fixed-length rather than variable-length strings: every reader (h5dump, h5py, ParaView) takes them as is.
+  void string_attribute(const std::string& object, const std::string& name, const std::string& value) {
+    Handle type(check(H5Tcopy(H5T_C_S1), "copy string type"), H5Tclose);
+    if (H5Tset_size(type.get(), value.size() + 1) < 0 || H5Tset_cset(type.get(), H5T_CSET_UTF8) < 0)
+      fail(path_, "HDF5 cannot make a string type for attribute '" + name + "'");
+    attribute(object, name, type.get(), value.c_str());
+  }
+
+  void close() {
+    if (!file_.close()) fail(path_, "HDF5 cannot close (flush) the file");
+  }
+
+ private:
+  std::string path_;
+  Handle file_;
+};
+
+void write_series_h5(const std::string& path, const std::vector<std::string>& columns,
+                     const std::vector<double>& rows) {
+  replace_atomically(path, [&](const std::string& tmp) {
+    H5Writer f(tmp, path);
+    const hsize_t ncol = columns.size(), nrow = ncol ? rows.size() / ncol : 0;
+    f.dataset(f.root(), "table", H5T_NATIVE_DOUBLE, rows.data(), {nrow, ncol});
+    f.string_attribute("table", "columns", join(columns, ','));
+    std::vector<double> column(nrow);
+    for (hsize_t c = 0; c < ncol; ++c) {
+      for (hsize_t r = 0; r < nrow; ++r) column[r] = rows[r * ncol + c];
+      const std::string name = dataset_name(columns[c]);
+      f.dataset(f.root(), name, H5T_NATIVE_DOUBLE, column.data(), {nrow});
+      f.string_attribute(name, "name", columns[c]);
+    }
+    f.close();
+  });
+}
+
+std::string series_csv(const std::vector<std::string>& columns, const std::vector<double>& rows) {
+  std::string text = join(columns, ',') + '\n';
+  char value[32];
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    std::snprintf(value, sizeof value, "%.10g", rows[i]);
+    text += value;
+    text += (i + 1) % columns.size() == 0 ? '\n' : ',';
+  }
+  return text;
+}
+
+/// A mismatch found here would otherwise be a read past a vector's end, or a file ParaView cannot load.
+void check_snapshot(const Snapshot& s, const SurfaceSnapshot* surface) {
+  const std::string context = "write_snapshot(step " + std::to_string(s.step) + ")";
+  const std::size_t n = s.radius.size();
+  std::vector<std::tuple<std::string, std::size_t, std::size_t>> sizes{
+      {"x", s.x.size(), 3 * n}, {"v", s.v.size(), 3 * n}, {"w", s.w.size(), 3 * n},
+      {"gid", s.gid.size(), n}, {"specimen", s.specimen.size(), n}};
+  std::vector<std::string> names;
+  for (const auto& [name, values] : s.scalars) sizes.emplace_back(name, values.size(), n), names.push_back(name);
+  for (const auto& [what, got, want] : sizes)
+    if (got != want)
+      throw std::invalid_argument(context + ": '" + what + "' has " + std::to_string(got) + " values, expected " +
+                                  std::to_string(want) + " (radius has " + std::to_string(n) + ")");
+  check_names(names, {"x", "v", "w", "radius", "gid", "specimen", "cells", "surface"}, context);
+  if (!surface) return;
+  const long nodes = long(surface->nodes.size() / 3);
+  const auto outside = [&](int node) { return node < 0 || node >= nodes; };
+  if (surface->nodes.size() % 3 || surface->triangles.size() % 3 ||
+      std::any_of(surface->triangles.begin(), surface->triangles.end(), outside))
+    throw std::invalid_argument(context + ": surface needs node and triangle triples, with node indices below " +
+                                std::to_string(nodes));
+}
+
+void write_surface(H5Writer& f, const SurfaceSnapshot& surface) {
+  Handle group(f.check(H5Gcreate2(f.root(), "surface", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), "create /surface"),
+               H5Gclose);
+  f.dataset(group.get(), "nodes", H5T_NATIVE_DOUBLE, surface.nodes.data(), {surface.nodes.size() / 3, 3});
+  f.dataset(group.get(), "triangles", H5T_NATIVE_INT, surface.triangles.data(), {surface.triangles.size() / 3, 3});
+}
+
+void write_snapshot_h5(const std::string& path, const Snapshot& s, const SurfaceSnapshot* surface) {
+  replace_atomically(path, [&](const std::string& tmp) {
+    H5Writer f(tmp, path);
+    const hsize_t n = s.radius.size();
+    f.dataset(f.root(), "x", H5T_NATIVE_DOUBLE, s.x.data(), {n, 3});
+    f.dataset(f.root(), "v", H5T_NATIVE_DOUBLE, s.v.data(), {n, 3});
+    f.dataset(f.root(), "w", H5T_NATIVE_DOUBLE, s.w.data(), {n, 3});
+    f.dataset(f.root(), "radius", H5T_NATIVE_DOUBLE, s.radius.data(), {n});
+    f.dataset(f.root(), "gid", H5T_NATIVE_UINT32, s.gid.data(), {n});
+    f.dataset(f.root(), "specimen", H5T_NATIVE_INT, s.specimen.data(), {n});
+    // One vertex cell per particle. Without this the Xdmf3 readers of ParaView make points but no cells,
+    // which the default representations do not draw.
+    std::vector<int> cells(n);
+    std::iota(cells.begin(), cells.end(), 0);
+    f.dataset(f.root(), "cells", H5T_NATIVE_INT, cells.data(), {n});
+    for (const auto& [name, values] : s.scalars) {
+      f.dataset(f.root(), dataset_name(name), H5T_NATIVE_DOUBLE, values.data(), {n});
+      f.string_attribute(dataset_name(name), "name", name);
+    }
+    const std::int64_t step = s.step;
+    f.attribute(".", "step", H5T_NATIVE_INT64, &step);
+    f.attribute(".", "time", H5T_NATIVE_DOUBLE, &s.time);
+    f.string_attribute(".", "label", s.label);
+    if (surface) write_surface(f, *surface);
+    f.close();
+  });
+}
+
+std::string xml_escape(const std::string& text) {
+  std::string out;
+  for (const char c : text)
+    out += c == '&' ? "&amp;" : c == '<' ? "&lt;" : c == '>' ? "&gt;" : c == '"' ? "&quot;" : std::string(1, c);
+  return out;
+}
+
+/// NumberType/Precision pair of an XDMF DataItem.
+constexpr const char* kF64 = "NumberType=\"Float\" Precision=\"8\"";
+constexpr const char* kU32 = "NumberType=\"UInt\" Precision=\"4\"";
+constexpr const char* kI32 = "NumberType=\"Int\" Precision=\"4\"";
+
+/// The file name is relative, so the output folder can be moved or copied as a whole.
+std::string data_item(const std::string& file, const std::string& dataset, long rows, int cols, const char* type) {
+  const std::string dims = std::to_string(rows) + (cols > 1 ? " " + std::to_string(cols) : "");
+  return "<DataItem Format=\"HDF\" Dimensions=\"" + dims + "\" " + type + ">" + xml_escape(file + ":/" + dataset) +
+         "</DataItem>";
+}
+
+std::string node_attribute(const std::string& name, const std::string& item, bool vector) {
+  return "      <Attribute Name=\"" + xml_escape(name) + "\" AttributeType=\"" + (vector ? "Vector" : "Scalar") +
+         "\" Center=\"Node\">" + item + "</Attribute>\n";
+}
+
+/// Opens a time step's grid. Time is the shortest text that reads back as the same double.
+std::string grid_head(long step, double time, const std::string& topology, long cells, const std::string& conn,
+                      const std::string& nodes) {
+  char value[32];
+  char* end = std::to_chars(value, value + sizeof value, time).ptr;
+  return "    <Grid Name=\"step_" + std::to_string(step) + "\" GridType=\"Uniform\">\n      <Time Value=\"" +
+         std::string(value, end) + "\"/>\n      <Topology " + topology + " NumberOfElements=\"" +
+         std::to_string(cells) + "\">" + conn + "</Topology>\n      <Geometry GeometryType=\"XYZ\">" + nodes +
+         "</Geometry>\n";
+}
+
+std::string particle_grid(const std::string& file, long step, double time, long n,
+                          const std::vector<std::string>& scalars) {
+  std::string grid = grid_head(step, time, "TopologyType=\"Polyvertex\" NodesPerElement=\"1\"", n,
+                               data_item(file, "cells", n, 1, kI32), data_item(file, "x", n, 3, kF64)) +
+                     node_attribute("radius", data_item(file, "radius", n, 1, kF64), false) +
+                     node_attribute("v", data_item(file, "v", n, 3, kF64), true) +
+                     node_attribute("w", data_item(file, "w", n, 3, kF64), true) +
+                     node_attribute("gid", data_item(file, "gid", n, 1, kU32), false) +
+                     node_attribute("specimen", data_item(file, "specimen", n, 1, kI32), false);
+  for (const std::string& name : scalars)
+    grid += node_attribute(name, data_item(file, dataset_name(name), n, 1, kF64), false);
+  return grid + "    </Grid>\n";
+}
+
+std::string surface_grid(const std::string& file, long step, double time, long nodes, long triangles) {
+  return grid_head(step, time, "TopologyType=\"Triangle\"", triangles,
+                   data_item(file, "surface/triangles", triangles, 3, kI32),
+                   data_item(file, "surface/nodes", nodes, 3, kF64)) +
+         "    </Grid>\n";
+}
+
+std::string temporal_collection(const char* name, const std::string& grids) {
+  if (grids.empty()) return "";
+  return std::string("  <Grid Name=\"") + name + "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n" + grids +
+         "  </Grid>\n";
+}
+
+}  // namespace
+
+Output::Output(std::string folder) : folder_(std::move(folder)) {
+  const auto refuse = [&](const std::string& reason) {
+    throw std::runtime_error("output folder '" + folder_ + "' is not writable: " + reason);
+  };
+  std::error_code ec;
+  fs::create_directories(folder_, ec);
+  if (ec) refuse(ec.message());
+  // Found out now rather than at the first snapshot, possibly hours into a run.
+  const std::string probe = in_folder(folder_, ".write_probe.tmp");
+  std::FILE* f = std::fopen(probe.c_str(), "wb");
+  if (!f) refuse(std::strerror(errno));
+  std::fclose(f);
+  if (!fs::remove(probe, ec)) refuse("cannot remove probe file: " + ec.message());
+}
+
+void Output::set_series_columns(std::vector<std::string> names) {
+  if (!rows_.empty())
+    throw std::invalid_argument("set_series_columns: the series already has rows; set the columns before the first");
+  check_names(names, {"table"}, "set_series_columns");
+  columns_ = std::move(names);
+}
+
+void Output::append_series(const std::vector<double>& row) {
+  if (row.size() != columns_.size() || columns_.empty())
+    throw std::invalid_argument("append_series: row has " + std::to_string(row.size()) + " values but the series has " +
+                                std::to_string(columns_.size()) + " columns");
+  rows_.insert(rows_.end(), row.begin(), row.end());
+}
+
+void Output::flush_series() {
+  write_series_h5(in_folder(folder_, "series.h5"), columns_, rows_);
+  write_text_atomic(in_folder(folder_, "series.csv"), series_csv(columns_, rows_));
+}
+
+void Output::write_snapshot(const Snapshot& s, const SurfaceSnapshot* surface) {
+  check_snapshot(s, surface);
+  char file[48];
+  std::snprintf(file, sizeof file, "snap_%09ld.h5", s.step);
+  write_snapshot_h5(in_folder(folder_, file), s, surface);
+  Entry e{s.step, s.time, file, long(s.radius.size()), 0, 0, {}};
+  if (surface) e.nsurf_nodes = long(surface->nodes.size() / 3), e.nsurf_tris = long(surface->triangles.size() / 3);
+  for (const auto& scalar : s.scalars) e.scalars.push_back(scalar.first);
+  // A step written again (e.g. after a restart) replaces its entry instead of adding a second one.
+  const auto same = std::find_if(snaps_.begin(), snaps_.end(), [&](const Entry& o) { return o.step == s.step; });
+  if (same != snaps_.end()) *same = std::move(e);
+  else snaps_.push_back(std::move(e));
+  write_xdmf();
+}
+
+/// Particles and surface are two temporal collections: a surface that exists only at some steps then just has
+/// fewer time steps in ParaView, rather than a block that appears and vanishes.
+void Output::write_xdmf() const {
+  std::string particles, surface;
+  // Empty grids are left out: the XDMF readers of ParaView fail on a zero-sized DataItem.
+  for (const Entry& e : snaps_) {
+    if (e.n > 0) particles += particle_grid(e.file, e.step, e.time, e.n, e.scalars);
+    if (e.nsurf_tris > 0) surface += surface_grid(e.file, e.step, e.time, e.nsurf_nodes, e.nsurf_tris);
+  }
+  write_text_atomic(in_folder(folder_, "snapshots.xdmf"),
+                    "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n<Domain>\n" +
+                        temporal_collection("particles", particles) + temporal_collection("surface", surface) +
+                        "</Domain>\n</Xdmf>\n");
+}
+
+void write_text_atomic(const std::string& path, const std::string& text) {
+  replace_atomically(path, [&](const std::string& tmp) {
+    std::FILE* f = std::fopen(tmp.c_str(), "wb");
+    bool ok = f && std::fwrite(text.data(), 1, text.size(), f) == text.size();
+    int err = errno;
+    // fclose flushes the buffer, so it can be the call that fails (e.g. disk full).
+    if (f && std::fclose(f) != 0 && ok) ok = false, err = errno;
+    if (!ok) fail(path, "write '" + tmp + "': " + std::strerror(err));
+  });
+}
+
+}  // namespace dem::io

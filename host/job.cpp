@@ -1,0 +1,122 @@
+#include "job.hpp"
+
+#include <cstdio>
+#include <numeric>
+
+#include "packing.hpp"
+#include "progress.hpp"
+
+namespace dem {
+
+std::unique_ptr<Simulation> build_simulation(const Config& cfg, bool verbose) {
+  std::vector<BallSpec> balls = make_packing(cfg);
+  std::vector<WallSpec> walls = box_walls(cfg);
+  SimParams prm;
+  for (int k = 0; k < 3; ++k) {
+    prm.domain.lo[k] = 0;
+    prm.domain.hi[k] = cfg.box.size[k];
+    prm.domain.periodic[k] = cfg.box.periodic[k];
+  }
+  prm.integ.gravity = Vec3(cfg.solver.gravity[0], cfg.solver.gravity[1], cfg.solver.gravity[2]);
+  prm.integ.alpha = cfg.solver.damping;
+  prm.integ.mass_scale = cfg.solver.mass_scale;
+  prm.skin = cfg.solver.skin * cfg.particles.diameter;
+  prm.overlap_limit = cfg.solver.overlap_limit;
+  // Material 0: balls, material 1: walls; ball-wall contacts use the wall material's law.
+  const std::vector<ContactParams> table = {cfg.ball, cfg.wall, cfg.wall, cfg.wall};
+  auto sim = std::make_unique<Simulation>(make_particles(balls), make_walls(walls), FacetMesh(), table, 2, prm);
+  const Real crit = sim->critical_dt();
+  const Real dt = cfg.solver.dt > 0 ? cfg.solver.dt : cfg.solver.dt_safety * crit;
+  if (dt > crit)
+    throw ConfigError(cfg.path + ": [solver] dt_s: " + std::to_string(dt) + " s is above the critical time step " +
+                      std::to_string(crit) + " s (allowed: (0, critical])");
+  sim->set_dt(dt);
+  if (verbose) {
+    std::printf("triaxdem: %zu balls, %zu walls; critical dt %.3e s, dt %.3e s (%s)\n", balls.size(), walls.size(),
+                crit, dt, cfg.solver.dt > 0 ? "set by [solver] dt_s" : "dt_safety x critical");
+    if (cfg.solver.mass_scale != 1)
+      std::printf("triaxdem: DENSITY SCALING x%g is on: inertia is not physical (quasi-static runs only)\n",
+                  cfg.solver.mass_scale);
+  }
+  return sim;
+}
+
+io::Snapshot take_snapshot(Simulation& sim, const std::string& label) {
+  Particles& p = sim.particles();
+  const HostParticles h = to_host_by_gid(p);
+  io::Snapshot s;
+  s.step = sim.step_count();
+  s.time = sim.time();
+  s.label = label;
+  auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), p.gid);
+  auto rad = Kokkos::create_mirror_view_and_copy(HostSpace(), p.radius);
+  auto spec = Kokkos::create_mirror_view_and_copy(HostSpace(), p.specimen);
+  s.radius.resize(p.n);
+  s.specimen.resize(p.n);
+  s.gid.resize(p.n);
+  std::iota(s.gid.begin(), s.gid.end(), 0u);
+  for (int i = 0; i < p.n; ++i) {
+    s.radius[gid(i)] = rad(i);
+    s.specimen[gid(i)] = spec(i);
+  }
+  for (int i = 0; i < p.n; ++i)
+    for (int d = 0; d < 3; ++d) {
+      s.x.push_back(h.x[i][d]);
+      s.v.push_back(h.v[i][d]);
+      s.w.push_back(h.w[i][d]);
+    }
+  return s;
+}
+
+int run_job(const Config& cfg) {
+  io::Output out(cfg.run.output);
+  auto sim = build_simulation(cfg, true);
+  out.set_series_columns({"step", "time_s", "kinetic_energy_J", "unbalanced_ratio", "contacts_ball_ball",
+                          "contacts_ball_wall", "wall_force_sum_N"});
+  auto record = [&]() {
+    const auto c = sim->touching();
+    Real fw = 0;
+    for (const Vec3& f : sim->wall_forces()) fw += norm(f);
+    out.append_series({static_cast<double>(sim->step_count()), sim->time(), sim->stats().kinetic,
+                       sim->unbalanced_ratio(), static_cast<double>(c[0]), static_cast<double>(c[1]), fw});
+  };
+  out.write_snapshot(take_snapshot(*sim, "initial"));
+  Progress progress(cfg.run.name, cfg.run.steps);
+  try {
+    for (long s = 1; s <= cfg.run.steps; ++s) {
+      sim->step();
+      if (s % cfg.run.series_every == 0) {
+        record();
+        char extra[96];
+        std::snprintf(extra, sizeof extra, "KE %.3e J, unbalanced %.2e", sim->stats().kinetic,
+                      sim->unbalanced_ratio());
+        progress.update(s, extra);
+        if (sim->unbalanced_ratio() < cfg.run.stop_ratio && sim->touching()[0] > 0) {
+          std::printf("\nunbalanced-force ratio below %g at step %ld: equilibrium reached\n", cfg.run.stop_ratio, s);
+          break;
+        }
+      }
+      if (cfg.run.snapshot_every > 0 && s % cfg.run.snapshot_every == 0 && s != cfg.run.steps)
+        out.write_snapshot(take_snapshot(*sim, "step " + std::to_string(s)));
+    }
+  } catch (const BlowUp& e) {
+    out.flush_series();
+    out.write_snapshot(take_snapshot(*sim, "blow-up"));
+    std::fprintf(stderr, "\ntriaxdem: %s\n  state at the blow-up saved in %s\n", e.what(), out.folder().c_str());
+    return 2;
+  }
+  out.flush_series();
+  out.write_snapshot(take_snapshot(*sim, "final"));
+  const StageTimes& t = sim->times();
+  const double total = t.rebuild + t.forces + t.gather + t.integrate + t.boundaries;
+  progress.finish("");
+  std::printf("stage times: rebuild %.2f s (%ld rebuilds), forces %.2f s, gather %.2f s, integrate %.2f s, "
+              "boundaries %.2f s\n", t.rebuild, t.rebuilds, t.forces, t.gather, t.integrate, t.boundaries);
+  std::printf("throughput: %.3g particle-steps/s on %s (%d threads)\n",
+              total > 0 ? sim->particles().n * static_cast<double>(sim->step_count()) / total : 0.0,
+              ExecSpace::name(), ExecSpace().concurrency());
+  std::printf("output: %s/snapshots.xdmf (ParaView), %s/series.csv\n", out.folder().c_str(), out.folder().c_str());
+  return 0;
+}
+
+}  // namespace dem

@@ -1,0 +1,22 @@
+#pragma once
+/// The `run` job: a box of balls built from a config, run for [run] steps with time series,
+/// snapshots (HDF5 + XDMF for ParaView) and a progress line.
+#include <memory>
+
+#include "config.hpp"
+#include "host/io_hdf5.hpp"
+#include "simulation.hpp"
+
+namespace dem {
+
+/// The simulation a config describes (particles, box walls, materials, time step). Prints the time
+/// step it chose and why.
+std::unique_ptr<Simulation> build_simulation(const Config& cfg, bool verbose);
+
+/// Particle state for io::Output (host copy, sorted by gid).
+io::Snapshot take_snapshot(Simulation& sim, const std::string& label);
+
+/// Runs the job; returns 0 on success, 2 on a blow-up (after saving a snapshot for inspection).
+int run_job(const Config& cfg);
+
+}  // namespace dem

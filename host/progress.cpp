@@ -1,0 +1,43 @@
+#include "progress.hpp"
+
+#include <unistd.h>
+
+#include <cstdio>
+
+namespace dem {
+
+std::string format_duration(double s) {
+  char buf[32];
+  const long t = static_cast<long>(s + 0.5);
+  if (t >= 3600) std::snprintf(buf, sizeof buf, "%ldh%02ldm", t / 3600, (t / 60) % 60);
+  else std::snprintf(buf, sizeof buf, "%ldm%02lds", t / 60, t % 60);
+  return buf;
+}
+
+Progress::Progress(std::string what, long total)
+    : what_(std::move(what)), total_(total), tty_(isatty(fileno(stdout)) != 0),
+      start_(std::chrono::steady_clock::now()), last_(start_) {}
+
+void Progress::update(long done, const std::string& extra) {
+  const auto now = std::chrono::steady_clock::now();
+  const double frac = total_ > 0 ? static_cast<double>(done) / total_ : 1.0;
+  const int decile = static_cast<int>(frac * 10);
+  if (tty_ ? std::chrono::duration<double>(now - last_).count() < 0.5 : decile == last_decile_) return;
+  last_ = now;
+  last_decile_ = decile;
+  const double elapsed = std::chrono::duration<double>(now - start_).count();
+  const double eta = frac > 0 ? elapsed * (1 - frac) / frac : 0;
+  std::printf("%s%s %ld/%ld (%3.0f%%) elapsed %s ETA %s %s%s", tty_ ? "\r" : "", what_.c_str(), done, total_,
+              100 * frac, format_duration(elapsed).c_str(), format_duration(eta).c_str(), extra.c_str(),
+              tty_ ? "   " : "\n");
+  std::fflush(stdout);
+}
+
+void Progress::finish(const std::string& extra) {
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  std::printf("%s%s done in %s %s\n", tty_ ? "\r" : "", what_.c_str(), format_duration(elapsed).c_str(),
+              extra.c_str());
+  std::fflush(stdout);
+}
+
+}  // namespace dem
