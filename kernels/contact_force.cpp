@@ -44,9 +44,9 @@ struct BallForce : MaxOverlap {
     k.vrel = (load(v, j) + cross(wj, r2)) - (load(v, i) + cross(wi, r1));
     k.dtheta = dt * (wj - wi);
     k.dt = dt;
-    store(c.normal, s, k.n);
-    store(c.point, s, load(x, i) + r1);
-    apply_law(c, s, params(material(i), material(j)), k, r1, r2);
+    const ContactParams& prm = params(material(i), material(j));
+    k.kn = RRLinear::stiffness(prm, ri, rj);
+    apply_law(c, s, prm, k, r1, r2);
     const value_type mine{overlap / kc::min(ri, rj), s};
     join(worst, mine);
   }
@@ -124,9 +124,9 @@ struct WallForce : MaxOverlap {
     k.vrel = vwall - (load(v, i) + cross(wi, r1));
     k.dtheta = -dt * wi;
     k.dt = dt;
-    store(c.normal, s, k.n);
-    store(c.point, s, xi + r1);
-    apply_law(c, s, params(material(i), wmat), k, r1, Vec3());
+    const ContactParams& prm = params(material(i), wmat);
+    k.kn = RRLinear::stiffness(prm, ri, 0);
+    apply_law(c, s, prm, k, r1, Vec3());
     const value_type mine{overlap / ri, s};
     join(worst, mine);
   }

@@ -29,6 +29,7 @@ struct ContactParams {
 struct ContactKinematics {
   Vec3 n;
   Real overlap;   ///< m, > 0 when touching
+  Real kn;        ///< N/m, normal stiffness of this pair (Normal::stiffness, computed once per contact)
   Real r1, r2;    ///< m
   Real mc;        ///< kg, reduced mass (m1 at walls), for the dashpot
   Vec3 vrel;      ///< m/s
@@ -58,13 +59,12 @@ struct NormalLinear {
     return Real(M_PI) * r * r * p.emod / L;
   }
   /// Linear normal force (>= 0) and the dashpot's addition (may make the sum tensile; clamped by caller).
-  KOKKOS_INLINE_FUNCTION static Real force(const ContactParams& p, const ContactKinematics& k) {
-    return stiffness(p, k.r1, k.r2) * k.overlap;
+  KOKKOS_INLINE_FUNCTION static Real force(const ContactParams&, const ContactKinematics& k) {
+    return k.kn * k.overlap;
   }
   KOKKOS_INLINE_FUNCTION static Real dashpot(const ContactParams& p, const ContactKinematics& k) {
     if (p.beta_n == Real(0)) return 0;
-    const Real kn = stiffness(p, k.r1, k.r2);
-    return Real(2) * p.beta_n * kc::sqrt(k.mc * kn) * dot(k.vrel, k.n);  // < 0 when approaching
+    return Real(2) * p.beta_n * kc::sqrt(k.mc * k.kn) * dot(k.vrel, k.n);  // < 0 when approaching
   }
 };
 
@@ -72,7 +72,7 @@ struct NormalLinear {
 struct TangentialCoulomb {
   KOKKOS_INLINE_FUNCTION static Vec3 update(const ContactParams& p, const ContactKinematics& k, Real fn,
                                              ContactHistory& h) {
-    const Real ks = NormalLinear::stiffness(p, k.r1, k.r2) / p.kratio;
+    const Real ks = k.kn / p.kratio;
     Vec3 fs = rotate_into_plane(h.fs, k.n) + ks * k.dt * tangential(k.vrel, k.n);
     const Real cap = p.mu_s * fn;
     const Real mag = norm(fs);
@@ -92,7 +92,7 @@ struct RollingLinear {
   KOKKOS_INLINE_FUNCTION static Vec3 update(const ContactParams& p, const ContactKinematics& k, Real fn,
                                              ContactHistory& h) {
     const Real rb = rbar(k.r1, k.r2);
-    const Real kr = NormalLinear::stiffness(p, k.r1, k.r2) / p.kratio * rb * rb;
+    const Real kr = k.kn / p.kratio * rb * rb;
     Vec3 mr = rotate_into_plane(h.mr, k.n) + kr * tangential(k.dtheta, k.n);
     const Real cap = p.mu_r * rb * fn;
     const Real mag = norm(mr);
@@ -108,7 +108,11 @@ struct RollingLinear {
 
 template <class Normal, class Tangential, class Rolling>
 struct ContactLaw {
-  /// Evaluates a touching contact (k.overlap > 0) and updates its history.
+  /// Normal stiffness of a pair, to be stored in ContactKinematics::kn before eval.
+  KOKKOS_INLINE_FUNCTION static Real stiffness(const ContactParams& p, Real r1, Real r2) {
+    return Normal::stiffness(p, r1, r2);
+  }
+  /// Evaluates a touching contact (k.overlap > 0, k.kn set) and updates its history.
   KOKKOS_INLINE_FUNCTION static ContactOutput eval(const ContactParams& p, const ContactKinematics& k,
                                                    ContactHistory& h) {
     ContactOutput out;

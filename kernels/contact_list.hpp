@@ -27,8 +27,6 @@ struct ContactList {
   // results of the current step
   Vec3View fc;            ///< total contact force on particle 1 (N)
   Vec3View m1, m2;        ///< moments on particle 1 and 2 (N m); m2 unused for walls
-  Vec3View normal;        ///< unit normal from 1 to 2
-  Vec3View point;         ///< contact point (m)
   ScalarView fn;          ///< linear normal force (N), 0 when not touching
   int n = 0;
 

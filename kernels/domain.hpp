@@ -11,13 +11,15 @@ struct Domain {
 
   KOKKOS_INLINE_FUNCTION Real length(int d) const { return hi[d] - lo[d]; }
 
-  /// Minimum-image separation for periodic axes (orthorhombic cell).
+  /// Minimum-image separation for periodic axes (orthorhombic cell). Positions are wrapped at every
+  /// rebuild and move less than the skin in between, so one shift always suffices (no floor call).
   KOKKOS_INLINE_FUNCTION Vec3 min_image(Vec3 d) const {
     Real c[3] = {d.x, d.y, d.z};
     for (int k = 0; k < 3; ++k) {
       if (!periodic[k]) continue;
       const Real L = length(k);
-      c[k] -= L * kc::floor(c[k] / L + Real(0.5));
+      if (c[k] > Real(0.5) * L) c[k] -= L;
+      else if (c[k] < Real(-0.5) * L) c[k] += L;
     }
     return Vec3(c[0], c[1], c[2]);
   }
