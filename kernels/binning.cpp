@@ -42,14 +42,22 @@ CellGrid make_grid(const Particles& p, const Domain& dom, Real cell_min) {
     }
     total *= g.nc[d];
   }
-  // A stray particle far away would blow up the cell count; coarser cells stay correct, only slower.
+  // A stray particle far away (or a sparse periodic box) would blow up the cell count; coarser cells
+  // stay correct, only slower. Periodic axes keep at least 3 cells for the minimum image.
   const long cap = 8L * p.n + 4096;
-  while (total > cap) {
+  bool coarsened = true;
+  while (total > cap && coarsened) {
+    coarsened = false;
     total = 1;
     for (int d = 0; d < 3; ++d) {
       if (!g.periodic[d]) {
         g.h[d] *= 2;
         g.nc[d] = static_cast<int>(std::floor((mx[d] - mn[d]) / g.h[d])) + 1;
+        coarsened = true;
+      } else if (g.nc[d] / 2 >= 3) {
+        g.nc[d] /= 2;
+        g.h[d] = dom.length(d) / g.nc[d];
+        coarsened = true;
       }
       total *= g.nc[d];
     }

@@ -10,7 +10,9 @@ using Real = double;                                   ///< SI units everywhere 
 using ExecSpace = Kokkos::DefaultExecutionSpace;
 using MemSpace = ExecSpace::memory_space;
 using HostSpace = Kokkos::HostSpace;
-using Layout = Kokkos::LayoutLeft;                      ///< SoA: x(i,0..2) components in separate runs
+/// The execution space's natural layout: LayoutRight on CPUs (a 3-vector is one cache line for
+/// gathers through neighbour indices), LayoutLeft on GPUs (coalesced components). perf/ measures both.
+using Layout = ExecSpace::array_layout;
 
 using Vec3View = Kokkos::View<Real* [3], Layout, MemSpace>;          ///< per-item 3-vector (m, m/s, N, ...)
 using ConstVec3View = Kokkos::View<const Real* [3], Layout, MemSpace>;

@@ -1,0 +1,113 @@
+// Config validation and blow-up detection: bad input is refused with the file, the key and the range.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "host/config.hpp"
+#include "host/builder.hpp"
+#include "host/job.hpp"
+
+#include <unistd.h>
+
+namespace {
+
+std::string write_config(const std::string& name, const std::string& text) {
+  const auto dir = std::filesystem::path(::testing::TempDir()) / ("triaxdem_cfg_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto path = dir / name;
+  std::ofstream(path) << text;
+  return path.string();
+}
+
+std::string error_of(const std::string& text) {
+  const std::string path = write_config("bad.toml", text);
+  try {
+    dem::load_config(path);
+  } catch (const dem::ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(Config, ShippedDefaultLoads) {
+  const dem::Config c = dem::load_config(std::string(TRIAXDEM_SOURCE_DIR) + "/configs/default.toml");
+  EXPECT_EQ(c.particles.count, 2000);
+  EXPECT_DOUBLE_EQ(c.particles.diameter, 2e-3);  // mm in the file, m inside
+  EXPECT_DOUBLE_EQ(c.ball.mu_s, 0.15);
+}
+
+TEST(Config, UnknownKeyNamesFileTableAndKey) {
+  const std::string e = error_of("[material]\nmu_ss = 0.3\n");
+  EXPECT_NE(e.find("bad.toml"), std::string::npos) << e;
+  EXPECT_NE(e.find("[material] mu_ss"), std::string::npos) << e;
+  EXPECT_NE(e.find("unknown key"), std::string::npos) << e;
+}
+
+TEST(Config, OutOfRangeNamesAllowedRange) {
+  const std::string e = error_of("[material]\nmu_s = -0.1\n");
+  EXPECT_NE(e.find("[material] mu_s"), std::string::npos) << e;
+  EXPECT_NE(e.find("allowed: [0, 10]"), std::string::npos) << e;
+  EXPECT_NE(error_of("[particles]\ndiameter_mm = 0\n").find("diameter_mm"), std::string::npos);
+  EXPECT_NE(error_of("[solver]\ndamping = 1.5\n").find("damping"), std::string::npos);
+}
+
+TEST(Config, WrongTypeUnknownTableAndSyntaxError) {
+  EXPECT_NE(error_of("[particles]\ncount = \"many\"\n").find("expected an integer"), std::string::npos);
+  EXPECT_NE(error_of("[partciles]\ncount = 3\n").find("unknown table"), std::string::npos);
+  const std::string e = error_of("[run\nsteps = 3\n");
+  EXPECT_NE(e.find("bad.toml:1"), std::string::npos) << e;
+  EXPECT_NE(error_of("[box]\nfill = \"hexagonal\"\n").find("allowed: lattice, random"), std::string::npos);
+}
+
+TEST(Config, TimeStepAboveCriticalRefused) {
+  dem::Config c = dem::load_config(write_config("dt.toml", "[particles]\ncount = 50\n[solver]\ndt_s = 1e-3\n"));
+  try {
+    dem::build_simulation(c, false);
+    FAIL() << "a time step of 1 ms is far above critical for 2 mm glass beads";
+  } catch (const dem::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("[solver] dt_s"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Config, UnplaceableCountRefused) {
+  // 2,000 balls of 2 mm (8.4 cm^3 of solid) cannot be inserted at random into a 1 cm^3 box.
+  dem::Config c = dem::load_config(write_config("full.toml", "[box]\nsize_mm = [10.0, 10.0, 10.0]\n"));
+  try {
+    dem::build_simulation(c, false);
+    FAIL() << "expected the packing to be refused";
+  } catch (const dem::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("[particles] count"), std::string::npos) << e.what();
+  }
+}
+
+TEST(BlowUp, ExcessiveOverlapStopsWithStepParticleAndFix) {
+  // Two balls closing at 20 m/s with a very soft contact: the overlap passes 10 % of the radius within
+  // a few steps, long before the springs could stop them (v^2 m*/kn >> (0.1 R)^2).
+  std::vector<dem::BallSpec> b(2);
+  b[0].x = dem::Vec3(0, 0, 0);
+  b[1].x = dem::Vec3(2.05e-3, 0, 0);
+  b[0].v = dem::Vec3(10, 0, 0);
+  b[1].v = dem::Vec3(-10, 0, 0);
+  for (auto& ball : b) ball.radius = 1e-3;
+  dem::ContactParams cp;
+  cp.emod = 1e5;
+  dem::SimParams prm;
+  prm.integ.alpha = 0;
+  prm.integ.gravity = dem::Vec3();
+  prm.skin = 0.4e-3;
+  dem::Simulation sim(dem::make_particles(b), dem::WallSet(), dem::FacetMesh(), {cp}, 1, prm);
+  sim.set_dt(1e-6);
+  try {
+    sim.run(1000);
+    FAIL() << "expected a blow-up";
+  } catch (const dem::BlowUp& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("at step"), std::string::npos) << m;
+    EXPECT_NE(m.find("particle 0"), std::string::npos) << m;
+    EXPECT_NE(m.find("suggested fix"), std::string::npos) << m;
+    EXPECT_LT(sim.step_count(), 100);
+  }
+}

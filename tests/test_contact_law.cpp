@@ -1,0 +1,358 @@
+/// Unit tests of the rrlinear contact law parts (kernels/contact_law.hpp), evaluated on the host as
+/// plain structs: no Simulation, no time loop. Expected values come from the PFC formulas
+/// (kn = pi r^2 E*/L, ks = kn/kratio, |Fs| <= mu_s Fn, kr = ks Rbar^2, |Mr| <= mu_r Rbar Fn), written
+/// out independently here.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "host/builder.hpp"
+#include "kernels/contact_force.hpp"
+#include "kernels/contact_law.hpp"
+#include "kernels/vec3.hpp"
+
+using namespace dem;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+ContactParams params(double emod, double kratio, double mu_s, double mu_r, double beta_n = 0) {
+  ContactParams p;
+  p.emod = emod;
+  p.kratio = kratio;
+  p.mu_s = mu_s;
+  p.mu_r = mu_r;
+  p.beta_n = beta_n;
+  return p;
+}
+
+Vec3 unit(const Vec3& a) { return (1.0 / norm(a)) * a; }
+
+/// kn of the deformability method, written out here: pi r^2 E* / L, r = min radius (the ball's at a
+/// wall), L = R1 + R2 (R1 at a wall).
+double kn_formula(double emod, double r1, double r2) {
+  const double r = r2 > 0 ? std::min(r1, r2) : r1;
+  return kPi * r * r * emod / (r2 > 0 ? r1 + r2 : r1);
+}
+
+/// A touching contact with unit normal n (from 1 to 2), overlap d, radii r1, r2 (r2 = 0: wall). The
+/// force kernels store the pair's stiffness in k.kn before calling the law; here it comes from the
+/// formula above.
+ContactKinematics kin(const ContactParams& p, const Vec3& n, double d, double r1, double r2, double dt) {
+  ContactKinematics k;
+  k.n = n;
+  k.overlap = d;
+  k.kn = kn_formula(p.emod, r1, r2);
+  k.r1 = r1;
+  k.r2 = r2;
+  k.mc = 1e-5;
+  k.vrel = Vec3();
+  k.dtheta = Vec3();
+  k.dt = dt;
+  return k;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------------
+// Stiffness: deformability method. Pure arithmetic on a handful of doubles: 1e-14 relative is a few
+// ulps of rounding in pi*r*r*E/L.
+TEST(ContactLaw, NormalStiffnessDeformabilityMethod) {
+  const ContactParams p = params(7.3e7, 1.5, 0.5, 0.1);
+  const double R = 1.3e-3;
+  // Equal balls: A = pi R^2, L = 2R -> kn = pi R E*/2.
+  EXPECT_NEAR(NormalLinear::stiffness(p, R, R), kPi * R * p.emod / 2, 1e-14 * kPi * R * p.emod / 2);
+  // Ball-wall (r2 = 0): A = pi R^2, L = R -> kn = pi R E*, twice the ball-ball value.
+  EXPECT_NEAR(NormalLinear::stiffness(p, R, 0), kPi * R * p.emod, 1e-14 * kPi * R * p.emod);
+  // Unequal: r = min(R1, R2), L = R1 + R2, and symmetric in the two radii.
+  const double R1 = 0.8e-3, R2 = 1.2e-3;
+  const double expect = kPi * R1 * R1 * p.emod / (R1 + R2);
+  EXPECT_NEAR(NormalLinear::stiffness(p, R1, R2), expect, 1e-14 * expect);
+  EXPECT_NEAR(NormalLinear::stiffness(p, R2, R1), expect, 1e-14 * expect);
+  // A ball-wall contact uses the ball's own radius even when it is the larger one.
+  EXPECT_NEAR(NormalLinear::stiffness(p, R2, 0), kPi * R2 * p.emod, 1e-14 * kPi * R2 * p.emod);
+  // The law's stiffness (what the force kernels store in ContactKinematics::kn) is the same.
+  EXPECT_NEAR(RRLinear::stiffness(p, R1, R2), expect, 1e-14 * expect);
+  EXPECT_NEAR(RRLinear::stiffness(p, R, 0), kPi * R * p.emod, 1e-14 * kPi * R * p.emod);
+  // The law's normal force is kn * overlap, reported in out.fn and pushing particle 1 away from 2.
+  const Vec3 n = unit(Vec3(0.3, -0.4, 0.86));
+  ContactHistory h;
+  const double d = 2e-6;
+  const ContactOutput out = RRLinear::eval(p, kin(p, n, d, R1, R2, 1e-7), h);
+  EXPECT_NEAR(out.fn, expect * d, 1e-13 * expect * d);
+  EXPECT_NEAR(dot(out.force, n), -expect * d, 1e-13 * expect * d);
+  EXPECT_TRUE(h.flags & kTouching);
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Coulomb: constant overlap, constant tangential relative velocity. Each step adds exactly
+// ks * |v_t| * dt to the shear force (incremental spring), which is tested to 1e-12 relative (a few
+// hundred additions of equal increments: accumulated rounding is ~N ulps ~ 1e-13). The cap
+// mu_s * Fn is applied by rescaling, so its magnitude is exact to rounding: 1e-12.
+TEST(ContactLaw, CoulombShearGrowsThenSaturates) {
+  const ContactParams p = params(1e8, 1.5, 0.4, 0.0);
+  const double R1 = 1e-3, R2 = 0.9e-3, dt = 1e-7, d = 1e-6;
+  const Vec3 n = unit(Vec3(1, 2, 2));
+  const Vec3 t = unit(cross(n, Vec3(0, 0, 1)));  // a tangent direction
+  const double vt = 0.05;
+  ContactKinematics k = kin(p, n, d, R1, R2, dt);
+  // Relative velocity of 2 w.r.t. 1 has a tangential part vt*t and a normal part that must not enter
+  // the shear spring (beta_n = 0, so it does not change the normal force either).
+  k.vrel = vt * t + 0.3 * n;
+  const double kn = kPi * R2 * R2 * p.emod / (R1 + R2);
+  const double ks = kn / p.kratio;
+  const double fn = kn * d;
+  const double cap = p.mu_s * fn;
+  const double inc = ks * vt * dt;
+  const int nsat = static_cast<int>(std::ceil(cap / inc));
+  ASSERT_GT(nsat, 20) << "test set-up: the elastic phase should last many steps";
+  ASSERT_LT(nsat, 2000);
+  ContactHistory h;
+  bool saturated = false;
+  for (int s = 1; s <= nsat + 50; ++s) {
+    const ContactOutput out = RRLinear::eval(p, k, h);
+    const Vec3 fs = h.fs;  // shear force on particle 1 (history = this step's shear force)
+    const double mag = norm(fs);
+    // The total force is the shear force minus the normal force along n (rounding of kn*d: 1e-13 fn).
+    EXPECT_NEAR(norm(out.force - (fs - fn * n)), 0.0, 1e-13 * fn);
+    const double elastic = s * inc;
+    if (elastic <= cap * (1 - 1e-9)) {
+      EXPECT_NEAR(mag, elastic, 1e-12 * elastic) << "step " << s;
+      EXPECT_FALSE(h.flags & kSliding) << "step " << s;
+    } else if (elastic >= cap * (1 + 1e-9)) {
+      saturated = true;
+      EXPECT_NEAR(mag, cap, 1e-12 * cap) << "step " << s;
+      EXPECT_TRUE(h.flags & kSliding) << "step " << s;
+    }
+    // The force on particle 1 points along the velocity of 2 relative to 1: it opposes the slip of 1
+    // relative to 2, and it lies in the contact plane.
+    EXPECT_NEAR(dot(fs, t), mag, 1e-12 * mag);
+    EXPECT_LT(std::fabs(dot(fs, n)), 1e-12 * mag);
+  }
+  EXPECT_TRUE(saturated);
+  // Reversal: slipping backwards unloads the spring elastically, by ks*v*dt per step, from the cap.
+  k.vrel = -vt * t;
+  for (int s = 1; s <= 10; ++s) {
+    RRLinear::eval(p, k, h);
+    EXPECT_NEAR(dot(h.fs, t), cap - s * inc, 1e-11 * cap) << "unloading step " << s;
+    EXPECT_FALSE(h.flags & kSliding);
+  }
+}
+
+// The shear cap uses the linear normal force, not the dashpot-augmented one (PFC: F_n^l).
+TEST(ContactLaw, CoulombCapUsesLinearNormalForce) {
+  const ContactParams p = params(1e8, 1.0, 0.5, 0.0, 0.5);
+  const double R = 1e-3, d = 1e-6;
+  const Vec3 n(0, 0, 1);
+  ContactKinematics k = kin(p, n, d, R, R, 1e-6);
+  k.vrel = Vec3(10.0, 0, -0.2);  // approaching (dashpot adds repulsion) and sliding hard
+  ContactHistory h;
+  const ContactOutput out = RRLinear::eval(p, k, h);
+  const double kn = kPi * R * p.emod / 2;
+  EXPECT_TRUE(h.flags & kSliding);
+  EXPECT_NEAR(norm(h.fs), p.mu_s * kn * d, 1e-12 * p.mu_s * kn * d);
+  // The dashpot did act on the normal force: 2 beta sqrt(mc kn) |vn| on top of kn d.
+  const double fnt = kn * d + 2 * p.beta_n * std::sqrt(k.mc * kn) * 0.2;
+  EXPECT_NEAR(-dot(out.force, n), fnt, 1e-12 * fnt);
+  EXPECT_NEAR(out.fn, kn * d, 1e-12 * kn * d);
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Rolling: relative bend rotation accumulates M = kr * theta with kr = ks Rbar^2 until mu_r Rbar Fn.
+// Same rounding argument as for the shear spring: 1e-12 relative.
+namespace {
+void check_rolling(double R1, double R2, double rbar_expect) {
+  const ContactParams p = params(1e8, 2.0, 0.5, 0.3);
+  const double dt = 1e-7, d = 2e-6;
+  const Vec3 n = unit(Vec3(-0.2, 0.5, 1.0));
+  const Vec3 t = unit(cross(n, Vec3(1, 0, 0)));
+  const double kn = R2 > 0 ? kPi * std::min(R1, R2) * std::min(R1, R2) * p.emod / (R1 + R2) : kPi * R1 * p.emod;
+  const double kr = kn / p.kratio * rbar_expect * rbar_expect;
+  const double cap = p.mu_r * rbar_expect * kn * d;
+  const double wrel = 20.0;  // rad/s, (w2 - w1) along t, plus a twist about n that must be ignored
+  ContactKinematics k = kin(p, n, d, R1, R2, dt);
+  k.dtheta = dt * (wrel * t + 35.0 * n);
+  const double inc = kr * wrel * dt;
+  const int nsat = static_cast<int>(std::ceil(cap / inc));
+  ASSERT_GT(nsat, 20);
+  ASSERT_LT(nsat, 5000);
+  ContactHistory h;
+  bool saturated = false;
+  for (int s = 1; s <= nsat + 30; ++s) {
+    const ContactOutput out = RRLinear::eval(p, k, h);
+    const double mag = norm(out.moment);
+    const double elastic = s * inc;
+    if (elastic <= cap * (1 - 1e-9)) {
+      EXPECT_NEAR(mag, elastic, 1e-12 * elastic) << "step " << s;
+      EXPECT_FALSE(h.flags & kRolling);
+    } else if (elastic >= cap * (1 + 1e-9)) {
+      saturated = true;
+      EXPECT_NEAR(mag, cap, 1e-12 * cap) << "step " << s;
+      EXPECT_TRUE(h.flags & kRolling);
+    }
+    // The moment on 1 follows the rotation of 2 relative to 1 (resists the relative rolling) and has
+    // no twist component.
+    EXPECT_NEAR(dot(out.moment, t), mag, 1e-12 * mag);
+    EXPECT_LT(std::fabs(dot(out.moment, n)), 1e-12 * mag);
+    // Rolling never makes the contact slide (no tangential velocity at the contact point here).
+    EXPECT_FALSE(h.flags & kSliding);
+  }
+  EXPECT_TRUE(saturated);
+}
+}  // namespace
+
+TEST(ContactLaw, RollingMomentCapBallBall) {
+  const double R = 1e-3;
+  check_rolling(R, R, R / 2);                       // 1/Rbar = 2/R
+  check_rolling(0.8e-3, 1.2e-3, 0.8e-3 * 1.2e-3 / 2.0e-3);
+}
+
+TEST(ContactLaw, RollingMomentCapWall) { check_rolling(1e-3, 0, 1e-3); }  // Rbar = R1 at walls
+
+// Twist (relative rotation about n) is not resisted: no moment however long it lasts, and no shear.
+TEST(ContactLaw, TwistProducesNoMoment) {
+  const ContactParams p = params(1e8, 1.5, 0.5, 0.5);
+  const Vec3 n = unit(Vec3(0.1, 0.2, -1));
+  ContactKinematics k = kin(p, n, 1e-6, 1e-3, 1e-3, 1e-6);
+  k.dtheta = 1e-6 * (500.0 * n);
+  ContactHistory h;
+  for (int s = 0; s < 1000; ++s) {
+    const ContactOutput out = RRLinear::eval(p, k, h);
+    // The only non-zero entries could come from rounding of the projection of a vector along n,
+    // ~1e-16 of kr*|dtheta| per step: compare with 1e-12 of the moment the same rotation would build
+    // up if it were bending (kr = ks Rbar^2, Rbar = R/2; cap mu_r Rbar Fn is far above this bound).
+    const double kr = kPi * 1e-3 * 1e8 / 2 / 1.5 * 0.25e-6;
+    EXPECT_LT(norm(out.moment), 1e-12 * kr * 5e-4 * (s + 1));
+    EXPECT_FALSE(h.flags & kRolling);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------
+// No tension. (a) With beta_n > 0, a fast separation makes kn d - 2 beta sqrt(mc kn) vn negative: the
+// total normal force is clamped to zero (exactly), while the linear force fn stays kn d > 0.
+TEST(ContactLaw, DashpotNeverMakesTension) {
+  const ContactParams p = params(1e8, 1.5, 0.5, 0.0, 0.3);
+  const double R = 1e-3, d = 1e-7;
+  const Vec3 n = unit(Vec3(1, -1, 0.5));
+  ContactKinematics k = kin(p, n, d, R, R, 1e-7);
+  const double kn = kPi * R * p.emod / 2;
+  const double c = 2 * p.beta_n * std::sqrt(k.mc * kn);
+  // Separating: 2 moves away from 1 along n, fast enough that the dashpot exceeds the spring.
+  const double vsep = 10 * kn * d / c;
+  k.vrel = vsep * n;
+  ContactHistory h;
+  ContactOutput out = RRLinear::eval(p, k, h);
+  EXPECT_EQ(dot(out.force, n), 0.0);
+  EXPECT_NEAR(out.fn, kn * d, 1e-13 * kn * d);
+  // Slowly separating: the dashpot only reduces the repulsion.
+  k.vrel = 0.5 * kn * d / c * n;
+  h = ContactHistory();
+  out = RRLinear::eval(p, k, h);
+  EXPECT_NEAR(-dot(out.force, n), 0.5 * kn * d, 1e-12 * kn * d);
+}
+
+// (b) A candidate contact with negative overlap is not evaluated by the force kernel: zero force, zero
+// moment, and its history is dropped (the contact opened). Runs the real kernel on two balls.
+TEST(ContactLaw, SeparatedCandidateCarriesNoForceAndLosesHistory) {
+  const double R = 1e-3;
+  std::vector<BallSpec> b(2);
+  b[0].x = Vec3(0, 0, 0);
+  b[1].x = Vec3(2 * R + 1e-7, 0, 0);  // gap of 1e-7 m: overlap < 0
+  b[0].radius = b[1].radius = R;
+  b[1].v = Vec3(0, 0.3, 0);
+  b[0].w = Vec3(0, 0, 50);
+  Particles p = make_particles(b);
+  ContactList c(1, true);
+  auto hi = Kokkos::create_mirror_view(c.i), hj = Kokkos::create_mirror_view(c.j);
+  auto hfs = Kokkos::create_mirror_view(c.fs), hmr = Kokkos::create_mirror_view(c.mr);
+  auto hfl = Kokkos::create_mirror_view(c.flags);
+  hi(0) = 0;
+  hj(0) = 1;
+  hfs(0, 1) = 1e-3;  // stale history from an earlier touching period
+  hmr(0, 2) = 1e-6;
+  hfl(0) = kTouching | kSliding | kRolling;
+  Kokkos::deep_copy(c.i, hi);
+  Kokkos::deep_copy(c.j, hj);
+  Kokkos::deep_copy(c.fs, hfs);
+  Kokkos::deep_copy(c.mr, hmr);
+  Kokkos::deep_copy(c.flags, hfl);
+  ParamTableView table("table", 1, 1);
+  auto ht = Kokkos::create_mirror_view(table);
+  ht(0, 0) = params(1e8, 1.5, 0.5, 0.5, 0.2);
+  Kokkos::deep_copy(table, ht);
+  Domain dom;
+  const OverlapStat st = compute_ball_forces(p, c, table, dom, 1e-7);
+  EXPECT_LE(st.ratio, 0.0);
+  auto fc = Kokkos::create_mirror_view_and_copy(HostSpace(), c.fc);
+  auto m1 = Kokkos::create_mirror_view_and_copy(HostSpace(), c.m1);
+  auto m2 = Kokkos::create_mirror_view_and_copy(HostSpace(), c.m2);
+  auto fn = Kokkos::create_mirror_view_and_copy(HostSpace(), c.fn);
+  auto fs = Kokkos::create_mirror_view_and_copy(HostSpace(), c.fs);
+  auto mr = Kokkos::create_mirror_view_and_copy(HostSpace(), c.mr);
+  auto fl = Kokkos::create_mirror_view_and_copy(HostSpace(), c.flags);
+  EXPECT_EQ(fn(0), 0.0);
+  EXPECT_EQ(fl(0), 0);
+  for (int d = 0; d < 3; ++d) {
+    EXPECT_EQ(fc(0, d), 0.0);
+    EXPECT_EQ(m1(0, d), 0.0);
+    EXPECT_EQ(m2(0, d), 0.0);
+    EXPECT_EQ(fs(0, d), 0.0);
+    EXPECT_EQ(mr(0, d), 0.0);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------
+// History rotates with the contact plane: rotate_into_plane keeps the magnitude and returns a vector
+// tangent to the new normal. Random vectors and normals; 1e-14 relative is rounding of a few flops.
+TEST(ContactLaw, RotateIntoPlaneKeepsMagnitudeAndIsTangent) {
+  std::mt19937_64 rng(12345);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int trial = 0; trial < 1000; ++trial) {
+    const Vec3 n0 = unit(Vec3(u(rng), u(rng), u(rng)));
+    const Vec3 s = tangential(Vec3(u(rng), u(rng), u(rng)), n0);  // a stored tangent vector
+    // The contact plane turns by a moderate angle.
+    const Vec3 n1 = unit(n0 + 0.3 * Vec3(u(rng), u(rng), u(rng)));
+    const Vec3 r = rotate_into_plane(s, n1);
+    EXPECT_NEAR(norm(r), norm(s), 1e-14 * norm(s));
+    EXPECT_LT(std::fabs(dot(r, n1)), 1e-14 * norm(s));
+    // It keeps the direction of the tangential part of s (no spurious rotation within the plane).
+    const Vec3 st = tangential(s, n1);
+    EXPECT_NEAR(dot(r, st), norm(r) * norm(st), 1e-13 * norm(r) * norm(st));
+    // Already tangent: unchanged.
+    const Vec3 same = rotate_into_plane(s, n0);
+    EXPECT_NEAR(norm(same - s), 0.0, 1e-14 * norm(s));
+  }
+  EXPECT_EQ(norm(rotate_into_plane(Vec3(), Vec3(0, 0, 1))), 0.0);
+}
+
+// Through the law: a loaded shear spring and rolling moment whose contact plane turns (no relative
+// motion) keep their magnitudes and are carried into the new plane.
+TEST(ContactLaw, HistoryFollowsTurningContactPlane) {
+  const ContactParams p = params(1e8, 1.5, 0.5, 0.2);
+  const double R = 1e-3, d = 3e-6, dt = 1e-7;
+  Vec3 n(0, 0, 1);
+  ContactKinematics k = kin(p, n, d, R, R, dt);
+  ContactHistory h;
+  k.vrel = Vec3(0.02, 0.01, 0);
+  k.dtheta = dt * Vec3(-3, 4, 0);
+  for (int s = 0; s < 5; ++s) RRLinear::eval(p, k, h);
+  ASSERT_FALSE(h.flags & (kSliding | kRolling)) << "test set-up: stay elastic";
+  const double fs0 = norm(h.fs), mr0 = norm(h.mr);
+  ASSERT_GT(fs0, 0);
+  ASSERT_GT(mr0, 0);
+  k.vrel = Vec3();
+  k.dtheta = Vec3();
+  for (int s = 1; s <= 90; ++s) {
+    const double a = s * kPi / 180;  // the pair rolls over: n turns 1 degree per step about y
+    k.n = Vec3(std::sin(a), 0, std::cos(a));
+    const ContactOutput out = RRLinear::eval(p, k, h);
+    EXPECT_NEAR(norm(h.fs), fs0, 1e-12 * fs0);
+    EXPECT_NEAR(norm(h.mr), mr0, 1e-12 * mr0);
+    EXPECT_LT(std::fabs(dot(h.fs, k.n)), 1e-12 * fs0);
+    EXPECT_LT(std::fabs(dot(h.mr, k.n)), 1e-12 * mr0);
+    EXPECT_NEAR(norm(out.moment - h.mr), 0.0, 1e-15 * mr0);
+  }
+}

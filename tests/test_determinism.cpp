@@ -1,0 +1,192 @@
+/// Bit-for-bit reproducibility across thread counts. Kokkos' OpenMP back end fixes its thread count at
+/// initialisation, so the test re-runs this very binary twice as a child process, with
+/// OMP_NUM_THREADS=1 and =2, each running the helper test Determinism.HashChild (skipped unless
+/// TRIAXDEM_HASH_CHILD=1), and compares the hashes of the final states.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cinttypes>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "host/builder.hpp"
+#include "host/simulation.hpp"
+
+using namespace dem;
+
+namespace {
+
+/// FNV-1a, 64 bit, over raw bytes.
+struct Fnv1a {
+  std::uint64_t h = 14695981039346656037ull;
+  void add(const void* p, std::size_t n) {
+    const unsigned char* b = static_cast<const unsigned char*>(p);
+    for (std::size_t k = 0; k < n; ++k) {
+      h ^= b[k];
+      h *= 1099511628211ull;
+    }
+  }
+  void add(const Vec3& v) {
+    const double c[3] = {v.x, v.y, v.z};
+    add(c, sizeof c);
+  }
+};
+
+bool child_mode() {
+  const char* e = std::getenv("TRIAXDEM_HASH_CHILD");
+  return e != nullptr && std::string(e) == "1";
+}
+
+struct ChildReport {
+  bool found = false;
+  int threads = 0;
+  unsigned long long hash = 0;
+  long touching = 0, sliding = 0, rolling = 0, rebuilds = 0;
+  int status = -1;
+  std::string output;
+};
+
+ChildReport run_child(int threads) {
+  ChildReport r;
+  char exe[4096];
+  const ssize_t len = readlink("/proc/self/exe", exe, sizeof exe - 1);
+  if (len <= 0) return r;
+  exe[len] = '\0';
+  // A clean gtest environment for the child (no XML output or sharding inherited from ctest).
+  // Passive waiting keeps a 2-thread child fast on a loaded machine (spinning threads starve each other
+  // when cores are oversubscribed); it changes nothing in what is computed.
+  const std::string cmd = "env -u GTEST_OUTPUT -u GTEST_SHARD_INDEX -u GTEST_TOTAL_SHARDS OMP_NUM_THREADS=" +
+                          std::to_string(threads) +
+                          " OMP_PROC_BIND=false OMP_WAIT_POLICY=passive TRIAXDEM_HASH_CHILD=1 '" + std::string(exe) +
+                          "' --gtest_filter=Determinism.HashChild 2>&1";
+  FILE* f = popen(cmd.c_str(), "r");
+  if (f == nullptr) return r;
+  char line[1024];
+  while (std::fgets(line, sizeof line, f) != nullptr) {
+    r.output += line;
+    int t;
+    unsigned long long h;
+    long tc, sl, ro, rb;
+    if (std::sscanf(line, "TRIAXDEM_HASH threads=%d hash=%llx touching=%ld sliding=%ld rolling=%ld rebuilds=%ld", &t,
+                    &h, &tc, &sl, &ro, &rb) == 6) {
+      r.found = true;
+      r.threads = t;
+      r.hash = h;
+      r.touching = tc;
+      r.sliding = sl;
+      r.rolling = ro;
+      r.rebuilds = rb;
+    }
+  }
+  r.status = pclose(f);
+  return r;
+}
+
+}  // namespace
+
+// Helper run in the child processes: a dense stack of 2,000 balls (jittered cubic lattice, many
+// overlapping neighbours) with random velocities and spins, under gravity in a box of six plane walls, friction, rolling resistance and local
+// damping on, 1,000 steps (several rebuilds; contacts slide and roll, so history matters). Prints a hash
+// of x, v, w in gid order and of the wall forces.
+TEST(Determinism, HashChild) {
+  if (!child_mode()) GTEST_SKIP() << "helper of Determinism.SameBitsForOneAndTwoThreads (TRIAXDEM_HASH_CHILD=1)";
+  const int nx = 10, ny = 10, nz = 20;
+  const double a = 2.0e-3;
+  std::mt19937_64 rng(31337);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<BallSpec> balls;
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        BallSpec b;
+        b.radius = (0.98 + 0.04 * u(rng)) * 1e-3;  // neighbours overlap by up to ~5% or have small gaps
+        b.x = Vec3((i + 0.5) * a + 2e-5 * (u(rng) - 0.5), (j + 0.5) * a + 2e-5 * (u(rng) - 0.5),
+                   (k + 0.5) * a + 2e-5 * (u(rng) - 0.5));
+        b.v = Vec3(0.4 * (u(rng) - 0.5), 0.4 * (u(rng) - 0.5), 0.4 * (u(rng) - 0.5));
+        b.w = Vec3(400 * (u(rng) - 0.5), 400 * (u(rng) - 0.5), 400 * (u(rng) - 0.5));
+        b.material = (i + j + k) % 2;
+        balls.push_back(b);
+      }
+  const double hi[3] = {nx * a, ny * a, nz * a};
+  std::vector<WallSpec> walls;
+  for (int d = 0; d < 3; ++d)
+    for (int side = 0; side < 2; ++side) {
+      WallSpec w;
+      double p[3] = {0, 0, 0}, n[3] = {0, 0, 0};
+      p[d] = side == 0 ? 0 : hi[d];
+      n[d] = side == 0 ? 1 : -1;
+      w.point = Vec3(p[0], p[1], p[2]);
+      w.normal = Vec3(n[0], n[1], n[2]);
+      w.material = side;
+      walls.push_back(w);
+    }
+  std::vector<ContactParams> table(4);
+  for (int m = 0; m < 4; ++m) {
+    table[m].emod = 1e8;
+    table[m].kratio = 1.5;
+    table[m].mu_s = 0.3 + 0.1 * m;
+    table[m].mu_r = 0.05 + 0.05 * m;
+    table[m].beta_n = 0.05;
+  }
+  SimParams prm;
+  prm.skin = 0.05e-3;
+  prm.integ.alpha = 0.3;
+  prm.integ.gravity = Vec3(0, 0, -9.81);
+  Simulation sim(make_particles(balls), make_walls(walls), FacetMesh(), table, 2, prm);
+  sim.set_dt(0.3 * sim.critical_dt());
+  sim.run(1000);
+
+  Fnv1a h;
+  const HostParticles hp = to_host_by_gid(sim.particles());
+  for (std::size_t i = 0; i < hp.x.size(); ++i) {
+    h.add(hp.x[i]);
+    h.add(hp.v[i]);
+    h.add(hp.w[i]);
+  }
+  for (const Vec3& f : sim.wall_forces()) h.add(f);
+  long touching = 0, sliding = 0, rolling = 0;
+  for (const ContactList* c : {&sim.ball_contacts(), &sim.wall_contacts()}) {
+    auto fl = Kokkos::create_mirror_view_and_copy(HostSpace(), c->flags);
+    auto fn = Kokkos::create_mirror_view_and_copy(HostSpace(), c->fn);
+    for (int k = 0; k < c->n; ++k) {
+      if (fn(k) <= 0) continue;
+      ++touching;
+      sliding += (fl(k) & kSliding) ? 1 : 0;
+      rolling += (fl(k) & kRolling) ? 1 : 0;
+    }
+  }
+  std::printf("TRIAXDEM_HASH threads=%d hash=%016llx touching=%ld sliding=%ld rolling=%ld rebuilds=%ld\n",
+              static_cast<int>(ExecSpace().concurrency()), static_cast<unsigned long long>(h.h), touching, sliding,
+              rolling, sim.times().rebuilds);
+  std::fflush(stdout);
+}
+
+// The same run with 1 and with 2 OpenMP threads must end in bit-identical states: contact lists are
+// sorted by key, forces gathered per particle in a fixed order, reductions summed in fixed blocks.
+TEST(Determinism, SameBitsForOneAndTwoThreads) {
+  if (child_mode()) GTEST_SKIP() << "inside a child run";
+  const ChildReport one = run_child(1);
+  const ChildReport two = run_child(2);
+  ASSERT_TRUE(one.found) << "child with 1 thread printed no hash (status " << one.status << "):\n" << one.output;
+  ASSERT_TRUE(two.found) << "child with 2 threads printed no hash (status " << two.status << "):\n" << two.output;
+  EXPECT_EQ(one.status, 0) << one.output;
+  EXPECT_EQ(two.status, 0) << two.output;
+  // The children really ran with the thread counts asked for.
+  EXPECT_EQ(one.threads, 1);
+  EXPECT_EQ(two.threads, 2);
+  // The run exercised what could break determinism: many contacts, sliding and rolling history,
+  // rebuilds (re-sorting, remapping).
+  EXPECT_GT(one.touching, 1000);
+  EXPECT_GT(one.sliding, 0);
+  EXPECT_GT(one.rolling, 0);
+  EXPECT_GT(one.rebuilds, 2);
+  EXPECT_EQ(one.touching, two.touching);
+  EXPECT_EQ(one.sliding, two.sliding);
+  EXPECT_EQ(one.rolling, two.rolling);
+  EXPECT_EQ(one.rebuilds, two.rebuilds);
+  EXPECT_EQ(one.hash, two.hash) << std::hex << "1 thread: " << one.hash << ", 2 threads: " << two.hash;
+}
