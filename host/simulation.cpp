@@ -68,8 +68,9 @@ void Simulation::rebuild() {
   FacetBins fb;
   if (mesh_.ntri > 0) fb = bin_facets(mesh_, cells_.grid, rmax_ + prm_.skin);
   wall_c_ = remap_history(detect_wall_pairs(p_, walls_, mesh_, fb, cells_, prm_.skin), wall_c_, g2l, false);
-  adj_balls_ = build_adjacency(p_.n, balls_, true);
-  adj_walls_ = build_adjacency(p_.n, wall_c_, false);
+  own_ = owner_ranges(p_, balls_);
+  adj_balls_ = build_adjacency(p_.n, balls_, balls_.j);
+  adj_walls_ = build_adjacency(p_.n, wall_c_, wall_c_.i);
   obj_offsets_ = object_offsets(wall_c_, walls_.n + mesh_.ntri);
   Kokkos::deep_copy(p_.x_ref, p_.x);
   wall_disp_ = 0;
@@ -82,13 +83,11 @@ void Simulation::step() {
   if (rebuild_due()) rebuild();
   times_.rebuild += seconds_since(t);
   const Real dt = prm_.integ.dt;
-  const OverlapStat ob = compute_ball_forces(p_, balls_, params_, prm_.domain, dt);
+  const OverlapStat ob = compute_ball_forces(p_, balls_, own_, params_, prm_.domain, dt);
   const OverlapStat ow = compute_wall_forces(p_, wall_c_, adj_walls_, walls_, mesh_, params_, dt);
   times_.forces += seconds_since(t);
-  gather_forces(p_, balls_, adj_balls_, wall_c_, adj_walls_);
-  times_.gather += seconds_since(t);
   check_blowup(ob, ow);
-  stats_ = integrate(p_, prm_.integ);
+  stats_ = integrate(p_, prm_.integ, make_gather(p_, balls_, adj_balls_, wall_c_, adj_walls_));
   times_.integrate += seconds_since(t);
   if (stats_.bad >= 0) check_blowup(ob, ow);
   move_boundaries();
@@ -176,7 +175,7 @@ Real Simulation::unbalanced_ratio() const {
   Real s[2];
   const ContactList b = balls_, w = wall_c_;
   const int nb = b.n;
-  deterministic_sum<2>("dem::sim::contact_force_sum", b.n + w.n, KOKKOS_LAMBDA(const int k, Real* v) {
+  deterministic_reduce<2, 0>("dem::sim::contact_force_sum", b.n + w.n, KOKKOS_LAMBDA(const int k, Real* v) {
     const Vec3 f = k < nb ? load(b.fc, k) : load(w.fc, k - nb);
     const Real fn = k < nb ? b.fn(k) : w.fn(k - nb);
     v[0] = norm(f);

@@ -28,7 +28,7 @@ struct SimParams {
 
 /// Wall-clock seconds spent per stage.
 struct StageTimes {
-  double rebuild = 0, forces = 0, gather = 0, integrate = 0, boundaries = 0;
+  double rebuild = 0, forces = 0, integrate = 0, boundaries = 0;  ///< integrate includes the gather
   long rebuilds = 0;
 };
 
@@ -78,6 +78,7 @@ class Simulation {
   CellList cells_;
   ContactList balls_, wall_c_;
   Adjacency adj_balls_, adj_walls_;
+  Index2View own_;
   IndexView obj_offsets_;
   Vec3View wall_force_;
   StepStats stats_;

@@ -1,17 +1,12 @@
 #include "accumulate.hpp"
 
-#include "vec3.hpp"
-
 namespace dem {
 
-Adjacency build_adjacency(int n, const ContactList& c, bool two_sided) {
+Adjacency build_adjacency(int n, const ContactList& c, const IndexView& side) {
   Adjacency a{IndexView("dem::accumulate::offset", n + 1), IndexView("dem::accumulate::entry", 0)};
   auto off = a.offset;
-  auto ci = c.i, cj = c.j;
-  Kokkos::parallel_for("dem::accumulate::count", RangePolicy(0, c.n), KOKKOS_LAMBDA(const int k) {
-    Kokkos::atomic_increment(&off(ci(k)));
-    if (two_sided) Kokkos::atomic_increment(&off(cj(k)));
-  });
+  Kokkos::parallel_for("dem::accumulate::count", RangePolicy(0, c.n),
+                       KOKKOS_LAMBDA(const int k) { Kokkos::atomic_increment(&off(side(k))); });
   int total = 0;
   Kokkos::parallel_scan("dem::accumulate::scan", RangePolicy(0, n + 1),
       KOKKOS_LAMBDA(const int i, int& acc, const bool final) {
@@ -23,8 +18,7 @@ Adjacency build_adjacency(int n, const ContactList& c, bool two_sided) {
   auto entry = a.entry;
   IndexView cursor("dem::accumulate::cursor", n);
   Kokkos::parallel_for("dem::accumulate::fill", RangePolicy(0, c.n), KOKKOS_LAMBDA(const int k) {
-    entry(off(ci(k)) + Kokkos::atomic_fetch_add(&cursor(ci(k)), 1)) = 2 * k;
-    if (two_sided) entry(off(cj(k)) + Kokkos::atomic_fetch_add(&cursor(cj(k)), 1)) = 2 * k + 1;
+    entry(off(side(k)) + Kokkos::atomic_fetch_add(&cursor(side(k)), 1)) = k;
   });
   // Fill order follows thread timing; sorting each particle's short list makes the sum order fixed.
   Kokkos::parallel_for("dem::accumulate::order", RangePolicy(0, n), KOKKOS_LAMBDA(const int i) {
@@ -38,26 +32,21 @@ Adjacency build_adjacency(int n, const ContactList& c, bool two_sided) {
   return a;
 }
 
-void gather_forces(Particles& p, const ContactList& balls, const Adjacency& ab, const ContactList& walls,
-                   const Adjacency& aw) {
-  auto f = p.f, m = p.m;
-  auto bfc = balls.fc, bm1 = balls.m1, bm2 = balls.m2, wfc = walls.fc, wm1 = walls.m1;
-  auto boff = ab.offset, bent = ab.entry, woff = aw.offset, went = aw.entry;
-  Kokkos::parallel_for("dem::accumulate::gather", RangePolicy(0, p.n), KOKKOS_LAMBDA(const int i) {
-    Vec3 fi, mi;
-    for (int a = boff(i); a < boff(i + 1); ++a) {
-      const int k = bent(a) >> 1;
-      if (bent(a) & 1) { fi -= load(bfc, k); mi += load(bm2, k); }
-      else { fi += load(bfc, k); mi += load(bm1, k); }
-    }
-    for (int a = woff(i); a < woff(i + 1); ++a) {
-      const int k = went(a) >> 1;
-      fi += load(wfc, k);
-      mi += load(wm1, k);
-    }
-    store(f, i, fi);
-    store(m, i, mi);
+Index2View owner_ranges(const Particles& p, const ContactList& balls) {
+  Index2View own("dem::accumulate::owner_ranges", p.n);
+  auto key = balls.key;
+  auto gid = p.gid;
+  const int n = balls.n;
+  Kokkos::parallel_for("dem::accumulate::owner_ranges", RangePolicy(0, p.n), KOKKOS_LAMBDA(const int i) {
+    own(i, 0) = key_lower_bound(key, n, std::uint64_t(gid(i)) << 32);
+    own(i, 1) = key_lower_bound(key, n, (std::uint64_t(gid(i)) + 1) << 32);
   });
+  return own;
+}
+
+Gather make_gather(const Particles& p, const ContactList& balls, const Adjacency& ab, const ContactList& walls,
+                   const Adjacency& aw) {
+  return Gather{p.f, p.m, balls.fc, balls.mt, walls.fc, walls.mt, ab.offset, ab.entry, aw.offset, aw.entry};
 }
 
 IndexView object_offsets(const ContactList& walls, int nobj) {
@@ -65,13 +54,7 @@ IndexView object_offsets(const ContactList& walls, int nobj) {
   auto key = walls.key;
   const int n = walls.n;
   Kokkos::parallel_for("dem::accumulate::object_offsets", RangePolicy(0, nobj + 1), KOKKOS_LAMBDA(const int o) {
-    const std::uint64_t k = std::uint64_t(o) << 32;
-    int lo = 0, hi = n;
-    while (lo < hi) {
-      const int mid = (lo + hi) / 2;
-      if (key(mid) < k) lo = mid + 1; else hi = mid;
-    }
-    off(o) = lo;
+    off(o) = key_lower_bound(key, n, std::uint64_t(o) << 32);
   });
   return off;
 }

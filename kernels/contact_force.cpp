@@ -17,38 +17,52 @@ struct MaxOverlap {
   KOKKOS_INLINE_FUNCTION void init(value_type& a) const { a.ratio = 0; a.contact = -1; }
 };
 
+/// One thread per particle: evaluates the contacts it owns, sums its own side in key order.
 struct BallForce : MaxOverlap {
   ConstVec3View x, v, w;
+  Vec3View f, m;
   ConstScalarView radius, mass;
   ConstIndexView material;
   ContactList c;
+  Index2View own;
   ParamTableView params;
   Domain dom;
   Real dt;
 
-  KOKKOS_INLINE_FUNCTION void operator()(const int s, value_type& worst) const {
-    const int i = c.i(s), j = c.j(s);
-    const Vec3 d = dom.min_image(load(x, j) - load(x, i));
-    const Real dist = norm(d);
-    const Real ri = radius(i), rj = radius(j);
-    const Real overlap = ri + rj - dist;
-    if (overlap <= 0 || dist == Real(0)) { open_contact(c, s); return; }
-    ContactKinematics k;
-    k.n = (Real(1) / dist) * d;
-    k.overlap = overlap;
-    k.r1 = ri; k.r2 = rj;
-    k.mc = mass(i) * mass(j) / (mass(i) + mass(j));
-    const Vec3 r1 = (ri - Real(0.5) * overlap) * k.n;
-    const Vec3 r2 = r1 - d;
-    const Vec3 wi = load(w, i), wj = load(w, j);
-    k.vrel = (load(v, j) + cross(wj, r2)) - (load(v, i) + cross(wi, r1));
-    k.dtheta = dt * (wj - wi);
-    k.dt = dt;
-    const ContactParams& prm = params(material(i), material(j));
-    k.kn = RRLinear::stiffness(prm, ri, rj);
-    apply_law(c, s, prm, k, r1, r2);
-    const value_type mine{overlap / kc::min(ri, rj), s};
-    join(worst, mine);
+  KOKKOS_INLINE_FUNCTION void operator()(const int i, value_type& worst) const {
+    const Vec3 xi = load(x, i), vi = load(v, i), wi = load(w, i);
+    const Real ri = radius(i);
+    Vec3 fi, mi;
+    for (int s = own(i, 0); s < own(i, 1); ++s) {
+      const int j = c.j(s);
+      const Vec3 d = dom.min_image(load(x, j) - xi);
+      const Real dist = norm(d);
+      const Real rj = radius(j);
+      const Real overlap = ri + rj - dist;
+      if (overlap <= 0 || dist == Real(0)) { open_contact(c, s); continue; }
+      ContactKinematics k;
+      k.n = (Real(1) / dist) * d;
+      k.overlap = overlap;
+      k.r1 = ri; k.r2 = rj;
+      k.m1 = mass(i);
+      k.m2 = mass(j);
+      const Vec3 r1 = (ri - Real(0.5) * overlap) * k.n;
+      const Vec3 r2 = r1 - d;
+      const Vec3 wj = load(w, j);
+      k.vrel = (load(v, j) + cross(wj, r2)) - (vi + cross(wi, r1));
+      k.dtheta = dt * (wj - wi);
+      k.dt = dt;
+      const ContactParams& prm = params(material(i), material(j));
+      k.kn = RRLinear::stiffness(prm, ri, rj);
+      const ContactOutput out = apply_law(c, s, prm, k);
+      store(c.mt, s, cross(r2, -out.force) - out.moment);
+      fi += out.force;
+      mi += cross(r1, out.force) + out.moment;
+      const value_type mine{overlap / kc::min(ri, rj), s};
+      join(worst, mine);
+    }
+    store(f, i, fi);
+    store(m, i, mi);
   }
 };
 
@@ -70,7 +84,7 @@ struct WallForce : MaxOverlap {
     feature_nodes(hit, t, nodes);
     const Real eps = Real(1e-12) * radius(i);
     for (int a = adj_off(i); a < adj_off(i + 1); ++a) {
-      const int g = c.j(adj_entry(a) >> 1) - walls.n;
+      const int g = c.j(adj_entry(a)) - walls.n;
       if (g < 0 || g == f) continue;
       bool shares = true;
       for (int q = 0; q < 2; ++q) {
@@ -118,7 +132,8 @@ struct WallForce : MaxOverlap {
     if (overlap <= 0) { open_contact(c, s); return; }
     k.overlap = overlap;
     k.r1 = ri; k.r2 = 0;
-    k.mc = mass(i);
+    k.m1 = mass(i);
+    k.m2 = 0;
     const Vec3 r1 = (ri - Real(0.5) * overlap) * k.n;
     const Vec3 wi = load(w, i);
     k.vrel = vwall - (load(v, i) + cross(wi, r1));
@@ -126,7 +141,8 @@ struct WallForce : MaxOverlap {
     k.dt = dt;
     const ContactParams& prm = params(material(i), wmat);
     k.kn = RRLinear::stiffness(prm, ri, 0);
-    apply_law(c, s, prm, k, r1, Vec3());
+    const ContactOutput out = apply_law(c, s, prm, k);
+    store(c.mt, s, cross(r1, out.force) + out.moment);
     const value_type mine{overlap / ri, s};
     join(worst, mine);
   }
@@ -139,13 +155,14 @@ void bind_particles(Kernel& k, const Particles& p) {
 
 }  // namespace
 
-OverlapStat compute_ball_forces(const Particles& p, ContactList& c, const ParamTableView& params, const Domain& dom,
-                                Real dt) {
+OverlapStat compute_ball_forces(Particles& p, ContactList& c, const Index2View& own, const ParamTableView& params,
+                                const Domain& dom, Real dt) {
   BallForce k;
   bind_particles(k, p);
-  k.c = c; k.params = params; k.dom = dom; k.dt = dt;
+  k.f = p.f; k.m = p.m;
+  k.c = c; k.own = own; k.params = params; k.dom = dom; k.dt = dt;
   OverlapStat worst;
-  Kokkos::parallel_reduce("dem::force::balls", RangePolicy(0, c.n), k, worst);
+  Kokkos::parallel_reduce("dem::force::balls", RangePolicy(0, p.n), k, worst);
   return worst;
 }
 

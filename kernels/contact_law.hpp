@@ -31,7 +31,7 @@ struct ContactKinematics {
   Real overlap;   ///< m, > 0 when touching
   Real kn;        ///< N/m, normal stiffness of this pair (Normal::stiffness, computed once per contact)
   Real r1, r2;    ///< m
-  Real mc;        ///< kg, reduced mass (m1 at walls), for the dashpot
+  Real m1, m2;    ///< kg, masses (m2 = 0 at walls), for the dashpot's reduced mass
   Vec3 vrel;      ///< m/s
   Vec3 dtheta;    ///< rad
   Real dt;        ///< s
@@ -51,6 +51,15 @@ struct ContactOutput {
   Real fn = 0;   ///< N, linear normal force (dashpot excluded), >= 0
 };
 
+/// Scales a down to magnitude `cap` if it is longer; true if it was. Compares squares, so the common
+/// elastic case costs no square root.
+KOKKOS_INLINE_FUNCTION bool cap_to(Vec3& a, Real cap) {
+  const Real m2 = norm2(a);
+  if (m2 <= cap * cap) return false;
+  a = cap > 0 ? (cap / kc::sqrt(m2)) * a : Vec3();
+  return true;
+}
+
 /// Linear normal spring, stiffness from the deformability method.
 struct NormalLinear {
   KOKKOS_INLINE_FUNCTION static Real stiffness(const ContactParams& p, Real r1, Real r2) {
@@ -64,7 +73,8 @@ struct NormalLinear {
   }
   KOKKOS_INLINE_FUNCTION static Real dashpot(const ContactParams& p, const ContactKinematics& k) {
     if (p.beta_n == Real(0)) return 0;
-    return Real(2) * p.beta_n * kc::sqrt(k.mc * k.kn) * dot(k.vrel, k.n);  // < 0 when approaching
+    const Real mc = k.m2 > 0 ? k.m1 * k.m2 / (k.m1 + k.m2) : k.m1;
+    return Real(2) * p.beta_n * kc::sqrt(mc * k.kn) * dot(k.vrel, k.n);  // < 0 when approaching
   }
 };
 
@@ -74,13 +84,8 @@ struct TangentialCoulomb {
                                              ContactHistory& h) {
     const Real ks = k.kn / p.kratio;
     Vec3 fs = rotate_into_plane(h.fs, k.n) + ks * k.dt * tangential(k.vrel, k.n);
-    const Real cap = p.mu_s * fn;
-    const Real mag = norm(fs);
     h.flags &= ~kSliding;
-    if (mag > cap) {
-      fs = mag > 0 ? (cap / mag) * fs : Vec3();
-      h.flags |= kSliding;
-    }
+    if (cap_to(fs, p.mu_s * fn)) h.flags |= kSliding;
     h.fs = fs;
     return fs;
   }
@@ -94,13 +99,8 @@ struct RollingLinear {
     const Real rb = rbar(k.r1, k.r2);
     const Real kr = k.kn / p.kratio * rb * rb;
     Vec3 mr = rotate_into_plane(h.mr, k.n) + kr * tangential(k.dtheta, k.n);
-    const Real cap = p.mu_r * rb * fn;
-    const Real mag = norm(mr);
     h.flags &= ~kRolling;
-    if (mag > cap) {
-      mr = mag > 0 ? (cap / mag) * mr : Vec3();
-      h.flags |= kRolling;
-    }
+    if (cap_to(mr, p.mu_r * rb * fn)) h.flags |= kRolling;
     h.mr = mr;
     return mr;
   }
@@ -113,7 +113,7 @@ struct ContactLaw {
     return Normal::stiffness(p, r1, r2);
   }
   /// Evaluates a touching contact (k.overlap > 0, k.kn set) and updates its history.
-  KOKKOS_INLINE_FUNCTION static ContactOutput eval(const ContactParams& p, const ContactKinematics& k,
+  KOKKOS_FORCEINLINE_FUNCTION static ContactOutput eval(const ContactParams& p, const ContactKinematics& k,
                                                    ContactHistory& h) {
     ContactOutput out;
     const Real fn = Normal::force(p, k);

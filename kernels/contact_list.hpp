@@ -16,6 +16,17 @@ KOKKOS_INLINE_FUNCTION std::uint64_t wall_key(int object, std::uint32_t gid) {
 KOKKOS_INLINE_FUNCTION std::uint32_t key_hi(std::uint64_t k) { return static_cast<std::uint32_t>(k >> 32); }
 KOKKOS_INLINE_FUNCTION std::uint32_t key_lo(std::uint64_t k) { return static_cast<std::uint32_t>(k & 0xffffffffu); }
 
+/// First position in sorted keys[0, n) whose key is not below k.
+template <class Keys>
+KOKKOS_INLINE_FUNCTION int key_lower_bound(const Keys& keys, int n, std::uint64_t k) {
+  int lo = 0, hi = n;
+  while (lo < hi) {
+    const int mid = (lo + hi) / 2;
+    if (keys(mid) < k) lo = mid + 1; else hi = mid;
+  }
+  return lo;
+}
+
 struct ContactList {
   PairKeyView key;
   IndexView i;            ///< local index of particle 1
@@ -26,12 +37,12 @@ struct ContactList {
   FlagView flags;
   // results of the current step
   Vec3View fc;            ///< total contact force on particle 1 (N)
-  Vec3View m1, m2;        ///< moments on particle 1 and 2 (N m); m2 unused for walls
+  Vec3View mt;            ///< moment on the gathering side (N m): particle 2 (ball-ball), the ball (ball-wall)
   ScalarView fn;          ///< linear normal force (N), 0 when not touching
   int n = 0;
 
   ContactList() = default;
-  ContactList(int count, bool two_sided);
+  explicit ContactList(int count);
 };
 
 }  // namespace dem

@@ -10,23 +10,10 @@ IndexView gid_to_local(const Particles& p) {
   return map;
 }
 
-namespace {
-
-KOKKOS_INLINE_FUNCTION int find_key(const PairKeyView& keys, int n, std::uint64_t k) {
-  int lo = 0, hi = n;
-  while (lo < hi) {
-    const int mid = (lo + hi) / 2;
-    if (keys(mid) < k) lo = mid + 1; else hi = mid;
-  }
-  return (lo < n && keys(lo) == k) ? lo : -1;
-}
-
-}  // namespace
-
 ContactList remap_history(const PairKeyView& keys, const ContactList& old, const IndexView& gid2local,
                           bool ball_ball) {
   const int n = static_cast<int>(keys.extent(0));
-  ContactList c(n, ball_ball);
+  ContactList c(n);
   c.key = keys;
   const int nold = old.n;
   auto okey = old.key;
@@ -41,7 +28,8 @@ ContactList remap_history(const PairKeyView& keys, const ContactList& old, const
       c.i(k) = gid2local(key_lo(key));
       c.j(k) = static_cast<int>(key_hi(key));
     }
-    const int o = nold > 0 ? find_key(okey, nold, key) : -1;
+    const int lb = key_lower_bound(okey, nold, key);
+    const int o = (lb < nold && okey(lb) == key) ? lb : -1;
     for (int d = 0; d < 3; ++d) {
       c.fs(k, d) = o >= 0 ? ofs(o, d) : Real(0);
       c.mr(k, d) = o >= 0 ? omr(o, d) : Real(0);

@@ -7,16 +7,20 @@ namespace dem {
 namespace {
 
 struct Leapfrog {
-  Vec3View x, v, w;
-  ConstVec3View f, m;
+  Vec3View x, v, w, f, m;
+  ConstVec3View x_ref;
   ConstScalarView mass, inertia;
+  Gather gather;
   IntegrateParams prm;
 
-  /// Advances particle i; vals = {|F + m g|, kinetic energy, non-finite flag}.
+  /// Advances particle i; vals = {|F + m g|, kinetic energy, non-finite flag, displacement^2 since rebuild}.
   KOKKOS_INLINE_FUNCTION void operator()(const int i, Real* vals) const {
     const Real mi = mass(i), ii = inertia(i);
-    const Vec3 force = load(f, i) + mi * prm.gravity;
-    const Vec3 moment = load(m, i);
+    Vec3 fc, moment;
+    gather(i, fc, moment);
+    store(f, i, fc);
+    store(m, i, moment);
+    const Vec3 force = fc + mi * prm.gravity;
     Vec3 vi = load(v, i), wi = load(w, i);
     const Real a = prm.dt / (mi * prm.mass_scale), b = prm.dt / (ii * prm.mass_scale);
     vi = vi + a * Vec3(force.x + local_damping(force.x, vi.x, prm.alpha), force.y + local_damping(force.y, vi.y, prm.alpha),
@@ -31,27 +35,22 @@ struct Leapfrog {
     vals[0] = norm(force);
     vals[1] = Real(0.5) * (mi * norm2(vi) + ii * norm2(wi));
     vals[2] = (kc::isfinite(xi.x) && kc::isfinite(xi.y) && kc::isfinite(xi.z)) ? Real(0) : Real(1);
+    vals[3] = norm2(xi - load(x_ref, i));
   }
 };
 
 }  // namespace
 
-StepStats integrate(Particles& p, const IntegrateParams& prm) {
-  const Leapfrog lf{p.x, p.v, p.w, p.f, p.m, p.mass, p.inertia, prm};
-  Real sums[3];
-  deterministic_sum<3>("dem::integrate::leapfrog", p.n,
-                       KOKKOS_LAMBDA(const int i, Real* vals) { lf(i, vals); }, sums);
+StepStats integrate(Particles& p, const IntegrateParams& prm, const Gather& gather) {
+  const Leapfrog lf{p.x, p.v, p.w, p.f, p.m, p.x_ref, p.mass, p.inertia, gather, prm};
+  Real sums[4];
+  deterministic_reduce<3, 1>("dem::integrate::leapfrog", p.n,
+                             KOKKOS_LAMBDA(const int i, Real* vals) { lf(i, vals); }, sums);
   StepStats st;
   st.unbalanced = sums[0];
   st.kinetic = sums[1];
-  auto x = p.x, xr = p.x_ref;
-  Real mx = 0;
-  Kokkos::parallel_reduce("dem::integrate::max_disp", RangePolicy(0, p.n),
-      KOKKOS_LAMBDA(const int i, Real& acc) {
-        const Real d2 = norm2(load(x, i) - load(xr, i));
-        acc = d2 > acc ? d2 : acc;
-      }, Kokkos::Max<Real>(mx));
-  st.max_disp2 = mx;
+  st.max_disp2 = sums[3];
+  auto x = p.x;
   if (sums[2] > 0) {
     int bad = -1;
     Kokkos::parallel_reduce("dem::integrate::find_bad", RangePolicy(0, p.n),

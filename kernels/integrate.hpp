@@ -3,6 +3,7 @@
 ///   F_d = -alpha |F| sign(v), component-wise on forces and on moments (PFC manual; sign(0) = 0),
 ///   v(t + dt/2) = v(t - dt/2) + (F + F_d) / m dt,   x(t + dt) = x(t) + v(t + dt/2) dt.
 /// Density scaling multiplies inertial mass and moment of inertia (not weight) by `mass_scale`.
+#include "accumulate.hpp"
 #include "particles.hpp"
 #include "vec3.hpp"
 
@@ -23,8 +24,9 @@ struct StepStats {
   int bad = -1;           ///< a particle with a non-finite position, or -1
 };
 
-/// Advances all particles one step. Returns the step's sums (deterministic: fixed-order reduction).
-StepStats integrate(Particles& p, const IntegrateParams& prm);
+/// Completes each particle's force and moment (gather), stores them in p.f, p.m, and advances all
+/// particles one step. Returns the step's sums (deterministic: fixed-order reduction).
+StepStats integrate(Particles& p, const IntegrateParams& prm, const Gather& gather);
 
 /// Local damping of one component: -alpha |F| sign(v).
 KOKKOS_INLINE_FUNCTION Real local_damping(Real f, Real v, Real alpha) {

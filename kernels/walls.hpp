@@ -126,8 +126,23 @@ KOKKOS_INLINE_FUNCTION FacetHit closest_on_triangle(const Vec3& x, const Vec3& a
     return h;
   }
   const Real denom = Real(1) / (va + vb + vc);
-  const Real v = vb * denom, w = vc * denom;
-  set(1 - v - w, v, w, kFace, 0);
+  const Real v = vb * denom, w = vc * denom, u = 1 - v - w;
+  // A point on a shared edge must get the same feature from both facets whatever the rounding (FMA or
+  // not), or both would claim a face contact: snap weights within 1e-10 of zero to the edge or vertex.
+  constexpr Real tol = Real(1e-10);
+  const bool su = u <= tol, sv = v <= tol, sw = w <= tol;
+  if (su + sv + sw >= 2) {
+    const int vtx = !su ? 0 : (!sv ? 1 : 2);
+    set(vtx == 0, vtx == 1, vtx == 2, kVertex, vtx);
+  } else if (sw) {
+    set(u, v, w, kEdge, 0);
+  } else if (su) {
+    set(u, v, w, kEdge, 1);
+  } else if (sv) {
+    set(u, v, w, kEdge, 2);
+  } else {
+    set(u, v, w, kFace, 0);
+  }
   return h;
 }
 

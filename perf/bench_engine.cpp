@@ -32,11 +32,13 @@ dem::Config packing_config(int side, bool periodic) {
 
 std::size_t bytes_per_particle(dem::Simulation& sim) {
   const auto& p = sim.particles();
-  const std::size_t per_particle = 6 * 3 * sizeof(double) + 3 * sizeof(double) + sizeof(std::uint32_t) + 2 * sizeof(int);
+  // x, v, w, f, m, x_ref; radius, mass, inertia; gid; specimen, material; owner range; 2 adjacency offsets
+  const std::size_t per_particle = 6 * 3 * sizeof(double) + 3 * sizeof(double) + sizeof(std::uint32_t) +
+                                   2 * sizeof(int) + 2 * sizeof(int) + 2 * sizeof(int);
   const auto& b = sim.ball_contacts();
   const auto& w = sim.wall_contacts();
-  // key, i, j, fs, mr, flags, fc, m1, m2, normal, point, fn (+ adjacency: 2 ints per ball-ball contact)
-  const std::size_t per_contact = 8 + 4 + 4 + 7 * 3 * 8 + 1 + 8 + 2 * 4;
+  // key, i, j, fs, mr, flags, fc, mt, fn, adjacency entry (+ owner ranges, per particle below)
+  const std::size_t per_contact = 8 + 4 + 4 + 4 * 3 * 8 + 1 + 8 + 4;
   return per_particle + (b.n + w.n) * per_contact / p.n;
 }
 
