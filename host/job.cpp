@@ -84,8 +84,9 @@ int run_job(const Config& cfg) {
   Progress progress(cfg.run.name, cfg.run.steps);
   try {
     for (long s = 1; s <= cfg.run.steps; ++s) {
-      sim->step();
-      if (s % cfg.run.series_every == 0) {
+      const bool record_now = s % cfg.run.series_every == 0;
+      sim->step(record_now);
+      if (record_now) {
         record();
         char extra[96];
         std::snprintf(extra, sizeof extra, "KE %.3e J, unbalanced %.2e", sim->stats().kinetic,

@@ -78,7 +78,7 @@ void Simulation::rebuild() {
   ++times_.rebuilds;
 }
 
-void Simulation::step() {
+void Simulation::step(bool measure) {
   Kokkos::Timer t;
   if (rebuild_due()) rebuild();
   times_.rebuild += seconds_since(t);
@@ -87,6 +87,7 @@ void Simulation::step() {
   const OverlapStat ow = compute_wall_forces(p_, wall_c_, adj_walls_, walls_, mesh_, params_, dt);
   times_.forces += seconds_since(t);
   check_blowup(ob, ow);
+  prm_.integ.measure = measure;
   stats_ = integrate(p_, prm_.integ, make_gather(p_, balls_, adj_balls_, wall_c_, adj_walls_));
   times_.integrate += seconds_since(t);
   if (stats_.bad >= 0) check_blowup(ob, ow);

@@ -46,18 +46,20 @@ struct BallForce : MaxOverlap {
       k.r1 = ri; k.r2 = rj;
       k.m1 = mass(i);
       k.m2 = mass(j);
-      const Vec3 r1 = (ri - Real(0.5) * overlap) * k.n;
-      const Vec3 r2 = r1 - d;
+      // Branch vectors from the centres to the contact point: r1 = a n, r2 = -b n (both along n),
+      // which folds the two spin terms of the relative velocity into one cross product.
+      const Real a = ri - Real(0.5) * overlap, b = rj - Real(0.5) * overlap;
       const Vec3 wj = load(w, j);
-      k.vrel = (load(v, j) + cross(wj, r2)) - (vi + cross(wi, r1));
+      k.vrel = load(v, j) - vi - cross(a * wi + b * wj, k.n);
       k.dtheta = dt * (wj - wi);
       k.dt = dt;
       const ContactParams& prm = params(material(i), material(j));
       k.kn = RRLinear::stiffness(prm, ri, rj);
       const ContactOutput out = apply_law(c, s, prm, k);
-      store(c.mt, s, cross(r2, -out.force) - out.moment);
+      const Vec3 nxf = cross(k.n, out.force);
+      store(c.mt, s, b * nxf - out.moment);
       fi += out.force;
-      mi += cross(r1, out.force) + out.moment;
+      mi += a * nxf + out.moment;
       const value_type mine{overlap / kc::min(ri, rj), s};
       join(worst, mine);
     }

@@ -32,8 +32,10 @@ struct Leapfrog {
     store(v, i, vi);
     store(w, i, wi);
     store(x, i, xi);
-    vals[0] = norm(force);
-    vals[1] = Real(0.5) * (mi * norm2(vi) + ii * norm2(wi));
+    if (prm.measure) {
+      vals[0] = norm(force);
+      vals[1] = Real(0.5) * (mi * norm2(vi) + ii * norm2(wi));
+    }
     vals[2] = (kc::isfinite(xi.x) && kc::isfinite(xi.y) && kc::isfinite(xi.z)) ? Real(0) : Real(1);
     vals[3] = norm2(xi - load(x_ref, i));
   }

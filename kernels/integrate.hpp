@@ -14,12 +14,13 @@ struct IntegrateParams {
   Real alpha = 0.7;       ///< local damping coefficient
   Real mass_scale = 1.0;  ///< density scaling factor for quasi-static runs (1 = physical)
   Real dt = 0;            ///< s
+  bool measure = true;    ///< fill StepStats::unbalanced and ::kinetic (skipped on unmeasured steps)
 };
 
 /// Per-step sums over particles, for the unbalanced-force ratio and energy.
 struct StepStats {
-  Real unbalanced = 0;    ///< sum |F + m g| before damping (N)
-  Real kinetic = 0;       ///< translational + rotational kinetic energy (J), at t + dt/2
+  Real unbalanced = 0;    ///< sum |F + m g| before damping (N), on measured steps
+  Real kinetic = 0;       ///< translational + rotational kinetic energy (J), at t + dt/2, on measured steps
   Real max_disp2 = 0;     ///< largest squared displacement since the last rebuild (m^2)
   int bad = -1;           ///< a particle with a non-finite position, or -1
 };
