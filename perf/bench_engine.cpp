@@ -20,7 +20,7 @@ dem::Config packing_config(int side, bool periodic) {
   const double pitch = c.box.lattice_spacing * c.particles.diameter;
   for (int k = 0; k < 3; ++k) {
     c.box.periodic[k] = periodic;
-    c.box.size[k] = periodic ? side * pitch : (side - 1) * pitch + c.particles.diameter * 0.999;
+    c.box.size[k] = periodic ? side * pitch : (side - 1) * pitch + c.particles.diameter * 1.0005;
   }
   c.box.walls = !periodic;
   c.ball.mu_s = 0.3;
