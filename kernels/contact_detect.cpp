@@ -23,15 +23,33 @@ int scan_counts(const IndexView& count, IndexView& offset) {
   return total;
 }
 
-/// Ball-ball search over the 27 neighbour cells; each pair found once, from its lower local index.
-struct PairSearch {
+/// The count and fill passes shared by the searches. Derived provides visit(i, f), calling f(other)
+/// for each candidate of particle i, and key(i, other).
+template <class Derived>
+struct CountFill {
   struct TagCount {};
   struct TagFill {};
+  IndexView count, offset;
+  PairKeyView keys;
+
+  KOKKOS_INLINE_FUNCTION const Derived& self() const { return static_cast<const Derived&>(*this); }
+  KOKKOS_INLINE_FUNCTION void operator()(TagCount, const int i) const {
+    int n = 0;
+    self().visit(i, [&](int) { ++n; });
+    count(i) = n;
+  }
+  KOKKOS_INLINE_FUNCTION void operator()(TagFill, const int i) const {
+    int k = offset(i);
+    self().visit(i, [&](int other) { keys(k++) = self().key(i, other); });
+  }
+};
+
+/// Ball-ball search over the 27 neighbour cells; each pair found once, from its lower local index.
+struct PairSearch : CountFill<PairSearch> {
   ConstVec3View x;
   ConstScalarView radius;
   GidView gid;
-  IndexView cell_start, count, offset;
-  PairKeyView keys;
+  IndexView cell_start;
   CellGrid g;
   Domain dom;
   Real skin;
@@ -59,29 +77,17 @@ struct PairSearch {
       }
     }
   }
-  KOKKOS_INLINE_FUNCTION void operator()(TagCount, const int i) const {
-    int n = 0;
-    visit(i, [&](int) { ++n; });
-    count(i) = n;
-  }
-  KOKKOS_INLINE_FUNCTION void operator()(TagFill, const int i) const {
-    int k = offset(i);
-    visit(i, [&](int j) { keys(k++) = pair_key(gid(i), gid(j)); });
-  }
+  KOKKOS_INLINE_FUNCTION std::uint64_t key(const int i, const int j) const { return pair_key(gid(i), gid(j)); }
 };
 
 /// Ball-wall search: every analytic wall, plus the facets binned into the ball's cell.
-struct WallSearch {
-  struct TagCount {};
-  struct TagFill {};
+struct WallSearch : CountFill<WallSearch> {
   ConstVec3View x;
   ConstScalarView radius;
   GidView gid;
   WallSet walls;
   FacetMesh mesh;
   IndexView fstart, ffacet;
-  IndexView count, offset;
-  PairKeyView keys;
   CellGrid g;
   Real skin;
 
@@ -103,15 +109,7 @@ struct WallSearch {
       if (norm2(facet_hit(mesh, t, xi).cp - xi) < reach * reach) f(walls.n + t);
     }
   }
-  KOKKOS_INLINE_FUNCTION void operator()(TagCount, const int i) const {
-    int n = 0;
-    visit(i, [&](int) { ++n; });
-    count(i) = n;
-  }
-  KOKKOS_INLINE_FUNCTION void operator()(TagFill, const int i) const {
-    int k = offset(i);
-    visit(i, [&](int obj) { keys(k++) = wall_key(obj, gid(i)); });
-  }
+  KOKKOS_INLINE_FUNCTION std::uint64_t key(const int i, const int obj) const { return wall_key(obj, gid(i)); }
 };
 
 template <class Search>

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "host/builder.hpp"
+#include "test_util.hpp"
 #include "kernels/contact_force.hpp"
 #include "kernels/contact_law.hpp"
 #include "kernels/vec3.hpp"
@@ -17,17 +18,8 @@ using namespace dem;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using test::kPi;
 
-ContactParams params(double emod, double kratio, double mu_s, double mu_r, double beta_n = 0) {
-  ContactParams p;
-  p.emod = emod;
-  p.kratio = kratio;
-  p.mu_s = mu_s;
-  p.mu_r = mu_r;
-  p.beta_n = beta_n;
-  return p;
-}
 
 Vec3 unit(const Vec3& a) { return (1.0 / norm(a)) * a; }
 
@@ -62,7 +54,7 @@ ContactKinematics kin(const ContactParams& p, const Vec3& n, double d, double r1
 // Stiffness: deformability method. Pure arithmetic on a handful of doubles: 1e-14 relative is a few
 // ulps of rounding in pi*r*r*E/L.
 TEST(ContactLaw, NormalStiffnessDeformabilityMethod) {
-  const ContactParams p = params(7.3e7, 1.5, 0.5, 0.1);
+  const ContactParams p = test::law(7.3e7, 1.5, 0.5, 0.1);
   const double R = 1.3e-3;
   // Equal balls: A = pi R^2, L = 2R -> kn = pi R E*/2.
   EXPECT_NEAR(NormalLinear::stiffness(p, R, R), kPi * R * p.emod / 2, 1e-14 * kPi * R * p.emod / 2);
@@ -94,7 +86,7 @@ TEST(ContactLaw, NormalStiffnessDeformabilityMethod) {
 // hundred additions of equal increments: accumulated rounding is ~N ulps ~ 1e-13). The cap
 // mu_s * Fn is applied by rescaling, so its magnitude is exact to rounding: 1e-12.
 TEST(ContactLaw, CoulombShearGrowsThenSaturates) {
-  const ContactParams p = params(1e8, 1.5, 0.4, 0.0);
+  const ContactParams p = test::law(1e8, 1.5, 0.4, 0.0);
   const double R1 = 1e-3, R2 = 0.9e-3, dt = 1e-7, d = 1e-6;
   const Vec3 n = unit(Vec3(1, 2, 2));
   const Vec3 t = unit(cross(n, Vec3(0, 0, 1)));  // a tangent direction
@@ -145,7 +137,7 @@ TEST(ContactLaw, CoulombShearGrowsThenSaturates) {
 
 // The shear cap uses the linear normal force, not the dashpot-augmented one (PFC: F_n^l).
 TEST(ContactLaw, CoulombCapUsesLinearNormalForce) {
-  const ContactParams p = params(1e8, 1.0, 0.5, 0.0, 0.5);
+  const ContactParams p = test::law(1e8, 1.0, 0.5, 0.0, 0.5);
   const double R = 1e-3, d = 1e-6;
   const Vec3 n(0, 0, 1);
   ContactKinematics k = kin(p, n, d, R, R, 1e-6);
@@ -166,7 +158,7 @@ TEST(ContactLaw, CoulombCapUsesLinearNormalForce) {
 // Same rounding argument as for the shear spring: 1e-12 relative.
 namespace {
 void check_rolling(double R1, double R2, double rbar_expect) {
-  const ContactParams p = params(1e8, 2.0, 0.5, 0.3);
+  const ContactParams p = test::law(1e8, 2.0, 0.5, 0.3);
   const double dt = 1e-7, d = 2e-6;
   const Vec3 n = unit(Vec3(-0.2, 0.5, 1.0));
   const Vec3 t = unit(cross(n, Vec3(1, 0, 0)));
@@ -215,7 +207,7 @@ TEST(ContactLaw, RollingMomentCapWall) { check_rolling(1e-3, 0, 1e-3); }  // Rba
 
 // Twist (relative rotation about n) is not resisted: no moment however long it lasts, and no shear.
 TEST(ContactLaw, TwistProducesNoMoment) {
-  const ContactParams p = params(1e8, 1.5, 0.5, 0.5);
+  const ContactParams p = test::law(1e8, 1.5, 0.5, 0.5);
   const Vec3 n = unit(Vec3(0.1, 0.2, -1));
   ContactKinematics k = kin(p, n, 1e-6, 1e-3, 1e-3, 1e-6);
   k.dtheta = 1e-6 * (500.0 * n);
@@ -235,7 +227,7 @@ TEST(ContactLaw, TwistProducesNoMoment) {
 // No tension. (a) With beta_n > 0, a fast separation makes kn d - 2 beta sqrt(mc kn) vn negative: the
 // total normal force is clamped to zero (exactly), while the linear force fn stays kn d > 0.
 TEST(ContactLaw, DashpotNeverMakesTension) {
-  const ContactParams p = params(1e8, 1.5, 0.5, 0.0, 0.3);
+  const ContactParams p = test::law(1e8, 1.5, 0.5, 0.0, 0.3);
   const double R = 1e-3, d = 1e-7;
   const Vec3 n = unit(Vec3(1, -1, 0.5));
   ContactKinematics k = kin(p, n, d, R, R, 1e-7);
@@ -284,7 +276,7 @@ TEST(ContactLaw, SeparatedCandidateCarriesNoForceAndLosesHistory) {
   Kokkos::deep_copy(c.flags, hfl);
   ParamTableView table("table", 1, 1);
   auto ht = Kokkos::create_mirror_view(table);
-  ht(0, 0) = params(1e8, 1.5, 0.5, 0.5, 0.2);
+  ht(0, 0) = test::law(1e8, 1.5, 0.5, 0.5, 0.2);
   Kokkos::deep_copy(table, ht);
   Domain dom;
   const OverlapStat st = compute_ball_forces(p, c, owner_ranges(p, c), table, dom, 1e-7);
@@ -336,7 +328,7 @@ TEST(ContactLaw, RotateIntoPlaneKeepsMagnitudeAndIsTangent) {
 // Through the law: a loaded shear spring and rolling moment whose contact plane turns (no relative
 // motion) keep their magnitudes and are carried into the new plane.
 TEST(ContactLaw, HistoryFollowsTurningContactPlane) {
-  const ContactParams p = params(1e8, 1.5, 0.5, 0.2);
+  const ContactParams p = test::law(1e8, 1.5, 0.5, 0.2);
   const double R = 1e-3, d = 3e-6, dt = 1e-7;
   Vec3 n(0, 0, 1);
   ContactKinematics k = kin(p, n, d, R, R, dt);

@@ -7,27 +7,19 @@
 #include <vector>
 
 #include "host/builder.hpp"
+#include "test_util.hpp"
 #include "host/simulation.hpp"
 
 using namespace dem;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using test::kPi;
 constexpr double kRho = 2500;   // kg/m^3
 constexpr double kG = 9.81;     // m/s^2
 
 double ball_mass(double r) { return kRho * 4.0 / 3.0 * kPi * r * r * r; }
 
-ContactParams law(double emod, double kratio, double mu_s, double mu_r, double beta_n) {
-  ContactParams p;
-  p.emod = emod;
-  p.kratio = kratio;
-  p.mu_s = mu_s;
-  p.mu_r = mu_r;
-  p.beta_n = beta_n;
-  return p;
-}
 
 SimParams sim_params(double skin, double alpha, const Vec3& gravity) {
   SimParams prm;
@@ -92,7 +84,7 @@ struct HeadOn {
     b[0].radius = b[1].radius = R;
     b[0].density = b[1].density = kRho;
     SimParams prm = sim_params(0.1 * R, 0.0, Vec3());
-    Simulation sim(make_particles(b), make_walls({}), FacetMesh(), {law(emod, 1.5, 0.0, 0.0, beta_n)}, 1, prm);
+    Simulation sim(make_particles(b), make_walls({}), FacetMesh(), {test::law(emod, 1.5, 0.0, 0.0, beta_n)}, 1, prm);
     const double dt = T / steps_per_contact;
     ASSERT_LT(dt, 0.5 * sim.critical_dt());
     sim.set_dt(dt);
@@ -180,7 +172,7 @@ TEST(Dynamics, SlidingBallTransitionsToRolling) {
   w[0].point = Vec3(0, 0, 0);
   w[0].normal = Vec3(0, 0, 1);
   SimParams prm = sim_params(0.1 * R, 0.0, Vec3(0, 0, -kG));
-  Simulation sim(make_particles(b), make_walls(w), FacetMesh(), {law(emod, kratio, mu, 0.0, 0.0)}, 1, prm);
+  Simulation sim(make_particles(b), make_walls(w), FacetMesh(), {test::law(emod, kratio, mu, 0.0, 0.0)}, 1, prm);
   const double dt = 0.2 * sim.critical_dt();
   sim.set_dt(dt);
   const double ts = v0 / (3.5 * mu * kG);
@@ -263,7 +255,7 @@ RollResult roll(double mu_r, double v0, double t_run, double& dt_out, double& ks
   w[0].kind = kPlane;
   w[0].normal = Vec3(0, 0, 1);
   SimParams prm = sim_params(0.1 * R, 0.0, Vec3(0, 0, -kG));
-  Simulation sim(make_particles(b), make_walls(w), FacetMesh(), {law(emod, kratio, mu, mu_r, 0.0)}, 1, prm);
+  Simulation sim(make_particles(b), make_walls(w), FacetMesh(), {test::law(emod, kratio, mu, mu_r, 0.0)}, 1, prm);
   const double dt = 0.4 * sim.critical_dt();
   sim.set_dt(dt);
   dt_out = dt;
@@ -368,7 +360,7 @@ EnergyRun energy_run(double dt_factor, int nsteps) {
     prm.domain.hi[d] = L;
     prm.domain.periodic[d] = true;
   }
-  Simulation sim(make_particles(b), make_walls({}), FacetMesh(), {law(emod, 1.5, 0.0, 0.0, 0.0)}, 1, prm);
+  Simulation sim(make_particles(b), make_walls({}), FacetMesh(), {test::law(emod, 1.5, 0.0, 0.0, 0.0)}, 1, prm);
   // A fixed dt for both runs of a pair (the critical dt does not depend on the state).
   sim.set_dt(dt_factor * sim.critical_dt());
   EnergyRun out;
@@ -460,7 +452,7 @@ TEST(Dynamics, StaticLoadOnPlaneEqualsWeight) {
   w[0].kind = kPlane;
   w[0].normal = Vec3(0, 0, 1);
   SimParams prm = sim_params(0.1 * R, 0.7, Vec3(0, 0, -kG));
-  Simulation sim(make_particles(b), make_walls(w), FacetMesh(), {law(emod, 1.5, 0.5, 0.1, 0.0)}, 1, prm);
+  Simulation sim(make_particles(b), make_walls(w), FacetMesh(), {test::law(emod, 1.5, 0.5, 0.1, 0.0)}, 1, prm);
   sim.set_dt(0.3 * sim.critical_dt());
   sim.run(5000);
   const std::vector<Vec3> f = sim.wall_forces();
