@@ -87,6 +87,12 @@ void Simulation::step(bool measure) {
   const OverlapStat ow = compute_wall_forces(p_, wall_c_, adj_walls_, walls_, mesh_, params_, dt);
   times_.forces += seconds_since(t);
   check_blowup(ob, ow);
+  if (membrane_.ntri > 0) {
+    // Before integrate: the reactions are split at the closest points of the balls' current centres.
+    membrane_prm_.dt = dt;
+    membrane_forces(membrane_, cell_pressure_, FacetContacts{wall_c_, obj_offsets_, walls_.n, p_.x}, membrane_f_);
+    membrane_stats_ = membrane_integrate(membrane_, membrane_f_, membrane_prm_);
+  }
   prm_.integ.measure = measure;
   stats_ = integrate(p_, prm_.integ, make_gather(p_, balls_, adj_balls_, wall_c_, adj_walls_));
   times_.integrate += seconds_since(t);
@@ -146,6 +152,14 @@ void Simulation::check_blowup(const OverlapStat& ob, const OverlapStat& ow) cons
            "step; suggested fix: raise emod, lower the wall speed or servo gain, or lower [solver] dt_safety";
     throw BlowUp(msg.str());
   }
+}
+
+void Simulation::set_membrane(const Membrane& m, const MembraneIntegrateParams& prm) {
+  if (m.mesh.node_x.data() != mesh_.node_x.data() || m.ntri != mesh_.ntri)
+    throw std::invalid_argument("set_membrane: the membrane's mesh is not this simulation's facet mesh");
+  membrane_ = m;
+  membrane_prm_ = prm;
+  membrane_prm_.move_nodes = false;  // move_boundaries moves every facet node by dt node_v
 }
 
 void Simulation::set_wall_velocity(int w, const Vec3& v) {

@@ -11,6 +11,7 @@
 #include "kernels/contact_detect.hpp"
 #include "kernels/contact_force.hpp"
 #include "kernels/integrate.hpp"
+#include "kernels/membrane.hpp"
 
 namespace dem {
 
@@ -59,6 +60,15 @@ class Simulation {
   Real critical_dt() const;
   void set_dt(Real dt) { prm_.integ.dt = dt; }
 
+  /// Makes the facet mesh a flexible membrane (m.mesh must be the mesh given to the constructor: the
+  /// Views are shared). Each step then loads its nodes with CST elasticity, the cell pressure and the
+  /// ball reactions, and advances their velocities; move_boundaries moves them (prm.move_nodes is forced off).
+  void set_membrane(const Membrane& m, const MembraneIntegrateParams& prm);
+  /// Cell pressure on the membrane (Pa), positive towards the axis.
+  void set_cell_pressure(Real p) { cell_pressure_ = p; }
+  Membrane& membrane() { return membrane_; }
+  const MembraneStepStats& membrane_stats() const { return membrane_stats_; }
+
   /// Rigid wall velocity (m/s) and position (m) control.
   void set_wall_velocity(int w, const Vec3& v);
   Vec3 wall_point(int w) const;
@@ -85,6 +95,11 @@ class Simulation {
   Index2View own_;
   IndexView obj_offsets_;
   Vec3View wall_force_;
+  Membrane membrane_;
+  MembraneIntegrateParams membrane_prm_;
+  Vec3View membrane_f_;
+  MembraneStepStats membrane_stats_;
+  Real cell_pressure_ = 0;
   StepStats stats_;
   StageTimes times_;
   Real rmax_ = 0, wall_disp_ = 0;
