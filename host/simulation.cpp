@@ -1,5 +1,6 @@
 #include "simulation.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -113,6 +114,23 @@ void Simulation::move_boundaries() {
     vmax = std::max(vmax, norm(v));
   }
   if (vmax > 0) Kokkos::deep_copy(walls_.point, hwall_point_);
+  const Real* rate = prm_.domain.strain_rate;
+  if (rate[0] != 0 || rate[1] != 0 || rate[2] != 0) {
+    Domain& dom = prm_.domain;
+    const Real s[3] = {1 + rate[0] * dt, 1 + rate[1] * dt, 1 + rate[2] * dt};
+    const Real lo[3] = {dom.lo[0], dom.lo[1], dom.lo[2]};
+    auto x = p_.x, xr = p_.x_ref;
+    Kokkos::parallel_for("dem::sim::affine", RangePolicy(0, p_.n), KOKKOS_LAMBDA(const int i) {
+      for (int d = 0; d < 3; ++d) {
+        x(i, d) = lo[d] + (x(i, d) - lo[d]) * s[d];
+        xr(i, d) = lo[d] + (xr(i, d) - lo[d]) * s[d];
+      }
+    });
+    for (int d = 0; d < 3; ++d) dom.hi[d] = lo[d] + (dom.hi[d] - lo[d]) * s[d];
+    // Neighbours within the cut-off drift apart (or together) by at most |rate| dt times the cut-off.
+    const Real rate_max = std::max({std::fabs(rate[0]), std::fabs(rate[1]), std::fabs(rate[2])});
+    vmax = std::max(vmax, rate_max * (2 * rmax_ + prm_.skin));
+  }
   if (mesh_.ntri > 0) {
     auto nx = mesh_.node_x, nv = mesh_.node_v;
     Real nmax = 0;
@@ -160,6 +178,28 @@ void Simulation::set_membrane(const Membrane& m, const MembraneIntegrateParams& 
   membrane_ = m;
   membrane_prm_ = prm;
   membrane_prm_.move_nodes = false;  // move_boundaries moves every facet node by dt node_v
+}
+
+void Simulation::set_strain_rate(const Vec3& rate) {
+  prm_.domain.strain_rate[0] = rate.x;
+  prm_.domain.strain_rate[1] = rate.y;
+  prm_.domain.strain_rate[2] = rate.z;
+}
+
+std::array<Real, 9> Simulation::contact_stress(Real volume) const {
+  Real s[9];
+  const ContactList c = balls_;
+  auto x = p_.x;
+  const Domain dom = prm_.domain;
+  deterministic_reduce<9, 0>("dem::sim::contact_stress", c.n, KOKKOS_LAMBDA(const int k, Real* v) {
+    const Vec3 f = load(c.fc, k);
+    const Vec3 l = dom.min_image(load(x, c.j(k)) - load(x, c.i(k)));
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) v[3 * a + b] = -f[a] * l[b];
+  }, s);
+  std::array<Real, 9> out;
+  for (int q = 0; q < 9; ++q) out[q] = s[q] / volume;
+  return out;
 }
 
 void Simulation::set_wall_velocity(int w, const Vec3& v) {

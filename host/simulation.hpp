@@ -69,6 +69,14 @@ class Simulation {
   Membrane& membrane() { return membrane_; }
   const MembraneStepStats& membrane_stats() const { return membrane_stats_; }
 
+  /// Homogeneous deformation of a periodic cell: each step the cell and the particle positions are
+  /// stretched about domain.lo by (1 + rate dt) along each axis (1/s, extension positive).
+  void set_strain_rate(const Vec3& rate);
+  const Domain& domain() const { return prm_.domain; }
+  /// Love-Weber stress of the ball-ball contacts over `volume` (m^3), compression positive, row-major
+  /// 3 x 3 (Pa): sigma = -(1/V) sum fc (x) (x2 - x1). Boundary (wall, facet) contacts are not included.
+  std::array<Real, 9> contact_stress(Real volume) const;
+
   /// Rigid wall velocity (m/s) and position (m) control.
   void set_wall_velocity(int w, const Vec3& v);
   Vec3 wall_point(int w) const;

@@ -50,7 +50,7 @@ struct BallForce : MaxOverlap {
       // which folds the two spin terms of the relative velocity into one cross product.
       const Real a = ri - Real(0.5) * overlap, b = rj - Real(0.5) * overlap;
       const Vec3 wj = load(w, j);
-      k.vrel = load(v, j) - vi - cross(a * wi + b * wj, k.n);
+      k.vrel = load(v, j) - vi - cross(a * wi + b * wj, k.n) + dom.affine_velocity(d);
       k.dtheta = dt * (wj - wi);
       k.dt = dt;
       const ContactParams& prm = params(material(i), material(j));

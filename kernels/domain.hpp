@@ -8,6 +8,9 @@ struct Domain {
   Real lo[3] = {0, 0, 0};   ///< m
   Real hi[3] = {0, 0, 0};   ///< m
   bool periodic[3] = {false, false, false};
+  /// Homogeneous strain rate of the cell along each axis (1/s, extension positive). Particle velocities
+  /// are fluctuations about this affine field, so a contact's relative velocity gains rate * branch.
+  Real strain_rate[3] = {0, 0, 0};
 
   KOKKOS_INLINE_FUNCTION Real length(int d) const { return hi[d] - lo[d]; }
 
@@ -23,6 +26,12 @@ struct Domain {
     }
     return Vec3(c[0], c[1], c[2]);
   }
+
+  /// Velocity of the affine field at separation d (m/s).
+  KOKKOS_INLINE_FUNCTION Vec3 affine_velocity(const Vec3& d) const {
+    return Vec3(strain_rate[0] * d.x, strain_rate[1] * d.y, strain_rate[2] * d.z);
+  }
+  KOKKOS_INLINE_FUNCTION Real volume() const { return length(0) * length(1) * length(2); }
 
   /// Maps a position into the primary cell along periodic axes.
   KOKKOS_INLINE_FUNCTION Vec3 wrap(Vec3 p) const {
