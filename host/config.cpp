@@ -113,11 +113,12 @@ Config load_config(const std::string& path) {
     s << path << ":" << e.source().begin.line << ":" << e.source().begin.column << ": " << e.description();
     throw ConfigError(s.str());
   }
-  static const std::set<std::string> tables = {"run", "particles", "box", "material", "wall_material", "solver"};
+  static const std::set<std::string> tables = {"run",    "particles", "box",     "material",
+                                               "wall_material", "solver", "specimen"};
   for (const auto& [k, v] : root) {
     if (!tables.count(std::string(k.str())) || !v.is_table())
       throw ConfigError(path + ": [" + std::string(k.str()) +
-                        "]: unknown table (allowed: run, particles, box, material, wall_material, solver)");
+                        "]: unknown table (allowed: run, particles, box, material, wall_material, solver, specimen)");
   }
   auto table = [&](const char* name) { return TableReader(path, name, root[name].as_table()); };
 
@@ -175,6 +176,22 @@ Config load_config(const std::string& path) {
   sv.number("skin", c.solver.skin, 0, 2, 1, true);
   sv.number("overlap_limit", c.solver.overlap_limit, 0, 1, 1, true);
   sv.finish();
+
+  TableReader sp = table("specimen");
+  c.has_specimen = root["specimen"].as_table() != nullptr;
+  sp.number("diameter_mm", c.specimen.diameter, 0, 1e6, 1e-3, true);
+  sp.number("height_mm", c.specimen.height, 0, 1e6, 1e-3, true);
+  // Monodisperse spheres pack no denser than random close packing (solid fraction 0.64, e = 0.5625).
+  sp.number("void_ratio", c.specimen.void_ratio, 0.5625, 3);
+  sp.integer("layers", c.specimen.layers, 1, 100);
+  sp.number("compaction_mu_s", c.specimen.compaction_mu_s, 0, 10);
+  sp.number("platen_speed_mm_s", c.specimen.platen_speed, 0, 1e4, 1e-3, true);
+  sp.number("stop_ratio", c.specimen.stop_ratio, 0, 1, 1, true);
+  sp.integer("max_steps_per_layer", c.specimen.max_steps_per_layer, 1, 1000000000L);
+  sp.finish();
+  if (c.has_specimen && c.specimen.diameter < 4 * c.particles.diameter)
+    throw ConfigError(path + ": [specimen] diameter_mm: must be at least 4 particle diameters (" +
+                      std::to_string(4e3 * c.particles.diameter) + " mm)");
 
   for (int d = 0; d < 3; ++d)
     if (c.box.size[d] < 3 * c.particles.diameter)

@@ -51,6 +51,18 @@ struct SolverConfig {
   Real overlap_limit = 0.1;                 ///< blow-up threshold: overlap / radius
 };
 
+/// Cylindrical specimen built by multilayer compaction (Tang et al. 2025, Sec. 3.3).
+struct SpecimenConfig {
+  Real diameter = 61.8e-3;       ///< m (file: diameter_mm)
+  Real height = 120e-3;          ///< m (file: height_mm)
+  Real void_ratio = 0.61;        ///< target e of the whole specimen; sets the ball count
+  long layers = 5;
+  Real compaction_mu_s = 0.0;    ///< ball-ball friction while compacting (denser packings need little)
+  Real platen_speed = 0.05;      ///< m/s, top platen speed while compacting a layer (file: platen_speed_mm_s)
+  Real stop_ratio = 1e-3;        ///< unbalanced-force ratio that ends a layer
+  long max_steps_per_layer = 200000;
+};
+
 struct Config {
   std::string path;  ///< file it came from (for messages)
   RunConfig run;
@@ -59,6 +71,8 @@ struct Config {
   ContactParams ball;   ///< ball-ball contact law
   ContactParams wall;   ///< ball-wall contact law (defaults to ball)
   SolverConfig solver;
+  SpecimenConfig specimen;
+  bool has_specimen = false;  ///< the file has a [specimen] table
 };
 
 /// Reads and validates a config file. Throws ConfigError.

@@ -4,6 +4,7 @@
 #include <numeric>
 
 #include "packing.hpp"
+#include "specimen.hpp"
 #include "progress.hpp"
 
 namespace dem {
@@ -119,6 +120,59 @@ int run_job(const Config& cfg) {
               total > 0 ? sim->particles().n * static_cast<double>(sim->step_count()) / total : 0.0,
               ExecSpace::name(), ExecSpace().concurrency());
   std::printf("output: %s/snapshots.xdmf (ParaView), %s/series.csv\n", out.folder().c_str(), out.folder().c_str());
+  return 0;
+}
+
+int specimen_job(const Config& cfg) {
+  if (!cfg.has_specimen) throw ConfigError(cfg.path + ": [specimen]: table missing (the specimen job needs it)");
+  io::Output out(cfg.run.output);
+  std::printf("specimen: %ld balls of %.2f mm for e = %.3f in a %.1f x %.1f mm cylinder, %ld layers\n",
+              specimen_ball_count(cfg), cfg.particles.diameter * 1e3, cfg.specimen.void_ratio,
+              cfg.specimen.diameter * 1e3, cfg.specimen.height * 1e3, cfg.specimen.layers);
+  Specimen sp;
+  try {
+    sp = build_specimen(cfg, true);
+  } catch (const BlowUp& e) {
+    std::fprintf(stderr, "triaxdem: %s\n", e.what());
+    return 2;
+  }
+  std::string layers = "layer,z_bottom_mm,z_top_mm,z_platen_mm,void_ratio,steps,unbalanced_ratio\n";
+  for (std::size_t k = 0; k < sp.layers.size(); ++k) {
+    const LayerReport& l = sp.layers[k];
+    char row[160];
+    std::snprintf(row, sizeof row, "%zu,%.4f,%.4f,%.4f,%.5f,%ld,%.3e\n", k + 1, l.z_bottom * 1e3, l.z_top * 1e3,
+                  l.z_platen * 1e3, l.void_ratio, l.steps, l.unbalanced);
+    layers += row;
+  }
+  io::write_text_atomic(out.folder() + "/layers.csv", layers);
+  std::string profile = "z_mm,porosity\n";
+  const std::size_t nb = sp.porosity_profile.size();
+  for (std::size_t b = 0; b < nb; ++b) {
+    char row[64];
+    std::snprintf(row, sizeof row, "%.4f,%.5f\n", (b + 0.5) * cfg.specimen.height / nb * 1e3, sp.porosity_profile[b]);
+    profile += row;
+  }
+  io::write_text_atomic(out.folder() + "/porosity_profile.csv", profile);
+  io::Snapshot snap;
+  snap.label = "specimen";
+  for (std::size_t q = 0; q < sp.balls.size(); ++q) {
+    for (int d = 0; d < 3; ++d) {
+      snap.x.push_back(sp.balls[q].x[d]);
+      snap.v.push_back(0);
+      snap.w.push_back(0);
+    }
+    snap.radius.push_back(sp.balls[q].radius);
+    snap.gid.push_back(static_cast<std::uint32_t>(q));
+    snap.specimen.push_back(0);
+  }
+  out.write_snapshot(snap);
+  std::printf("specimen: e = %.4f (target %.3f), height %.3f mm (target %.3f); layers.csv, porosity_profile.csv, "
+              "snapshots.xdmf in %s\n", sp.void_ratio, cfg.specimen.void_ratio, sp.height * 1e3,
+              cfg.specimen.height * 1e3, out.folder().c_str());
+  if (sp.height > cfg.specimen.height * (1 + 1e-9))
+    std::printf("specimen: WARNING: the top platen stopped above the target height: the void ratio %.3f is not "
+                "reachable in this mould with these beads without squeezing them (try a larger e)\n",
+                cfg.specimen.void_ratio);
   return 0;
 }
 

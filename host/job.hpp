@@ -19,4 +19,8 @@ io::Snapshot take_snapshot(Simulation& sim, const std::string& label);
 /// Runs the job; returns 0 on success, 2 on a blow-up (after saving a snapshot for inspection).
 int run_job(const Config& cfg);
 
+/// Builds the [specimen] of a config by multilayer compaction and writes it (snapshot, layers.csv with
+/// the void ratio of each layer, porosity_profile.csv). Returns 0 on success, 2 on a blow-up.
+int specimen_job(const Config& cfg);
+
 }  // namespace dem

@@ -19,6 +19,10 @@ int main(int argc, char** argv) {
   run->add_option("-o,--output", output, "output folder (overrides [run] output)");
   run->add_option("-n,--steps", steps, "number of steps (overrides [run] steps)")->check(CLI::NonNegativeNumber);
 
+  auto* specimen = app.add_subcommand("specimen", "build the [specimen] of a config by multilayer compaction");
+  specimen->add_option("config", config_path, "TOML config file")->required()->check(CLI::ExistingFile);
+  specimen->add_option("-o,--output", output, "output folder (overrides [run] output)");
+
   auto* check = app.add_subcommand("check", "validate a config and print the derived time step");
   check->add_option("config", config_path, "TOML config file")->required()->check(CLI::ExistingFile);
 
@@ -39,6 +43,7 @@ int main(int argc, char** argv) {
       std::printf("%s: OK\n", config_path.c_str());
       return 0;
     }
+    if (specimen->parsed()) return dem::specimen_job(cfg);
     return dem::run_job(cfg);
   } catch (const dem::ConfigError& e) {
     std::fprintf(stderr, "triaxdem: config error: %s\n", e.what());

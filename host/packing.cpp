@@ -7,71 +7,70 @@
 
 namespace dem {
 
-namespace {
-
-std::vector<BallSpec> random_insertion(const Config& cfg, std::mt19937_64& rng) {
-  const auto& pc = cfg.particles;
+std::vector<BallSpec> insert_random(const ParticleConfig& pc, const InsertRegion& reg,
+                                    const std::vector<BallSpec>& existing, std::mt19937_64& rng) {
   const Real dmax = 2 * pc.diameter * pc.diameter_ratio / (1 + pc.diameter_ratio);
   const Real dmin = dmax / pc.diameter_ratio;
   std::uniform_real_distribution<Real> u01(0, 1);
+  const Real size[3] = {reg.hi.x - reg.lo.x, reg.hi.y - reg.lo.y, reg.hi.z - reg.lo.z};
   // Hash grid of cell size dmax: a new ball only checks the 27 cells around it.
   const Real h = dmax;
-  auto cell_key = [&](const Vec3& x) {
-    const long cx = static_cast<long>(std::floor(x.x / h)), cy = static_cast<long>(std::floor(x.y / h)),
-               cz = static_cast<long>(std::floor(x.z / h));
-    return (cx * 73856093L) ^ (cy * 19349663L) ^ (cz * 83492791L);
-  };
+  auto cell_of = [&](const Vec3& x, int d) { return static_cast<long>(std::floor(x[d] / h)); };
+  auto hash = [](long cx, long cy, long cz) { return (cx * 73856093L) ^ (cy * 19349663L) ^ (cz * 83492791L); };
   std::unordered_multimap<long, int> grid;
-  std::vector<BallSpec> balls;
-  balls.reserve(pc.count);
+  std::vector<BallSpec> all = existing;
+  for (int q = 0; q < static_cast<int>(all.size()); ++q)
+    grid.emplace(hash(cell_of(all[q].x, 0), cell_of(all[q].x, 1), cell_of(all[q].x, 2)), q);
   const long max_tries = 200 * pc.count + 10000;
-  long tries = 0;
-  while (static_cast<long>(balls.size()) < pc.count) {
-    if (++tries > max_tries) {
-      const Real vbox = cfg.box.size[0] * cfg.box.size[1] * cfg.box.size[2];
-      const Real vsolid = pc.count * M_PI / 6 * pc.diameter * pc.diameter * pc.diameter;
-      throw ConfigError(cfg.path + ": [particles] count: could place only " + std::to_string(balls.size()) + " of " +
-                        std::to_string(pc.count) + " balls by random insertion (solid fraction " +
-                        std::to_string(vsolid / vbox) +
-                        "; random insertion reaches about 0.3): enlarge [box] size_mm or use fill = \"lattice\"");
-    }
-    const Real d = dmin + (dmax - dmin) * u01(rng);
-    const Real r = d / 2;
-    Vec3 x;
+  long placed = 0;
+  for (long tries = 0; placed < pc.count && tries < max_tries; ++tries) {
+    const Real r = (dmin + (dmax - dmin) * u01(rng)) / 2;
     Real c[3];
     for (int k = 0; k < 3; ++k) {
-      const Real margin = cfg.box.periodic[k] ? 0 : r;
-      c[k] = margin + (cfg.box.size[k] - 2 * margin) * u01(rng);
+      // Periodic axes: keep off the seams by one diameter (the hash grid does not wrap).
+      const Real margin = reg.periodic[k] ? dmax : r;
+      c[k] = reg.lo[k] + margin + (size[k] - 2 * margin) * u01(rng);
     }
-    x = Vec3(c[0], c[1], c[2]);
+    const Vec3 x(c[0], c[1], c[2]);
+    if (reg.radius > 0 && std::hypot(x.x - reg.axis.x, x.y - reg.axis.y) > reg.radius - r) continue;
     bool free = true;
-    const long base[3] = {static_cast<long>(std::floor(x.x / h)), static_cast<long>(std::floor(x.y / h)),
-                          static_cast<long>(std::floor(x.z / h))};
+    const long b[3] = {cell_of(x, 0), cell_of(x, 1), cell_of(x, 2)};
     for (int dz = -1; dz <= 1 && free; ++dz)
       for (int dy = -1; dy <= 1 && free; ++dy)
         for (int dx = -1; dx <= 1 && free; ++dx) {
-          const Vec3 probe((base[0] + dx + 0.5) * h, (base[1] + dy + 0.5) * h, (base[2] + dz + 0.5) * h);
-          auto range = grid.equal_range(cell_key(probe));
+          auto range = grid.equal_range(hash(b[0] + dx, b[1] + dy, b[2] + dz));
           for (auto it = range.first; it != range.second && free; ++it) {
-            const BallSpec& o = balls[it->second];
-            Vec3 sep = o.x - x;
-            Real s[3] = {sep.x, sep.y, sep.z};
-            for (int k = 0; k < 3; ++k)
-              if (cfg.box.periodic[k]) s[k] -= cfg.box.size[k] * std::round(s[k] / cfg.box.size[k]);
-            if (norm2(Vec3(s[0], s[1], s[2])) < (r + o.radius) * (r + o.radius)) free = false;
+            const BallSpec& o = all[it->second];
+            if (norm2(o.x - x) < (r + o.radius) * (r + o.radius)) free = false;
           }
         }
-    // Periodic images across the box faces are only checked through the wrapped distance of
-    // neighbours found in the hash grid, so keep balls off the periodic seams by one diameter.
-    for (int k = 0; k < 3 && free; ++k)
-      if (cfg.box.periodic[k] && (c[k] < dmax || c[k] > cfg.box.size[k] - dmax)) free = false;
     if (!free) continue;
-    BallSpec b;
-    b.x = x;
-    b.radius = r;
-    b.density = pc.density;
-    grid.emplace(cell_key(x), static_cast<int>(balls.size()));
-    balls.push_back(b);
+    BallSpec ball;
+    ball.x = x;
+    ball.radius = r;
+    ball.density = pc.density;
+    grid.emplace(hash(b[0], b[1], b[2]), static_cast<int>(all.size()));
+    all.push_back(ball);
+    ++placed;
+  }
+  return std::vector<BallSpec>(all.begin() + existing.size(), all.end());
+}
+
+namespace {
+
+std::vector<BallSpec> random_insertion(const Config& cfg, std::mt19937_64& rng) {
+  InsertRegion reg;
+  reg.hi = Vec3(cfg.box.size[0], cfg.box.size[1], cfg.box.size[2]);
+  for (int k = 0; k < 3; ++k) reg.periodic[k] = cfg.box.periodic[k];
+  std::vector<BallSpec> balls = insert_random(cfg.particles, reg, {}, rng);
+  if (static_cast<long>(balls.size()) < cfg.particles.count) {
+    const auto& pc = cfg.particles;
+    const Real vbox = cfg.box.size[0] * cfg.box.size[1] * cfg.box.size[2];
+    const Real vsolid = pc.count * M_PI / 6 * pc.diameter * pc.diameter * pc.diameter;
+    throw ConfigError(cfg.path + ": [particles] count: could place only " + std::to_string(balls.size()) + " of " +
+                      std::to_string(pc.count) + " balls by random insertion (solid fraction " +
+                      std::to_string(vsolid / vbox) +
+                      "; random insertion reaches about 0.3): enlarge [box] size_mm or use fill = \"lattice\"");
   }
   return balls;
 }

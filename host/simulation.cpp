@@ -225,6 +225,21 @@ std::vector<Vec3> Simulation::wall_forces() {
   return out;
 }
 
+std::vector<int> Simulation::wall_contact_counts() const {
+  const int nobj = walls_.n + mesh_.ntri;
+  if (fresh_) return std::vector<int>(nobj, 0);
+  IndexView counts("dem::sim::wall_contact_counts", nobj);
+  auto off = obj_offsets_;
+  auto fn = wall_c_.fn;
+  Kokkos::parallel_for("dem::sim::wall_contact_counts", RangePolicy(0, nobj), KOKKOS_LAMBDA(const int o) {
+    int c = 0;
+    for (int k = off(o); k < off(o + 1); ++k) c += fn(k) > 0 ? 1 : 0;
+    counts(o) = c;
+  });
+  auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), counts);
+  return std::vector<int>(h.data(), h.data() + nobj);
+}
+
 Real Simulation::unbalanced_ratio() const {
   if (p_.n == 0) return 0;
   Real s[2];

@@ -84,6 +84,9 @@ class Simulation {
   /// Force exerted by the balls on wall object `obj` (analytic walls first, then facets), N.
   std::vector<Vec3> wall_forces();
 
+  /// Touching contacts on each wall object (analytic walls first, then facets).
+  std::vector<int> wall_contact_counts() const;
+
   /// Mean unbalanced force over mean contact force (YADE/PFC definition) after the last measured step;
   /// 1 when there are no contacts.
   Real unbalanced_ratio() const;

@@ -1,0 +1,156 @@
+#include "specimen.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <string>
+
+#include "packing.hpp"
+#include "simulation.hpp"
+
+namespace dem {
+
+namespace {
+
+constexpr int kProfileBins = 24;
+
+Real ball_volume(Real d) { return M_PI / 6 * d * d * d; }
+
+/// Volume of a spherical cap of height h (0 <= h <= 2r).
+Real cap_volume(Real r, Real h) { return M_PI * h * h * (3 * r - h) / 3; }
+
+enum WallIndex { kBottom = 0, kMould = 1, kTop = 2 };
+
+/// Rigid mould: bottom platen, cylinder, top platen at z_top.
+std::vector<WallSpec> mould(Real radius, Real z_top) {
+  std::vector<WallSpec> w(3);
+  w[kBottom].kind = kPlane;
+  w[kBottom].normal = Vec3(0, 0, 1);
+  w[kMould].kind = kCylinder;
+  w[kMould].normal = Vec3(0, 0, 1);
+  w[kMould].radius = radius;
+  w[kTop].kind = kPlane;
+  w[kTop].point = Vec3(0, 0, z_top);
+  w[kTop].normal = Vec3(0, 0, -1);
+  for (auto& x : w) x.material = 1;
+  return w;
+}
+
+/// Presses the top platen down to z_target, then settles. The platen stops early where the mean force of
+/// its contacts would squeeze them by more than 1% of the radius (the layer is then looser than asked;
+/// pressing on would only overlap the balls). Returns the layer's step count and ratio.
+std::pair<long, Real> compact(Simulation& sim, Real z_target, const SpecimenConfig& sc, Real f_limit) {
+  const long check_every = 200;
+  long s = 0;
+  Real ratio = 1;
+  bool blocked = false;
+  while (s < sc.max_steps_per_layer) {
+    const Real z = sim.wall_point(kTop).z;
+    const Real dt = sim.params().integ.dt;
+    if (s % 5 == 0) {
+      const int n = sim.wall_contact_counts()[kTop];
+      blocked = n > 0 && std::fabs(sim.wall_forces()[kTop].z) / n > f_limit;
+    }
+    const Real v = blocked ? 0 : std::min(sc.platen_speed, (z - z_target) / dt);
+    sim.set_wall_velocity(kTop, Vec3(0, 0, -std::max(v, Real(0))));
+    const bool measure = (s + 1) % check_every == 0;
+    sim.step(measure);
+    ++s;
+    if (measure) {
+      ratio = sim.unbalanced_ratio();
+      if ((z - z_target < 1e-9 || blocked) && ratio < sc.stop_ratio) break;
+    }
+  }
+  sim.set_wall_velocity(kTop, Vec3());
+  return {s, ratio};
+}
+
+}  // namespace
+
+Real sphere_slab_volume(Real zc, Real r, Real z0, Real z1) {
+  const Real a = std::clamp(z0 - (zc - r), Real(0), 2 * r);  // height of the part below z0
+  const Real b = std::clamp(z1 - (zc - r), Real(0), 2 * r);  // height of the part below z1
+  return cap_volume(r, b) - cap_volume(r, a);
+}
+
+Real slab_void_ratio(const std::vector<BallSpec>& balls, Real radius, Real z0, Real z1) {
+  Real solid = 0;
+  for (const BallSpec& b : balls) solid += sphere_slab_volume(b.x.z, b.radius, z0, z1);
+  const Real total = M_PI * radius * radius * (z1 - z0);
+  return solid > 0 ? (total - solid) / solid : INFINITY;
+}
+
+long specimen_ball_count(const Config& cfg) {
+  const SpecimenConfig& sc = cfg.specimen;
+  const Real v = M_PI * sc.diameter * sc.diameter / 4 * sc.height;
+  return std::lround(v / ((1 + sc.void_ratio) * ball_volume(cfg.particles.diameter)));
+}
+
+Specimen build_specimen(const Config& cfg, bool verbose) {
+  const SpecimenConfig& sc = cfg.specimen;
+  const Real R = sc.diameter / 2, h_layer = sc.height / sc.layers;
+  const long total = specimen_ball_count(cfg);
+  std::mt19937_64 rng(cfg.run.seed);
+  Specimen out;
+  ContactParams ball_law = cfg.ball, wall_law = cfg.wall;
+  ball_law.mu_s = sc.compaction_mu_s;
+  wall_law.mu_s = 0;  // a smooth mould, so that walls do not hold the layers up
+  wall_law.mu_r = 0;
+  for (long k = 0; k < sc.layers; ++k) {
+    ParticleConfig pc = cfg.particles;
+    pc.count = total / sc.layers + (k == sc.layers - 1 ? total % sc.layers : 0);
+    const Real z0 = k * h_layer, z1 = (k + 1) * h_layer;
+    // Pour into a loose column about 3 times the layer's final height (random insertion reaches ~0.3).
+    Real h_loose = 3 * h_layer;
+    std::vector<BallSpec> fresh;
+    for (int attempt = 0; attempt < 6; ++attempt, h_loose *= 1.4) {
+      InsertRegion reg;
+      reg.lo = Vec3(-R, -R, z0);
+      reg.hi = Vec3(R, R, z0 + h_loose);
+      reg.radius = R;
+      fresh = insert_random(pc, reg, out.balls, rng);
+      if (static_cast<long>(fresh.size()) == pc.count) break;
+    }
+    if (static_cast<long>(fresh.size()) < pc.count)
+      throw ConfigError(cfg.path + ": [specimen]: could not pour layer " + std::to_string(k + 1) + " (" +
+                        std::to_string(pc.count) + " balls) into the mould");
+    std::vector<BallSpec> all = out.balls;
+    all.insert(all.end(), fresh.begin(), fresh.end());
+    SimParams prm;
+    prm.integ.gravity = Vec3(cfg.solver.gravity[0], cfg.solver.gravity[1], cfg.solver.gravity[2]);
+    prm.integ.alpha = cfg.solver.damping;
+    prm.integ.mass_scale = cfg.solver.mass_scale;
+    prm.skin = cfg.solver.skin * cfg.particles.diameter;
+    prm.overlap_limit = cfg.solver.overlap_limit;
+    Simulation sim(make_particles(all), make_walls(mould(R, z0 + h_loose)), FacetMesh(),
+                   {ball_law, wall_law, wall_law, wall_law}, 2, prm);
+    sim.set_dt(cfg.solver.dt > 0 ? cfg.solver.dt : cfg.solver.dt_safety * sim.critical_dt());
+    const Real f_limit = 0.01 * cfg.particles.diameter / 2 *
+                         NormalLinear::stiffness(wall_law, cfg.particles.diameter / 2, 0);
+    const auto [steps, ratio] = compact(sim, z1, sc, f_limit);
+    const HostParticles h = to_host_by_gid(sim.particles());
+    for (std::size_t q = 0; q < all.size(); ++q) {
+      all[q].x = h.x[q];
+      all[q].v = Vec3();
+      all[q].w = Vec3();
+    }
+    out.balls = all;
+    LayerReport rep{z0, z1, sim.wall_point(kTop).z, slab_void_ratio(out.balls, R, z0, z1), steps, ratio};
+    out.layers.push_back(rep);
+    if (verbose)
+      std::printf("specimen: layer %ld/%ld: %ld balls, platen at %.3f mm (target %.3f), %ld steps, unbalanced ratio "
+                  "%.1e\n", k + 1, sc.layers, pc.count, rep.z_platen * 1e3, z1 * 1e3, steps, ratio);
+  }
+  // Later layers press on the earlier ones: report every layer as it is in the finished specimen.
+  for (LayerReport& l : out.layers) l.void_ratio = slab_void_ratio(out.balls, R, l.z_bottom, l.z_top);
+  out.height = std::max(out.layers.back().z_platen, sc.height);
+  out.void_ratio = slab_void_ratio(out.balls, R, 0, out.height);
+  for (int b = 0; b < kProfileBins; ++b) {
+    const Real e = slab_void_ratio(out.balls, R, b * sc.height / kProfileBins, (b + 1) * sc.height / kProfileBins);
+    out.porosity_profile.push_back(e / (1 + e));
+  }
+  return out;
+}
+
+}  // namespace dem

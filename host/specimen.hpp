@@ -1,0 +1,43 @@
+#pragma once
+/// Cylindrical specimen by multilayer compaction (Tang et al. 2025, Sec. 3.3): the specimen height is
+/// split into equal layers; each layer's share of balls (count from the target void ratio) is poured at
+/// random above the previous layers inside a rigid cylinder and pressed by the top platen to the layer's
+/// target height, then left to settle until the unbalanced-force ratio is below the threshold.
+#include <vector>
+
+#include "config.hpp"
+#include "host/builder.hpp"
+
+namespace dem {
+
+struct LayerReport {
+  Real z_bottom = 0, z_top = 0;  ///< m, the layer's target slab
+  Real z_platen = 0;             ///< m, where the top platen stopped (above z_top if it could not get there)
+  Real void_ratio = 0;           ///< of the slab in the finished specimen (exact sphere-slab volumes)
+  long steps = 0;
+  Real unbalanced = 0;           ///< ratio when the layer ended
+};
+
+struct Specimen {
+  std::vector<BallSpec> balls;
+  std::vector<LayerReport> layers;
+  Real void_ratio = 0;           ///< whole specimen, up to where the last platen stopped
+  Real height = 0;               ///< m, where the last platen stopped
+  /// Porosity in `profile_bins` equal slices from bottom to top.
+  std::vector<Real> porosity_profile;
+};
+
+/// Balls needed for the target void ratio: V / ((1 + e) V_ball), V_ball of the mean diameter.
+long specimen_ball_count(const Config& cfg);
+
+/// Builds the specimen of cfg.specimen with cfg.particles sizes and the cfg.ball / cfg.wall laws.
+/// Throws ConfigError when a layer cannot be placed or compacted.
+Specimen build_specimen(const Config& cfg, bool verbose);
+
+/// Exact volume of the part of a sphere (centre height zc, radius r) between the planes z0 < z1 (m^3).
+Real sphere_slab_volume(Real zc, Real r, Real z0, Real z1);
+
+/// Void ratio of the cylinder slab of radius R between z0 and z1 (balls assumed inside the cylinder).
+Real slab_void_ratio(const std::vector<BallSpec>& balls, Real radius, Real z0, Real z1);
+
+}  // namespace dem
