@@ -114,11 +114,12 @@ Config load_config(const std::string& path) {
     throw ConfigError(s.str());
   }
   static const std::set<std::string> tables = {"run",    "particles", "box",     "material",
-                                               "wall_material", "solver", "specimen"};
+                                               "wall_material", "solver", "specimen", "triaxial"};
   for (const auto& [k, v] : root) {
     if (!tables.count(std::string(k.str())) || !v.is_table())
       throw ConfigError(path + ": [" + std::string(k.str()) +
-                        "]: unknown table (allowed: run, particles, box, material, wall_material, solver, specimen)");
+                        "]: unknown table (allowed: run, particles, box, material, wall_material, solver, specimen, "
+                        "triaxial)");
   }
   auto table = [&](const char* name) { return TableReader(path, name, root[name].as_table()); };
 
@@ -192,6 +193,25 @@ Config load_config(const std::string& path) {
   if (c.has_specimen && c.specimen.diameter < 4 * c.particles.diameter)
     throw ConfigError(path + ": [specimen] diameter_mm: must be at least 4 particle diameters (" +
                       std::to_string(4e3 * c.particles.diameter) + " mm)");
+
+  TableReader tx = table("triaxial");
+  tx.number("sigma3_kPa", c.triaxial.sigma3, 0, 1e6, 1e3, true);
+  tx.number("axial_strain_end_pct", c.triaxial.axial_strain_end, 0, 50, 1e-2, true);
+  tx.number("inertial_number", c.triaxial.inertial_number, 0, 1e-1, 1, true);
+  tx.number("record_every_pct", c.triaxial.record_every, 0, 10, 1e-2, true);
+  tx.number("consolidation_tol", c.triaxial.consolidation_tol, 0, 0.5, 1, true);
+  tx.number("stop_ratio", c.triaxial.stop_ratio, 0, 1, 1, true);
+  tx.integer("max_consolidation_steps", c.triaxial.max_consolidation_steps, 1, 1000000000L);
+  long around = c.triaxial.membrane_around, segs = c.triaxial.membrane_segments;
+  tx.integer("membrane_nodes_around", around, 8, 10000);
+  tx.integer("membrane_segments", segs, 1, 10000);
+  c.triaxial.membrane_around = static_cast<int>(around);
+  c.triaxial.membrane_segments = static_cast<int>(segs);
+  tx.number("membrane_modulus_MPa", c.triaxial.membrane_modulus, 0, 1e5, 1e6, true);
+  tx.number("membrane_poisson", c.triaxial.membrane_poisson, -0.99, 0.499);
+  tx.number("membrane_thickness_mm", c.triaxial.membrane_thickness, 0, 100, 1e-3, true);
+  tx.number("membrane_density_kg_m3", c.triaxial.membrane_density, 0, 1e5, 1, true);
+  tx.finish();
 
   for (int d = 0; d < 3; ++d)
     if (c.box.size[d] < 3 * c.particles.diameter)

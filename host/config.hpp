@@ -63,6 +63,23 @@ struct SpecimenConfig {
   long max_steps_per_layer = 200000;
 };
 
+/// Drained triaxial test on the [specimen]: membrane, isotropic consolidation, shear (Sec. 3.3).
+struct TriaxialConfig {
+  Real sigma3 = 100e3;            ///< Pa, cell pressure (file: sigma3_kPa)
+  Real axial_strain_end = 0.15;   ///< (file: axial_strain_end_pct)
+  Real inertial_number = 1e-3;    ///< shear rate from I = eps_dot d sqrt(rho / sigma3)
+  Real record_every = 0.001;      ///< axial strain between records (file: record_every_pct)
+  Real consolidation_tol = 0.005; ///< relative stress error that ends consolidation
+  Real stop_ratio = 1e-3;         ///< unbalanced-force ratio that ends consolidation
+  long max_consolidation_steps = 400000;
+  int membrane_around = 81;       ///< nodes around
+  int membrane_segments = 20;     ///< segments in height
+  Real membrane_modulus = 1.4e6;  ///< Pa (file: membrane_modulus_MPa; latex)
+  Real membrane_poisson = 0.49;
+  Real membrane_thickness = 0.5e-3;  ///< m (file: membrane_thickness_mm)
+  Real membrane_density = 930;    ///< kg/m^3
+};
+
 struct Config {
   std::string path;  ///< file it came from (for messages)
   RunConfig run;
@@ -73,6 +90,7 @@ struct Config {
   SolverConfig solver;
   SpecimenConfig specimen;
   bool has_specimen = false;  ///< the file has a [specimen] table
+  TriaxialConfig triaxial;
 };
 
 /// Reads and validates a config file. Throws ConfigError.

@@ -7,6 +7,7 @@
 
 #include "host/config.hpp"
 #include "host/job.hpp"
+#include "host/triaxial.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"triaxdem: DEM laboratory for triaxial tests on granular materials"};
@@ -22,6 +23,10 @@ int main(int argc, char** argv) {
   auto* specimen = app.add_subcommand("specimen", "build the [specimen] of a config by multilayer compaction");
   specimen->add_option("config", config_path, "TOML config file")->required()->check(CLI::ExistingFile);
   specimen->add_option("-o,--output", output, "output folder (overrides [run] output)");
+
+  auto* triaxial = app.add_subcommand("triaxial", "specimen, membrane, consolidation and shear (drained triaxial test)");
+  triaxial->add_option("config", config_path, "TOML config file")->required()->check(CLI::ExistingFile);
+  triaxial->add_option("-o,--output", output, "output folder (overrides [run] output)");
 
   auto* check = app.add_subcommand("check", "validate a config and print the derived time step");
   check->add_option("config", config_path, "TOML config file")->required()->check(CLI::ExistingFile);
@@ -44,6 +49,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (specimen->parsed()) return dem::specimen_job(cfg);
+    if (triaxial->parsed()) return dem::triaxial_job(cfg);
     return dem::run_job(cfg);
   } catch (const dem::ConfigError& e) {
     std::fprintf(stderr, "triaxdem: config error: %s\n", e.what());

@@ -1,0 +1,42 @@
+#pragma once
+/// The drained triaxial test of Tang et al. (2025), Sec. 3.3, on a specimen from multilayer compaction:
+/// the rigid mould is replaced by a flexible membrane (tied to the platens) under the cell pressure, the
+/// specimen is consolidated isotropically with the top platen under stress servo, then sheared with the
+/// top platen at constant velocity and the cell pressure held, to the end strain.
+#include <vector>
+
+#include "config.hpp"
+#include "host/specimen.hpp"
+#include "io_hdf5.hpp"
+
+namespace dem {
+
+/// One record of the shear stage. Stresses compression positive.
+struct TriaxialRecord {
+  Real eps_a = 0;       ///< (h0 - h) / h0
+  Real eps_v = 0;       ///< (V0 - V) / V0, from the membrane's enclosed volume (compression positive)
+  Real sigma1 = 0;      ///< Pa, top platen force / platen area
+  Real sigma1_bottom = 0;  ///< Pa, the same from the bottom platen (a check of equilibrium)
+  Real q = 0;           ///< Pa, sigma1 - sigma3
+  Real unbalanced = 0;
+  Real kinetic = 0;     ///< J
+};
+
+struct TriaxialResult {
+  Real void_ratio_consolidated = 0;
+  long consolidation_steps = 0;
+  Real shear_rate = 0;         ///< 1/s
+  Real inertial_number = 0;
+  std::vector<TriaxialRecord> records;
+  Real q_peak = 0, eps_a_peak = 0, phi_peak_deg = 0;
+  Real q_end = 0, max_dilatancy = 0;  ///< max of -d eps_v / d eps_a
+  double wall_seconds = 0;
+};
+
+/// Runs consolidation and shear on `specimen`; writes series and snapshots to `out` when given.
+TriaxialResult run_triaxial(const Config& cfg, const Specimen& specimen, io::Output* out, bool verbose);
+
+/// The `triaxial` CLI job: specimen, then run_triaxial, outputs and a summary. Returns 0, or 2 on a blow-up.
+int triaxial_job(const Config& cfg);
+
+}  // namespace dem
