@@ -30,6 +30,7 @@ struct TriaxialResult {
   std::vector<TriaxialRecord> records;
   Real q_peak = 0, eps_a_peak = 0, phi_peak_deg = 0;
   Real q_end = 0, max_dilatancy = 0;  ///< max of -d eps_v / d eps_a
+  int escaped = 0;             ///< balls whose centre ended outside the membrane (should be 0)
   double wall_seconds = 0;
 };
 
