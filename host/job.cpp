@@ -9,20 +9,25 @@
 
 namespace dem {
 
-std::unique_ptr<Simulation> build_simulation(const Config& cfg, bool verbose) {
-  std::vector<BallSpec> balls = make_packing(cfg);
-  std::vector<WallSpec> walls = box_walls(cfg);
+SimParams solver_params(const Config& cfg) {
   SimParams prm;
-  for (int k = 0; k < 3; ++k) {
-    prm.domain.lo[k] = 0;
-    prm.domain.hi[k] = cfg.box.size[k];
-    prm.domain.periodic[k] = cfg.box.periodic[k];
-  }
   prm.integ.gravity = Vec3(cfg.solver.gravity[0], cfg.solver.gravity[1], cfg.solver.gravity[2]);
   prm.integ.alpha = cfg.solver.damping;
   prm.integ.mass_scale = cfg.solver.mass_scale;
   prm.skin = cfg.solver.skin * cfg.particles.diameter;
   prm.overlap_limit = cfg.solver.overlap_limit;
+  return prm;
+}
+
+std::unique_ptr<Simulation> build_simulation(const Config& cfg, bool verbose) {
+  std::vector<BallSpec> balls = make_packing(cfg);
+  std::vector<WallSpec> walls = box_walls(cfg);
+  SimParams prm = solver_params(cfg);
+  for (int k = 0; k < 3; ++k) {
+    prm.domain.lo[k] = 0;
+    prm.domain.hi[k] = cfg.box.size[k];
+    prm.domain.periodic[k] = cfg.box.periodic[k];
+  }
   // Material 0: balls, material 1: walls; ball-wall contacts use the wall material's law.
   const std::vector<ContactParams> table = {cfg.ball, cfg.wall, cfg.wall, cfg.wall};
   auto sim = std::make_unique<Simulation>(make_particles(balls), make_walls(walls), FacetMesh(), table, 2, prm);

@@ -9,6 +9,10 @@
 
 namespace dem {
 
+/// The [solver] settings as simulation parameters (gravity, damping, density scaling, skin, blow-up limit);
+/// the domain is left open (non-periodic).
+SimParams solver_params(const Config& cfg);
+
 /// The simulation a config describes (particles, box walls, materials, time step). Prints the time
 /// step it chose and why.
 std::unique_ptr<Simulation> build_simulation(const Config& cfg, bool verbose);

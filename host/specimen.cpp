@@ -7,6 +7,7 @@
 #include <string>
 
 #include "packing.hpp"
+#include "job.hpp"
 #include "simulation.hpp"
 
 namespace dem {
@@ -117,12 +118,7 @@ Specimen build_specimen(const Config& cfg, bool verbose) {
                         std::to_string(pc.count) + " balls) into the mould");
     std::vector<BallSpec> all = out.balls;
     all.insert(all.end(), fresh.begin(), fresh.end());
-    SimParams prm;
-    prm.integ.gravity = Vec3(cfg.solver.gravity[0], cfg.solver.gravity[1], cfg.solver.gravity[2]);
-    prm.integ.alpha = cfg.solver.damping;
-    prm.integ.mass_scale = cfg.solver.mass_scale;
-    prm.skin = cfg.solver.skin * cfg.particles.diameter;
-    prm.overlap_limit = cfg.solver.overlap_limit;
+    const SimParams prm = solver_params(cfg);
     Simulation sim(make_particles(all), make_walls(mould(R, z0 + h_loose)), FacetMesh(),
                    {ball_law, wall_law, wall_law, wall_law}, 2, prm);
     sim.set_dt(cfg.solver.dt > 0 ? cfg.solver.dt : cfg.solver.dt_safety * sim.critical_dt());

@@ -46,12 +46,7 @@ Cell make_cell(const Config& cfg, const Specimen& sp) {
   w[kTopPlaten].point = Vec3(0, 0, sp.height);
   w[kTopPlaten].normal = Vec3(0, 0, -1);
   for (auto& x : w) x.material = 1;
-  SimParams prm;
-  prm.integ.gravity = Vec3(cfg.solver.gravity[0], cfg.solver.gravity[1], cfg.solver.gravity[2]);
-  prm.integ.alpha = cfg.solver.damping;
-  prm.integ.mass_scale = cfg.solver.mass_scale;
-  prm.skin = cfg.solver.skin * cfg.particles.diameter;
-  prm.overlap_limit = cfg.solver.overlap_limit;
+  const SimParams prm = solver_params(cfg);
   c.sim = std::make_unique<Simulation>(make_particles(sp.balls), make_walls(w), c.membrane.mesh,
                                        std::vector<ContactParams>{cfg.ball, cfg.wall, cfg.wall, cfg.wall}, 2, prm);
   MembraneIntegrateParams mp;
