@@ -65,6 +65,23 @@ class TableReader {
     }
     out = *v;
   }
+  /// An array of numbers, each in [lo, hi], converted by `scale`.
+  void numbers(const std::string& key, std::vector<Real>& out, Real lo, Real hi, Real scale) {
+    const toml::node* n = get(key);
+    if (!n) return;
+    const toml::array* a = n->as_array();
+    if (!a) fail(key, "expected an array of numbers");
+    out.clear();
+    for (const toml::node& e : *a) {
+      auto v = e.value<double>();
+      if (!v || !(*v >= lo && *v <= hi)) {
+        std::ostringstream r;
+        r << "every value must be a number in [" << lo << ", " << hi << "]";
+        fail(key, r.str());
+      }
+      out.push_back(*v * scale);
+    }
+  }
   template <class T, class F>
   void triple(const std::string& key, std::array<T, 3>& out, F&& element) {
     const toml::node* n = get(key);
@@ -114,12 +131,12 @@ Config load_config(const std::string& path) {
     throw ConfigError(s.str());
   }
   static const std::set<std::string> tables = {"run",    "particles", "box",     "material",
-                                               "wall_material", "solver", "specimen", "triaxial"};
+                                               "wall_material", "solver", "specimen", "triaxial", "periodic"};
   for (const auto& [k, v] : root) {
     if (!tables.count(std::string(k.str())) || !v.is_table())
       throw ConfigError(path + ": [" + std::string(k.str()) +
                         "]: unknown table (allowed: run, particles, box, material, wall_material, solver, specimen, "
-                        "triaxial)");
+                        "triaxial, periodic)");
   }
   auto table = [&](const char* name) { return TableReader(path, name, root[name].as_table()); };
 
@@ -184,12 +201,26 @@ Config load_config(const std::string& path) {
   sp.number("height_mm", c.specimen.height, 0, 1e6, 1e-3, true);
   // Monodisperse spheres pack no denser than random close packing (solid fraction 0.64, e = 0.5625).
   sp.number("void_ratio", c.specimen.void_ratio, 0.5625, 3);
+  sp.integer("ball_count", c.specimen.ball_count, 0, 2000000000L);
   sp.integer("layers", c.specimen.layers, 1, 100);
   sp.number("compaction_mu_s", c.specimen.compaction_mu_s, 0, 10);
   sp.number("platen_speed_mm_s", c.specimen.platen_speed, 0, 1e4, 1e-3, true);
   sp.number("stop_ratio", c.specimen.stop_ratio, 0, 1, 1, true);
   sp.integer("max_steps_per_layer", c.specimen.max_steps_per_layer, 1, 1000000000L);
   sp.finish();
+  if (c.specimen.ball_count > 0) {
+    // The count decides; the target e is the one it gives in the nominal cylinder.
+    const Real d = c.particles.diameter;
+    const Real cylinder = M_PI / 4 * c.specimen.diameter * c.specimen.diameter * c.specimen.height;
+    c.specimen.void_ratio = cylinder / (c.specimen.ball_count * M_PI / 6 * d * d * d) - 1;
+    if (c.specimen.void_ratio < 0.5625) {
+      std::ostringstream r;
+      r << "value " << c.specimen.ball_count << " gives e = " << c.specimen.void_ratio
+        << " in the cylinder, denser than random close packing (allowed: e >= 0.5625, at most "
+        << std::floor(cylinder / (1.5625 * M_PI / 6 * d * d * d)) << " balls)";
+      sp.fail("ball_count", r.str());
+    }
+  }
   if (c.has_specimen && c.specimen.diameter < 4 * c.particles.diameter)
     throw ConfigError(path + ": [specimen] diameter_mm: must be at least 4 particle diameters (" +
                       std::to_string(4e3 * c.particles.diameter) + " mm)");
@@ -212,6 +243,30 @@ Config load_config(const std::string& path) {
   tx.number("membrane_thickness_mm", c.triaxial.membrane_thickness, 0, 100, 1e-3, true);
   tx.number("membrane_density_kg_m3", c.triaxial.membrane_density, 0, 1e5, 1, true);
   tx.finish();
+
+  TableReader pr = table("periodic");
+  c.has_periodic = root["periodic"].as_table() != nullptr;
+  PeriodicTriaxialParams& t = c.periodic.triax;
+  pr.number("sigma3_kPa", t.sigma3, 0, 1e7, 1e3, true);
+  pr.number("axial_rate_per_s", t.axial_rate, 0, 1e6);
+  pr.number("target_inertial", t.target_inertial, 0, 1, 1, true);
+  pr.number("max_inertial", t.max_inertial, 0, 1, 1, true);
+  pr.boolean("allow_high_inertial", t.allow_high_inertial);
+  pr.number("target_axial_strain_pct", t.target_strain, 0, 90, 1e-2, true);
+  pr.number("servo_alpha", t.servo_alpha, 0, 1, 1, true);
+  pr.number("max_lateral_rate_per_s", t.max_lateral_rate, 0, 1e6);
+  pr.number("consolidation_rate_per_s", t.consolidation_rate, 0, 1e6);
+  pr.number("stress_tolerance", t.stress_tolerance, 0, 1, 1, true);
+  pr.number("unbalanced_tolerance", t.unbalanced_tolerance, 0, 1, 1, true);
+  pr.integer("max_consolidation_steps", t.max_consolidation_steps, 1, 1000000000L);
+  pr.integer("check_every", t.check_every, 1, 1000000L);
+  pr.integer("stiffness_every", t.stiffness_every, 1, 1000000L);
+  pr.number("record_strain_pct", t.record_strain, 0, 90, 1e-2, true);
+  pr.numbers("snapshot_strains_pct", t.snapshot_strains, 0, 90, 1e-2);
+  pr.number("prep_mu_s", c.periodic.prep_mu_s, 0, 10);
+  pr.number("prep_mu_r", c.periodic.prep_mu_r, 0, 10);
+  pr.number("prep_unbalanced_tolerance", c.periodic.prep_unbalanced_tolerance, 0, 1, 1, true);
+  pr.finish();
 
   for (int d = 0; d < 3; ++d)
     if (c.box.size[d] < 3 * c.particles.diameter)

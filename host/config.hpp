@@ -5,6 +5,7 @@
 #include <array>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "kernels/contact_law.hpp"
 
@@ -56,6 +57,7 @@ struct SpecimenConfig {
   Real diameter = 61.8e-3;       ///< m (file: diameter_mm)
   Real height = 120e-3;          ///< m (file: height_mm)
   Real void_ratio = 0.61;        ///< target e of the whole specimen; sets the ball count
+  long ball_count = 0;           ///< > 0: this many balls instead (the target e then follows from it)
   long layers = 5;
   Real compaction_mu_s = 0.0;    ///< ball-ball friction while compacting (denser packings need little)
   Real platen_speed = 0.05;      ///< m/s, top platen speed while compacting a layer (file: platen_speed_mm_s)
@@ -80,6 +82,39 @@ struct TriaxialConfig {
   Real membrane_density = 930;    ///< kg/m^3
 };
 
+/// Periodic-cell triaxial test parameters (SI); see host/periodic_triaxial.hpp for the method.
+struct PeriodicTriaxialParams {
+  std::string name = "periodic";     ///< label of the progress line
+  Real sigma3 = 100e3;               ///< Pa, confining stress (all axes in consolidation, lateral in shear)
+  Real axial_rate = 0;               ///< 1/s, compression positive (the cell shortens along z); 0: from target_inertial
+  Real target_inertial = 5e-4;       ///< I at p = sigma3 that sets axial_rate when it is 0
+  Real max_inertial = 1e-3;          ///< refuse an axial_rate whose I at p = sigma3 is above this ...
+  bool allow_high_inertial = false;  ///< ... unless this is set (the run is then labelled not quasi-static)
+  Real target_strain = 0.15;         ///< engineering axial strain at the end of shear
+  Real servo_alpha = 0.5;            ///< fraction of the stress error one step of affine response corrects, (0, 1]
+  Real max_lateral_rate = 0;         ///< 1/s, clamp of the servoed rates in shear; 0: 5 x axial_rate
+  Real consolidation_rate = 0;       ///< 1/s, clamp of the servoed rates in consolidation; 0: max_lateral_rate
+  Real stress_tolerance = 0.005;     ///< consolidation: |sigma_ii - sigma3| / sigma3 on every axis
+  Real unbalanced_tolerance = 1e-3;  ///< consolidation: unbalanced-force ratio
+  long max_consolidation_steps = 2000000;
+  long check_every = 100;            ///< consolidation: steps between convergence checks
+  long stiffness_every = 10;         ///< steps between updates of the servo stiffness K_ii
+  Real record_strain = 0.001;        ///< eps_a between series rows
+  std::vector<Real> snapshot_strains{0, 0.01, 0.05, 0.15};  ///< eps_a of particle snapshots (with output)
+  bool verbose = true;               ///< progress lines and the summary on stdout
+};
+
+/// The [periodic] table: the periodic-cell triaxial test (host/periodic_triaxial.hpp).
+struct PeriodicConfig {
+  PeriodicTriaxialParams triax;
+  /// Friction during a preparatory consolidation (YADE's compaction friction): below the test's mu_s
+  /// gives a denser specimen. < 0: the material's value (no preparatory stage).
+  Real prep_mu_s = -1, prep_mu_r = -1;
+  /// Unbalanced-force ratio that ends the preparatory consolidation (the test's own consolidation then
+  /// brings it to unbalanced_tolerance with the test's friction; frictionless packings creep for long).
+  Real prep_unbalanced_tolerance = 1e-2;
+};
+
 struct Config {
   std::string path;  ///< file it came from (for messages)
   RunConfig run;
@@ -91,6 +126,8 @@ struct Config {
   SpecimenConfig specimen;
   bool has_specimen = false;  ///< the file has a [specimen] table
   TriaxialConfig triaxial;
+  PeriodicConfig periodic;
+  bool has_periodic = false;  ///< the file has a [periodic] table
 };
 
 /// Reads and validates a config file. Throws ConfigError.

@@ -3,6 +3,7 @@
 /// split into equal layers; each layer's share of balls (count from the target void ratio) is poured at
 /// random above the previous layers inside a rigid cylinder and pressed by the top platen to the layer's
 /// target height, then left to settle until the unbalanced-force ratio is below the threshold.
+#include <string>
 #include <vector>
 
 #include "config.hpp"
@@ -33,6 +34,20 @@ long specimen_ball_count(const Config& cfg);
 /// Builds the specimen of cfg.specimen with cfg.particles sizes and the cfg.ball / cfg.wall laws.
 /// Throws ConfigError when a layer cannot be placed or compacted.
 Specimen build_specimen(const Config& cfg, bool verbose);
+
+/// Text key of everything that decides the specimen (particles, [specimen], seed, compaction laws, solver):
+/// equal keys build identical specimens, so a study's cases can share one.
+std::string specimen_key(const Config& cfg);
+
+/// Writes / reads a specimen as CSV (x_m, y_m, z_m, radius_m, density_kg_m3 per ball; the layer reports,
+/// height and key in '#' lines). The write is atomic; load_specimen returns false when the file is missing
+/// or was built for another key, and throws std::runtime_error naming the file and line when it is damaged.
+void save_specimen(const std::string& path, const Specimen& sp, const std::string& key);
+bool load_specimen(const std::string& path, const std::string& key, Specimen& sp);
+
+/// build_specimen through a cache folder: reuses cache/<hash of the key>.csv when it holds this key,
+/// otherwise builds the specimen and stores it there.
+Specimen cached_specimen(const Config& cfg, const std::string& cache, bool verbose);
 
 /// Exact volume of the part of a sphere (centre height zc, radius r) between the planes z0 < z1 (m^3).
 Real sphere_slab_volume(Real zc, Real r, Real z0, Real z1);

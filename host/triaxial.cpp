@@ -4,12 +4,14 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 
 #include "host/membrane_mesh.hpp"
 #include "job.hpp"
 #include "progress.hpp"
 #include "servo.hpp"
+#include "study.hpp"
 #include "simulation.hpp"
 
 namespace dem {
@@ -26,6 +28,7 @@ struct Cell {
   Real radius = 0, area = 0;  ///< m, m^2: mould radius and platen area
   Real kn_wall = 0;           ///< N/m, platen contact stiffness of a mean ball
   Real solid_volume = 0;      ///< m^3
+  Real mean_radius = 0;       ///< m
 };
 
 Cell make_cell(const Config& cfg, const Specimen& sp) {
@@ -57,7 +60,10 @@ Cell make_cell(const Config& cfg, const Specimen& sp) {
   c.sim->set_cell_pressure(cfg.triaxial.sigma3);
   c.sim->set_dt(cfg.solver.dt > 0 ? cfg.solver.dt : cfg.solver.dt_safety * c.sim->critical_dt());
   c.kn_wall = NormalLinear::stiffness(cfg.wall, cfg.particles.diameter / 2, 0);
-  for (const BallSpec& b : sp.balls) c.solid_volume += 4.0 / 3.0 * M_PI * b.radius * b.radius * b.radius;
+  for (const BallSpec& b : sp.balls) {
+    c.solid_volume += 4.0 / 3.0 * M_PI * b.radius * b.radius * b.radius;
+    c.mean_radius += b.radius / sp.balls.size();
+  }
   return c;
 }
 
@@ -81,25 +87,118 @@ std::pair<Real, Real> platen_stresses(Cell& c) {
 
 Real specimen_volume(const Cell& c) { return enclosed_volume(c.membrane, 0, c.sim->wall_point(kTopPlaten).z); }
 
-/// Balls whose centre lies outside the membrane: radius above the local ring radius (mean radius of the
-/// two rings around the ball's height, interpolated).
-int count_escaped(Cell& c, int n_around) {
+/// The membrane as a triangle surface for the snapshots (ParaView shows it with the balls).
+io::SurfaceSnapshot surface(const Cell& c) {
   auto nx = Kokkos::create_mirror_view_and_copy(HostSpace(), c.membrane.mesh.node_x);
-  const int nring = c.membrane.nnode / n_around;
-  std::vector<Real> zr(nring, 0), rr(nring, 0);
-  for (int r = 0; r < nring; ++r)
-    for (int k = 0; k < n_around; ++k) {
-      const int q = r * n_around + k;
-      zr[r] += nx(q, 2) / n_around;
-      rr[r] += std::hypot(nx(q, 0), nx(q, 1)) / n_around;
-    }
+  auto tri = Kokkos::create_mirror_view_and_copy(HostSpace(), c.membrane.mesh.tri);
+  io::SurfaceSnapshot s;
+  for (int k = 0; k < c.membrane.mesh.nnode; ++k)
+    for (int d = 0; d < 3; ++d) s.nodes.push_back(nx(k, d));
+  for (int t = 0; t < c.membrane.mesh.ntri; ++t)
+    for (int d = 0; d < 3; ++d) s.triangles.push_back(tri(t, d));
+  return s;
+}
+
+/// Lateral stress the balls exert on the membrane (Pa): the outward normal component of the ball-facet forces
+/// over the area of the facets clear of the end rings. It differs from the cell pressure by what the
+/// membrane itself carries (hoop and axial tension of a deforming membrane, inertia). The end bands are left
+/// out: the balls cannot fill the corner between platen and membrane, so there the tied rings and the
+/// platen edge carry part of the pressure, as a lab's platens do.
+Real lateral_stress(Cell& c) {
+  const std::vector<Vec3> f = c.sim->wall_forces();
+  auto nx = Kokkos::create_mirror_view_and_copy(HostSpace(), c.membrane.mesh.node_x);
+  auto tri = Kokkos::create_mirror_view_and_copy(HostSpace(), c.membrane.mesh.tri);
+  auto fixed = Kokkos::create_mirror_view_and_copy(HostSpace(), c.membrane.fixed);
+  const int w0 = c.sim->num_walls();
+  Real fn = 0, area = 0;
+  for (int t = 0; t < c.membrane.mesh.ntri; ++t) {
+    if (fixed(tri(t, 0)) || fixed(tri(t, 1)) || fixed(tri(t, 2))) continue;
+    const Vec3 a = load(nx, tri(t, 0)), b = load(nx, tri(t, 1)), d = load(nx, tri(t, 2));
+    const Vec3 s = 0.5 * cross(b - a, d - a);  // area vector, outward (counter-clockwise seen from outside)
+    fn += dot(f[w0 + t], s) / norm(s);
+    area += norm(s);
+  }
+  return area > 0 ? fn / area : 0;
+}
+
+/// Area of the convex hull of discs of radius r centred at `pts` (m^2): hull of the centres (Andrew's
+/// monotone chain) grown by r, i.e. A_hull + r P_hull + pi r^2.
+Real disc_hull_area(std::vector<std::pair<Real, Real>> pts, Real r) {
+  std::sort(pts.begin(), pts.end());
+  pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+  if (pts.size() < 3) return M_PI * r * r;
+  auto turn = [](const std::pair<Real, Real>& o, const std::pair<Real, Real>& a, const std::pair<Real, Real>& b) {
+    return (a.first - o.first) * (b.second - o.second) - (a.second - o.second) * (b.first - o.first);
+  };
+  std::vector<std::pair<Real, Real>> h(2 * pts.size());
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    while (k >= 2 && turn(h[k - 2], h[k - 1], pts[i]) <= 0) --k;
+    h[k++] = pts[i];
+  }
+  for (std::size_t i = pts.size() - 1, t = k + 1; i > 0; --i) {
+    while (k >= t && turn(h[k - 2], h[k - 1], pts[i - 1]) <= 0) --k;
+    h[k++] = pts[i - 1];
+  }
+  h.resize(k - 1);
+  Real area = 0, perimeter = 0;
+  for (std::size_t i = 0; i < h.size(); ++i) {
+    const auto& a = h[i];
+    const auto& b = h[(i + 1) % h.size()];
+    area += 0.5 * (a.first * b.second - b.first * a.second);
+    perimeter += std::hypot(b.first - a.first, b.second - a.second);
+  }
+  return area + r * perimeter + M_PI * r * r;
+}
+
+/// Volume of the balls' envelope (m^3), measured without the membrane: the specimen between the platens cut
+/// into `slabs` slabs, each slab's cross-section the convex hull of its balls (centres within the slab,
+/// grown by the mean ball radius). It bounds the granular body as a wrapping membrane would, except for the
+/// dimples a soft membrane makes between the outer balls.
+Real envelope_volume(Cell& c, int slabs) {
+  const Real top = c.sim->wall_point(kTopPlaten).z, dz = top / slabs;
+  std::vector<std::vector<std::pair<Real, Real>>> xy(slabs);
+  const HostParticles h = to_host_by_gid(c.sim->particles());
+  for (const Vec3& x : h.x) xy[std::clamp(static_cast<int>(x.z / dz), 0, slabs - 1)].emplace_back(x.x, x.y);
+  Real v = 0;
+  for (auto& pts : xy) v += disc_hull_area(std::move(pts), c.mean_radius) * dz;
+  return v;
+}
+
+/// True when the horizontal ray from x away from the axis crosses triangle (a, b, c) (Moller-Trumbore).
+bool ray_crosses(const Vec3& x, const Vec3& dir, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 e1 = b - a, e2 = c - a, p = cross(dir, e2);
+  const Real det = dot(e1, p);
+  if (std::fabs(det) < 1e-300) return false;
+  const Vec3 s = x - a;
+  const Real u = dot(s, p) / det;
+  if (u < 0 || u > 1) return false;
+  const Vec3 q = cross(s, e1);
+  const Real v = dot(dir, q) / det;
+  if (v < 0 || u + v > 1) return false;
+  return dot(e2, q) / det > 0;
+}
+
+/// Balls whose centre lies outside the membrane tube or beyond the platens. Inside the tube a ray from the
+/// centre straight away from the axis crosses the membrane an odd number of times; this holds wherever the
+/// membrane bulges, unlike a comparison with a mean ring radius.
+int count_escaped(Cell& c) {
+  auto nx = Kokkos::create_mirror_view_and_copy(HostSpace(), c.membrane.mesh.node_x);
+  auto tri = Kokkos::create_mirror_view_and_copy(HostSpace(), c.membrane.mesh.tri);
+  const Real top = c.sim->wall_point(kTopPlaten).z;
   const HostParticles h = to_host_by_gid(c.sim->particles());
   int out = 0;
   for (const Vec3& x : h.x) {
-    const int r = std::clamp(static_cast<int>(std::upper_bound(zr.begin(), zr.end(), x.z) - zr.begin()) - 1, 0,
-                             nring - 2);
-    const Real t = std::clamp((x.z - zr[r]) / (zr[r + 1] - zr[r]), Real(0), Real(1));
-    if (std::hypot(x.x, x.y) > (1 - t) * rr[r] + t * rr[r + 1] || x.z < zr.front() || x.z > zr.back()) ++out;
+    const Real rho = std::hypot(x.x, x.y);
+    if (x.z < 0 || x.z > top || !(rho > 0)) {
+      out += x.z < 0 || x.z > top;
+      continue;
+    }
+    const Vec3 dir(x.x / rho, x.y / rho, 0);
+    int crossings = 0;
+    for (int t = 0; t < c.membrane.mesh.ntri; ++t)
+      crossings += ray_crosses(x, dir, load(nx, tri(t, 0)), load(nx, tri(t, 1)), load(nx, tri(t, 2)));
+    out += crossings % 2 == 0;
   }
   return out;
 }
@@ -147,6 +246,8 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
   res.consolidation_steps = s + 1;
   const Real h0 = sim.wall_point(kTopPlaten).z;
   const Real v0 = specimen_volume(cell);
+  const int env_slabs = tc.membrane_segments;
+  const Real v0_envelope = envelope_volume(cell, env_slabs);
   res.void_ratio_consolidated = v0 / cell.solid_volume - 1;
   if (verbose)
     std::printf("\nconsolidated at %.0f kPa: e = %.4f, height %.3f mm after %ld steps\n", tc.sigma3 / 1e3,
@@ -164,7 +265,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
                 tc.axial_strain_end * 100);
   if (out)
     out->set_series_columns({"eps_a_pct", "eps_v_pct", "q_kPa", "sigma1_kPa", "sigma1_bottom_kPa", "sigma3_kPa",
-                             "unbalanced_ratio", "kinetic_energy_J"});
+                             "sigma3_balls_kPa", "eps_v_envelope_pct", "unbalanced_ratio", "kinetic_energy_J"});
   const Real snaps[] = {0.0, 0.01, 0.05, tc.axial_strain_end};
   int next_snap = 0;
   Real next_record = 0;
@@ -179,12 +280,15 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
       r.sigma1 = top;
       r.sigma1_bottom = bottom;
       r.q = top - tc.sigma3;
+      r.sigma3_balls = lateral_stress(cell);
+      r.eps_v_envelope = (v0_envelope - envelope_volume(cell, env_slabs)) / v0_envelope;
       r.unbalanced = sim.unbalanced_ratio();
       r.kinetic = sim.stats().kinetic;
       res.records.push_back(r);
       if (out)
         out->append_series({100 * r.eps_a, 100 * r.eps_v, r.q / 1e3, r.sigma1 / 1e3, r.sigma1_bottom / 1e3,
-                            tc.sigma3 / 1e3, r.unbalanced, r.kinetic});
+                            tc.sigma3 / 1e3, r.sigma3_balls / 1e3, 100 * r.eps_v_envelope, r.unbalanced,
+                            r.kinetic});
       next_record += tc.record_every;
       if (verbose) {
         char extra[64];
@@ -195,7 +299,8 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
     if (out && next_snap < 4 && eps_a >= snaps[next_snap] - 1e-12) {
       char label[48];
       std::snprintf(label, sizeof label, "shear eps_a=%.0f%%", 100 * snaps[next_snap]);
-      out->write_snapshot(take_snapshot(sim, label));
+      const io::SurfaceSnapshot membrane_surface = surface(cell);
+      out->write_snapshot(take_snapshot(sim, label), &membrane_surface);
       ++next_snap;
     }
     if (k == steps) break;
@@ -214,7 +319,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
                                                           (r.eps_a - res.records[i - 1].eps_a));
   }
   if (!res.records.empty()) res.q_end = res.records.back().q;
-  res.escaped = count_escaped(cell, tc.membrane_around);
+  res.escaped = count_escaped(cell);
   res.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return res;
 }
@@ -223,14 +328,35 @@ int triaxial_job(const Config& cfg) {
   if (!cfg.has_specimen) throw ConfigError(cfg.path + ": [specimen]: table missing (the triaxial job needs it)");
   io::Output out(cfg.run.output);
   try {
-    const Specimen sp = build_specimen(cfg, true);
+    // Specimens are shared through a cache beside the output folder (the nine paper cases build one).
+    const Specimen sp =
+        cached_specimen(cfg, (std::filesystem::path(out.folder()).parent_path() / ".specimens").string(), true);
+    std::printf("specimen: %zu balls, e = %.4f, height %.3f mm\n", sp.balls.size(), sp.void_ratio, sp.height * 1e3);
     const TriaxialResult r = run_triaxial(cfg, sp, &out, true);
     std::printf("\nresult: q_peak %.1f kPa at eps_a %.2f%%, peak friction angle %.1f deg, q at %.0f%% %.1f kPa, "
                 "max dilatancy %.3f, wall time %s\n",
                 r.q_peak / 1e3, 100 * r.eps_a_peak, r.phi_peak_deg, 100 * cfg.triaxial.axial_strain_end,
                 r.q_end / 1e3, r.max_dilatancy, format_duration(r.wall_seconds).c_str());
     if (r.escaped > 0) std::printf("WARNING: %d balls ended outside the membrane\n", r.escaped);
-    std::printf("output: %s/series.csv, %s/snapshots.xdmf\n", out.folder().c_str(), out.folder().c_str());
+    TestSummary s;
+    s.kind = "membrane";
+    s.sigma3 = cfg.triaxial.sigma3;
+    s.mu_s = cfg.ball.mu_s;
+    s.mu_r = cfg.ball.mu_r;
+    s.balls = static_cast<long>(sp.balls.size());
+    s.void_ratio0 = r.void_ratio_consolidated;
+    s.q_peak = r.q_peak;
+    s.phi_peak_deg = r.phi_peak_deg;
+    s.eps_a_peak = r.eps_a_peak;
+    s.q_end = r.q_end;
+    s.eps_a_end = r.records.empty() ? 0 : r.records.back().eps_a;
+    s.max_dilatancy = r.max_dilatancy;
+    s.inertial_number = r.inertial_number;
+    s.wall_seconds = r.wall_seconds;
+    write_summary(out.folder(), s);
+    std::printf("output: %s/series.csv, summary.csv, snapshots.xdmf (ParaView: balls and membrane)\n",
+                out.folder().c_str());
+    run_plot_script("plot_triaxial.py", {out.folder(), "--title", cfg.run.name});
   } catch (const BlowUp& e) {
     std::fprintf(stderr, "\ntriaxdem: %s\n", e.what());
     return 2;

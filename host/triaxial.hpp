@@ -18,6 +18,8 @@ struct TriaxialRecord {
   Real sigma1 = 0;      ///< Pa, top platen force / platen area
   Real sigma1_bottom = 0;  ///< Pa, the same from the bottom platen (a check of equilibrium)
   Real q = 0;           ///< Pa, sigma1 - sigma3
+  Real sigma3_balls = 0;   ///< Pa, lateral stress the balls exert on the membrane (cell pressure + membrane)
+  Real eps_v_envelope = 0; ///< (V0 - V) / V0 of the balls' envelope (a check of eps_v without the membrane)
   Real unbalanced = 0;
   Real kinetic = 0;     ///< J
 };

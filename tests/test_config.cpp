@@ -83,6 +83,35 @@ TEST(Config, UnplaceableCountRefused) {
   }
 }
 
+TEST(Config, TriaxialInputsOutOfReachRefused) {
+  // Denser than random close packing of equal spheres (e = 0.5625): no compaction reaches it.
+  std::string e = error_of("[specimen]\nvoid_ratio = 0.5\n");
+  EXPECT_NE(e.find("[specimen] void_ratio"), std::string::npos) << e;
+  EXPECT_NE(e.find("allowed: [0.5625, 3]"), std::string::npos) << e;
+  // 60,000 balls of 2 mm in the paper's cylinder would be e = 0.43.
+  e = error_of("[specimen]\ndiameter_mm = 61.8\nheight_mm = 120.0\nball_count = 60000\n");
+  EXPECT_NE(e.find("[specimen] ball_count"), std::string::npos) << e;
+  EXPECT_NE(e.find("random close packing"), std::string::npos) << e;
+  e = error_of("[triaxial]\nmembrane_nodes_around = 6\n");
+  EXPECT_NE(e.find("[triaxial] membrane_nodes_around"), std::string::npos) << e;
+  EXPECT_NE(e.find("allowed: [8, 10000]"), std::string::npos) << e;
+  e = error_of("[triaxial]\nsigma3_kPa = -100.0\n");
+  EXPECT_NE(e.find("[triaxial] sigma3_kPa"), std::string::npos) << e;
+  EXPECT_NE(e.find("out of range"), std::string::npos) << e;
+  EXPECT_NE(error_of("[periodic]\nsigma3_kPa = 0.0\n").find("[periodic] sigma3_kPa"), std::string::npos);
+  EXPECT_NE(error_of("[periodic]\nsigma3 = 100.0\n").find("unknown key"), std::string::npos);
+}
+
+TEST(Config, PaperCountGivesTheLabVoidRatio) {
+  // The paper's 53,704 beads of 2 mm in 61.8 mm x 120 mm: e = 0.600 (Sec. 2.3), not Table 4's 0.61.
+  const dem::Config c = dem::load_config(std::string(TRIAXDEM_SOURCE_DIR) + "/configs/paper/S1_100kPa.toml");
+  EXPECT_EQ(c.specimen.ball_count, 53704);
+  EXPECT_NEAR(c.specimen.void_ratio, 0.600, 5e-4);
+  EXPECT_DOUBLE_EQ(c.triaxial.sigma3, 100e3);
+  EXPECT_DOUBLE_EQ(c.ball.mu_s, 0.15);
+  EXPECT_DOUBLE_EQ(c.ball.mu_r, 0.015);
+}
+
 TEST(BlowUp, ExcessiveOverlapStopsWithStepParticleAndFix) {
   // Two balls closing at 20 m/s with a very soft contact: the overlap passes 10 % of the radius within
   // a few steps, long before the springs could stop them (v^2 m*/kn >> (0.1 R)^2).

@@ -1,6 +1,11 @@
 // Multilayer compaction of a cylindrical specimen, and the exact sphere-slab volumes it is measured with.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
 #include <cmath>
 
 #include "host/specimen.hpp"
@@ -15,6 +20,48 @@ TEST(Specimen, SphereSlabVolumeIsExact) {
   const double t = r / 2;
   EXPECT_NEAR(sphere_slab_volume(0, r, -t / 2, t / 2), M_PI * (r * r * t - t * t * t / 12), 1e-15 * full);
   EXPECT_EQ(sphere_slab_volume(0, r, 2 * r, 3 * r), 0.0);
+}
+
+TEST(Specimen, CacheRoundTripsBitForBitAndRefusesOtherKeys) {
+  Specimen sp;
+  sp.height = 12e-3;
+  sp.void_ratio = 0.7123456789012345;
+  sp.layers.push_back({0, 6e-3, 6.1e-3, 0.69, 1234, 8.5e-4});
+  sp.porosity_profile = {0.41, 0.40};
+  BallSpec b;
+  b.x = Vec3(1.0 / 3.0 * 1e-3, -2.0 / 7.0 * 1e-3, 5e-3);
+  b.radius = 1e-3;
+  b.density = 2500;
+  sp.balls = {b, b};
+  sp.balls[1].x.z = 7.123456789e-3;
+  const auto dir = std::filesystem::path(::testing::TempDir()) / ("triaxdem_sp_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "s.csv").string();
+  save_specimen(path, sp, "key A");
+  Specimen back;
+  EXPECT_FALSE(load_specimen(path, "key B", back));  // built for other settings: not reused
+  ASSERT_TRUE(load_specimen(path, "key A", back));
+  ASSERT_EQ(back.balls.size(), 2u);
+  EXPECT_EQ(back.balls[0].x.x, sp.balls[0].x.x);  // 17 digits: the same double
+  EXPECT_EQ(back.balls[1].x.z, sp.balls[1].x.z);
+  EXPECT_EQ(back.void_ratio, sp.void_ratio);
+  ASSERT_EQ(back.layers.size(), 1u);
+  EXPECT_EQ(back.layers[0].steps, 1234);
+  EXPECT_EQ(back.porosity_profile.size(), 2u);
+  std::ofstream(dir / "bad.csv") << "# key key A\n# height_m 0.012 void_ratio 0.7\nx_m,y_m,z_m,radius_m,density_kg_m3\n1,2\n";
+  try {
+    load_specimen((dir / "bad.csv").string(), "key A", back);
+    FAIL() << "a truncated row must be refused";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.csv:4"), std::string::npos) << e.what();
+  }
+  // The test's friction does not enter the key: the nine paper cases share one specimen.
+  const Config s1 = load_config(std::string(TRIAXDEM_SOURCE_DIR) + "/configs/paper/S1_100kPa.toml");
+  const Config s3 = load_config(std::string(TRIAXDEM_SOURCE_DIR) + "/configs/paper/S3_300kPa.toml");
+  EXPECT_EQ(specimen_key(s1), specimen_key(s3));
+  Config other = s1;
+  other.run.seed = 2;
+  EXPECT_NE(specimen_key(s1), specimen_key(other));
 }
 
 TEST(Specimen, SmallSpecimenReachesTheTargetVoidRatio) {

@@ -1,0 +1,250 @@
+#include "study.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include "io_hdf5.hpp"
+#include "progress.hpp"
+
+namespace dem {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Column names and scales of summary.csv: one place for the writer and the reader.
+struct Column {
+  const char* name;
+  Real TestSummary::*field;
+  double scale;  ///< file value = SI value x scale
+};
+const Column kColumns[] = {
+    {"sigma3_kPa", &TestSummary::sigma3, 1e-3},       {"mu_s", &TestSummary::mu_s, 1},
+    {"mu_r", &TestSummary::mu_r, 1},                  {"void_ratio0", &TestSummary::void_ratio0, 1},
+    {"q_peak_kPa", &TestSummary::q_peak, 1e-3},       {"phi_peak_deg", &TestSummary::phi_peak_deg, 1},
+    {"eps_a_peak_pct", &TestSummary::eps_a_peak, 100}, {"q_end_kPa", &TestSummary::q_end, 1e-3},
+    {"eps_a_end_pct", &TestSummary::eps_a_end, 100},  {"max_dilatancy", &TestSummary::max_dilatancy, 1},
+    {"inertial_number", &TestSummary::inertial_number, 1},
+};
+
+std::vector<std::string> split_csv(const std::string& line) {
+  std::vector<std::string> out;
+  std::stringstream s(line);
+  std::string cell;
+  while (std::getline(s, cell, ',')) out.push_back(cell);
+  return out;
+}
+
+std::string summary_header() {
+  std::string h = "kind,balls,wall_s";
+  for (const Column& c : kColumns) h += std::string(",") + c.name;
+  return h;
+}
+
+std::string summary_values(const TestSummary& s) {
+  char b[64];
+  std::snprintf(b, sizeof b, "%s,%ld,%.1f", s.kind.c_str(), s.balls, s.wall_seconds);
+  std::string row = b;
+  for (const Column& c : kColumns) {
+    std::snprintf(b, sizeof b, ",%.6g", s.*(c.field) * c.scale);
+    row += b;
+  }
+  return row;
+}
+
+/// Where tools/<script> is: beside the executable's folder (build tree or install prefix), else the sources.
+std::string find_tool(const std::string& script) {
+  std::vector<fs::path> roots;
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) roots = {exe.parent_path() / "..", exe.parent_path() / "../share/triaxdem"};
+#ifdef TRIAXDEM_SOURCE_DIR
+  roots.emplace_back(TRIAXDEM_SOURCE_DIR);
+#endif
+  for (const fs::path& r : roots)
+    if (fs::exists(r / "tools" / script)) return fs::weakly_canonical(r / "tools" / script).string();
+  return "";
+}
+
+struct Running {
+  std::size_t index;
+  std::chrono::steady_clock::time_point start;
+};
+
+/// Starts `self job config -o folder` with its output in folder/log.txt and `threads` OpenMP threads.
+pid_t launch(const char* self, const StudyCase& c, const std::string& folder, int threads) {
+  fs::create_directories(folder);
+  const std::string log = folder + "/log.txt";
+  const pid_t pid = fork();
+  if (pid < 0) throw std::runtime_error("study: cannot start a process for " + c.config);
+  if (pid == 0) {
+    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd >= 0) {
+      dup2(fd, 1);
+      dup2(fd, 2);
+      close(fd);
+    }
+    setenv("OMP_NUM_THREADS", std::to_string(threads).c_str(), 1);
+    setenv("OMP_PROC_BIND", "false", 0);
+    execl(self, self, c.job.c_str(), c.config.c_str(), "-o", folder.c_str(), static_cast<char*>(nullptr));
+    std::perror("study: exec");
+    _exit(127);
+  }
+  return pid;
+}
+
+}  // namespace
+
+void write_summary(const std::string& folder, const TestSummary& s) {
+  io::write_text_atomic(folder + "/summary.csv", summary_header() + "\n" + summary_values(s) + "\n");
+}
+
+TestSummary read_summary(const std::string& path) {
+  std::ifstream f(path);
+  if (!f) throw std::runtime_error(path + ": cannot be read");
+  std::string h, v;
+  std::getline(f, h);
+  std::getline(f, v);
+  const std::vector<std::string> names = split_csv(h), values = split_csv(v);
+  if (names.size() != values.size()) throw std::runtime_error(path + ": line 2 has " + std::to_string(values.size()) +
+                                                              " cells, the header " + std::to_string(names.size()));
+  std::map<std::string, std::string> m;
+  for (std::size_t k = 0; k < names.size(); ++k) m[names[k]] = values[k];
+  auto get = [&](const std::string& name) -> const std::string& {
+    auto it = m.find(name);
+    if (it == m.end()) throw std::runtime_error(path + ": column '" + name + "' missing");
+    return it->second;
+  };
+  TestSummary s;
+  s.kind = get("kind");
+  s.balls = std::stol(get("balls"));
+  s.wall_seconds = std::stod(get("wall_s"));
+  for (const Column& c : kColumns) s.*(c.field) = std::stod(get(c.name)) / c.scale;
+  return s;
+}
+
+std::vector<StudyCase> study_cases(const std::vector<std::string>& inputs) {
+  std::vector<std::string> files;
+  for (const std::string& in : inputs) {
+    if (fs::is_directory(in)) {
+      std::vector<std::string> here;
+      for (const auto& e : fs::directory_iterator(in))
+        if (e.is_regular_file() && e.path().extension() == ".toml") here.push_back(e.path().string());
+      if (here.empty()) throw std::runtime_error(in + ": no .toml configs in this folder");
+      std::sort(here.begin(), here.end());
+      files.insert(files.end(), here.begin(), here.end());
+    } else if (fs::is_regular_file(in)) {
+      files.push_back(in);
+    } else {
+      throw std::runtime_error(in + ": no such config file or folder");
+    }
+  }
+  std::vector<StudyCase> cases;
+  for (const std::string& f : files) {
+    const Config cfg = load_config(f);  // a bad file stops the study before anything runs
+    StudyCase c;
+    c.config = f;
+    c.name = fs::path(f).stem().string();
+    if (cfg.has_periodic) c.job = "periodic";
+    else if (cfg.has_specimen) c.job = "triaxial";
+    else throw ConfigError(f + ": neither a [specimen] (membrane test) nor a [periodic] table: not a triaxial test");
+    for (const StudyCase& o : cases)
+      if (o.name == c.name) throw std::runtime_error(f + ": two cases named '" + c.name + "' (" + o.config + ")");
+    cases.push_back(c);
+  }
+  return cases;
+}
+
+int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, const char* self_exe) {
+  const std::vector<StudyCase> cases = study_cases(inputs);
+  const int cores = std::max(1u, std::thread::hardware_concurrency());
+  const int jobs = std::clamp(opt.jobs > 0 ? opt.jobs : cores / 2, 1, static_cast<int>(cases.size()));
+  const int threads = std::max(1, cores / jobs);
+  fs::create_directories(opt.output);
+  std::printf("study: %zu cases, %d at a time with %d OpenMP threads each; logs in %s/<case>/log.txt\n",
+              cases.size(), jobs, threads, opt.output.c_str());
+  std::vector<int> status(cases.size(), -1);
+  std::map<pid_t, Running> running;
+  std::size_t next = 0, done = 0;
+  Progress progress("study", static_cast<long>(cases.size()));
+  while (done < cases.size()) {
+    while (next < cases.size() && static_cast<int>(running.size()) < jobs) {
+      const pid_t pid = launch(self_exe, cases[next], opt.output + "/" + cases[next].name, threads);
+      running[pid] = {next, std::chrono::steady_clock::now()};
+      std::printf("study: started %s (%s)\n", cases[next].name.c_str(), cases[next].config.c_str());
+      ++next;
+    }
+    int ws = 0;
+    const pid_t pid = waitpid(-1, &ws, 0);
+    if (pid < 0) throw std::runtime_error("study: lost track of the running cases");
+    auto it = running.find(pid);
+    if (it == running.end()) continue;
+    const std::size_t k = it->second.index;
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - it->second.start).count();
+    running.erase(it);
+    status[k] = WIFEXITED(ws) ? WEXITSTATUS(ws) : 128 + WTERMSIG(ws);
+    ++done;
+    std::printf("study: %s %s after %s\n", cases[k].name.c_str(),
+                status[k] == 0 ? "finished" : ("FAILED (exit " + std::to_string(status[k]) + ", see its log.txt)").c_str(),
+                format_duration(secs).c_str());
+    progress.update(static_cast<long>(done));
+  }
+  progress.finish("");
+
+  std::string table = "case,config,job,status," + summary_header() + "\n";
+  int failed = 0;
+  std::printf("\n%-14s %8s %6s %6s %10s %9s %10s %10s %8s\n", "case", "s3 kPa", "mu_s", "mu_r", "q_peak kPa",
+              "phi deg", "eps_pk %", "q_end kPa", "max dil");
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    const StudyCase& c = cases[k];
+    const std::string path = opt.output + "/" + c.name + "/summary.csv";
+    if (status[k] != 0 || !fs::exists(path)) {
+      ++failed;
+      table += c.name + "," + c.config + "," + c.job + ",failed\n";
+      std::printf("%-14s FAILED: see %s/%s/log.txt\n", c.name.c_str(), opt.output.c_str(), c.name.c_str());
+      continue;
+    }
+    const TestSummary s = read_summary(path);
+    table += c.name + "," + c.config + "," + c.job + ",ok," + summary_values(s) + "\n";
+    std::printf("%-14s %8.0f %6.3f %6.3f %10.1f %9.2f %10.2f %10.1f %8.3f\n", c.name.c_str(), s.sigma3 / 1e3, s.mu_s,
+                s.mu_r, s.q_peak / 1e3, s.phi_peak_deg, 100 * s.eps_a_peak, s.q_end / 1e3, s.max_dilatancy);
+  }
+  io::write_text_atomic(opt.output + "/study_summary.csv", table);
+  std::printf("\nstudy: summary in %s/study_summary.csv\n", opt.output.c_str());
+  if (run_plot_script("plot_study.py", {opt.output}))
+    std::printf("study: figure in %s/study.png\n", opt.output.c_str());
+  return failed == 0 ? 0 : 1;
+}
+
+bool run_plot_script(const std::string& script, const std::vector<std::string>& args) {
+  const std::string path = find_tool(script);
+  if (path.empty()) {
+    std::fprintf(stderr, "triaxdem: tools/%s not found: no plot drawn\n", script.c_str());
+    return false;
+  }
+  std::string cmd = "python3 '" + path + "'";
+  for (const std::string& a : args) cmd += " '" + a + "'";
+  cmd += " 2>&1";
+  const int rc = std::system(cmd.c_str());
+  if (rc != 0) {
+    std::fprintf(stderr, "triaxdem: %s failed (python3 with matplotlib is needed for the plots): no plot drawn\n",
+                 script.c_str());
+    return false;
+  }
+  return true;
+}
+
+}  // namespace dem

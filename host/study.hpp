@@ -1,0 +1,57 @@
+#pragma once
+/// A set of triaxial cases run as one study (`triaxdem study configs/paper/`): each config a child process of
+/// this program (in parallel where the machine has cores to spare), then one summary table and one figure.
+/// Each test job leaves a summary.csv in its output folder (write_summary); the study reads them back.
+#include <string>
+#include <vector>
+
+#include "config.hpp"
+
+namespace dem {
+
+/// The headline numbers of one drained triaxial test (SI inside; the CSV speaks kPa, %, deg).
+struct TestSummary {
+  std::string kind;             ///< "membrane" or "periodic"
+  Real sigma3 = 0;              ///< Pa
+  Real mu_s = 0, mu_r = 0;      ///< ball-ball friction of the test
+  long balls = 0;
+  Real void_ratio0 = 0;         ///< at the start of shear
+  Real q_peak = 0;              ///< Pa
+  Real phi_peak_deg = 0;        ///< asin(q / (q + 2 sigma3)) at the peak
+  Real eps_a_peak = 0;          ///< axial strain at the peak
+  Real q_end = 0;               ///< Pa, q at the end strain
+  Real eps_a_end = 0;
+  Real max_dilatancy = 0;       ///< max of -d eps_v / d eps_a
+  Real inertial_number = 0;
+  double wall_seconds = 0;
+};
+
+/// Writes folder/summary.csv atomically (a header line and one row).
+void write_summary(const std::string& folder, const TestSummary& s);
+/// Reads it back; throws std::runtime_error naming the file and the missing column.
+TestSummary read_summary(const std::string& path);
+
+/// One case of a study: the config, which job runs it, and where its output goes.
+struct StudyCase {
+  std::string config;           ///< path of the TOML file
+  std::string name;             ///< file stem, also the output subfolder
+  std::string job;              ///< "triaxial" ([specimen] + [triaxial]) or "periodic" ([periodic])
+};
+
+/// The cases of `inputs` (folders, whose *.toml files are taken in name order, or single files). Every file
+/// is validated first; one that describes no triaxial test is refused with its name and why.
+std::vector<StudyCase> study_cases(const std::vector<std::string>& inputs);
+
+struct StudyOptions {
+  std::string output = "out/study";  ///< the summary and one subfolder per case
+  int jobs = 0;                      ///< cases run at once; 0: one per two cores (at least one)
+};
+
+/// Runs the study; returns 0 when every case finished, 1 otherwise (the summary then lists the failures).
+int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, const char* self_exe);
+
+/// Runs tools/<script> with python3 on `args` (found beside the executable or in the source tree). Returns
+/// false, after saying why on stderr, when python3, matplotlib or the script is missing: plots are extras.
+bool run_plot_script(const std::string& script, const std::vector<std::string>& args);
+
+}  // namespace dem

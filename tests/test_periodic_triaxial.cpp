@@ -1,0 +1,182 @@
+// Periodic-cell triaxial test (host/periodic_triaxial.hpp): servo, numbering independence, friction and
+// dilatancy. Small specimens: 300 monodisperse balls of 2 mm (E* = 1e8 Pa, kn/ks = 1.5, no rolling
+// resistance, local damping 0.7, no density scaling), prepared dense by frictionless isotropic consolidation
+// to sigma3 = 100 kPa, then sheared at I = 9e-4 (just below the quasi-static limit) to 4-5% axial strain.
+// About 1.5 s of preparation and 1.3 s per shear on one core.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <random>
+
+#include "host/packing.hpp"
+#include "host/periodic_triaxial.hpp"
+#include "test_util.hpp"
+
+using namespace dem;
+
+namespace {
+
+constexpr int kBalls = 300;
+constexpr Real kSigma3 = 100e3;
+
+SolverConfig solver() {
+  SolverConfig s;
+  s.gravity = {0, 0, 0};
+  s.damping = 0.7;
+  s.dt_safety = 0.2;
+  return s;
+}
+
+PeriodicTriaxialParams quiet(Real target_strain) {
+  PeriodicTriaxialParams p;
+  p.verbose = false;
+  p.sigma3 = kSigma3;
+  p.target_strain = target_strain;
+  p.record_strain = 0.001;
+  p.target_inertial = 9e-4;  // just below the quasi-static limit 1e-3, to keep the tests short
+  return p;
+}
+
+struct Specimen {
+  std::vector<BallSpec> balls;
+  std::array<Real, 3> cell{};
+};
+
+/// A dense random specimen: random insertion of `n` balls of 2 mm (solid fraction 0.2: insertion keeps balls
+/// a diameter off the seams), then isotropic consolidation to 100 kPa without friction (solid fraction about
+/// 0.63) until the unbalanced ratio is below 5e-2; frictionless packings creep for long after that, and the
+/// test's own consolidation (with friction) brings the ratio to 1e-3.
+Specimen dense_specimen(int n, unsigned seed) {
+  Config cfg;
+  cfg.particles.count = n;
+  cfg.particles.diameter = 2e-3;
+  const Real L = std::cbrt(n * test::kPi / 6 * 8e-9 / 0.2);
+  cfg.box.size = {L, L, L};
+  cfg.box.periodic = {true, true, true};
+  cfg.run.seed = seed;
+  Specimen s;
+  s.balls = make_packing(cfg);
+  auto sim = make_periodic_simulation(s.balls, cfg.box.size, test::law(1e8, 1.5, 0, 0), solver());
+  PeriodicTriaxialParams p = quiet(0.05);
+  p.consolidation_rate = 100;  // a gas compresses freely; the servo takes over once contacts carry load
+  p.unbalanced_tolerance = 5e-2;
+  consolidate_isotropic(*sim, resolve_periodic_params(*sim, p));
+  s.balls = extract_balls(*sim, s.cell);
+  return s;
+}
+
+PeriodicTriaxialResult shear(const Specimen& s, Real mu_s, const PeriodicTriaxialParams& p) {
+  auto sim = make_periodic_simulation(s.balls, s.cell, test::law(1e8, 1.5, mu_s, 0), solver());
+  return run_periodic_triaxial(*sim, p);
+}
+
+}  // namespace
+
+TEST(PeriodicTriaxial, LateralStressesHeldAtSigma3ThroughShear) {
+  const Specimen s = dense_specimen(kBalls, 1);
+  const PeriodicTriaxialResult r = shear(s, 0.3, quiet(0.04));
+  ASSERT_GT(r.series.size(), 40u);
+  EXPECT_NEAR(r.series.back().eps_a, 0.04, 0.001);
+  EXPECT_LT(r.inertial, 1e-3);
+  EXPECT_GT(r.q_peak, 0.5 * kSigma3);  // the specimen carries a deviator (observed about 1.4 sigma3)
+  // Consolidated state: every axis within the 0.5% consolidation tolerance.
+  EXPECT_NEAR(r.series.front().sigma1, kSigma3, 0.005 * kSigma3);
+  // Shear: both lateral stresses within 1% of sigma3 at every row (observed: within 0.3%).
+  for (const PeriodicTriaxialRecord& row : r.series) {
+    EXPECT_NEAR(row.sigma2, kSigma3, 0.01 * kSigma3) << "eps_a " << row.eps_a;
+    EXPECT_NEAR(row.sigma3, kSigma3, 0.01 * kSigma3) << "eps_a " << row.eps_a;
+  }
+  // The 1% band is not met by any servo: one with a hundredth of the gain lags by far more than 1%.
+  PeriodicTriaxialParams weak = quiet(0.01);
+  weak.servo_alpha = 0.005;
+  EXPECT_GT(shear(s, 0.3, weak).max_lateral_error, 0.01);
+}
+
+TEST(PeriodicTriaxial, CurveIndependentOfBallNumbering) {
+  // The same balls in another order get other gids, so contacts have other owners and forces are summed in
+  // another order: the runs differ by rounding, not bitwise. A granular assembly amplifies rounding at each
+  // plastic instability, so the two runs follow one curve until the first rearrangements (about 0.5-1%
+  // axial strain; observed |dq| <= 1e-4 q_peak up to 0.5% on several specimens), then diverge into two
+  // realisations of the same material (observed |dq| up to 5e-3 q_peak by 4%, |d eps_v| up to 5e-5).
+  // Tolerances: 5e-4 q_peak up to 0.5%, the peak within 2%, eps_v within 3e-4 throughout. Sensitivity
+  // (checked by mutation): a contact stiffness 10% higher on contacts with an odd gid gives |dq| = 3e-3
+  // q_peak at 0.5% and fails; 1% gives 4e-4 and passes, i.e. this resolves numbering effects of a few percent.
+  const Specimen s = dense_specimen(kBalls, 2);
+  Specimen t = s;
+  std::vector<int> perm(s.balls.size());
+  std::iota(perm.begin(), perm.end(), 0);
+  std::shuffle(perm.begin(), perm.end(), std::mt19937(7));
+  for (std::size_t k = 0; k < perm.size(); ++k) t.balls[k] = s.balls[perm[k]];
+  const PeriodicTriaxialResult a = shear(s, 0.3, quiet(0.04));
+  const PeriodicTriaxialResult b = shear(t, 0.3, quiet(0.04));
+  ASSERT_EQ(a.series.size(), b.series.size());
+  for (std::size_t k = 0; k < a.series.size(); ++k) {
+    const PeriodicTriaxialRecord &ra = a.series[k], &rb = b.series[k];
+    ASSERT_NEAR(ra.eps_a, rb.eps_a, 1e-12);  // prescribed: the same in both runs
+    if (ra.eps_a <= 0.005) EXPECT_NEAR(ra.q, rb.q, 5e-4 * a.q_peak) << "eps_a " << ra.eps_a;
+    EXPECT_NEAR(ra.eps_v, rb.eps_v, 3e-4) << "eps_a " << ra.eps_a;
+  }
+  EXPECT_NEAR(a.q_peak, b.q_peak, 0.02 * a.q_peak);
+  EXPECT_GT(a.q_peak, 0.5 * kSigma3);
+}
+
+TEST(PeriodicTriaxial, HigherFrictionGivesHigherPeak) {
+  // Same packing, same law but mu_s: observed q_peak 88 kPa (phi 17.8 deg) for 0.1, 195 kPa (29.6 deg) for 0.5.
+  const Specimen s = dense_specimen(kBalls, 3);
+  const PeriodicTriaxialResult lo = shear(s, 0.1, quiet(0.03));
+  const PeriodicTriaxialResult hi = shear(s, 0.5, quiet(0.03));
+  EXPECT_GT(hi.q_peak, 1.5 * lo.q_peak);
+  EXPECT_GT(hi.phi_peak_deg, lo.phi_peak_deg + 5);
+}
+
+TEST(PeriodicTriaxial, DenseSpecimenContractsThenDilates) {
+  // mu_s = 0.3 on a dense specimen (void ratio about 0.59): observed eps_v +0.11% at eps_a = 0.4%, back to 0
+  // near 0.8%, -0.6% at 2% and -1.5% at 4% (dilation rate about 0.55).
+  const Specimen s = dense_specimen(kBalls, 4);
+  const PeriodicTriaxialResult r = shear(s, 0.3, quiet(0.04));
+  ASSERT_GT(r.series.size(), 40u);
+  EXPECT_LT(r.void_ratio0, 0.62);  // dense: frictionless preparation
+  const PeriodicTriaxialRecord* top = &r.series.front();
+  Real at2 = 0;
+  for (const PeriodicTriaxialRecord& row : r.series) {
+    if (row.eps_v > top->eps_v) top = &row;
+    if (std::fabs(row.eps_a - 0.02) < 5e-4) at2 = row.eps_v;
+  }
+  EXPECT_GT(r.series[1].eps_v, 0) << "contracts first";
+  EXPECT_GT(top->eps_v, 5e-4) << "contraction of at least 0.05%";
+  EXPECT_LT(top->eps_a, 0.01) << "contraction ends early";
+  EXPECT_LT(at2, top->eps_v - 2e-3) << "then dilates";
+  EXPECT_LT(r.series.back().eps_v, at2 - 2e-3) << "and keeps dilating";
+  EXPECT_LT(r.series.back().eps_v, -5e-3) << "past the consolidated volume";
+}
+
+TEST(PeriodicTriaxial, RefusesFastRatesAndReportsUnconvergedConsolidation) {
+  Config cfg;
+  cfg.particles.count = 100;
+  const Real L = std::cbrt(100 * test::kPi / 6 * 8e-9 / 0.1);  // small boxes lose more room to the seams
+  cfg.box.size = {L, L, L};
+  cfg.box.periodic = {true, true, true};
+  auto sim = make_periodic_simulation(make_packing(cfg), cfg.box.size, test::law(1e8, 1.5, 0.3, 0), solver());
+  PeriodicTriaxialParams p = quiet(0.05);
+  // Default rate: I = target_inertial at p = sigma3 (d = 2 mm, rho = 2500 kg/m^3: I = rate x 3.16e-4 s).
+  const PeriodicTriaxialParams auto_rate = resolve_periodic_params(*sim, p);
+  EXPECT_NEAR(auto_rate.axial_rate * 2e-3 * std::sqrt(2500 / kSigma3), 9e-4, 1e-9);
+  EXPECT_DOUBLE_EQ(auto_rate.max_lateral_rate, 5 * auto_rate.axial_rate);
+  p.axial_rate = 10;  // I = 3.2e-3
+  EXPECT_THROW(resolve_periodic_params(*sim, p), std::invalid_argument);
+  p.allow_high_inertial = true;
+  EXPECT_NO_THROW(resolve_periodic_params(*sim, p));
+  p.servo_alpha = 1.5;  // above 1 the servo overshoots (it oscillates between its clamps)
+  EXPECT_THROW(resolve_periodic_params(*sim, p), std::invalid_argument);
+  // A gas cannot reach sigma3 in 300 steps: a clear error, not a silent start of shear.
+  PeriodicTriaxialParams short_run = quiet(0.05);
+  short_run.max_consolidation_steps = 300;
+  try {
+    consolidate_isotropic(*sim, resolve_periodic_params(*sim, short_run));
+    ADD_FAILURE() << "consolidation converged in 300 steps";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("did not converge in 300 steps"), std::string::npos) << e.what();
+  }
+}
