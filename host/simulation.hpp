@@ -54,6 +54,8 @@ class Simulation {
   long step_count() const { return step_; }
   Real time() const { return time_; }
   int num_walls() const { return walls_.n; }
+  const WallSet& walls() const { return walls_; }
+  const FacetMesh& mesh() const { return mesh_; }
 
   /// Largest stable time step estimate (s): min over particles of sqrt(m/kn) and sqrt(I/k_rot) for the
   /// stiffest (ball-wall) contact; the caller multiplies by a safety factor.

@@ -12,6 +12,7 @@
 
 #include "io_hdf5.hpp"
 #include "packing.hpp"
+#include "progress.hpp"
 #include "job.hpp"
 #include "simulation.hpp"
 
@@ -46,8 +47,11 @@ std::vector<WallSpec> mould(Real radius, Real z_top) {
 /// Presses the top platen down to z_target, then settles. The platen stops early where the mean force of
 /// its contacts would squeeze them by more than 1% of the radius (the layer is then looser than asked;
 /// pressing on would only overlap the balls). Returns the layer's step count and ratio.
-std::pair<long, Real> compact(Simulation& sim, Real z_target, const SpecimenConfig& sc, Real f_limit) {
+/// `progress` (may be null) is told the platen's travel in micrometres, then the unbalanced ratio.
+std::pair<long, Real> compact(Simulation& sim, Real z_target, const SpecimenConfig& sc, Real f_limit,
+                              Progress* progress) {
   const long check_every = 200;
+  const Real z_start = sim.wall_point(kTop).z;
   long s = 0;
   Real ratio = 1;
   bool blocked = false;
@@ -65,6 +69,12 @@ std::pair<long, Real> compact(Simulation& sim, Real z_target, const SpecimenConf
     ++s;
     if (measure) {
       ratio = sim.unbalanced_ratio();
+      if (progress) {
+        char extra[80];
+        std::snprintf(extra, sizeof extra, "(um of platen travel), unbalanced ratio %.1e (stop at %.0e)", ratio,
+                      sc.stop_ratio);
+        progress->update(std::lround((z_start - z) * 1e6), extra);
+      }
       if ((z - z_target < 1e-9 || blocked) && ratio < sc.stop_ratio) break;
     }
   }
@@ -132,7 +142,9 @@ Specimen build_specimen(const Config& cfg, bool verbose) {
     sim.set_dt(cfg.solver.dt > 0 ? cfg.solver.dt : cfg.solver.dt_safety * sim.critical_dt());
     const Real f_limit = 0.01 * cfg.particles.diameter / 2 *
                          NormalLinear::stiffness(wall_law, cfg.particles.diameter / 2, 0);
-    const auto [steps, ratio] = compact(sim, z1, sc, f_limit);
+    Progress progress("specimen layer " + std::to_string(k + 1) + "/" + std::to_string(sc.layers),
+                      std::lround((z0 + h_loose - z1) * 1e6));
+    const auto [steps, ratio] = compact(sim, z1, sc, f_limit, verbose ? &progress : nullptr);
     const HostParticles h = to_host_by_gid(sim.particles());
     for (std::size_t q = 0; q < all.size(); ++q) {
       all[q].x = h.x[q];

@@ -53,7 +53,7 @@ height_mm = {height}
 {size_line}
 layers = 5                # five equal layers (Sec. 3.3)
 compaction_mu_s = 0.0     # frictionless while compacting, so that the platen can reach the target density
-platen_speed_mm_s = 50.0
+platen_speed_mm_s = 200.0  # fast enough to compact 53,704 beads in minutes; impacts squeeze the beads by about 1% of the radius
 stop_ratio = 1e-3         # unbalanced-force ratio that ends each layer (Sec. 3.3)
 
 [triaxial]

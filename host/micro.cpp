@@ -1,0 +1,358 @@
+#include "micro.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <stdexcept>
+
+#include "host/builder.hpp"
+#include "io_hdf5.hpp"
+#include "simulation.hpp"
+
+namespace dem {
+
+namespace {
+
+constexpr Real kPi = 3.14159265358979323846;
+
+Tensor outer(const Vec3& a, const Vec3& b) {
+  Tensor t;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) t[3 * i + j] = a[i] * b[j];
+  return t;
+}
+
+Tensor deviator(const Tensor& t) {
+  Tensor d = t;
+  const Real m = (t[0] + t[4] + t[8]) / 3;
+  for (int i = 0; i < 3; ++i) d[4 * i] -= m;
+  return d;
+}
+
+Real contract(const Tensor& a, const Tensor& b) {
+  Real s = 0;
+  for (int k = 0; k < 9; ++k) s += a[k] * b[k];
+  return s;
+}
+
+Real quad(const Tensor& a, const Vec3& n) {
+  Real s = 0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) s += a[3 * i + j] * n[i] * n[j];
+  return s;
+}
+
+Real mean_ball_fn(const ContactSet& s) {
+  Real sum = 0;
+  long n = 0;
+  for (const ContactRecord& c : s.contacts)
+    if (c.boundary == Boundary::kNone) sum += c.fn, ++n;
+  return n > 0 ? sum / n : 0;
+}
+
+bool in_network(const ContactRecord& c, Network net, Real threshold) {
+  return net == Network::kAll || (net == Network::kStrong ? c.fn > threshold : c.fn <= threshold);
+}
+
+}  // namespace
+
+ContactSet contact_set(Simulation& sim) {
+  Particles& p = sim.particles();
+  ContactSet s;
+  const HostParticles h = to_host_by_gid(p);
+  s.x = h.x;
+  auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), p.gid);
+  auto rad = Kokkos::create_mirror_view_and_copy(HostSpace(), p.radius);
+  s.radius.resize(p.n);
+  for (int i = 0; i < p.n; ++i) s.radius[gid(i)] = rad(i);
+  const Domain& dom = sim.domain();
+
+  const ContactList& bc = sim.ball_contacts();
+  auto ci = Kokkos::create_mirror_view_and_copy(HostSpace(), bc.i);
+  auto cj = Kokkos::create_mirror_view_and_copy(HostSpace(), bc.j);
+  auto fc = Kokkos::create_mirror_view_and_copy(HostSpace(), bc.fc);
+  auto fn = Kokkos::create_mirror_view_and_copy(HostSpace(), bc.fn);
+  for (int k = 0; k < bc.n; ++k) {
+    if (!(fn(k) > 0)) continue;
+    ContactRecord c;
+    c.a = static_cast<int>(gid(ci(k)));
+    c.b = static_cast<int>(gid(cj(k)));
+    c.branch = dom.min_image(s.x[c.b] - s.x[c.a]);
+    const Real l = norm(c.branch);
+    c.normal = (1 / l) * c.branch;
+    const Vec3 f = -1.0 * load(fc, k);  // fc acts on particle a: the force on b is its reaction
+    c.fn = fn(k);
+    c.ft = f - dot(f, c.normal) * c.normal;
+    const Real overlap = s.radius[c.a] + s.radius[c.b] - l;
+    c.point = s.x[c.a] + (s.radius[c.a] - overlap / 2) * c.normal;
+    s.contacts.push_back(c);
+  }
+
+  const ContactList& wc = sim.wall_contacts();
+  auto wi = Kokkos::create_mirror_view_and_copy(HostSpace(), wc.i);
+  auto wj = Kokkos::create_mirror_view_and_copy(HostSpace(), wc.j);
+  auto wf = Kokkos::create_mirror_view_and_copy(HostSpace(), wc.fc);
+  auto wn = Kokkos::create_mirror_view_and_copy(HostSpace(), wc.fn);
+  const WallSet& walls = sim.walls();
+  auto kind = Kokkos::create_mirror_view_and_copy(HostSpace(), walls.kind);
+  auto wp = Kokkos::create_mirror_view_and_copy(HostSpace(), walls.point);
+  auto wnorm = Kokkos::create_mirror_view_and_copy(HostSpace(), walls.normal);
+  auto wrad = Kokkos::create_mirror_view_and_copy(HostSpace(), walls.radius);
+  const FacetMesh& mesh = sim.mesh();
+  auto nx = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.node_x);
+  auto tri = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.tri);
+  for (int k = 0; k < wc.n; ++k) {
+    if (!(wn(k) > 0)) continue;
+    ContactRecord c;
+    c.a = static_cast<int>(gid(wi(k)));
+    const Vec3& x = s.x[c.a];
+    const int obj = wj(k);
+    Vec3 cp;
+    if (obj < walls.n) {
+      c.boundary = Boundary::kPlaten;
+      if (!wall_closest_point(kind(obj), load(wp, obj), load(wnorm, obj), wrad(obj), x, cp)) continue;
+    } else {
+      c.boundary = Boundary::kMembrane;
+      const int t = obj - walls.n;
+      cp = closest_on_triangle(x, load(nx, tri(t, 0)), load(nx, tri(t, 1)), load(nx, tri(t, 2))).cp;
+    }
+    const Vec3 d = cp - x;
+    const Real l = norm(d);
+    if (!(l > 0)) continue;
+    c.normal = (1 / l) * d;
+    const Vec3 f = -1.0 * load(wf, k);
+    c.fn = wn(k);
+    c.ft = f - dot(f, c.normal) * c.normal;
+    c.point = cp;
+    c.branch = d;
+    s.contacts.push_back(c);
+  }
+  return s;
+}
+
+Coordination coordination(const ContactSet& s, Network net) {
+  const std::size_t np = s.radius.size();
+  const Real threshold = mean_ball_fn(s);
+  std::vector<int> counted(np, 0), balls_only(np, 0);
+  long nc = 0, nbb = 0;
+  for (const ContactRecord& c : s.contacts) {
+    if (c.boundary == Boundary::kPlaten || !in_network(c, net, threshold)) continue;
+    ++nc;
+    ++counted[c.a];
+    if (c.boundary == Boundary::kNone) {
+      ++nbb;
+      ++counted[c.b];
+      ++balls_only[c.a];
+      ++balls_only[c.b];
+    }
+  }
+  Coordination z;
+  if (np == 0) return z;
+  // Every ball-ball contact has two ends, a membrane contact one ball end: Eq. 17 counts contacts, so
+  // 2 Nc / Np with Nc = ball-ball + membrane contacts, as the paper's PFC count does.
+  z.z = 2.0 * nc / np;
+  z.z_balls = 2.0 * nbb / np;
+  const long n0 = std::count(balls_only.begin(), balls_only.end(), 0);
+  const long n1 = std::count(balls_only.begin(), balls_only.end(), 1);
+  z.z_mech = static_cast<long>(np) - n0 - n1 > 0 ? (2.0 * nbb - n1) / (static_cast<long>(np) - n0 - n1) : 0;
+  const int nmax = np > 0 ? *std::max_element(counted.begin(), counted.end()) : 0;
+  z.on.assign(nmax + 1, 0);
+  for (int n : counted) ++z.on[n];
+  return z;
+}
+
+Networks networks(const ContactSet& s, Real volume) {
+  Networks w;
+  w.threshold = mean_ball_fn(s);
+  NetworkStats* sets[3] = {&w.all, &w.strong, &w.weak};
+  const Network kinds[3] = {Network::kAll, Network::kStrong, Network::kWeak};
+  for (int k = 0; k < 3; ++k) {
+    NetworkStats& n = *sets[k];
+    std::vector<char> touched(s.radius.size(), 0);
+    for (const ContactRecord& c : s.contacts) {
+      if (c.boundary != Boundary::kNone || !in_network(c, kinds[k], w.threshold)) continue;
+      ++n.contacts;
+      n.mean_fn += c.fn;
+      n.mean_ft += norm(c.ft);
+      touched[c.a] = touched[c.b] = 1;
+      const Tensor t = outer(c.branch, c.fn * c.normal + c.ft);
+      for (int q = 0; q < 9; ++q) n.stress[q] += t[q] / volume;
+    }
+    n.particles = std::count(touched.begin(), touched.end(), 1);
+    if (n.contacts > 0) {
+      n.mean_fn /= n.contacts;
+      n.mean_ft /= n.contacts;
+    }
+  }
+  w.fn_ratio = w.weak.mean_fn > 0 ? w.strong.mean_fn / w.weak.mean_fn : 0;
+  w.ft_ratio = w.weak.mean_ft > 0 ? w.strong.mean_ft / w.weak.mean_ft : 0;
+  return w;
+}
+
+Real signed_magnitude(const Tensor& a, const Tensor& reference) {
+  Tensor sref = deviator(reference);
+  if (contract(sref, sref) == 0) sref = {-1, 0, 0, 0, -1, 0, 0, 0, 2};  // compression along z
+  const Real m = std::sqrt(1.5 * contract(a, a));
+  return contract(a, sref) < 0 ? -m : m;
+}
+
+Anisotropy anisotropy(const ContactSet& s, Network net, const Tensor& reference) {
+  const Real threshold = mean_ball_fn(s);
+  Anisotropy a;
+  std::vector<const ContactRecord*> cs;
+  for (const ContactRecord& c : s.contacts)
+    if (c.boundary == Boundary::kNone && in_network(c, net, threshold)) cs.push_back(&c);
+  a.contacts = static_cast<long>(cs.size());
+  if (cs.empty()) return a;
+  for (const ContactRecord* c : cs) {
+    const Tensor t = outer(c->normal, c->normal);
+    for (int q = 0; q < 9; ++q) a.fabric[q] += t[q] / cs.size();
+  }
+  const Tensor fd = deviator(a.fabric);
+  for (int q = 0; q < 9; ++q) a.ac[q] = 7.5 * fd[q];
+  // Average force tensors, each contact weighted by 1 / E(n) relative to isotropy (Ouadfel & Rothenburg).
+  Tensor chi_n{}, chi_t{};
+  for (const ContactRecord* c : cs) {
+    const Real w = 1 / (cs.size() * (1 + quad(a.ac, c->normal)));
+    const Tensor tn = outer(c->normal, c->normal), tt = outer(c->ft, c->normal);
+    for (int q = 0; q < 9; ++q) {
+      chi_n[q] += w * c->fn * tn[q];
+      chi_t[q] += w * tt[q];
+    }
+  }
+  a.f0 = chi_n[0] + chi_n[4] + chi_n[8];
+  if (a.f0 > 0) {
+    const Tensor dn = deviator(chi_n);
+    // The tangential tensor is used symmetrised: its antisymmetric part carries no stress (moment balance).
+    Tensor st;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) st[3 * i + j] = 0.5 * (chi_t[3 * i + j] + chi_t[3 * j + i]);
+    const Tensor dt = deviator(st);
+    for (int q = 0; q < 9; ++q) {
+      a.an[q] = 7.5 * dn[q] / a.f0;
+      a.at[q] = 5.0 * dt[q] / a.f0;
+    }
+  }
+  a.a_c = signed_magnitude(a.ac, reference);
+  a.a_n = signed_magnitude(a.an, reference);
+  a.a_t = signed_magnitude(a.at, reference);
+  return a;
+}
+
+std::vector<RoseBin> rose(const ContactSet& s, int bins, Network net) {
+  if (bins < 1) throw std::invalid_argument("rose: bins must be >= 1");
+  const Real threshold = mean_ball_fn(s);
+  std::vector<RoseBin> r(bins);
+  long total = 0;
+  for (const ContactRecord& c : s.contacts) {
+    if (c.boundary != Boundary::kNone || !in_network(c, net, threshold)) continue;
+    ++total;
+    // n and -n both: theta and 180 - theta, so each contact counts twice with weight 1/2.
+    const Real th = std::acos(std::clamp(c.normal.z, Real(-1), Real(1)));
+    for (Real t : {th, kPi - th}) {
+      const int k = std::clamp(static_cast<int>(t / kPi * bins), 0, bins - 1);
+      r[k].count += 1;
+      r[k].mean_fn += c.fn;
+      r[k].mean_ft += norm(c.ft);
+    }
+  }
+  for (int k = 0; k < bins; ++k) {
+    const Real t0 = k * kPi / bins, t1 = (k + 1) * kPi / bins;
+    r[k].theta_deg = (k + 0.5) * 180.0 / bins;
+    const Real solid = 2 * kPi * (std::cos(t0) - std::cos(t1));
+    r[k].density = total > 0 ? 0.5 * r[k].count / (total * solid) : 0;
+    if (r[k].count > 0) {
+      r[k].mean_fn /= r[k].count;
+      r[k].mean_ft /= r[k].count;
+    }
+    r[k].count /= 2;
+  }
+  return r;
+}
+
+Tensor love_weber(const ContactSet& s, Real volume, bool include_boundary) {
+  Tensor t{};
+  for (const ContactRecord& c : s.contacts) {
+    if (c.boundary != Boundary::kNone && !include_boundary) continue;
+    const Tensor o = outer(c.branch, c.fn * c.normal + c.ft);
+    for (int q = 0; q < 9; ++q) t[q] += o[q] / volume;
+  }
+  return t;
+}
+
+ContactSet restrict_to_cube(const ContactSet& s, const Vec3& centre, Real edge) {
+  Real lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+  for (int d = 0; d < 3 && !s.x.empty(); ++d) lo[d] = hi[d] = s.x[0][d];
+  for (std::size_t q = 0; q < s.x.size(); ++q)
+    for (int d = 0; d < 3; ++d) {
+      lo[d] = std::min(lo[d], s.x[q][d] - s.radius[q]);
+      hi[d] = std::max(hi[d], s.x[q][d] + s.radius[q]);
+    }
+  for (int d = 0; d < 3; ++d)
+    if (!(edge > 0) || centre[d] - edge / 2 < lo[d] || centre[d] + edge / 2 > hi[d]) {
+      std::ostringstream m;
+      m << "representative volume: a cube of edge " << edge * 1e3 << " mm centred at (" << centre.x * 1e3 << ", "
+        << centre.y * 1e3 << ", " << centre.z * 1e3 << ") mm does not fit in the specimen, which spans (" << lo[0] * 1e3
+        << ".." << hi[0] * 1e3 << ", " << lo[1] * 1e3 << ".." << hi[1] * 1e3 << ", " << lo[2] * 1e3 << ".."
+        << hi[2] * 1e3 << ") mm";
+      throw std::invalid_argument(m.str());
+    }
+  auto inside = [&](const Vec3& p) {
+    for (int d = 0; d < 3; ++d)
+      if (std::fabs(p[d] - centre[d]) > edge / 2) return false;
+    return true;
+  };
+  ContactSet r;
+  r.x = s.x;
+  r.radius = s.radius;
+  for (const ContactRecord& c : s.contacts)
+    if (inside(c.point)) r.contacts.push_back(c);
+  // Balls outside the cube stay in the arrays (indices are gids) but get no contacts; coordination over
+  // the cube uses the balls whose centres are inside.
+  std::vector<Vec3> x;
+  std::vector<Real> rad;
+  std::vector<int> map(s.x.size(), -1);
+  for (std::size_t q = 0; q < s.x.size(); ++q)
+    if (inside(s.x[q])) {
+      map[q] = static_cast<int>(x.size());
+      x.push_back(s.x[q]);
+      rad.push_back(s.radius[q]);
+    }
+  ContactSet out;
+  out.x = x;
+  out.radius = rad;
+  for (ContactRecord c : r.contacts) {
+    if (map[c.a] < 0 || (c.b >= 0 && map[c.b] < 0)) continue;
+    c.a = map[c.a];
+    if (c.b >= 0) c.b = map[c.b];
+    out.contacts.push_back(c);
+  }
+  return out;
+}
+
+void write_force_chains_vtk(const std::string& path, const ContactSet& s) {
+  const Real threshold = mean_ball_fn(s);
+  std::vector<const ContactRecord*> cs;
+  for (const ContactRecord& c : s.contacts)
+    if (c.boundary == Boundary::kNone) cs.push_back(&c);
+  std::ostringstream o;
+  o.precision(9);
+  o << "# vtk DataFile Version 3.0\ntriaxdem force chains: segments between ball centres\nASCII\n"
+       "DATASET POLYDATA\nPOINTS "
+    << 2 * cs.size() << " double\n";
+  for (const ContactRecord* c : cs) {
+    const Vec3& a = s.x[c->a];
+    const Vec3 b = a + c->branch;
+    o << a.x << " " << a.y << " " << a.z << "\n" << b.x << " " << b.y << " " << b.z << "\n";
+  }
+  o << "LINES " << cs.size() << " " << 3 * cs.size() << "\n";
+  for (std::size_t k = 0; k < cs.size(); ++k) o << "2 " << 2 * k << " " << 2 * k + 1 << "\n";
+  o << "CELL_DATA " << cs.size() << "\nSCALARS normal_force_N double 1\nLOOKUP_TABLE default\n";
+  for (const ContactRecord* c : cs) o << c->fn << "\n";
+  o << "SCALARS strong int 1\nLOOKUP_TABLE default\n";
+  for (const ContactRecord* c : cs) o << (c->fn > threshold ? 1 : 0) << "\n";
+  io::write_text_atomic(path, o.str());
+}
+
+}  // namespace dem
