@@ -131,12 +131,12 @@ Config load_config(const std::string& path) {
     throw ConfigError(s.str());
   }
   static const std::set<std::string> tables = {"run",    "particles", "box",     "material",
-                                               "wall_material", "solver", "specimen", "triaxial", "periodic"};
+                                               "wall_material", "solver", "specimen", "triaxial", "micro", "periodic"};
   for (const auto& [k, v] : root) {
     if (!tables.count(std::string(k.str())) || !v.is_table())
       throw ConfigError(path + ": [" + std::string(k.str()) +
                         "]: unknown table (allowed: run, particles, box, material, wall_material, solver, specimen, "
-                        "triaxial, periodic)");
+                        "triaxial, micro, periodic)");
   }
   auto table = [&](const char* name) { return TableReader(path, name, root[name].as_table()); };
 
@@ -243,6 +243,24 @@ Config load_config(const std::string& path) {
   tx.number("membrane_thickness_mm", c.triaxial.membrane_thickness, 0, 100, 1e-3, true);
   tx.number("membrane_density_kg_m3", c.triaxial.membrane_density, 0, 1e5, 1, true);
   tx.finish();
+
+  TableReader mi = table("micro");
+  mi.boolean("enabled", c.micro.enabled);
+  mi.number("rve_edge_mm", c.micro.rve_edge, 0, 1e6, 1e-3, true);
+  long bins = c.micro.rose_bins;
+  mi.integer("rose_bins", bins, 2, 3600);
+  c.micro.rose_bins = static_cast<int>(bins);
+  mi.finish();
+  if (c.has_specimen && c.micro.enabled) {
+    // The cube must lie inside the cylinder: half its diagonal within the radius, its edge within the height.
+    const Real fit = std::min(c.specimen.diameter / std::sqrt(2.0), c.specimen.height);
+    if (c.micro.rve_edge > fit) {
+      std::ostringstream r;
+      r << "value " << c.micro.rve_edge * 1e3 << " does not fit in the " << c.specimen.diameter * 1e3 << " x "
+        << c.specimen.height * 1e3 << " mm specimen (allowed: (0, " << fit * 1e3 << "])";
+      mi.fail("rve_edge_mm", r.str());
+    }
+  }
 
   TableReader pr = table("periodic");
   c.has_periodic = root["periodic"].as_table() != nullptr;

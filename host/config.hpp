@@ -82,6 +82,13 @@ struct TriaxialConfig {
   Real membrane_density = 930;    ///< kg/m^3
 };
 
+/// Micromechanics recorded during a triaxial test ([micro] table; host/micro_report.hpp).
+struct MicroConfig {
+  bool enabled = true;
+  Real rve_edge = 20e-3;   ///< m, edge of the central cube (the paper's 20 mm; file: rve_edge_mm)
+  int rose_bins = 18;      ///< angle bins of the directional distributions over 0-180 deg
+};
+
 /// Periodic-cell triaxial test parameters (SI); see host/periodic_triaxial.hpp for the method.
 struct PeriodicTriaxialParams {
   std::string name = "periodic";     ///< label of the progress line
@@ -126,6 +133,7 @@ struct Config {
   SpecimenConfig specimen;
   bool has_specimen = false;  ///< the file has a [specimen] table
   TriaxialConfig triaxial;
+  MicroConfig micro;
   PeriodicConfig periodic;
   bool has_periodic = false;  ///< the file has a [periodic] table
 };

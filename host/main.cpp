@@ -41,6 +41,8 @@ int main(int argc, char** argv) {
   study->add_option("-o,--output", study_opt.output, "output folder: summary, figure, one subfolder per case");
   study->add_option("-j,--jobs", study_opt.jobs, "cases run at once (default: one per two cores)")
       ->check(CLI::NonNegativeNumber);
+  study->add_option("-t,--threads", study_opt.threads, "OpenMP threads per case (default: the cores shared out)")
+      ->check(CLI::NonNegativeNumber);
 
   auto* check = app.add_subcommand("check", "validate a config and print the derived time step");
   check->add_option("config", config_path, "TOML config file")->required()->check(CLI::ExistingFile);
@@ -49,13 +51,20 @@ int main(int argc, char** argv) {
 
   CLI11_PARSE(app, argc, argv);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // progress reaches a log file as it happens
+  if (study->parsed()) {  // the study only starts child processes: no Kokkos of its own
+    try {
+      return dem::study_job(study_inputs, study_opt, "/proc/self/exe");
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "triaxdem: %s\n", e.what());
+      return 1;
+    }
+  }
   Kokkos::ScopeGuard guard(argc, argv);
   try {
     if (info->parsed()) {
       Kokkos::print_configuration(std::cout, false);
       return 0;
     }
-    if (study->parsed()) return dem::study_job(study_inputs, study_opt, "/proc/self/exe");
     dem::Config cfg = dem::load_config(config_path);
     if (!output.empty()) cfg.run.output = output;
     if (steps >= 0) cfg.run.steps = steps;

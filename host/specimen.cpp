@@ -44,25 +44,26 @@ std::vector<WallSpec> mould(Real radius, Real z_top) {
   return w;
 }
 
-/// Presses the top platen down to z_target, then settles. The platen stops early where the mean force of
-/// its contacts would squeeze them by more than 1% of the radius (the layer is then looser than asked;
-/// pressing on would only overlap the balls). Returns the layer's step count and ratio.
-/// `progress` (may be null) is told the platen's travel in micrometres, then the unbalanced ratio.
+/// Presses the top platen down to z_target, then settles. The platen slows down in proportion to the mean
+/// force of its contacts and stops where that force would squeeze them by 1% of the radius (f_limit): the
+/// layer is then looser than asked, and pressing on would only overlap the balls. The proportional approach
+/// avoids the stop-and-go of an on/off limit, which keeps a packing agitated and the unbalanced ratio
+/// high. Returns the layer's step count and ratio; `progress` (may be null) is told the platen's travel in
+/// micrometres.
 std::pair<long, Real> compact(Simulation& sim, Real z_target, const SpecimenConfig& sc, Real f_limit,
                               Progress* progress) {
   const long check_every = 200;
   const Real z_start = sim.wall_point(kTop).z;
   long s = 0;
-  Real ratio = 1;
-  bool blocked = false;
+  Real ratio = 1, load = 0;  // load: mean platen contact force / f_limit
   while (s < sc.max_steps_per_layer) {
     const Real z = sim.wall_point(kTop).z;
     const Real dt = sim.params().integ.dt;
     if (s % 5 == 0) {
       const int n = sim.wall_contact_counts()[kTop];
-      blocked = n > 0 && std::fabs(sim.wall_forces()[kTop].z) / n > f_limit;
+      load = n > 0 ? std::fabs(sim.wall_forces()[kTop].z) / (n * f_limit) : 0;
     }
-    const Real v = blocked ? 0 : std::min(sc.platen_speed, (z - z_target) / dt);
+    const Real v = std::min(sc.platen_speed * std::clamp(1 - load, Real(0), Real(1)), (z - z_target) / dt);
     sim.set_wall_velocity(kTop, Vec3(0, 0, -std::max(v, Real(0))));
     const bool measure = (s + 1) % check_every == 0;
     sim.step(measure);
@@ -75,6 +76,7 @@ std::pair<long, Real> compact(Simulation& sim, Real z_target, const SpecimenConf
                       sc.stop_ratio);
         progress->update(std::lround((z_start - z) * 1e6), extra);
       }
+      const bool blocked = load > 0.9;
       if ((z - z_target < 1e-9 || blocked) && ratio < sc.stop_ratio) break;
     }
   }

@@ -172,7 +172,7 @@ int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, c
   const std::vector<StudyCase> cases = study_cases(inputs);
   const int cores = std::max(1u, std::thread::hardware_concurrency());
   const int jobs = std::clamp(opt.jobs > 0 ? opt.jobs : cores / 2, 1, static_cast<int>(cases.size()));
-  const int threads = std::max(1, cores / jobs);
+  const int threads = opt.threads > 0 ? opt.threads : std::max(1, cores / jobs);
   fs::create_directories(opt.output);
   std::printf("study: %zu cases, %d at a time with %d OpenMP threads each; logs in %s/<case>/log.txt\n",
               cases.size(), jobs, threads, opt.output.c_str());

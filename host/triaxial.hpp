@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "config.hpp"
+#include "host/micro_report.hpp"
 #include "host/specimen.hpp"
 #include "io_hdf5.hpp"
 
@@ -30,6 +31,7 @@ struct TriaxialResult {
   Real shear_rate = 0;         ///< 1/s
   Real inertial_number = 0;
   std::vector<TriaxialRecord> records;
+  std::vector<MicroRow> micro;   ///< with each record when [micro] is enabled
   Real q_peak = 0, eps_a_peak = 0, phi_peak_deg = 0;
   Real q_end = 0, max_dilatancy = 0;  ///< max of -d eps_v / d eps_a
   int escaped = 0;             ///< balls whose centre ended outside the membrane (should be 0)

@@ -17,13 +17,13 @@ SCALES = {
         diameter=61.8, height=120.0, size_line="ball_count = 53704        # the paper's count (Sec. 3.3)",
         size_note="""# Choice: 53,704 balls, the paper's count. In the nominal 61.8 x 120 mm cylinder that is e = 0.600, the
 # lab value of Sec. 2.3; Table 4's e = 0.61 would give 53,373 balls. We follow the count (and the lab).""",
-        record=0.1, around=81, segments=20),
+        record=0.1, around=81, segments=20, rve=20.0),
     "small": dict(
         title="scaled down for tests and quick looks: about 3,700 beads of 2 mm in 25 mm x 50 mm",
         diameter=25.0, height=50.0, size_line="void_ratio = 0.60          # the paper's (and the lab's) e",
         size_note="""# Scaled down: 12.5 beads across instead of 31, so the looser packing along the mould weighs more
 # and q_peak is not to be compared with Table 6 at better than about 10%.""",
-        record=0.1, around=81, segments=20),
+        record=0.1, around=81, segments=20, rve=12.0),
 }
 
 TEMPLATE = """# Drained triaxial test of Tang et al. (2025), {mat_name} beads at sigma3 = {p} kPa, {title}.
@@ -68,6 +68,10 @@ membrane_poisson = 0.49
 membrane_thickness_mm = 0.5
 membrane_density_kg_m3 = 930
 
+[micro]                   # recorded with every row of the series; distributions at A-D and at the peak
+rve_edge_mm = {rve}       # central cube of the micro statistics (the paper's 20 mm where it fits)
+rose_bins = 18
+
 [material]                # rolling resistance linear, deformability method (Table 4), {mat_name} of Table 5
 emod_Pa = 1.0e8
 kratio = 1.5
@@ -94,7 +98,7 @@ def main():
                                        size_note=s["size_note"], name=f"{scale} {mat} {p} kPa",
                                        outdir=f"{scale}_{stem}", diameter=s["diameter"], height=s["height"],
                                        size_line=s["size_line"], record=s["record"], around=s["around"],
-                                       segments=s["segments"], mu_s=mu_s, mu_r=mu_r)
+                                       segments=s["segments"], rve=s["rve"], mu_s=mu_s, mu_r=mu_r)
                 with open(os.path.join(root, path), "w") as f:
                     f.write(text)
                 print("wrote", path)

@@ -28,6 +28,7 @@ Config tiny_config(double mu_s, double mu_r) {
   c.triaxial.record_every = 0.005;
   c.triaxial.membrane_around = 24;
   c.triaxial.membrane_segments = 8;
+  c.micro.rve_edge = 8e-3;
   c.solver.gravity = {0, 0, 0};
   c.solver.mass_scale = 100;
   c.ball.mu_s = mu_s;
@@ -59,6 +60,19 @@ TEST_F(Triaxial, DenseFrictionalSpecimenContractsThenDilatesInsideTheMembrane) {
   EXPECT_GT(r.q_peak, 0.5 * c.triaxial.sigma3);
   EXPECT_EQ(r.escaped, 0);
   EXPECT_LE(r.inertial_number, 1e-2);
+  // Love-Weber stress of all contacts (platens and membrane included) is the specimen's mean stress: when
+  // consolidated it must equal the boundary stresses within 2% (issue 4). Axially the two platens differ by
+  // what the membrane carries by friction, so the mean of the two is the boundary value.
+  ASSERT_EQ(r.micro.size(), r.records.size());
+  const MicroRow& m0 = r.micro.front();
+  const TriaxialRecord& r0 = r.records.front();
+  EXPECT_NEAR(m0.stress[8], 0.5 * (r0.sigma1 + r0.sigma1_bottom), 0.02 * c.triaxial.sigma3);
+  EXPECT_NEAR(0.5 * (m0.stress[0] + m0.stress[4]), c.triaxial.sigma3, 0.02 * c.triaxial.sigma3);
+  // Stress-force-fabric: q/p from the anisotropies tracks the contacts' q/p (the relation neglects
+  // branch-length anisotropy and cross terms: 0.1 in q/p, about 8% of its peak here).
+  for (const MicroRow& m : r.micro) EXPECT_NEAR(m.q_over_p_sff, m.q_over_p, 0.1);
+  EXPECT_GT(r.micro[r.micro.size() / 3].all.a_c, r.micro.front().all.a_c);  // shear aligns the contacts
+  EXPECT_GT(r.micro.front().z.z, 4.0);  // a consolidated frictional packing
   // The membrane's volume change against the balls' own envelope (convex hull of each slab's balls): they
   // differ by the gap between the outer balls and the membrane, which the hull cannot see. On an 8 mm
   // radius a change of that mean gap by 0.04 mm (4% of a ball radius) is 2 dg / R = 1% of the volume.
