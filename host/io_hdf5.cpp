@@ -198,7 +198,24 @@ void write_surface(H5Writer& f, const SurfaceSnapshot& surface) {
   f.dataset(group.get(), "triangles", H5T_NATIVE_INT, surface.triangles.data(), {surface.triangles.size() / 3, 3});
 }
 
-void write_snapshot_h5(const std::string& path, const Snapshot& s, const SurfaceSnapshot* surface) {
+void write_contacts(H5Writer& f, const ContactTable& c) {
+  const std::size_t n = c.a.size();
+  if (c.b.size() != n || c.boundary.size() != n || c.fn.size() != n || c.normal.size() != 3 * n ||
+      c.point.size() != 3 * n || c.branch.size() != 3 * n || c.ft.size() != 3 * n)
+    throw std::invalid_argument("write_snapshot: contact table columns of unequal length");
+  Handle group(f.check(H5Gcreate2(f.root(), "contacts", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), "create /contacts"),
+               H5Gclose);
+  f.dataset(group.get(), "a", H5T_NATIVE_INT, c.a.data(), {n});
+  f.dataset(group.get(), "b", H5T_NATIVE_INT, c.b.data(), {n});
+  f.dataset(group.get(), "boundary", H5T_NATIVE_INT, c.boundary.data(), {n});
+  f.dataset(group.get(), "fn", H5T_NATIVE_DOUBLE, c.fn.data(), {n});
+  for (const auto& [name, v] : {std::pair<const char*, const std::vector<double>*>{"normal", &c.normal},
+                                {"point", &c.point}, {"branch", &c.branch}, {"ft", &c.ft}})
+    f.dataset(group.get(), name, H5T_NATIVE_DOUBLE, v->data(), {n, 3});
+}
+
+void write_snapshot_h5(const std::string& path, const Snapshot& s, const SurfaceSnapshot* surface,
+                       const ContactTable* contacts) {
   replace_atomically(path, [&](const std::string& tmp) {
     H5Writer f(tmp, path);
     const hsize_t n = s.radius.size();
@@ -222,6 +239,7 @@ void write_snapshot_h5(const std::string& path, const Snapshot& s, const Surface
     f.attribute(".", "time", H5T_NATIVE_DOUBLE, &s.time);
     f.string_attribute(".", "label", s.label);
     if (surface) write_surface(f, *surface);
+    if (contacts) write_contacts(f, *contacts);
     f.close();
   });
 }
@@ -324,11 +342,11 @@ void Output::flush_series() {
   write_text_atomic(in_folder(folder_, "series.csv"), series_csv(columns_, rows_));
 }
 
-void Output::write_snapshot(const Snapshot& s, const SurfaceSnapshot* surface) {
+void Output::write_snapshot(const Snapshot& s, const SurfaceSnapshot* surface, const ContactTable* contacts) {
   check_snapshot(s, surface);
   char file[48];
   std::snprintf(file, sizeof file, "snap_%09ld.h5", s.step);
-  write_snapshot_h5(in_folder(folder_, file), s, surface);
+  write_snapshot_h5(in_folder(folder_, file), s, surface, contacts);
   Entry e{s.step, s.time, file, long(s.radius.size()), 0, 0, {}};
   if (surface) e.nsurf_nodes = long(surface->nodes.size() / 3), e.nsurf_tris = long(surface->triangles.size() / 3);
   for (const auto& scalar : s.scalars) e.scalars.push_back(scalar.first);
@@ -363,6 +381,82 @@ void write_text_atomic(const std::string& path, const std::string& text) {
     if (f && std::fclose(f) != 0 && ok) ok = false, err = errno;
     if (!ok) fail(path, "write '" + tmp + "': " + std::strerror(err));
   });
+}
+
+namespace {
+
+/// One HDF5 file opened for reading; errors name the file.
+class H5Reader {
+ public:
+  explicit H5Reader(std::string path)
+      : path_(std::move(path)), file_(H5Fopen(path_.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose) {
+    if (file_.get() < 0) throw std::runtime_error(path_ + ": not a readable HDF5 file");
+  }
+  bool exists(const std::string& name) const { return H5Lexists(file_.get(), name.c_str(), H5P_DEFAULT) > 0; }
+  template <class T>
+  std::vector<T> read(const std::string& name, hid_t type, std::size_t columns) const {
+    if (!exists(name.substr(0, name.find('/', 1))) || !exists(name))
+      throw std::runtime_error(path_ + ": dataset '" + name + "' missing");
+    Handle set(H5Dopen2(file_.get(), name.c_str(), H5P_DEFAULT), H5Dclose);
+    Handle space(H5Dget_space(set.get()), H5Sclose);
+    hsize_t dims[2] = {0, 0};
+    const int rank = H5Sget_simple_extent_dims(space.get(), dims, nullptr);
+    if (set.get() < 0 || rank < 1 || rank > 2 || (columns > 1 && (rank != 2 || dims[1] != columns)))
+      throw std::runtime_error(path_ + ": dataset '" + name + "' has an unexpected shape");
+    std::vector<T> out(dims[0] * columns);
+    if (!out.empty() && H5Dread(set.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()) < 0)
+      throw std::runtime_error(path_ + ": cannot read dataset '" + name + "'");
+    return out;
+  }
+  std::string label() const {
+    if (H5Aexists(file_.get(), "label") <= 0) return "";
+    Handle attr(H5Aopen(file_.get(), "label", H5P_DEFAULT), H5Aclose);
+    Handle type(H5Aget_type(attr.get()), H5Tclose);
+    std::string text(H5Tget_size(type.get()), '\0');
+    if (H5Aread(attr.get(), type.get(), text.data()) < 0) return "";
+    return text.substr(0, text.find('\0'));
+  }
+
+ private:
+  std::string path_;
+  Handle file_;
+};
+
+}  // namespace
+
+SnapshotFile read_snapshot(const std::string& path) {
+  const H5Reader f(path);
+  SnapshotFile out;
+  out.particles.x = f.read<double>("/x", H5T_NATIVE_DOUBLE, 3);
+  out.particles.radius = f.read<double>("/radius", H5T_NATIVE_DOUBLE, 1);
+  out.particles.gid = f.read<std::uint32_t>("/gid", H5T_NATIVE_UINT32, 1);
+  out.particles.label = f.label();
+  if (out.particles.x.size() != 3 * out.particles.radius.size())
+    throw std::runtime_error(path + ": /x and /radius disagree on the number of balls");
+  out.has_surface = f.exists("/surface");
+  if (out.has_surface) {
+    out.surface.nodes = f.read<double>("/surface/nodes", H5T_NATIVE_DOUBLE, 3);
+    out.surface.triangles = f.read<int>("/surface/triangles", H5T_NATIVE_INT, 3);
+  }
+  out.has_contacts = f.exists("/contacts");
+  if (out.has_contacts) {
+    ContactTable& c = out.contacts;
+    c.a = f.read<int>("/contacts/a", H5T_NATIVE_INT, 1);
+    c.b = f.read<int>("/contacts/b", H5T_NATIVE_INT, 1);
+    c.boundary = f.read<int>("/contacts/boundary", H5T_NATIVE_INT, 1);
+    c.fn = f.read<double>("/contacts/fn", H5T_NATIVE_DOUBLE, 1);
+    c.normal = f.read<double>("/contacts/normal", H5T_NATIVE_DOUBLE, 3);
+    c.point = f.read<double>("/contacts/point", H5T_NATIVE_DOUBLE, 3);
+    c.branch = f.read<double>("/contacts/branch", H5T_NATIVE_DOUBLE, 3);
+    c.ft = f.read<double>("/contacts/ft", H5T_NATIVE_DOUBLE, 3);
+    const std::size_t n = c.a.size(), balls = out.particles.radius.size();
+    if (c.b.size() != n || c.boundary.size() != n || c.fn.size() != n || c.normal.size() != 3 * n)
+      throw std::runtime_error(path + ": /contacts datasets of unequal length");
+    for (std::size_t k = 0; k < n; ++k)
+      if (c.a[k] < 0 || std::size_t(c.a[k]) >= balls || c.b[k] < -1 || (c.b[k] >= 0 && std::size_t(c.b[k]) >= balls))
+        throw std::runtime_error(path + ": contact " + std::to_string(k) + " names a ball that is not in the file");
+  }
+  return out;
 }
 
 }  // namespace dem::io

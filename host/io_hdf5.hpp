@@ -33,6 +33,25 @@ struct SurfaceSnapshot {
   std::vector<int> triangles;
 };
 
+/// Touching contacts of a snapshot (group /contacts), structure of arrays: a and b are gids (b = -1 at a
+/// boundary), boundary 0 = none, 1 = platen, 2 = membrane; normal, point, branch and ft are n x 3 (m, N), fn
+/// is n (N). The force a exerts on b (or on the boundary) is fn normal + ft.
+struct ContactTable {
+  std::vector<int> a, b, boundary;
+  std::vector<double> normal, point, branch, fn, ft;
+};
+
+/// A snapshot file read back.
+struct SnapshotFile {
+  Snapshot particles;             ///< x and radius by row; v, w, scalars not read
+  bool has_surface = false;
+  SurfaceSnapshot surface;
+  bool has_contacts = false;
+  ContactTable contacts;
+};
+/// Reads a snap_<step>.h5 written by Output. Throws std::runtime_error naming the file and what is missing.
+SnapshotFile read_snapshot(const std::string& path);
+
 /// Writes a run's output folder. Not thread-safe; one per run.
 class Output {
  public:
@@ -47,8 +66,10 @@ class Output {
   /// Rewrites series.h5 and series.csv atomically from all rows so far.
   void flush_series();
 
-  /// Writes snap_<step>.h5 (with the optional surface in /surface) and rewrites snapshots.xdmf.
-  void write_snapshot(const Snapshot& s, const SurfaceSnapshot* surface = nullptr);
+  /// Writes snap_<step>.h5 (with the optional surface in /surface and contacts in /contacts) and rewrites
+  /// snapshots.xdmf.
+  void write_snapshot(const Snapshot& s, const SurfaceSnapshot* surface = nullptr,
+                      const ContactTable* contacts = nullptr);
 
  private:
   std::string folder_;

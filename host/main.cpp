@@ -3,10 +3,12 @@
 #include <Kokkos_Core.hpp>
 
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 
 #include "host/config.hpp"
 #include "host/job.hpp"
+#include "host/micro_report.hpp"
 #include "host/periodic_triaxial.hpp"
 #include "host/study.hpp"
 #include "host/triaxial.hpp"
@@ -44,6 +46,16 @@ int main(int argc, char** argv) {
   study->add_option("-t,--threads", study_opt.threads, "OpenMP threads per case (default: the cores shared out)")
       ->check(CLI::NonNegativeNumber);
 
+  std::string micro_source, micro_out;
+  double micro_at = 0, micro_rve = 20;
+  int micro_bins = 18;
+  auto* micro = app.add_subcommand("micro", "micromechanics of a saved state (a run folder and a strain, or a snapshot)");
+  micro->add_option("source", micro_source, "run folder or snap_<step>.h5")->required();
+  micro->add_option("--at", micro_at, "axial strain of the saved state, % (with a run folder)");
+  micro->add_option("--rve", micro_rve, "edge of the central cube, mm (default 20)");
+  micro->add_option("--bins", micro_bins, "rose bins over 0-180 deg (default 18)")->check(CLI::Range(2, 3600));
+  micro->add_option("-o,--output", micro_out, "output folder (default: the run folder or the snapshot's)");
+
   auto* check = app.add_subcommand("check", "validate a config and print the derived time step");
   check->add_option("config", config_path, "TOML config file")->required()->check(CLI::ExistingFile);
 
@@ -64,6 +76,13 @@ int main(int argc, char** argv) {
     if (info->parsed()) {
       Kokkos::print_configuration(std::cout, false);
       return 0;
+    }
+    if (micro->parsed()) {
+      namespace fs = std::filesystem;
+      const std::string out = !micro_out.empty() ? micro_out
+                              : fs::is_directory(micro_source) ? micro_source
+                                                               : fs::path(micro_source).parent_path().string();
+      return dem::micro_job(micro_source, micro_at, micro_rve, micro_bins, out.empty() ? "." : out);
     }
     dem::Config cfg = dem::load_config(config_path);
     if (!output.empty()) cfg.run.output = output;

@@ -131,6 +131,55 @@ ContactSet contact_set(Simulation& sim) {
   return s;
 }
 
+io::ContactTable contact_table(const ContactSet& s) {
+  io::ContactTable t;
+  for (const ContactRecord& c : s.contacts) {
+    t.a.push_back(c.a);
+    t.b.push_back(c.b);
+    t.boundary.push_back(static_cast<int>(c.boundary));
+    t.fn.push_back(c.fn);
+    for (int d = 0; d < 3; ++d) {
+      t.normal.push_back(c.normal[d]);
+      t.point.push_back(c.point[d]);
+      t.branch.push_back(c.branch[d]);
+      t.ft.push_back(c.ft[d]);
+    }
+  }
+  return t;
+}
+
+ContactSet contact_set(const io::SnapshotFile& f, const std::string& path) {
+  if (!f.has_contacts)
+    throw std::runtime_error(path + ": the snapshot holds no contacts (only the triaxial test's snapshots at A-D "
+                                    "carry them, with [micro] enabled)");
+  ContactSet s;
+  const std::size_t n = f.particles.radius.size();
+  s.x.resize(n);
+  s.radius.resize(n);
+  for (std::size_t q = 0; q < n; ++q) {
+    // Rows are in gid order (take_snapshot); the gid column says so.
+    const std::size_t g = f.particles.gid.size() == n ? f.particles.gid[q] : q;
+    if (g >= n) throw std::runtime_error(path + ": gid " + std::to_string(g) + " out of range");
+    s.x[g] = Vec3(f.particles.x[3 * q], f.particles.x[3 * q + 1], f.particles.x[3 * q + 2]);
+    s.radius[g] = f.particles.radius[q];
+  }
+  const io::ContactTable& t = f.contacts;
+  auto v3 = [](const std::vector<double>& v, std::size_t k) { return Vec3(v[3 * k], v[3 * k + 1], v[3 * k + 2]); };
+  for (std::size_t k = 0; k < t.a.size(); ++k) {
+    ContactRecord c;
+    c.a = t.a[k];
+    c.b = t.b[k];
+    c.boundary = static_cast<Boundary>(std::clamp(t.boundary[k], 0, 2));
+    c.fn = t.fn[k];
+    c.normal = v3(t.normal, k);
+    c.point = v3(t.point, k);
+    c.branch = v3(t.branch, k);
+    c.ft = v3(t.ft, k);
+    s.contacts.push_back(c);
+  }
+  return s;
+}
+
 Coordination coordination(const ContactSet& s, Network net) {
   const std::size_t np = s.radius.size();
   const Real threshold = mean_ball_fn(s);

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "host/io_hdf5.hpp"
 #include "kernels/vec3.hpp"
 
 namespace dem {
@@ -38,6 +39,10 @@ struct ContactSet {
 
 /// Touching contacts of a simulation. Analytic walls count as platens, facets as membrane.
 ContactSet contact_set(Simulation& sim);
+/// The same to and from a snapshot file's /contacts group. contact_set(file) throws std::runtime_error
+/// naming the file when it holds no contacts.
+io::ContactTable contact_table(const ContactSet& s);
+ContactSet contact_set(const io::SnapshotFile& f, const std::string& path);
 
 using Tensor = std::array<Real, 9>;  ///< row-major 3 x 3
 

@@ -1,7 +1,11 @@
 #include "micro_report.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <stdexcept>
 
 #include "io_hdf5.hpp"
 
@@ -82,6 +86,111 @@ void write_micro_state(const std::string& folder, const std::string& label, cons
   }
   io::write_text_atomic(folder + "/micro_rose_" + label + ".csv", t);
   write_force_chains_vtk(folder + "/force_chains_" + label + ".vtk", rve);
+}
+
+Real surface_volume(const io::SurfaceSnapshot& surface) {
+  const std::size_t n = surface.nodes.size() / 3;
+  auto node = [&](int k) { return Vec3(surface.nodes[3 * k], surface.nodes[3 * k + 1], surface.nodes[3 * k + 2]); };
+  Real z0 = INFINITY, z1 = -INFINITY;
+  for (std::size_t k = 0; k < n; ++k) z0 = std::min(z0, node(k).z), z1 = std::max(z1, node(k).z);
+  const Vec3 o(0, 0, z0);
+  Real v = 0;
+  for (std::size_t t = 0; t + 2 < surface.triangles.size(); t += 3) {
+    const Vec3 a = node(surface.triangles[t]) - o, b = node(surface.triangles[t + 1]) - o,
+               c = node(surface.triangles[t + 2]) - o;
+    v += dot(a, cross(b, c)) / 6;
+  }
+  // Top cap: the ring of nodes at the top platen, ordered by angle, as a polygon; its cone from o.
+  std::vector<std::pair<Real, Vec3>> ring;
+  for (std::size_t k = 0; k < n; ++k)
+    if (node(k).z > z1 - 1e-9 * std::max(Real(1e-3), z1 - z0)) ring.emplace_back(std::atan2(node(k).y, node(k).x), node(k));
+  std::sort(ring.begin(), ring.end(), [](const auto& p, const auto& q) { return p.first < q.first; });
+  Real area = 0;
+  for (std::size_t k = 0; k < ring.size(); ++k) {
+    const Vec3& p = ring[k].second;
+    const Vec3& q = ring[(k + 1) % ring.size()].second;
+    area += 0.5 * (p.x * q.y - q.x * p.y);
+  }
+  return std::fabs(v) + area * (z1 - z0) / 3;
+}
+
+namespace {
+
+/// The nominal axial strain (%) in a snapshot label "shear eps_a=5%"; NaN when the label has none.
+double label_strain(const std::string& label) {
+  const auto k = label.find("eps_a=");
+  return k == std::string::npos ? NAN : std::atof(label.c_str() + k + 6);
+}
+
+}  // namespace
+
+int micro_job(const std::string& source, double at_pct, double rve_edge_mm, int rose_bins, const std::string& output) {
+  namespace fs = std::filesystem;
+  std::string path = source;
+  if (fs::is_directory(source)) {
+    std::vector<std::pair<double, std::string>> found;
+    for (const auto& e : fs::directory_iterator(source)) {
+      const std::string name = e.path().filename().string();
+      if (name.rfind("snap_", 0) != 0 || e.path().extension() != ".h5") continue;
+      found.emplace_back(label_strain(io::read_snapshot(e.path().string()).particles.label), e.path().string());
+    }
+    std::sort(found.begin(), found.end());
+    path.clear();
+    std::string have;
+    for (const auto& [eps, file] : found) {
+      if (std::isfinite(eps)) have += (have.empty() ? "" : ", ") + std::to_string(eps).substr(0, std::to_string(eps).find('.') + 2) + "%";
+      if (std::isfinite(eps) && std::fabs(eps - at_pct) < 1e-6) path = file;
+    }
+    if (path.empty())
+      throw std::runtime_error(source + ": no snapshot at axial strain " + std::to_string(at_pct) +
+                               "% (the run saved states at: " + (have.empty() ? std::string("none") : have) + ")");
+  } else if (!fs::is_regular_file(source)) {
+    throw std::runtime_error(source + ": no such run folder or snapshot file");
+  }
+  const io::SnapshotFile f = io::read_snapshot(path);
+  const ContactSet cs = contact_set(f, path);
+  if (cs.contacts.empty()) throw std::runtime_error(path + ": the snapshot's contact list is empty");
+  if (!f.has_surface) throw std::runtime_error(path + ": no membrane surface in the snapshot: the specimen volume is unknown");
+  const Real volume = surface_volume(f.surface);
+  Real zmax = -INFINITY, zmin = INFINITY, rmax = 0;
+  for (std::size_t k = 0; k < f.surface.nodes.size(); k += 3) {
+    zmin = std::min(zmin, f.surface.nodes[k + 2]);
+    zmax = std::max(zmax, f.surface.nodes[k + 2]);
+  }
+  for (std::size_t q = 0; q < cs.x.size(); ++q) rmax = std::max(rmax, std::hypot(cs.x[q].x, cs.x[q].y));
+  const Real edge = rve_edge_mm * 1e-3;
+  if (!(edge > 0) || edge / std::sqrt(2.0) > rmax || edge > zmax - zmin)
+    throw std::runtime_error("representative volume: a cube of edge " + std::to_string(rve_edge_mm) +
+                             " mm does not fit in this specimen (ball centres within a radius of " +
+                             std::to_string(rmax * 1e3) + " mm, height " + std::to_string((zmax - zmin) * 1e3) +
+                             " mm)");
+  const ContactSet rve = restrict_to_cube(cs, Vec3(0, 0, 0.5 * (zmin + zmax)), edge);
+  const MicroRow all = micro_row(cs, volume), cube = micro_row(rve, edge * edge * edge);
+  fs::create_directories(output);
+  const std::string label = fs::path(path).stem().string();
+  std::string text;
+  for (const std::string& c : micro_columns()) text += c + ",";
+  for (const std::string& c : micro_columns("rve_")) text += c + (c == micro_columns("rve_").back() ? "\n" : ",");
+  std::vector<double> v = micro_values(all);
+  for (double x : micro_values(cube)) v.push_back(x);
+  char cell[32];
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    std::snprintf(cell, sizeof cell, "%.6g%s", v[k], k + 1 == v.size() ? "\n" : ",");
+    text += cell;
+  }
+  io::write_text_atomic(output + "/micro_" + label + ".csv", text);
+  write_micro_state(output, label, cs, rve, rose_bins);
+  std::printf("%s (%s): %zu balls, %zu contacts, volume %.1f cm^3\n", path.c_str(), f.particles.label.c_str(),
+              cs.x.size(), cs.contacts.size(), volume * 1e6);
+  std::printf("  Z %.3f (with membrane contacts), Z_mech %.3f; mean fn %.3f N, strong/weak fn ratio %.2f\n",
+              all.z.z, all.z.z_mech, all.net.all.mean_fn, all.net.fn_ratio);
+  std::printf("  a_c %.3f, a_n %.3f, a_t %.3f; q/p from the contacts %.3f, stress-force-fabric %.3f\n", all.all.a_c,
+              all.all.a_n, all.all.a_t, all.q_over_p, all.q_over_p_sff);
+  std::printf("  central %.0f mm cube: %zu contacts, mean fn %.3f N, a_c %.3f, a_n %.3f\n", rve_edge_mm,
+              rve.contacts.size(), cube.net.all.mean_fn, cube.all.a_c, cube.all.a_n);
+  std::printf("  written: %s/micro_%s.csv, micro_coordination_%s.csv, micro_rose_%s.csv, force_chains_%s.vtk\n",
+              output.c_str(), label.c_str(), label.c_str(), label.c_str(), label.c_str());
+  return 0;
 }
 
 }  // namespace dem

@@ -30,4 +30,14 @@ std::vector<double> micro_values(const MicroRow& r);
 void write_micro_state(const std::string& folder, const std::string& label, const ContactSet& s,
                        const ContactSet& rve, int rose_bins);
 
+/// Volume enclosed by a snapshot's membrane surface and the two platens (m^3): signed tetrahedra from the
+/// axis point on the bottom platen, plus the cone over the top cap.
+Real surface_volume(const io::SurfaceSnapshot& surface);
+
+/// `triaxdem micro`: the micromechanics of one saved state. `source` is a run folder (then `at_pct` picks
+/// the snapshot taken at that axial strain) or a snapshot file. Writes micro_<label>.csv (one row of the
+/// micro columns for the specimen and the cube), the distributions and the force chains into `output`
+/// and prints the headline numbers. Throws std::runtime_error with what was asked and what exists.
+int micro_job(const std::string& source, double at_pct, double rve_edge_mm, int rose_bins, const std::string& output);
+
 }  // namespace dem

@@ -235,7 +235,8 @@ bool run_plot_script(const std::string& script, const std::vector<std::string>& 
     std::fprintf(stderr, "triaxdem: tools/%s not found: no plot drawn\n", script.c_str());
     return false;
   }
-  std::string cmd = "python3 '" + path + "'";
+  // Debian's interpreter first: python3-matplotlib is installed for it, not for a python3 earlier on PATH.
+  std::string cmd = std::string(fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3") + " '" + path + "'";
   for (const std::string& a : args) cmd += " '" + a + "'";
   cmd += " 2>&1";
   const int rc = std::system(cmd.c_str());

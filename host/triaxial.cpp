@@ -324,7 +324,8 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
       char label[48];
       std::snprintf(label, sizeof label, "shear eps_a=%.0f%%", 100 * snaps[next_snap]);
       const io::SurfaceSnapshot membrane_surface = surface(cell);
-      out->write_snapshot(take_snapshot(sim, label), &membrane_surface);
+      const io::ContactTable contacts = contact_table(contact_set(sim));
+      out->write_snapshot(take_snapshot(sim, label), &membrane_surface, mc.enabled ? &contacts : nullptr);
       ++next_snap;
     }
     if (k == steps) break;

@@ -10,6 +10,7 @@
 #include <random>
 
 #include "host/micro.hpp"
+#include "host/micro_report.hpp"
 
 using namespace dem;
 
@@ -188,4 +189,22 @@ TEST(Micro, ForceChainFileListsEverySegment) {
   EXPECT_NE(text.find("POINTS 4 double"), std::string::npos);
   EXPECT_NE(text.find("LINES 2 6"), std::string::npos);
   EXPECT_NE(text.find("SCALARS strong int 1\nLOOKUP_TABLE default\n0\n1\n"), std::string::npos) << text;
+}
+
+TEST(Micro, SurfaceVolumeOfAPrismIsExact) {
+  // An open 12-sided tube between z = 1 and 3 mm (as a membrane between the platens): the enclosed volume
+  // is the inscribed prism, (n/2) R^2 sin(2 pi/n) H, to rounding.
+  const int n = 12;
+  const Real R = 5e-3, z0 = 1e-3, H = 2e-3;
+  io::SurfaceSnapshot s;
+  for (int ring = 0; ring < 2; ++ring)
+    for (int k = 0; k < n; ++k) {
+      const Real a = 2 * M_PI * k / n;
+      s.nodes.insert(s.nodes.end(), {R * std::cos(a), R * std::sin(a), z0 + ring * H});
+    }
+  for (int k = 0; k < n; ++k) {
+    const int a = k, b = (k + 1) % n, c = n + k, d = n + (k + 1) % n;
+    s.triangles.insert(s.triangles.end(), {a, b, d, a, d, c});  // counter-clockwise seen from outside
+  }
+  EXPECT_NEAR(surface_volume(s), 0.5 * n * R * R * std::sin(2 * M_PI / n) * H, 1e-15);
 }

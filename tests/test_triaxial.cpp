@@ -3,8 +3,13 @@
 // 24 x 8 membrane) so that each run takes seconds; the physics checked is qualitative and robust at this size.
 #include <gtest/gtest.h>
 
-#include <algorithm>
+#include <unistd.h>
 
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+
+#include "host/micro_report.hpp"
 #include "host/triaxial.hpp"
 
 using namespace dem;
@@ -105,4 +110,62 @@ TEST_F(Triaxial, HigherFrictionGivesHigherPeakStrength) {
   const TriaxialResult low = run_triaxial(tiny_config(0.1, 0.02), *specimen_, nullptr, false);
   const TriaxialResult high = run_triaxial(tiny_config(0.5, 0.02), *specimen_, nullptr, false);
   EXPECT_GT(high.q_peak, 1.1 * low.q_peak) << "q_peak " << low.q_peak << " -> " << high.q_peak;
+}
+
+TEST_F(Triaxial, MicromechanicsFromSavedStatesAndClearRefusals) {
+  const auto dir = std::filesystem::path(::testing::TempDir()) / ("triaxdem_micro_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  Config c = tiny_config(0.3, 0.02);
+  c.triaxial.axial_strain_end = 0.05;  // snapshots A (0%), B (1%) and D = C (5%)
+  {
+    io::Output out(dir.string());
+    run_triaxial(c, *specimen_, &out, false);
+  }
+  EXPECT_TRUE(std::filesystem::exists(dir / "micro_rose_B.csv"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "force_chains_C.vtk"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "micro_coordination_peak.csv"));
+  const auto out = dir / "again";
+  ASSERT_EQ(micro_job(dir.string(), 1.0, 8.0, 18, out.string()), 0);
+  bool found = false;
+  for (const auto& e : std::filesystem::directory_iterator(out)) {
+    if (e.path().filename().string().rfind("micro_snap_", 0) != 0) continue;
+    std::ifstream f(e.path());
+    std::string header, row;
+    std::getline(f, header);
+    std::getline(f, row);
+    EXPECT_EQ(header.rfind("Z,Z_balls,Z_mech", 0), 0u) << header;
+    EXPECT_GT(std::stod(row.substr(0, row.find(','))), 4.0);  // Z of a consolidated, lightly sheared packing
+    EXPECT_EQ(row.find("nan"), std::string::npos) << row;
+    found = true;
+  }
+  EXPECT_TRUE(found);
+  try {
+    micro_job(dir.string(), 7.0, 8.0, 18, out.string());
+    FAIL() << "no state was saved at 7%";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("0.0%, 1.0%, 5.0%"), std::string::npos) << e.what();
+  }
+  try {
+    micro_job(dir.string(), 1.0, 30.0, 18, out.string());
+    FAIL() << "a 30 mm cube does not fit in a 16 mm specimen";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("does not fit"), std::string::npos) << e.what();
+  }
+  {
+    io::Output bare((dir / "bare").string());
+    io::Snapshot s;
+    s.label = "shear eps_a=1%";
+    s.x = {0, 0, 0};
+    s.v = s.w = s.x;
+    s.radius = {1e-3};
+    s.gid = {0};
+    s.specimen = {0};
+    bare.write_snapshot(s);
+  }
+  try {
+    micro_job((dir / "bare").string(), 1.0, 8.0, 18, out.string());
+    FAIL() << "a snapshot without contacts";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("holds no contacts"), std::string::npos) << e.what();
+  }
 }
