@@ -263,7 +263,10 @@ Anisotropy anisotropy(const ContactSet& s, Network net, const Tensor& reference)
   // Average force tensors, each contact weighted by 1 / E(n) relative to isotropy (Ouadfel & Rothenburg).
   Tensor chi_n{}, chi_t{};
   for (const ContactRecord* c : cs) {
-    const Real w = 1 / (cs.size() * (1 + quad(a.ac, c->normal)));
+    // A strongly aligned set (a strong network: a_c of 2 or more) makes the second-order density
+    // 1 + a^c:nn small or negative across the axis, where it no longer describes the set: the floor keeps
+    // those contacts' weights finite (at most 10 times the isotropic one).
+    const Real w = 1 / (cs.size() * std::max(1 + quad(a.ac, c->normal), Real(0.1)));
     const Tensor tn = outer(c->normal, c->normal), tt = outer(c->ft, c->normal);
     for (int q = 0; q < 9; ++q) {
       chi_n[q] += w * c->fn * tn[q];
@@ -294,22 +297,23 @@ std::vector<RoseBin> rose(const ContactSet& s, int bins, Network net) {
   const Real threshold = mean_ball_fn(s);
   std::vector<RoseBin> r(bins);
   long total = 0;
+  // Bins of equal solid angle (equal steps in cos theta): an isotropic set fills them equally, so the bins
+  // near the axis are as well sampled as those at the equator.
+  auto bin_of = [&](Real cos_theta) { return std::clamp(static_cast<int>((1 - cos_theta) / 2 * bins), 0, bins - 1); };
   for (const ContactRecord& c : s.contacts) {
     if (c.boundary != Boundary::kNone || !in_network(c, net, threshold)) continue;
     ++total;
-    // n and -n both: theta and 180 - theta, so each contact counts twice with weight 1/2.
-    const Real th = std::acos(std::clamp(c.normal.z, Real(-1), Real(1)));
-    for (Real t : {th, kPi - th}) {
-      const int k = std::clamp(static_cast<int>(t / kPi * bins), 0, bins - 1);
-      r[k].count += 1;
-      r[k].mean_fn += c.fn;
-      r[k].mean_ft += norm(c.ft);
+    const Real ct = std::clamp(c.normal.z, Real(-1), Real(1));
+    for (Real t : {ct, -ct}) {  // n and -n: each contact counts twice with weight 1/2
+      RoseBin& b = r[bin_of(t)];
+      b.count += 1;
+      b.mean_fn += c.fn;
+      b.mean_ft += norm(c.ft);
     }
   }
+  const Real solid = 4 * kPi / bins;
   for (int k = 0; k < bins; ++k) {
-    const Real t0 = k * kPi / bins, t1 = (k + 1) * kPi / bins;
-    r[k].theta_deg = (k + 0.5) * 180.0 / bins;
-    const Real solid = 2 * kPi * (std::cos(t0) - std::cos(t1));
+    r[k].theta_deg = std::acos(1 - (2 * k + 1.0) / bins) * 180 / kPi;
     r[k].density = total > 0 ? 0.5 * r[k].count / (total * solid) : 0;
     if (r[k].count > 0) {
       r[k].mean_fn /= r[k].count;

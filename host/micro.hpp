@@ -84,8 +84,8 @@ struct Anisotropy {
 Anisotropy anisotropy(const ContactSet& s, Network net, const Tensor& reference);
 
 /// Directional distribution against the angle theta between the contact normal and the z axis (n and -n
-/// both counted, theta in [0, 180) deg): density per unit solid angle (integrates to 1 over the sphere;
-/// (1 + a^c:nn)/4pi for a second-order fabric), mean fn and mean |ft| per bin.
+/// both counted, theta in [0, 180] deg, bins of equal solid angle): density per unit solid angle
+/// (integrates to 1 over the sphere; (1 + a^c:nn)/4pi for a second-order fabric), mean fn and mean |ft|.
 struct RoseBin {
   Real theta_deg = 0;      ///< bin centre
   long count = 0;
