@@ -128,6 +128,26 @@ int run_job(const Config& cfg) {
   return 0;
 }
 
+void write_specimen_report(const std::string& folder, const Config& cfg, const Specimen& sp) {
+  std::string layers = "layer,z_bottom_mm,z_top_mm,z_platen_mm,void_ratio,steps,unbalanced_ratio\n";
+  for (std::size_t k = 0; k < sp.layers.size(); ++k) {
+    const LayerReport& l = sp.layers[k];
+    char row[160];
+    std::snprintf(row, sizeof row, "%zu,%.4f,%.4f,%.4f,%.5f,%ld,%.3e\n", k + 1, l.z_bottom * 1e3, l.z_top * 1e3,
+                  l.z_platen * 1e3, l.void_ratio, l.steps, l.unbalanced);
+    layers += row;
+  }
+  io::write_text_atomic(folder + "/layers.csv", layers);
+  std::string profile = "z_mm,porosity\n";
+  const std::size_t nb = sp.porosity_profile.size();
+  for (std::size_t b = 0; b < nb; ++b) {
+    char row[64];
+    std::snprintf(row, sizeof row, "%.4f,%.5f\n", (b + 0.5) * cfg.specimen.height / nb * 1e3, sp.porosity_profile[b]);
+    profile += row;
+  }
+  io::write_text_atomic(folder + "/porosity_profile.csv", profile);
+}
+
 int specimen_job(const Config& cfg) {
   if (!cfg.has_specimen) throw ConfigError(cfg.path + ": [specimen]: table missing (the specimen job needs it)");
   io::Output out(cfg.run.output);
@@ -141,23 +161,7 @@ int specimen_job(const Config& cfg) {
     std::fprintf(stderr, "triaxdem: %s\n", e.what());
     return 2;
   }
-  std::string layers = "layer,z_bottom_mm,z_top_mm,z_platen_mm,void_ratio,steps,unbalanced_ratio\n";
-  for (std::size_t k = 0; k < sp.layers.size(); ++k) {
-    const LayerReport& l = sp.layers[k];
-    char row[160];
-    std::snprintf(row, sizeof row, "%zu,%.4f,%.4f,%.4f,%.5f,%ld,%.3e\n", k + 1, l.z_bottom * 1e3, l.z_top * 1e3,
-                  l.z_platen * 1e3, l.void_ratio, l.steps, l.unbalanced);
-    layers += row;
-  }
-  io::write_text_atomic(out.folder() + "/layers.csv", layers);
-  std::string profile = "z_mm,porosity\n";
-  const std::size_t nb = sp.porosity_profile.size();
-  for (std::size_t b = 0; b < nb; ++b) {
-    char row[64];
-    std::snprintf(row, sizeof row, "%.4f,%.5f\n", (b + 0.5) * cfg.specimen.height / nb * 1e3, sp.porosity_profile[b]);
-    profile += row;
-  }
-  io::write_text_atomic(out.folder() + "/porosity_profile.csv", profile);
+  write_specimen_report(out.folder(), cfg, sp);
   io::Snapshot snap;
   snap.label = "specimen";
   for (std::size_t q = 0; q < sp.balls.size(); ++q) {

@@ -5,6 +5,7 @@
 
 #include "config.hpp"
 #include "host/io_hdf5.hpp"
+#include "host/specimen.hpp"
 #include "simulation.hpp"
 
 namespace dem {
@@ -22,6 +23,9 @@ io::Snapshot take_snapshot(Simulation& sim, const std::string& label);
 
 /// Runs the job; returns 0 on success, 2 on a blow-up (after saving a snapshot for inspection).
 int run_job(const Config& cfg);
+
+/// Writes layers.csv (each layer's void ratio in the finished specimen) and porosity_profile.csv.
+void write_specimen_report(const std::string& folder, const Config& cfg, const Specimen& sp);
 
 /// Builds the [specimen] of a config by multilayer compaction and writes it (snapshot, layers.csv with
 /// the void ratio of each layer, porosity_profile.csv). Returns 0 on success, 2 on a blow-up.

@@ -357,7 +357,9 @@ int triaxial_job(const Config& cfg) {
     // Specimens are shared through a cache beside the output folder (the nine paper cases build one).
     const Specimen sp =
         cached_specimen(cfg, (std::filesystem::path(out.folder()).parent_path() / ".specimens").string(), true);
-    std::printf("specimen: %zu balls, e = %.4f, height %.3f mm\n", sp.balls.size(), sp.void_ratio, sp.height * 1e3);
+    std::printf("specimen: %zu balls, e = %.4f, height %.3f mm (layers.csv, porosity_profile.csv)\n",
+                sp.balls.size(), sp.void_ratio, sp.height * 1e3);
+    write_specimen_report(out.folder(), cfg, sp);
     const TriaxialResult r = run_triaxial(cfg, sp, &out, true);
     std::printf("\nresult: q_peak %.1f kPa at eps_a %.2f%%, peak friction angle %.1f deg, q at %.0f%% %.1f kPa, "
                 "max dilatancy %.3f, wall time %s\n",

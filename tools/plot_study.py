@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Draws a study's figure like Figure 8 of Tang et al. (2025): one column per confining pressure, deviator
 stress q (top) and volumetric strain eps_v (bottom, contraction positive) against axial strain, one curve per
-case, and writes STUDY/study.png.
+case, and writes STUDY/study.png; with the runs' micro columns also STUDY/study_networks.png (Figure 10).
 
 Reads STUDY/study_summary.csv (written by `triaxdem study`) and each case's STUDY/<case>/series.csv.
 
@@ -65,6 +65,38 @@ def main():
             ax.legend(fontsize=7, loc="best")
         axes[0][col].set_ylim(bottom=0)
     out = args.output or os.path.join(args.study, "study.png")
+    fig.savefig(out, dpi=120)
+    print(f"plot_study: wrote {out}")
+    figure_10(args.study, cases, pressures)
+
+
+def figure_10(study, cases, pressures):
+    """Strong/weak ratios of the mean normal and tangential contact force at peak q against mu_s, one line
+    per confining pressure, like the paper's Figure 10 (needs the runs' micro columns)."""
+    points = {}
+    for r in cases:
+        rows = read_csv(os.path.join(study, r["case"], "series.csv"))
+        if not rows or "fn_ratio_strong_weak" not in rows[0]:
+            return
+        peak = max(rows, key=lambda x: float(x["q_kPa"]))
+        points.setdefault(float(r["sigma3_kPa"]), []).append(
+            (float(r["mu_s"]), float(peak["fn_ratio_strong_weak"]), float(peak["ft_ratio_strong_weak"])))
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4), constrained_layout=True)
+    for p in pressures:
+        v = sorted(points.get(p, []))
+        if not v:
+            continue
+        mu, fn, ft = zip(*v)
+        a1.plot(mu, fn, "o-", label=f"{p:g} kPa")
+        a2.plot(mu, ft, "s-", label=f"{p:g} kPa")
+    a1.set_ylabel("strong / weak mean normal force")
+    a2.set_ylabel("strong / weak mean tangential force")
+    for ax in (a1, a2):
+        ax.set_xlabel("sliding friction mu_s")
+        ax.grid(True, lw=0.4, alpha=0.6)
+        ax.legend(fontsize=8)
+    fig.suptitle("at peak deviator stress (Fig. 10)", fontsize=10)
+    out = os.path.join(study, "study_networks.png")
     fig.savefig(out, dpi=120)
     print(f"plot_study: wrote {out}")
 
