@@ -32,7 +32,8 @@ std::vector<std::string> micro_columns(const std::string& prefix) {
                                 "ft_weak_N", "fn_ratio_strong_weak", "ft_ratio_strong_weak"};
   for (const char* net : {"", "_strong", "_weak"})
     for (const char* a : {"a_c", "a_n", "a_t"}) c.push_back(std::string(a) + net);
-  for (const char* x : {"lw_sigma_zz_kPa", "lw_sigma_xx_kPa", "lw_sigma_yy_kPa", "lw_q_over_p", "sff_q_over_p"})
+  for (const char* x : {"lw_sigma_zz_kPa", "lw_sigma_xx_kPa", "lw_sigma_yy_kPa", "lw_q_over_p", "sff_q_over_p",
+                        "q_strong_kPa", "q_weak_kPa"})
     c.emplace_back(x);
   for (std::string& name : c) name = prefix + name;
   return c;
@@ -59,7 +60,10 @@ std::vector<double> micro_values(const MicroRow& r) {
     v.push_back(a->a_n);
     v.push_back(a->a_t);
   }
-  v.insert(v.end(), {r.stress[8] / 1e3, r.stress[0] / 1e3, r.stress[4] / 1e3, r.q_over_p, r.q_over_p_sff});
+  // Deviator of the partial (ball-ball) stresses: how the strong and weak networks share q.
+  auto q_of = [](const Tensor& t) { return (t[8] - 0.5 * (t[0] + t[4])) / 1e3; };
+  v.insert(v.end(), {r.stress[8] / 1e3, r.stress[0] / 1e3, r.stress[4] / 1e3, r.q_over_p, r.q_over_p_sff,
+                     q_of(r.net.strong.stress), q_of(r.net.weak.stress)});
   return v;
 }
 
@@ -85,6 +89,23 @@ void write_micro_state(const std::string& folder, const std::string& label, cons
     t += row;
   }
   io::write_text_atomic(folder + "/micro_rose_" + label + ".csv", t);
+  // The full tensors (row-major xx xy xz yx ... zz), for directions other than the axis.
+  t = "network,tensor,xx,xy,xz,yx,yy,yz,zx,zy,zz\n";
+  const Tensor stress = love_weber(s, 1.0, true);  // only its deviator's direction is used, for the signs
+  for (const auto& [name, net] : {std::pair<const char*, Network>{"all", Network::kAll}, {"strong", Network::kStrong},
+                                  {"weak", Network::kWeak}}) {
+    const Anisotropy a = anisotropy(s, net, stress);
+    for (const auto& [tn, tensor] : {std::pair<const char*, const Tensor*>{"fabric", &a.fabric}, {"a_c", &a.ac},
+                                     {"a_n", &a.an}, {"a_t", &a.at}}) {
+      t += std::string(name) + "," + tn;
+      for (Real x : *tensor) {
+        std::snprintf(row, sizeof row, ",%.6g", x);
+        t += row;
+      }
+      t += "\n";
+    }
+  }
+  io::write_text_atomic(folder + "/micro_tensors_" + label + ".csv", t);
   write_force_chains_vtk(folder + "/force_chains_" + label + ".vtk", rve);
 }
 

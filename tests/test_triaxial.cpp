@@ -123,6 +123,7 @@ TEST_F(Triaxial, MicromechanicsFromSavedStatesAndClearRefusals) {
   }
   EXPECT_TRUE(std::filesystem::exists(dir / "micro_rose_B.csv"));
   EXPECT_TRUE(std::filesystem::exists(dir / "force_chains_C.vtk"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "micro_tensors_A.csv"));
   EXPECT_TRUE(std::filesystem::exists(dir / "micro_coordination_peak.csv"));
   const auto out = dir / "again";
   ASSERT_EQ(micro_job(dir.string(), 1.0, 8.0, 18, out.string()), 0);
