@@ -1,0 +1,182 @@
+#include "measured.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+namespace dem {
+
+namespace {
+
+constexpr Real kNaN = std::numeric_limits<Real>::quiet_NaN();
+
+/// A column's quantity and the factor that turns the file's unit into SI.
+struct ColumnSpec {
+  std::string quantity;  ///< e.g. "q_peak", "eps_a", "material"
+  Real scale = 1;
+};
+
+const std::map<std::string, Real> kStressUnits = {{"Pa", 1}, {"kPa", 1e3}, {"MPa", 1e6}};
+const std::map<std::string, Real> kStrainUnits = {{"pct", 1e-2}, {"frac", 1}};
+const std::map<std::string, const std::map<std::string, Real>*> kQuantities = {
+    {"sigma3", &kStressUnits}, {"q", &kStressUnits},         {"q_peak", &kStressUnits}, {"q_end", &kStressUnits},
+    {"eps_a", &kStrainUnits},  {"eps_v", &kStrainUnits}, {"eps_a_peak", &kStrainUnits}};
+
+std::string trim(const std::string& s) {
+  const auto a = s.find_first_not_of(" \t\r");
+  if (a == std::string::npos) return "";
+  return s.substr(a, s.find_last_not_of(" \t\r") - a + 1);
+}
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> out;
+  std::stringstream s(line);
+  std::string cell;
+  while (std::getline(s, cell, ',')) out.push_back(trim(cell));
+  if (!line.empty() && line.back() == ',') out.emplace_back();
+  return out;
+}
+
+[[noreturn]] void fail(const std::string& path, long line, const std::string& column, const std::string& what) {
+  throw DataError(path + ":" + std::to_string(line) + (column.empty() ? "" : ":" + column) + ": " + what);
+}
+
+ColumnSpec parse_header(const std::string& path, const std::string& name) {
+  if (name == "material" || name == "max_dilatancy") return {name, 1};
+  const auto cut = name.rfind('_');
+  if (cut != std::string::npos) {
+    const std::string q = name.substr(0, cut), unit = name.substr(cut + 1);
+    auto it = kQuantities.find(q);
+    if (it != kQuantities.end()) {
+      auto u = it->second->find(unit);
+      if (u == it->second->end()) {
+        std::string allowed;
+        for (const auto& [k, v] : *it->second) allowed += (allowed.empty() ? "" : ", ") + k;
+        fail(path, 1, name, "unit '" + unit + "' does not parse for " + q + " (allowed: " + allowed + ")");
+      }
+      return {q, u->second};
+    }
+  }
+  fail(path, 1, name,
+       "unknown column (allowed: material, sigma3_<unit>, eps_a_<unit>, q_<unit>, eps_v_<unit>, q_peak_<unit>, "
+       "eps_a_peak_<unit>, q_end_<unit>, max_dilatancy)");
+}
+
+}  // namespace
+
+MeasuredData load_measured(const std::string& path) {
+  std::ifstream f(path);
+  if (!f) throw DataError(path + ": cannot be read");
+  MeasuredData d;
+  d.path = path;
+  std::string line;
+  long n = 0;
+  std::vector<ColumnSpec> cols;
+  std::vector<std::string> names;
+  std::map<std::string, int> index;  // quantity -> column
+  std::map<std::pair<std::string, Real>, std::size_t> test_of;
+  while (std::getline(f, line)) {
+    ++n;
+    const std::string t = trim(line);
+    if (t.empty() || t[0] == '#') continue;
+    const std::vector<std::string> cells = split(t);
+    if (cols.empty()) {
+      names = cells;
+      for (const std::string& c : cells) {
+        cols.push_back(parse_header(path, c));
+        if (index.count(cols.back().quantity)) fail(path, n, c, "column given twice");
+        index[cols.back().quantity] = static_cast<int>(cols.size()) - 1;
+      }
+      d.curves = index.count("eps_a") > 0;
+      const std::vector<std::string> need =
+          d.curves ? std::vector<std::string>{"material", "sigma3", "eps_a", "q"}
+                   : std::vector<std::string>{"material", "sigma3", "q_peak"};
+      for (const std::string& q : need)
+        if (!index.count(q))
+          fail(path, n, "", "missing column '" + q + "'" + (q == "material" ? "" : " (with its unit, e.g. " + q +
+                                                                                      (q.rfind("eps", 0) == 0 ? "_pct" : "_kPa") + ")"));
+      if (!d.curves && index.count("eps_v")) fail(path, n, names[index["eps_v"]], "eps_v needs curves (an eps_a column)");
+      continue;
+    }
+    if (cells.size() != cols.size())
+      fail(path, n, "", "has " + std::to_string(cells.size()) + " cells, the header " + std::to_string(cols.size()));
+    auto number = [&](const std::string& q) {
+      auto it = index.find(q);
+      if (it == index.end()) return kNaN;
+      const std::string& c = cells[it->second];
+      char* end = nullptr;
+      errno = 0;
+      const double v = std::strtod(c.c_str(), &end);
+      if (c.empty() || end != c.c_str() + c.size() || errno != 0 || !std::isfinite(v))
+        fail(path, n, names[it->second], "'" + c + "' is not a number");
+      return v * cols[it->second].scale;
+    };
+    const std::string material = cells[index["material"]];
+    if (material.empty()) fail(path, n, "material", "empty");
+    const Real sigma3 = number("sigma3");
+    if (!(sigma3 > 0)) fail(path, n, names[index["sigma3"]], "confining pressure must be > 0");
+    const auto key = std::make_pair(material, sigma3);
+    auto it = test_of.find(key);
+    if (it == test_of.end()) {
+      MeasuredTest mt;
+      mt.material = material;
+      mt.sigma3 = sigma3;
+      d.tests.push_back(mt);
+      it = test_of.emplace(key, d.tests.size() - 1).first;
+    } else if (!d.curves) {
+      fail(path, n, "", "material " + material + " at " + std::to_string(sigma3 / 1e3) + " kPa given twice");
+    }
+    MeasuredTest& mt = d.tests[it->second];
+    if (d.curves) {
+      const Real ea = number("eps_a");
+      if (!mt.eps_a.empty() && !(ea > mt.eps_a.back()))
+        fail(path, n, names[index["eps_a"]], "axial strain must increase within a test (" + material + " at " +
+                                                 std::to_string(sigma3 / 1e3) + " kPa)");
+      mt.eps_a.push_back(ea);
+      mt.q.push_back(number("q"));
+      if (index.count("eps_v")) mt.eps_v.push_back(number("eps_v"));
+    } else {
+      mt.q_peak = number("q_peak");
+      mt.eps_a_peak = number("eps_a_peak");
+      mt.q_end = number("q_end");
+      mt.max_dilatancy = number("max_dilatancy");
+    }
+  }
+  if (cols.empty()) throw DataError(path + ": no header line");
+  if (d.tests.empty()) throw DataError(path + ": no data rows");
+  if (d.curves)
+    for (MeasuredTest& t : d.tests) summarise(t);
+  return d;
+}
+
+void summarise(MeasuredTest& t) {
+  if (t.q.empty()) return;
+  const auto k = std::max_element(t.q.begin(), t.q.end()) - t.q.begin();
+  t.q_peak = t.q[k];
+  t.eps_a_peak = t.eps_a[k];
+  t.q_end = t.q.back();
+  t.max_dilatancy = t.eps_v.empty() ? kNaN : 0;
+  for (std::size_t i = 1; i < t.eps_v.size(); ++i)
+    t.max_dilatancy = std::max(t.max_dilatancy, -(t.eps_v[i] - t.eps_v[i - 1]) / (t.eps_a[i] - t.eps_a[i - 1]));
+}
+
+void check_pressures(const MeasuredData& d, const std::vector<Real>& sigma3) {
+  for (const MeasuredTest& t : d.tests) {
+    const bool known = std::any_of(sigma3.begin(), sigma3.end(),
+                                   [&](Real s) { return std::fabs(s - t.sigma3) <= 1e-9 * std::max(s, t.sigma3); });
+    if (!known) {
+      std::ostringstream m;
+      m << d.path << ": material " << t.material << " at sigma3 = " << t.sigma3 / 1e3
+        << " kPa: no config for this pressure (configs have:";
+      for (Real s : sigma3) m << " " << s / 1e3;
+      m << " kPa)";
+      throw DataError(m.str());
+    }
+  }
+}
+
+}  // namespace dem

@@ -1,0 +1,82 @@
+// Measured triaxial data (host/measured.hpp): the shipped Table 6, curves, and refusals with line and column.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "host/measured.hpp"
+
+using namespace dem;
+
+namespace {
+
+std::string write(const std::string& name, const std::string& text) {
+  const auto dir = std::filesystem::path(::testing::TempDir()) / ("triaxdem_data_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / name) << text;
+  return (dir / name).string();
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    load_measured(write("bad.csv", text));
+  } catch (const DataError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(Measured, ShippedTable6Loads) {
+  const MeasuredData d = load_measured(std::string(TRIAXDEM_SOURCE_DIR) + "/data/tang2025_table6_peak.csv");
+  EXPECT_FALSE(d.curves);
+  ASSERT_EQ(d.tests.size(), 9u);
+  EXPECT_EQ(d.tests[3].material, "S-2");
+  EXPECT_DOUBLE_EQ(d.tests[3].sigma3, 100e3);
+  EXPECT_DOUBLE_EQ(d.tests[8].q_peak, 667.26e3);  // kPa in the file, Pa inside
+  EXPECT_TRUE(std::isnan(d.tests[0].eps_a_peak));  // not given
+  check_pressures(d, {100e3, 200e3, 300e3});
+  try {
+    check_pressures(d, {100e3, 200e3});
+    FAIL() << "300 kPa has no config";
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("at sigma3 = 300 kPa"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Measured, CurvesInOtherUnitsAreSummarised) {
+  const MeasuredData d = load_measured(write("curve.csv",
+                                             "# a test\nmaterial,sigma3_MPa,eps_a_frac,q_kPa,eps_v_pct\n"
+                                             "A,0.1,0.00,0,0\nA,0.1,0.01,100,0.2\nA,0.1,0.02,150,0.1\n"
+                                             "A,0.1,0.03,140,-0.3\n"));
+  ASSERT_TRUE(d.curves);
+  ASSERT_EQ(d.tests.size(), 1u);
+  const MeasuredTest& t = d.tests[0];
+  EXPECT_DOUBLE_EQ(t.sigma3, 100e3);
+  EXPECT_DOUBLE_EQ(t.q_peak, 150e3);
+  EXPECT_DOUBLE_EQ(t.eps_a_peak, 0.02);
+  EXPECT_DOUBLE_EQ(t.q_end, 140e3);
+  EXPECT_NEAR(t.max_dilatancy, 0.4, 1e-12);  // -(-0.003 - 0.001) / 0.01
+}
+
+TEST(Measured, BadFilesAreRefusedWithLineAndColumn) {
+  std::string e = error_of("material,sigma3_kPa\nS-1,100\n");
+  EXPECT_NE(e.find("bad.csv:1: missing column 'q_peak'"), std::string::npos) << e;
+  e = error_of("material,sigma3_kPa,q_peak_kPa\nS-1,100,1x2\n");
+  EXPECT_NE(e.find("bad.csv:2:q_peak_kPa: '1x2' is not a number"), std::string::npos) << e;
+  e = error_of("material,sigma3_psi,q_peak_kPa\nS-1,100,12\n");
+  EXPECT_NE(e.find("bad.csv:1:sigma3_psi: unit 'psi' does not parse"), std::string::npos) << e;
+  e = error_of("material,sigma3_kPa,eps_a_pct,q_kPa\nS-1,100,0,0\nS-1,100,1,50\nS-1,100,0.5,60\n");
+  EXPECT_NE(e.find("bad.csv:4:eps_a_pct: axial strain must increase"), std::string::npos) << e;
+  e = error_of("material,sigma3_kPa,q_peak_kPa\nS-1,100,12\nS-1,100,13\n");
+  EXPECT_NE(e.find("bad.csv:3: material S-1 at 100"), std::string::npos) << e;
+  e = error_of("material,sigma3_kPa,q_peak_kPa\nS-1,100\n");
+  EXPECT_NE(e.find("bad.csv:2: has 2 cells, the header 3"), std::string::npos) << e;
+  e = error_of("material,sigma3_kPa,q_peak_kPa,colour\nS-1,100,1,red\n");
+  EXPECT_NE(e.find("bad.csv:1:colour: unknown column"), std::string::npos) << e;
+  EXPECT_NE(error_of("# only a comment\n").find("no header line"), std::string::npos);
+}
