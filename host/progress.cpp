@@ -22,7 +22,10 @@ void Progress::update(long done, const std::string& extra) {
   const auto now = std::chrono::steady_clock::now();
   const double frac = total_ > 0 ? static_cast<double>(done) / total_ : 1.0;
   const int decile = static_cast<int>(frac * 10);
-  if (tty_ ? std::chrono::duration<double>(now - last_).count() < 0.5 : decile == last_decile_) return;
+  // A terminal line is rewritten twice a second; a log gets a line per tenth of the work, and at least one
+  // every 30 s so that a long stage (a settling layer) still shows its state.
+  const double since = std::chrono::duration<double>(now - last_).count();
+  if (tty_ ? since < 0.5 : decile == last_decile_ && since < 30) return;
   last_ = now;
   last_decile_ = decile;
   const double elapsed = std::chrono::duration<double>(now - start_).count();

@@ -1,6 +1,6 @@
 #pragma once
 /// A one-line progress report with ETA for long runs: rewritten in place on a terminal, a fresh
-/// line every 10% otherwise (logs stay short).
+/// line every 10% (and at least every 30 s) otherwise, so logs stay short.
 #include <chrono>
 #include <string>
 
