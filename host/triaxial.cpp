@@ -214,123 +214,136 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
   const Real dt = sim.params().integ.dt;
   TriaxialResult res;
 
-  // Isotropic consolidation: cell pressure on the membrane, stress servo on the top platen.
-  StressServo servo;
-  servo.target = tc.sigma3;
-  servo.area = cell.area;
-  servo.v_max = 0.05 * sp.height / (2000 * dt);  // at most 5% of the height in 2000 steps
-  Progress cons("consolidation", tc.max_consolidation_steps);
-  long s = 0;
-  for (; s < tc.max_consolidation_steps; ++s) {
-    const auto [top, bottom] = platen_stresses(cell);
-    const int n = sim.wall_contact_counts()[kTopPlaten];
-    set_top_velocity(cell, -servo.speed(top, n * cell.kn_wall, dt));
-    const bool check = (s + 1) % 200 == 0;
-    sim.step(check);
-    if (!check) continue;
-    const Real ratio = sim.unbalanced_ratio();
-    // The servo holds the top platen; the bottom one differs by what the membrane carries through
-    // friction and its own axial stiffness, so only the controlled stress decides.
-    const Real err = std::fabs(top - tc.sigma3) / tc.sigma3;
-    if (verbose) {
-      char extra[96];
-      std::snprintf(extra, sizeof extra, "sigma_top %.1f kPa, sigma_bottom %.1f kPa, unbalanced %.1e", top / 1e3,
-                    bottom / 1e3, ratio);
-      cons.update(s + 1, extra);
-    }
-    if (err < tc.consolidation_tol && ratio < tc.stop_ratio) break;
-  }
-  if (s >= tc.max_consolidation_steps)
-    throw ConfigError(cfg.path + ": [triaxial] max_consolidation_steps: consolidation to " +
-                      std::to_string(tc.sigma3 / 1e3) + " kPa did not settle within " +
-                      std::to_string(tc.max_consolidation_steps) + " steps");
-  res.consolidation_steps = s + 1;
-  const Real h0 = sim.wall_point(kTopPlaten).z;
-  const Real v0 = specimen_volume(cell);
-  const int env_slabs = tc.membrane_segments;
-  const Real v0_envelope = envelope_volume(cell, env_slabs);
-  res.void_ratio_consolidated = v0 / cell.solid_volume - 1;
-  if (verbose)
-    std::printf("\nconsolidated at %.0f kPa: e = %.4f, height %.3f mm after %ld steps\n", tc.sigma3 / 1e3,
-                res.void_ratio_consolidated, h0 * 1e3, res.consolidation_steps);
-
-  // Shear: constant platen speed from the inertial number (density scaling counts in rho).
-  const Real rho = cfg.particles.density * cfg.solver.mass_scale;
-  res.shear_rate = tc.inertial_number / (cfg.particles.diameter * std::sqrt(rho / tc.sigma3));
-  res.inertial_number = tc.inertial_number;
-  set_top_velocity(cell, -res.shear_rate * h0);
-  const long steps = static_cast<long>(std::ceil(tc.axial_strain_end / (res.shear_rate * dt)));
-  if (verbose)
-    std::printf("shear: strain rate %.3g 1/s (inertial number %.1e%s), %ld steps to %.0f%%\n", res.shear_rate,
-                tc.inertial_number, cfg.solver.mass_scale != 1 ? ", with density scaling" : "", steps,
-                tc.axial_strain_end * 100);
-  std::vector<std::string> columns = {"eps_a_pct",        "eps_v_pct",          "q_kPa",
-                                      "sigma1_kPa",       "sigma1_bottom_kPa",  "sigma3_kPa",
-                                      "sigma3_balls_kPa", "eps_v_envelope_pct", "unbalanced_ratio",
-                                      "kinetic_energy_J"};
-  const MicroConfig& mc = cfg.micro;
-  if (mc.enabled)
-    for (const std::string& prefix : {std::string(), std::string("rve_")})
-      for (const std::string& c : micro_columns(prefix)) columns.push_back(c);
-  if (out) out->set_series_columns(columns);
-  const Real snaps[] = {0.0, 0.01, 0.05, tc.axial_strain_end};
-  const char* snap_labels[] = {"A", "B", "C", "D"};  // the paper's points A-D (Figure 8)
-  Real q_max = -INFINITY;
-  int next_snap = 0;
-  Real next_record = 0;
-  Progress shear("shear", steps);
-  for (long k = 0; k <= steps; ++k) {
-    const Real eps_a = (h0 - sim.wall_point(kTopPlaten).z) / h0;
-    if (eps_a >= next_record - 1e-12 || k == steps) {
-      TriaxialRecord r;
+  // A blow-up saves the state it happened in (balls, membrane, contacts) and the curve so far, then stops.
+  try {
+    // Isotropic consolidation: cell pressure on the membrane, stress servo on the top platen.
+    StressServo servo;
+    servo.target = tc.sigma3;
+    servo.area = cell.area;
+    servo.v_max = 0.05 * sp.height / (2000 * dt);  // at most 5% of the height in 2000 steps
+    Progress cons("consolidation", tc.max_consolidation_steps);
+    long s = 0;
+    for (; s < tc.max_consolidation_steps; ++s) {
       const auto [top, bottom] = platen_stresses(cell);
-      r.eps_a = eps_a;
-      r.eps_v = (v0 - specimen_volume(cell)) / v0;
-      r.sigma1 = top;
-      r.sigma1_bottom = bottom;
-      r.q = top - tc.sigma3;
-      r.sigma3_balls = lateral_stress(cell);
-      r.eps_v_envelope = (v0_envelope - envelope_volume(cell, env_slabs)) / v0_envelope;
-      r.unbalanced = sim.unbalanced_ratio();
-      r.kinetic = sim.stats().kinetic;
-      res.records.push_back(r);
-      std::vector<double> row = {100 * r.eps_a,        100 * r.eps_v,          r.q / 1e3,    r.sigma1 / 1e3,
-                                 r.sigma1_bottom / 1e3, tc.sigma3 / 1e3,        r.sigma3_balls / 1e3,
-                                 100 * r.eps_v_envelope, r.unbalanced,          r.kinetic};
-      if (mc.enabled) {
-        const ContactSet cs = contact_set(sim);
-        const ContactSet rve = restrict_to_cube(cs, Vec3(0, 0, sim.wall_point(kTopPlaten).z / 2), mc.rve_edge);
-        const MicroRow m = micro_row(cs, specimen_volume(cell));
-        res.micro.push_back(m);
-        for (const MicroRow& x : {m, micro_row(rve, mc.rve_edge * mc.rve_edge * mc.rve_edge)})
-          for (double v : micro_values(x)) row.push_back(v);
-        const bool snap_due = next_snap < 4 && eps_a >= snaps[next_snap] - 1e-12;
-        if (out && snap_due) write_micro_state(out->folder(), snap_labels[next_snap], cs, rve, mc.rose_bins);
-        if (out && r.q > q_max) write_micro_state(out->folder(), "peak", cs, rve, mc.rose_bins);
-      }
-      q_max = std::max(q_max, r.q);
-      if (out) {
-        out->append_series(row);
-        if (res.records.size() % 25 == 0) out->flush_series();  // a crash keeps the curve so far
-      }
-      next_record += tc.record_every;
+      const int n = sim.wall_contact_counts()[kTopPlaten];
+      set_top_velocity(cell, -servo.speed(top, n * cell.kn_wall, dt));
+      const bool check = (s + 1) % 200 == 0;
+      sim.step(check);
+      if (!check) continue;
+      const Real ratio = sim.unbalanced_ratio();
+      // The servo holds the top platen; the bottom one differs by what the membrane carries through
+      // friction and its own axial stiffness, so only the controlled stress decides.
+      const Real err = std::fabs(top - tc.sigma3) / tc.sigma3;
       if (verbose) {
-        char extra[64];
-        std::snprintf(extra, sizeof extra, "eps_a %.2f%%, q %.1f kPa", 100 * eps_a, r.q / 1e3);
-        shear.update(k, extra);
+        char extra[96];
+        std::snprintf(extra, sizeof extra, "sigma_top %.1f kPa, sigma_bottom %.1f kPa, unbalanced %.1e", top / 1e3,
+                      bottom / 1e3, ratio);
+        cons.update(s + 1, extra);
       }
+      if (err < tc.consolidation_tol && ratio < tc.stop_ratio) break;
     }
-    if (out && next_snap < 4 && eps_a >= snaps[next_snap] - 1e-12) {
-      char label[48];
-      std::snprintf(label, sizeof label, "shear eps_a=%.0f%%", 100 * snaps[next_snap]);
+    if (s >= tc.max_consolidation_steps)
+      throw ConfigError(cfg.path + ": [triaxial] max_consolidation_steps: consolidation to " +
+                        std::to_string(tc.sigma3 / 1e3) + " kPa did not settle within " +
+                        std::to_string(tc.max_consolidation_steps) + " steps");
+    res.consolidation_steps = s + 1;
+    const Real h0 = sim.wall_point(kTopPlaten).z;
+    const Real v0 = specimen_volume(cell);
+    const int env_slabs = tc.membrane_segments;
+    const Real v0_envelope = envelope_volume(cell, env_slabs);
+    res.void_ratio_consolidated = v0 / cell.solid_volume - 1;
+    if (verbose)
+      std::printf("\nconsolidated at %.0f kPa: e = %.4f, height %.3f mm after %ld steps\n", tc.sigma3 / 1e3,
+                  res.void_ratio_consolidated, h0 * 1e3, res.consolidation_steps);
+
+    // Shear: constant platen speed from the inertial number (density scaling counts in rho).
+    const Real rho = cfg.particles.density * cfg.solver.mass_scale;
+    res.shear_rate = tc.inertial_number / (cfg.particles.diameter * std::sqrt(rho / tc.sigma3));
+    res.inertial_number = tc.inertial_number;
+    set_top_velocity(cell, -res.shear_rate * h0);
+    const long steps = static_cast<long>(std::ceil(tc.axial_strain_end / (res.shear_rate * dt)));
+    if (verbose)
+      std::printf("shear: strain rate %.3g 1/s (inertial number %.1e%s), %ld steps to %.0f%%\n", res.shear_rate,
+                  tc.inertial_number, cfg.solver.mass_scale != 1 ? ", with density scaling" : "", steps,
+                  tc.axial_strain_end * 100);
+    std::vector<std::string> columns = {"eps_a_pct",        "eps_v_pct",          "q_kPa",
+                                        "sigma1_kPa",       "sigma1_bottom_kPa",  "sigma3_kPa",
+                                        "sigma3_balls_kPa", "eps_v_envelope_pct", "unbalanced_ratio",
+                                        "kinetic_energy_J"};
+    const MicroConfig& mc = cfg.micro;
+    if (mc.enabled)
+      for (const std::string& prefix : {std::string(), std::string("rve_")})
+        for (const std::string& c : micro_columns(prefix)) columns.push_back(c);
+    if (out) out->set_series_columns(columns);
+    const Real snaps[] = {0.0, 0.01, 0.05, tc.axial_strain_end};
+    const char* snap_labels[] = {"A", "B", "C", "D"};  // the paper's points A-D (Figure 8)
+    Real q_max = -INFINITY;
+    int next_snap = 0;
+    Real next_record = 0;
+    Progress shear("shear", steps);
+    for (long k = 0; k <= steps; ++k) {
+      const Real eps_a = (h0 - sim.wall_point(kTopPlaten).z) / h0;
+      if (eps_a >= next_record - 1e-12 || k == steps) {
+        TriaxialRecord r;
+        const auto [top, bottom] = platen_stresses(cell);
+        r.eps_a = eps_a;
+        r.eps_v = (v0 - specimen_volume(cell)) / v0;
+        r.sigma1 = top;
+        r.sigma1_bottom = bottom;
+        r.q = top - tc.sigma3;
+        r.sigma3_balls = lateral_stress(cell);
+        r.eps_v_envelope = (v0_envelope - envelope_volume(cell, env_slabs)) / v0_envelope;
+        r.unbalanced = sim.unbalanced_ratio();
+        r.kinetic = sim.stats().kinetic;
+        res.records.push_back(r);
+        std::vector<double> row = {100 * r.eps_a,        100 * r.eps_v,          r.q / 1e3,    r.sigma1 / 1e3,
+                                   r.sigma1_bottom / 1e3, tc.sigma3 / 1e3,        r.sigma3_balls / 1e3,
+                                   100 * r.eps_v_envelope, r.unbalanced,          r.kinetic};
+        if (mc.enabled) {
+          const ContactSet cs = contact_set(sim);
+          const ContactSet rve = restrict_to_cube(cs, Vec3(0, 0, sim.wall_point(kTopPlaten).z / 2), mc.rve_edge);
+          const MicroRow m = micro_row(cs, specimen_volume(cell));
+          res.micro.push_back(m);
+          for (const MicroRow& x : {m, micro_row(rve, mc.rve_edge * mc.rve_edge * mc.rve_edge)})
+            for (double v : micro_values(x)) row.push_back(v);
+          const bool snap_due = next_snap < 4 && eps_a >= snaps[next_snap] - 1e-12;
+          if (out && snap_due) write_micro_state(out->folder(), snap_labels[next_snap], cs, rve, mc.rose_bins);
+          if (out && r.q > q_max) write_micro_state(out->folder(), "peak", cs, rve, mc.rose_bins);
+        }
+        q_max = std::max(q_max, r.q);
+        if (out) {
+          out->append_series(row);
+          if (res.records.size() % 25 == 0) out->flush_series();  // a crash keeps the curve so far
+        }
+        next_record += tc.record_every;
+        if (verbose) {
+          char extra[64];
+          std::snprintf(extra, sizeof extra, "eps_a %.2f%%, q %.1f kPa", 100 * eps_a, r.q / 1e3);
+          shear.update(k, extra);
+        }
+      }
+      if (out && next_snap < 4 && eps_a >= snaps[next_snap] - 1e-12) {
+        char label[48];
+        std::snprintf(label, sizeof label, "shear eps_a=%.0f%%", 100 * snaps[next_snap]);
+        const io::SurfaceSnapshot membrane_surface = surface(cell);
+        const io::ContactTable contacts = contact_table(contact_set(sim));
+        out->write_snapshot(take_snapshot(sim, label), &membrane_surface, mc.enabled ? &contacts : nullptr);
+        ++next_snap;
+      }
+      if (k == steps) break;
+      // The unbalanced ratio and kinetic energy cost a pass: measured on the steps before a record only.
+      sim.step((h0 - sim.wall_point(kTopPlaten).z) / h0 + res.shear_rate * dt >= next_record - 1e-12 || k + 1 == steps);
+    }
+  } catch (const BlowUp&) {
+    if (out) {
+      out->flush_series();
       const io::SurfaceSnapshot membrane_surface = surface(cell);
       const io::ContactTable contacts = contact_table(contact_set(sim));
-      out->write_snapshot(take_snapshot(sim, label), &membrane_surface, mc.enabled ? &contacts : nullptr);
-      ++next_snap;
+      out->write_snapshot(take_snapshot(sim, "blow-up"), &membrane_surface, &contacts);
+      std::fprintf(stderr, "triaxdem: state at the blow-up saved in %s (snapshots.xdmf, last entry)\n",
+                   out->folder().c_str());
     }
-    if (k == steps) break;
-    // The unbalanced ratio and kinetic energy cost a pass: measured on the steps before a record only.
-    sim.step((h0 - sim.wall_point(kTopPlaten).z) / h0 + res.shear_rate * dt >= next_record - 1e-12 || k + 1 == steps);
+    throw;
   }
   if (out) out->flush_series();
   for (std::size_t i = 0; i < res.records.size(); ++i) {
