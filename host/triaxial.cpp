@@ -221,7 +221,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
     servo.target = tc.sigma3;
     servo.area = cell.area;
     servo.v_max = 0.05 * sp.height / (2000 * dt);  // at most 5% of the height in 2000 steps
-    Progress cons("consolidation", tc.max_consolidation_steps);
+    Progress cons("consolidation (ETA to the step cap)", tc.max_consolidation_steps);
     long s = 0;
     for (; s < tc.max_consolidation_steps; ++s) {
       const auto [top, bottom] = platen_stresses(cell);
