@@ -113,13 +113,13 @@ def main():
             continue
         r = read_csv(path)
         th = np.radians(r["theta_deg"])
-        # The rose in a vertical plane: theta from the z axis, mirrored to the other side of the axis.
-        ang = np.concatenate([np.pi / 2 - th, np.pi / 2 + th, [np.pi / 2 - th[0]]])
+        # The rose in a vertical plane: theta from the z axis (up), down one side and back up the mirror side.
+        ang = np.concatenate([np.pi / 2 - th, (np.pi / 2 + th)[::-1], [np.pi / 2 - th[0]]])
         pa = fig.add_subplot(gs[1, k], projection="polar")
         for key, label in (("density_all", "contact density"), ("fn_all_N", "normal force"),
                            ("ft_all_N", "tangential force")):
             v = r[key] / max(r[key].max(), 1e-300)
-            pa.plot(ang, np.concatenate([v, v, [v[0]]]), label=label)
+            pa.plot(ang, np.concatenate([v, v[::-1], [v[0]]]), label=label)
         pa.set_title(f"{p}", fontsize=10)
         pa.set_yticklabels([])
         if k == 0:
