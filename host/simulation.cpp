@@ -93,6 +93,7 @@ void Simulation::step(bool measure) {
     membrane_prm_.dt = dt;
     membrane_forces(membrane_, cell_pressure_, FacetContacts{wall_c_, obj_offsets_, walls_.n, p_.x}, membrane_f_);
     membrane_stats_ = membrane_integrate(membrane_, membrane_f_, membrane_prm_);
+    times_.membrane += seconds_since(t);
   }
   prm_.integ.measure = measure;
   stats_ = integrate(p_, prm_.integ, make_gather(p_, balls_, adj_balls_, wall_c_, adj_walls_));

@@ -30,6 +30,7 @@ struct SimParams {
 /// Wall-clock seconds spent per stage.
 struct StageTimes {
   double rebuild = 0, forces = 0, integrate = 0, boundaries = 0;  ///< integrate includes the gather
+  double membrane = 0;  ///< membrane elasticity, pressure, reactions and node integration
   long rebuilds = 0;
 };
 

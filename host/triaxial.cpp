@@ -360,6 +360,9 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
   if (!res.records.empty()) res.q_end = res.records.back().q;
   res.escaped = count_escaped(cell);
   res.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  res.times = sim.times();
+  res.steps = sim.step_count();
+  res.balls = sim.particles().n;
   return res;
 }
 
@@ -390,6 +393,13 @@ int triaxial_job(const Config& cfg) {
                   r.records[k].q / (cfg.triaxial.sigma3 + r.records[k].q / 3), m.q_over_p, m.q_over_p_sff, m.all.a_c,
                   m.all.a_n, m.all.a_t, m.z.z);
     }
+    const StageTimes& t = r.times;
+    const double loop = t.rebuild + t.forces + t.membrane + t.integrate + t.boundaries;
+    std::printf("time loop (consolidation and shear): %ld steps, rebuild %.1f s (%ld rebuilds), forces %.1f s, "
+                "membrane %.1f s, gather+integrate %.1f s, walls %.1f s; %.3g particle-steps/s; measurements and "
+                "output %.1f s\n",
+                r.steps, t.rebuild, t.rebuilds, t.forces, t.membrane, t.integrate, t.boundaries,
+                r.balls * static_cast<double>(r.steps) / std::max(1e-9, loop), r.wall_seconds - loop);
     TestSummary s;
     s.kind = "membrane";
     s.sigma3 = cfg.triaxial.sigma3;

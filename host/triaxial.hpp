@@ -9,6 +9,7 @@
 #include "host/micro_report.hpp"
 #include "host/specimen.hpp"
 #include "io_hdf5.hpp"
+#include "simulation.hpp"
 
 namespace dem {
 
@@ -36,6 +37,9 @@ struct TriaxialResult {
   Real q_end = 0, max_dilatancy = 0;  ///< max of -d eps_v / d eps_a
   int escaped = 0;             ///< balls whose centre ended outside the membrane (should be 0)
   double wall_seconds = 0;
+  StageTimes times;            ///< time loop of consolidation and shear, per stage
+  long steps = 0;              ///< time steps of consolidation and shear
+  long balls = 0;
 };
 
 /// Runs consolidation and shear on `specimen`; writes series and snapshots to `out` when given.
