@@ -47,13 +47,21 @@ Real mean_ball_fn(const ContactSet& s) {
   Real sum = 0;
   long n = 0;
   for (const ContactRecord& c : s.contacts)
-    if (c.boundary == Boundary::kNone) sum += c.fn, ++n;
+    if (c.boundary == Boundary::kNone && c.in_volume) sum += c.fn, ++n;
   return n > 0 ? sum / n : 0;
 }
 
-bool in_network(const ContactRecord& c, Network net, Real threshold) {
+/// Whether a contact is of the network (its volume membership aside).
+bool of_network(const ContactRecord& c, Network net, Real threshold) {
   return net == Network::kAll || (net == Network::kStrong ? c.fn > threshold : c.fn <= threshold);
 }
+
+/// Contact averages use the contacts of the network inside the volume.
+bool in_network(const ContactRecord& c, Network net, Real threshold) {
+  return c.in_volume && of_network(c, net, threshold);
+}
+
+bool ball_inside(const ContactSet& s, int q) { return s.inside.empty() || s.inside[q]; }
 
 }  // namespace
 
@@ -181,33 +189,43 @@ ContactSet contact_set(const io::SnapshotFile& f, const std::string& path) {
 }
 
 Coordination coordination(const ContactSet& s, Network net) {
-  const std::size_t np = s.radius.size();
+  const std::size_t nball = s.radius.size();
   const Real threshold = mean_ball_fn(s);
-  std::vector<int> counted(np, 0), balls_only(np, 0);
+  std::vector<int> counted(nball, 0), balls_only(nball, 0);
   long nc = 0, nbb = 0;
   for (const ContactRecord& c : s.contacts) {
-    if (c.boundary == Boundary::kPlaten || !in_network(c, net, threshold)) continue;
-    ++nc;
+    if (c.boundary == Boundary::kPlaten || !of_network(c, net, threshold)) continue;
+    if (c.in_volume) ++nc, nbb += c.boundary == Boundary::kNone;
     ++counted[c.a];
     if (c.boundary == Boundary::kNone) {
-      ++nbb;
       ++counted[c.b];
       ++balls_only[c.a];
       ++balls_only[c.b];
     }
   }
   Coordination z;
+  long np = 0, n0 = 0, n1 = 0;
+  int nmax = 0;
+  for (std::size_t q = 0; q < nball; ++q) {
+    if (!ball_inside(s, static_cast<int>(q))) continue;
+    ++np;
+    n0 += balls_only[q] == 0;
+    n1 += balls_only[q] == 1;
+    nmax = std::max(nmax, counted[q]);
+  }
   if (np == 0) return z;
   // Every ball-ball contact has two ends, a membrane contact one ball end: Eq. 17 counts contacts, so
   // 2 Nc / Np with Nc = ball-ball + membrane contacts, as the paper's PFC count does.
   z.z = 2.0 * nc / np;
   z.z_balls = 2.0 * nbb / np;
-  const long n0 = std::count(balls_only.begin(), balls_only.end(), 0);
-  const long n1 = std::count(balls_only.begin(), balls_only.end(), 1);
-  z.z_mech = static_cast<long>(np) - n0 - n1 > 0 ? (2.0 * nbb - n1) / (static_cast<long>(np) - n0 - n1) : 0;
-  const int nmax = np > 0 ? *std::max_element(counted.begin(), counted.end()) : 0;
+  // Thornton's Z_m from the balls' own counts (each contact of a ball inside, wherever its point lies).
+  long ends = 0;
+  for (std::size_t q = 0; q < nball; ++q)
+    if (ball_inside(s, static_cast<int>(q))) ends += balls_only[q];
+  z.z_mech = np - n0 - n1 > 0 ? static_cast<Real>(ends - n1) / (np - n0 - n1) : 0;
   z.on.assign(nmax + 1, 0);
-  for (int n : counted) ++z.on[n];
+  for (std::size_t q = 0; q < nball; ++q)
+    if (ball_inside(s, static_cast<int>(q))) ++z.on[counted[q]];
   return z;
 }
 
@@ -220,15 +238,16 @@ Networks networks(const ContactSet& s, Real volume) {
     NetworkStats& n = *sets[k];
     std::vector<char> touched(s.radius.size(), 0);
     for (const ContactRecord& c : s.contacts) {
-      if (c.boundary != Boundary::kNone || !in_network(c, kinds[k], w.threshold)) continue;
+      if (c.boundary != Boundary::kNone || !of_network(c, kinds[k], w.threshold)) continue;
+      touched[c.a] = touched[c.b] = 1;
+      if (!c.in_volume) continue;
       ++n.contacts;
       n.mean_fn += c.fn;
       n.mean_ft += norm(c.ft);
-      touched[c.a] = touched[c.b] = 1;
       const Tensor t = outer(c.branch, c.fn * c.normal + c.ft);
       for (int q = 0; q < 9; ++q) n.stress[q] += t[q] / volume;
     }
-    n.particles = std::count(touched.begin(), touched.end(), 1);
+    for (std::size_t q = 0; q < touched.size(); ++q) n.particles += touched[q] && ball_inside(s, static_cast<int>(q));
     if (n.contacts > 0) {
       n.mean_fn /= n.contacts;
       n.mean_ft /= n.contacts;
@@ -327,7 +346,7 @@ std::vector<RoseBin> rose(const ContactSet& s, int bins, Network net) {
 Tensor love_weber(const ContactSet& s, Real volume, bool include_boundary) {
   Tensor t{};
   for (const ContactRecord& c : s.contacts) {
-    if (c.boundary != Boundary::kNone && !include_boundary) continue;
+    if ((c.boundary != Boundary::kNone && !include_boundary) || !c.in_volume) continue;
     const Tensor o = outer(c.branch, c.fn * c.normal + c.ft);
     for (int q = 0; q < 9; ++q) t[q] += o[q] / volume;
   }
@@ -359,36 +378,20 @@ ContactSet restrict_to_cube(const ContactSet& s, const Vec3& centre, Real edge) 
   ContactSet r;
   r.x = s.x;
   r.radius = s.radius;
-  for (const ContactRecord& c : s.contacts)
-    if (inside(c.point)) r.contacts.push_back(c);
-  // Balls outside the cube stay in the arrays (indices are gids) but get no contacts; coordination over
-  // the cube uses the balls whose centres are inside.
-  std::vector<Vec3> x;
-  std::vector<Real> rad;
-  std::vector<int> map(s.x.size(), -1);
-  for (std::size_t q = 0; q < s.x.size(); ++q)
-    if (inside(s.x[q])) {
-      map[q] = static_cast<int>(x.size());
-      x.push_back(s.x[q]);
-      rad.push_back(s.radius[q]);
-    }
-  ContactSet out;
-  out.x = x;
-  out.radius = rad;
-  for (ContactRecord c : r.contacts) {
-    if (map[c.a] < 0 || (c.b >= 0 && map[c.b] < 0)) continue;
-    c.a = map[c.a];
-    if (c.b >= 0) c.b = map[c.b];
-    out.contacts.push_back(c);
+  r.inside.assign(s.x.size(), 0);
+  for (std::size_t q = 0; q < s.x.size(); ++q) r.inside[q] = ball_inside(s, static_cast<int>(q)) && inside(s.x[q]);
+  for (ContactRecord c : s.contacts) {
+    c.in_volume = c.in_volume && inside(c.point);
+    if (c.in_volume || r.inside[c.a] || (c.b >= 0 && r.inside[c.b])) r.contacts.push_back(c);
   }
-  return out;
+  return r;
 }
 
 void write_force_chains_vtk(const std::string& path, const ContactSet& s) {
   const Real threshold = mean_ball_fn(s);
   std::vector<const ContactRecord*> cs;
   for (const ContactRecord& c : s.contacts)
-    if (c.boundary == Boundary::kNone) cs.push_back(&c);
+    if (c.boundary == Boundary::kNone && c.in_volume) cs.push_back(&c);
   std::ostringstream o;
   o.precision(9);
   o << "# vtk DataFile Version 3.0\ntriaxdem force chains: segments between ball centres\nASCII\n"

@@ -29,12 +29,14 @@ struct ContactRecord {
   Vec3 branch;           ///< x_b - x_a (ball-ball) or point - x_a (boundary), m
   Real fn = 0;           ///< normal force (N), > 0
   Vec3 ft;               ///< tangential force on b (N), perpendicular to normal
+  bool in_volume = true; ///< contact point inside the analysed volume (false: kept only for per-ball counts)
 };
 
 struct ContactSet {
   std::vector<Vec3> x;          ///< ball centres by gid (m)
   std::vector<Real> radius;     ///< m
   std::vector<ContactRecord> contacts;  ///< touching contacts only
+  std::vector<char> inside;     ///< balls of the analysed volume (empty: all)
 };
 
 /// Touching contacts of a simulation. Analytic walls count as platens, facets as membrane.
@@ -97,8 +99,10 @@ std::vector<RoseBin> rose(const ContactSet& s, int bins, Network net = Network::
 /// With boundary contacts included it is the specimen's mean stress.
 Tensor love_weber(const ContactSet& s, Real volume, bool include_boundary);
 
-/// The contacts and balls of a cube of side `edge` centred at `centre` (contact point inside; balls by
-/// centre). Throws std::invalid_argument naming the cube and the specimen's extent when it does not fit.
+/// The cube of side `edge` centred at `centre`: balls by centre, contacts by contact point. Contact
+/// averages (2 Nc / Np, forces, fabric, stress) use the contacts inside; per-ball counts (O_n, Z_mech) use
+/// every contact of the balls inside, so balls at the faces are not undercounted. Throws
+/// std::invalid_argument naming the cube and the specimen's extent when it does not fit.
 ContactSet restrict_to_cube(const ContactSet& s, const Vec3& centre, Real edge);
 
 /// Force chains for ParaView (legacy VTK polydata): a segment between the centres of every ball-ball

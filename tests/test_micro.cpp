@@ -4,6 +4,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -167,9 +168,18 @@ TEST(Micro, CubeCutKeepsInsideContactsAndRefusesAnOversizedCube) {
     s.contacts.push_back(c);
   }
   const ContactSet cube = restrict_to_cube(s, Vec3(0, 0, 9e-3), 2.2e-3);  // z in [7.9, 10.1] mm: balls 4, 5
-  EXPECT_EQ(cube.x.size(), 2u);
-  ASSERT_EQ(cube.contacts.size(), 1u);  // the contact at z = 9 mm
-  EXPECT_DOUBLE_EQ(cube.contacts[0].fn, 5.0);
+  EXPECT_EQ(std::count(cube.inside.begin(), cube.inside.end(), 1), 2);
+  // Contact averages see only the contact at z = 9 mm (between balls 4 and 5) ...
+  const Networks w = networks(cube, 1.0);
+  EXPECT_EQ(w.all.contacts, 1);
+  EXPECT_DOUBLE_EQ(w.all.mean_fn, 5.0);
+  // ... while each ball inside keeps both its contacts for its own count (O_2 = 2, Z_mech = 2), and
+  // 2 Nc / Np = 2 x 1 / 2 counts the contacts inside.
+  const Coordination z = coordination(cube);
+  EXPECT_DOUBLE_EQ(z.z, 1.0);
+  EXPECT_DOUBLE_EQ(z.z_mech, 2.0);
+  ASSERT_EQ(z.on.size(), 3u);
+  EXPECT_EQ(z.on[2], 2);
   try {
     restrict_to_cube(s, Vec3(0, 0, 9e-3), 20e-3);
     FAIL() << "a 20 mm cube does not fit in a 2 mm wide column";

@@ -7,8 +7,8 @@ Markdown table to stdout and to RUN/micro_comparison.md.
 
 The paper's mean contact forces are read in its 20 mm central cube, so the run's rve_ columns are used.
 Definitions used here (the paper gives none): strong contacts have fn above the mean; a particle belongs to
-a network when it has at least one contact of it; the coordination plateau starts where Z stays within 2%
-of its mean over the last third of the test; the peak of anisotropy is the maximum of a_n.
+a network when it has at least one contact of it; the coordination plateau starts where 90% of the fall of Z
+from its maximum to its mean over the last third is done; the peak of anisotropy is the maximum of a_n.
 """
 import argparse
 import csv
@@ -38,10 +38,13 @@ def at(s, key, eps):
 
 
 def plateau_start(ea, z):
-    tail = z[ea >= ea[-1] * 2 / 3]
-    level = tail.mean()
-    outside = np.nonzero(np.abs(z - level) > 0.02 * level)[0]
-    return float(ea[outside[-1] + 1]) if len(outside) and outside[-1] + 1 < len(ea) else float(ea[0])
+    """First strain after the maximum of Z where 90% of its fall to the final level (mean of the last third)
+    is done."""
+    level = z[ea >= ea[-1] * 2 / 3].mean()
+    k = int(np.argmax(z))
+    drop = z[k] - level
+    after = np.nonzero(z[k:] - level <= 0.1 * drop)[0]
+    return float(ea[k + after[0]]) if len(after) else float(ea[-1])
 
 
 def main():
@@ -62,7 +65,7 @@ def main():
         "mean_contact_force_at_peak_5pct": (float(s["rve_fn_mean_N"][ipk]), f"central cube, at peak q ({ea[ipk]:.1f}%)"),
         "mean_contact_force_at_15pct": (float(s["rve_fn_mean_N"][-1]), f"central cube, at {ea[-1]:.1f}%"),
         "strain_at_peak_anisotropy": (float(ea[int(np.argmax(s["a_n"]))]), "maximum of a_n"),
-        "coordination_plateau_from_strain": (plateau_start(ea, s["Z"]), "Z within 2% of its final level"),
+        "coordination_plateau_from_strain": (plateau_start(ea, s["Z"]), "90% of the fall of Z from its maximum done"),
         "strong_to_weak_contact_force_ratio": (float(s["fn_ratio_strong_weak"][ipk]), "mean fn, at peak q"),
         "weak_to_strong_particle_ratio": (float(s["particles_weak"][ipk] / max(s["particles_strong"][ipk], 1)),
                                           "balls with a weak / a strong contact, at peak q"),
