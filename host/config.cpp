@@ -204,6 +204,7 @@ Config load_config(const std::string& path) {
   sp.integer("ball_count", c.specimen.ball_count, 0, 2000000000L);
   sp.integer("layers", c.specimen.layers, 1, 100);
   sp.number("compaction_mu_s", c.specimen.compaction_mu_s, 0, 10);
+  sp.number("settle_mu_s", c.specimen.settle_mu_s, 0, 10);
   sp.number("platen_speed_mm_s", c.specimen.platen_speed, 0, 1e4, 1e-3, true);
   sp.number("stop_ratio", c.specimen.stop_ratio, 0, 1, 1, true);
   sp.integer("max_steps_per_layer", c.specimen.max_steps_per_layer, 1, 1000000000L);

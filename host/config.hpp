@@ -60,6 +60,7 @@ struct SpecimenConfig {
   long ball_count = 0;           ///< > 0: this many balls instead (the target e then follows from it)
   long layers = 5;
   Real compaction_mu_s = 0.0;    ///< ball-ball friction while compacting (denser packings need little)
+  Real settle_mu_s = -1;         ///< >= 0: ball-ball friction once a layer is pressed, while it settles
   Real platen_speed = 0.05;      ///< m/s, top platen speed while compacting a layer (file: platen_speed_mm_s)
   Real stop_ratio = 1e-3;        ///< unbalanced-force ratio that ends a layer
   long max_steps_per_layer = 200000;

@@ -24,10 +24,7 @@ Simulation::Simulation(Particles particles, WallSet walls, FacetMesh mesh, const
   if (static_cast<int>(table.size()) != nmat * nmat)
     throw std::invalid_argument("contact parameter table must have nmat^2 entries");
   params_ = ParamTableView("dem::sim::params", nmat, nmat);
-  auto hp = Kokkos::create_mirror_view(params_);
-  for (int a = 0; a < nmat; ++a)
-    for (int b = 0; b < nmat; ++b) hp(a, b) = table[a * nmat + b];
-  Kokkos::deep_copy(params_, hp);
+  set_contact_params(table);
   if (walls_.n == 0) walls_ = WallSet(0);
   hwall_point_ = Kokkos::create_mirror_view_and_copy(HostSpace(), walls_.point);
   hwall_vel_ = Kokkos::create_mirror_view_and_copy(HostSpace(), walls_.velocity);
@@ -35,6 +32,16 @@ Simulation::Simulation(Particles particles, WallSet walls, FacetMesh mesh, const
   Kokkos::parallel_reduce("dem::sim::rmax", RangePolicy(0, p_.n),
       KOKKOS_LAMBDA(const int i, Real& acc) { acc = r(i) > acc ? r(i) : acc; }, Kokkos::Max<Real>(rmax_));
   if (prm_.skin <= 0) throw std::invalid_argument("Verlet skin must be > 0");
+}
+
+void Simulation::set_contact_params(const std::vector<ContactParams>& table) {
+  const int nmat = static_cast<int>(params_.extent(0));
+  if (static_cast<int>(table.size()) != nmat * nmat)
+    throw std::invalid_argument("contact parameter table must have nmat^2 entries");
+  auto hp = Kokkos::create_mirror_view(params_);
+  for (int a = 0; a < nmat; ++a)
+    for (int b = 0; b < nmat; ++b) hp(a, b) = table[a * nmat + b];
+  Kokkos::deep_copy(params_, hp);
 }
 
 Real Simulation::critical_dt() const {

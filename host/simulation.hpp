@@ -61,6 +61,8 @@ class Simulation {
   /// Largest stable time step estimate (s): min over particles of sqrt(m/kn) and sqrt(I/k_rot) for the
   /// stiffest (ball-wall) contact; the caller multiplies by a safety factor.
   Real critical_dt() const;
+  /// Replaces the contact laws (same nmat x nmat layout as the constructor's); contact history is kept.
+  void set_contact_params(const std::vector<ContactParams>& table);
   void set_dt(Real dt) { prm_.integ.dt = dt; }
 
   /// Makes the facet mesh a flexible membrane (m.mesh must be the mesh given to the constructor: the

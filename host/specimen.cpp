@@ -51,7 +51,7 @@ std::vector<WallSpec> mould(Real radius, Real z_top) {
 /// high. Returns the layer's step count and ratio; `progress` (may be null) is told the platen's travel in
 /// micrometres.
 std::pair<long, Real> compact(Simulation& sim, Real z_target, const SpecimenConfig& sc, Real f_limit,
-                              Progress* progress) {
+                              Progress* progress, const std::vector<ContactParams>* settle) {
   const long check_every = 200;
   const Real z_start = sim.wall_point(kTop).z;
   long s = 0;
@@ -77,6 +77,12 @@ std::pair<long, Real> compact(Simulation& sim, Real z_target, const SpecimenConf
         progress->update(std::lround((z_start - z) * 1e6), extra);
       }
       const bool blocked = load > 0.9;
+      // Pressed to its height (or as far as it goes, nearly at rest): friction now only helps the layer come
+      // to rest; switched on earlier, it would lock the packing before the platen gets there.
+      if (settle && (z - z_target < 1e-9 || (blocked && ratio < 10 * sc.stop_ratio))) {
+        sim.set_contact_params(*settle);
+        settle = nullptr;
+      }
       if ((z - z_target < 1e-9 || blocked) && ratio < sc.stop_ratio) break;
     }
   }
@@ -146,7 +152,11 @@ Specimen build_specimen(const Config& cfg, bool verbose) {
                          NormalLinear::stiffness(wall_law, cfg.particles.diameter / 2, 0);
     Progress progress("specimen layer " + std::to_string(k + 1) + "/" + std::to_string(sc.layers),
                       std::lround((z0 + h_loose - z1) * 1e6));
-    const auto [steps, ratio] = compact(sim, z1, sc, f_limit, verbose ? &progress : nullptr);
+    ContactParams settle_law = ball_law;
+    settle_law.mu_s = sc.settle_mu_s;
+    const std::vector<ContactParams> settle_table{settle_law, wall_law, wall_law, wall_law};
+    const auto [steps, ratio] = compact(sim, z1, sc, f_limit, verbose ? &progress : nullptr,
+                                        sc.settle_mu_s >= 0 ? &settle_table : nullptr);
     const HostParticles h = to_host_by_gid(sim.particles());
     for (std::size_t q = 0; q < all.size(); ++q) {
       all[q].x = h.x[q];
@@ -179,6 +189,7 @@ std::string specimen_key(const Config& cfg) {
   k.precision(17);
   k << "v2 d " << pc.diameter << " ratio " << pc.diameter_ratio << " rho " << pc.density << " D " << sc.diameter
     << " H " << sc.height << " n " << specimen_ball_count(cfg) << " layers " << sc.layers << " mu " << sc.compaction_mu_s
+    << " settle " << sc.settle_mu_s
     << " v " << sc.platen_speed << " stop " << sc.stop_ratio << " max " << sc.max_steps_per_layer << " seed "
     << cfg.run.seed << " E " << cfg.ball.emod << " kr " << cfg.ball.kratio << " bn " << cfg.ball.beta_n << " Ew "
     << cfg.wall.emod << " krw " << cfg.wall.kratio << " bnw " << cfg.wall.beta_n << " damp " << sv.damping << " g "

@@ -96,3 +96,26 @@ TEST(Specimen, SmallSpecimenReachesTheTargetVoidRatio) {
   }
   EXPECT_EQ(s.porosity_profile.size(), 24u);
 }
+
+TEST(Specimen, FrictionWhileSettlingKeepsTheTargetAndSavesSteps) {
+  // Frictionless packings creep: a layer pressed without friction takes long to reach the unbalanced ratio
+  // of 1e-3. Friction switched on once the layer is pressed must not change how far it was pressed (e
+  // within 0.01 of the target) and must bring it to rest in fewer steps.
+  Config c;
+  c.path = "<test>";
+  c.has_specimen = true;
+  c.specimen.diameter = 12e-3;
+  c.specimen.height = 12e-3;
+  c.specimen.void_ratio = 0.75;
+  c.specimen.layers = 2;
+  c.solver.mass_scale = 100;
+  c.solver.gravity = {0, 0, 0};
+  const Specimen plain = build_specimen(c, false);
+  c.specimen.settle_mu_s = 0.15;
+  const Specimen settled = build_specimen(c, false);
+  EXPECT_NEAR(settled.void_ratio, 0.75, 0.01);
+  long steps_plain = 0, steps_settled = 0;
+  for (const LayerReport& l : plain.layers) steps_plain += l.steps;
+  for (const LayerReport& l : settled.layers) steps_settled += l.steps;
+  EXPECT_LT(steps_settled, steps_plain) << steps_settled << " against " << steps_plain;
+}
