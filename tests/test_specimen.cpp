@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "host/specimen.hpp"
+#include "test_util.hpp"
 
 using namespace dem;
 
@@ -68,15 +69,8 @@ TEST(Specimen, SmallSpecimenReachesTheTargetVoidRatio) {
   // 12 mm x 12 mm, 2 mm beads, 3 layers, e = 0.80: 180 beads. The ball count is set from the target,
   // and the last platen stroke ends at the full height, so the whole specimen lands on the target up to
   // the beads that bulge over the top and bottom (their caps are cut by the slab): 0.01 as the issue asks.
-  Config c;
-  c.path = "<test>";
-  c.has_specimen = true;
-  c.specimen.diameter = 12e-3;
-  c.specimen.height = 12e-3;
-  c.specimen.void_ratio = 0.80;
-  c.specimen.layers = 3;
-  c.specimen.platen_speed = 0.05;
-  c.solver.mass_scale = 100;
+  Config c = test::specimen_config(12e-3, 0.80, 3);
+  c.solver.gravity = {0, 0, -9.81};
   c.ball.mu_s = 0.15;
   c.ball.mu_r = 0.015;
   c.wall = c.ball;
@@ -101,15 +95,7 @@ TEST(Specimen, FrictionWhileSettlingKeepsTheTargetAndSavesSteps) {
   // Frictionless packings creep: a layer pressed without friction takes long to reach the unbalanced ratio
   // of 1e-3. Friction switched on once the layer is pressed must not change how far it was pressed (e
   // within 0.01 of the target) and must bring it to rest in fewer steps.
-  Config c;
-  c.path = "<test>";
-  c.has_specimen = true;
-  c.specimen.diameter = 12e-3;
-  c.specimen.height = 12e-3;
-  c.specimen.void_ratio = 0.75;
-  c.specimen.layers = 2;
-  c.solver.mass_scale = 100;
-  c.solver.gravity = {0, 0, 0};
+  Config c = test::specimen_config(12e-3, 0.75, 2);
   const Specimen plain = build_specimen(c, false);
   c.specimen.settle_mu_s = 0.15;
   const Specimen settled = build_specimen(c, false);

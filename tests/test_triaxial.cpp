@@ -11,20 +11,14 @@
 
 #include "host/micro_report.hpp"
 #include "host/triaxial.hpp"
+#include "test_util.hpp"
 
 using namespace dem;
 
 namespace {
 
 Config tiny_config(double mu_s, double mu_r) {
-  Config c;
-  c.path = "<test>";
-  c.has_specimen = true;
-  c.specimen.diameter = 16e-3;
-  c.specimen.height = 16e-3;
-  c.specimen.void_ratio = 0.70;
-  c.specimen.layers = 3;
-  c.specimen.platen_speed = 0.05;
+  Config c = test::specimen_config(16e-3, 0.70, 3);
   c.specimen.stop_ratio = 1e-2;  // the specimen only has to be at rest enough to be sheared
   c.triaxial.sigma3 = 100e3;
   c.triaxial.stop_ratio = 1e-2;
@@ -34,8 +28,6 @@ Config tiny_config(double mu_s, double mu_r) {
   c.triaxial.membrane_around = 24;
   c.triaxial.membrane_segments = 8;
   c.micro.rve_edge = 8e-3;
-  c.solver.gravity = {0, 0, 0};
-  c.solver.mass_scale = 100;
   c.ball.mu_s = mu_s;
   c.ball.mu_r = mu_r;
   c.wall = c.ball;

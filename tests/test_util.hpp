@@ -1,5 +1,6 @@
 #pragma once
 /// Small helpers shared by the test files.
+#include "host/config.hpp"
 #include "kernels/contact_law.hpp"
 
 namespace dem::test {
@@ -15,6 +16,22 @@ inline ContactParams law(double emod, double kratio, double mu_s, double mu_r, d
   p.mu_r = mu_r;
   p.beta_n = beta_n;
   return p;
+}
+
+/// A cylindrical specimen of 2 mm beads (diameter = height = size, m) for the quick tests: density scaling
+/// x100, no gravity, the platen at 50 mm/s.
+inline Config specimen_config(double size, double void_ratio, long layers) {
+  Config c;
+  c.path = "<test>";
+  c.has_specimen = true;
+  c.specimen.diameter = size;
+  c.specimen.height = size;
+  c.specimen.void_ratio = void_ratio;
+  c.specimen.layers = layers;
+  c.specimen.platen_speed = 0.05;
+  c.solver.mass_scale = 100;
+  c.solver.gravity = {0, 0, 0};
+  return c;
 }
 
 }  // namespace dem::test
