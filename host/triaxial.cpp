@@ -13,6 +13,7 @@
 #include "progress.hpp"
 #include "servo.hpp"
 #include "study.hpp"
+#include "triaxial_measure.hpp"
 #include "simulation.hpp"
 
 namespace dem {
@@ -88,122 +89,6 @@ std::pair<Real, Real> platen_stresses(Cell& c) {
 
 Real specimen_volume(const Cell& c) { return enclosed_volume(c.membrane, 0, c.sim->wall_point(kTopPlaten).z); }
 
-/// The membrane as a triangle surface for the snapshots (ParaView shows it with the balls).
-io::SurfaceSnapshot surface(const Cell& c) {
-  auto nx = Kokkos::create_mirror_view_and_copy(HostSpace(), c.membrane.mesh.node_x);
-  auto tri = Kokkos::create_mirror_view_and_copy(HostSpace(), c.membrane.mesh.tri);
-  io::SurfaceSnapshot s;
-  for (int k = 0; k < c.membrane.mesh.nnode; ++k)
-    for (int d = 0; d < 3; ++d) s.nodes.push_back(nx(k, d));
-  for (int t = 0; t < c.membrane.mesh.ntri; ++t)
-    for (int d = 0; d < 3; ++d) s.triangles.push_back(tri(t, d));
-  return s;
-}
-
-/// Lateral stress the balls exert on the membrane (Pa): the outward normal component of the ball-facet forces
-/// over the area of the facets clear of the end rings. It differs from the cell pressure by what the
-/// membrane itself carries (hoop and axial tension of a deforming membrane, inertia). The end bands are left
-/// out: the balls cannot fill the corner between platen and membrane, so there the tied rings and the
-/// platen edge carry part of the pressure, as a lab's platens do.
-Real lateral_stress(Cell& c) {
-  const std::vector<Vec3> f = c.sim->wall_forces();
-  auto nx = Kokkos::create_mirror_view_and_copy(HostSpace(), c.membrane.mesh.node_x);
-  auto tri = Kokkos::create_mirror_view_and_copy(HostSpace(), c.membrane.mesh.tri);
-  auto fixed = Kokkos::create_mirror_view_and_copy(HostSpace(), c.membrane.fixed);
-  const int w0 = c.sim->num_walls();
-  Real fn = 0, area = 0;
-  for (int t = 0; t < c.membrane.mesh.ntri; ++t) {
-    if (fixed(tri(t, 0)) || fixed(tri(t, 1)) || fixed(tri(t, 2))) continue;
-    const Vec3 a = load(nx, tri(t, 0)), b = load(nx, tri(t, 1)), d = load(nx, tri(t, 2));
-    const Vec3 s = 0.5 * cross(b - a, d - a);  // area vector, outward (counter-clockwise seen from outside)
-    fn += dot(f[w0 + t], s) / norm(s);
-    area += norm(s);
-  }
-  return area > 0 ? fn / area : 0;
-}
-
-/// Area of the convex hull of discs of radius r centred at `pts` (m^2): hull of the centres (Andrew's
-/// monotone chain) grown by r, i.e. A_hull + r P_hull + pi r^2.
-Real disc_hull_area(std::vector<std::pair<Real, Real>> pts, Real r) {
-  std::sort(pts.begin(), pts.end());
-  pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
-  if (pts.size() < 3) return M_PI * r * r;
-  auto turn = [](const std::pair<Real, Real>& o, const std::pair<Real, Real>& a, const std::pair<Real, Real>& b) {
-    return (a.first - o.first) * (b.second - o.second) - (a.second - o.second) * (b.first - o.first);
-  };
-  std::vector<std::pair<Real, Real>> h(2 * pts.size());
-  std::size_t k = 0;
-  for (std::size_t i = 0; i < pts.size(); ++i) {
-    while (k >= 2 && turn(h[k - 2], h[k - 1], pts[i]) <= 0) --k;
-    h[k++] = pts[i];
-  }
-  for (std::size_t i = pts.size() - 1, t = k + 1; i > 0; --i) {
-    while (k >= t && turn(h[k - 2], h[k - 1], pts[i - 1]) <= 0) --k;
-    h[k++] = pts[i - 1];
-  }
-  h.resize(k - 1);
-  Real area = 0, perimeter = 0;
-  for (std::size_t i = 0; i < h.size(); ++i) {
-    const auto& a = h[i];
-    const auto& b = h[(i + 1) % h.size()];
-    area += 0.5 * (a.first * b.second - b.first * a.second);
-    perimeter += std::hypot(b.first - a.first, b.second - a.second);
-  }
-  return area + r * perimeter + M_PI * r * r;
-}
-
-/// Volume of the balls' envelope (m^3), measured without the membrane: the specimen between the platens cut
-/// into `slabs` slabs, each slab's cross-section the convex hull of its balls (centres within the slab,
-/// grown by the mean ball radius). It bounds the granular body as a wrapping membrane would, except for the
-/// dimples a soft membrane makes between the outer balls.
-Real envelope_volume(Cell& c, int slabs) {
-  const Real top = c.sim->wall_point(kTopPlaten).z, dz = top / slabs;
-  std::vector<std::vector<std::pair<Real, Real>>> xy(slabs);
-  const HostParticles h = to_host_by_gid(c.sim->particles());
-  for (const Vec3& x : h.x) xy[std::clamp(static_cast<int>(x.z / dz), 0, slabs - 1)].emplace_back(x.x, x.y);
-  Real v = 0;
-  for (auto& pts : xy) v += disc_hull_area(std::move(pts), c.mean_radius) * dz;
-  return v;
-}
-
-/// True when the horizontal ray from x away from the axis crosses triangle (a, b, c) (Moller-Trumbore).
-bool ray_crosses(const Vec3& x, const Vec3& dir, const Vec3& a, const Vec3& b, const Vec3& c) {
-  const Vec3 e1 = b - a, e2 = c - a, p = cross(dir, e2);
-  const Real det = dot(e1, p);
-  if (std::fabs(det) < 1e-300) return false;
-  const Vec3 s = x - a;
-  const Real u = dot(s, p) / det;
-  if (u < 0 || u > 1) return false;
-  const Vec3 q = cross(s, e1);
-  const Real v = dot(dir, q) / det;
-  if (v < 0 || u + v > 1) return false;
-  return dot(e2, q) / det > 0;
-}
-
-/// Balls whose centre lies outside the membrane tube or beyond the platens. Inside the tube a ray from the
-/// centre straight away from the axis crosses the membrane an odd number of times; this holds wherever the
-/// membrane bulges, unlike a comparison with a mean ring radius.
-int count_escaped(Cell& c) {
-  auto nx = Kokkos::create_mirror_view_and_copy(HostSpace(), c.membrane.mesh.node_x);
-  auto tri = Kokkos::create_mirror_view_and_copy(HostSpace(), c.membrane.mesh.tri);
-  const Real top = c.sim->wall_point(kTopPlaten).z;
-  const HostParticles h = to_host_by_gid(c.sim->particles());
-  int out = 0;
-  for (const Vec3& x : h.x) {
-    const Real rho = std::hypot(x.x, x.y);
-    if (x.z < 0 || x.z > top || !(rho > 0)) {
-      out += x.z < 0 || x.z > top;
-      continue;
-    }
-    const Vec3 dir(x.x / rho, x.y / rho, 0);
-    int crossings = 0;
-    for (int t = 0; t < c.membrane.mesh.ntri; ++t)
-      crossings += ray_crosses(x, dir, load(nx, tri(t, 0)), load(nx, tri(t, 1)), load(nx, tri(t, 2)));
-    out += crossings % 2 == 0;
-  }
-  return out;
-}
-
 }  // namespace
 
 TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* out, bool verbose) {
@@ -250,7 +135,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
     const Real h0 = sim.wall_point(kTopPlaten).z;
     const Real v0 = specimen_volume(cell);
     const int env_slabs = tc.membrane_segments;
-    const Real v0_envelope = envelope_volume(cell, env_slabs);
+    const Real v0_envelope = envelope_volume(sim, sim.wall_point(kTopPlaten).z, cell.mean_radius, env_slabs);
     res.void_ratio_consolidated = v0 / cell.solid_volume - 1;
     if (verbose)
       std::printf("\nconsolidated at %.0f kPa: e = %.4f, height %.3f mm after %ld steps\n", tc.sigma3 / 1e3,
@@ -291,8 +176,8 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
         r.sigma1 = top;
         r.sigma1_bottom = bottom;
         r.q = top - tc.sigma3;
-        r.sigma3_balls = lateral_stress(cell);
-        r.eps_v_envelope = (v0_envelope - envelope_volume(cell, env_slabs)) / v0_envelope;
+        r.sigma3_balls = lateral_stress(sim, cell.membrane);
+        r.eps_v_envelope = (v0_envelope - envelope_volume(sim, sim.wall_point(kTopPlaten).z, cell.mean_radius, env_slabs)) / v0_envelope;
         r.unbalanced = sim.unbalanced_ratio();
         r.kinetic = sim.stats().kinetic;
         res.records.push_back(r);
@@ -325,9 +210,9 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
       if (out && next_snap < 4 && eps_a >= snaps[next_snap] - 1e-12) {
         char label[48];
         std::snprintf(label, sizeof label, "shear eps_a=%.0f%%", 100 * snaps[next_snap]);
-        const io::SurfaceSnapshot membrane_surface = surface(cell);
+        const io::SurfaceSnapshot surface = membrane_surface(cell.membrane);
         const io::ContactTable contacts = contact_table(contact_set(sim));
-        out->write_snapshot(take_snapshot(sim, label), &membrane_surface, mc.enabled ? &contacts : nullptr);
+        out->write_snapshot(take_snapshot(sim, label), &surface, mc.enabled ? &contacts : nullptr);
         ++next_snap;
       }
       if (k == steps) break;
@@ -337,9 +222,9 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
   } catch (const BlowUp&) {
     if (out) {
       out->flush_series();
-      const io::SurfaceSnapshot membrane_surface = surface(cell);
+      const io::SurfaceSnapshot surface = membrane_surface(cell.membrane);
       const io::ContactTable contacts = contact_table(contact_set(sim));
-      out->write_snapshot(take_snapshot(sim, "blow-up"), &membrane_surface, &contacts);
+      out->write_snapshot(take_snapshot(sim, "blow-up"), &surface, &contacts);
       std::fprintf(stderr, "triaxdem: state at the blow-up saved in %s (snapshots.xdmf, last entry)\n",
                    out->folder().c_str());
     }
@@ -358,7 +243,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
                                                           (r.eps_a - res.records[i - 1].eps_a));
   }
   if (!res.records.empty()) res.q_end = res.records.back().q;
-  res.escaped = count_escaped(cell);
+  res.escaped = count_escaped(sim, cell.membrane, sim.wall_point(kTopPlaten).z);
   res.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   res.times = sim.times();
   res.steps = sim.step_count();
