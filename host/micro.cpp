@@ -63,6 +63,19 @@ bool in_network(const ContactRecord& c, Network net, Real threshold) {
 
 bool ball_inside(const ContactSet& s, int q) { return s.inside.empty() || s.inside[q]; }
 
+/// A touching contact of ball a along `d` (from a's centre to the other centre or to the contact point),
+/// from the force on a (`fc_on_a`) and the linear normal force: the force on b is the reaction.
+ContactRecord record(int a, const Vec3& d, const Vec3& fc_on_a, Real fn) {
+  ContactRecord c;
+  c.a = a;
+  c.branch = d;
+  c.normal = (1 / norm(d)) * d;
+  const Vec3 f = -1.0 * fc_on_a;
+  c.fn = fn;
+  c.ft = f - dot(f, c.normal) * c.normal;
+  return c;
+}
+
 }  // namespace
 
 ContactSet contact_set(Simulation& sim) {
@@ -83,16 +96,10 @@ ContactSet contact_set(Simulation& sim) {
   auto fn = Kokkos::create_mirror_view_and_copy(HostSpace(), bc.fn);
   for (int k = 0; k < bc.n; ++k) {
     if (!(fn(k) > 0)) continue;
-    ContactRecord c;
-    c.a = static_cast<int>(gid(ci(k)));
-    c.b = static_cast<int>(gid(cj(k)));
-    c.branch = dom.min_image(s.x[c.b] - s.x[c.a]);
-    const Real l = norm(c.branch);
-    c.normal = (1 / l) * c.branch;
-    const Vec3 f = -1.0 * load(fc, k);  // fc acts on particle a: the force on b is its reaction
-    c.fn = fn(k);
-    c.ft = f - dot(f, c.normal) * c.normal;
-    const Real overlap = s.radius[c.a] + s.radius[c.b] - l;
+    const int a = static_cast<int>(gid(ci(k))), b = static_cast<int>(gid(cj(k)));
+    ContactRecord c = record(a, dom.min_image(s.x[b] - s.x[a]), load(fc, k), fn(k));
+    c.b = b;
+    const Real overlap = s.radius[a] + s.radius[b] - norm(c.branch);
     c.point = s.x[c.a] + (s.radius[c.a] - overlap / 2) * c.normal;
     s.contacts.push_back(c);
   }
@@ -112,28 +119,20 @@ ContactSet contact_set(Simulation& sim) {
   auto tri = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.tri);
   for (int k = 0; k < wc.n; ++k) {
     if (!(wn(k) > 0)) continue;
-    ContactRecord c;
-    c.a = static_cast<int>(gid(wi(k)));
-    const Vec3& x = s.x[c.a];
+    const int a = static_cast<int>(gid(wi(k)));
+    const Vec3& x = s.x[a];
     const int obj = wj(k);
     Vec3 cp;
     if (obj < walls.n) {
-      c.boundary = Boundary::kPlaten;
       if (!wall_closest_point(kind(obj), load(wp, obj), load(wnorm, obj), wrad(obj), x, cp)) continue;
     } else {
-      c.boundary = Boundary::kMembrane;
       const int t = obj - walls.n;
       cp = closest_on_triangle(x, load(nx, tri(t, 0)), load(nx, tri(t, 1)), load(nx, tri(t, 2))).cp;
     }
-    const Vec3 d = cp - x;
-    const Real l = norm(d);
-    if (!(l > 0)) continue;
-    c.normal = (1 / l) * d;
-    const Vec3 f = -1.0 * load(wf, k);
-    c.fn = wn(k);
-    c.ft = f - dot(f, c.normal) * c.normal;
+    if (!(norm(cp - x) > 0)) continue;
+    ContactRecord c = record(a, cp - x, load(wf, k), wn(k));
+    c.boundary = obj < walls.n ? Boundary::kPlaten : Boundary::kMembrane;
     c.point = cp;
-    c.branch = d;
     s.contacts.push_back(c);
   }
   return s;

@@ -159,7 +159,9 @@ int micro_job(const std::string& source, double at_pct, double rve_edge_mm, int 
     path.clear();
     std::string have;
     for (const auto& [eps, file] : found) {
-      if (std::isfinite(eps)) have += (have.empty() ? "" : ", ") + std::to_string(eps).substr(0, std::to_string(eps).find('.') + 2) + "%";
+      char level[32];
+      std::snprintf(level, sizeof level, "%s%.1f%%", have.empty() ? "" : ", ", eps);
+      if (std::isfinite(eps)) have += level;
       if (std::isfinite(eps) && std::fabs(eps - at_pct) < 1e-6) path = file;
     }
     if (path.empty())

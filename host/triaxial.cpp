@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "host/membrane_mesh.hpp"
@@ -81,9 +82,8 @@ void set_top_velocity(Cell& c, Real vz) {
   });
 }
 
-/// Axial stresses on the two platens (Pa, compression positive).
-std::pair<Real, Real> platen_stresses(Cell& c) {
-  const std::vector<Vec3> f = c.sim->wall_forces();
+/// Axial stresses on the two platens (Pa, compression positive) from the wall forces `f`.
+std::pair<Real, Real> platen_stresses(const Cell& c, const std::vector<Vec3>& f) {
   return {f[kTopPlaten].z / c.area, -f[kBottomPlaten].z / c.area};
 }
 
@@ -109,7 +109,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
     Progress cons("consolidation (ETA to the step cap)", tc.max_consolidation_steps);
     long s = 0;
     for (; s < tc.max_consolidation_steps; ++s) {
-      const auto [top, bottom] = platen_stresses(cell);
+      const auto [top, bottom] = platen_stresses(cell, sim.wall_forces());
       const int n = sim.wall_contact_counts()[kTopPlaten];
       set_top_velocity(cell, -servo.speed(top, n * cell.kn_wall, dt));
       const bool check = (s + 1) % 200 == 0;
@@ -168,16 +168,24 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
     Progress shear("shear", steps);
     for (long k = 0; k <= steps; ++k) {
       const Real eps_a = (h0 - sim.wall_point(kTopPlaten).z) / h0;
+      // The contacts are copied to the host at most once a step, for the record and the snapshot alike.
+      std::optional<ContactSet> contacts;
+      auto contacts_now = [&]() -> const ContactSet& {
+        if (!contacts) contacts = contact_set(sim);
+        return *contacts;
+      };
       if (eps_a >= next_record - 1e-12 || k == steps) {
         TriaxialRecord r;
-        const auto [top, bottom] = platen_stresses(cell);
+        const std::vector<Vec3> wall_f = sim.wall_forces();
+        const auto [top, bottom] = platen_stresses(cell, wall_f);
+        const Real top_z = sim.wall_point(kTopPlaten).z, volume = specimen_volume(cell);
         r.eps_a = eps_a;
-        r.eps_v = (v0 - specimen_volume(cell)) / v0;
+        r.eps_v = (v0 - volume) / v0;
         r.sigma1 = top;
         r.sigma1_bottom = bottom;
         r.q = top - tc.sigma3;
-        r.sigma3_balls = lateral_stress(sim, cell.membrane);
-        r.eps_v_envelope = (v0_envelope - envelope_volume(sim, sim.wall_point(kTopPlaten).z, cell.mean_radius, env_slabs)) / v0_envelope;
+        r.sigma3_balls = lateral_stress(sim, cell.membrane, wall_f);
+        r.eps_v_envelope = (v0_envelope - envelope_volume(sim, top_z, cell.mean_radius, env_slabs)) / v0_envelope;
         r.unbalanced = sim.unbalanced_ratio();
         r.kinetic = sim.stats().kinetic;
         res.records.push_back(r);
@@ -185,9 +193,9 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
                                    r.sigma1_bottom / 1e3, tc.sigma3 / 1e3,        r.sigma3_balls / 1e3,
                                    100 * r.eps_v_envelope, r.unbalanced,          r.kinetic};
         if (mc.enabled) {
-          const ContactSet cs = contact_set(sim);
-          const ContactSet rve = restrict_to_cube(cs, Vec3(0, 0, sim.wall_point(kTopPlaten).z / 2), mc.rve_edge);
-          const MicroRow m = micro_row(cs, specimen_volume(cell));
+          const ContactSet& cs = contacts_now();
+          const ContactSet rve = restrict_to_cube(cs, Vec3(0, 0, top_z / 2), mc.rve_edge);
+          const MicroRow m = micro_row(cs, volume);
           res.micro.push_back(m);
           for (const MicroRow& x : {m, micro_row(rve, mc.rve_edge * mc.rve_edge * mc.rve_edge)})
             for (double v : micro_values(x)) row.push_back(v);
@@ -211,8 +219,8 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
         char label[48];
         std::snprintf(label, sizeof label, "shear eps_a=%.0f%%", 100 * snaps[next_snap]);
         const io::SurfaceSnapshot surface = membrane_surface(cell.membrane);
-        const io::ContactTable contacts = contact_table(contact_set(sim));
-        out->write_snapshot(take_snapshot(sim, label), &surface, mc.enabled ? &contacts : nullptr);
+        const io::ContactTable table = mc.enabled ? contact_table(contacts_now()) : io::ContactTable();
+        out->write_snapshot(take_snapshot(sim, label), &surface, mc.enabled ? &table : nullptr);
         ++next_snap;
       }
       if (k == steps) break;

@@ -69,8 +69,7 @@ io::SurfaceSnapshot membrane_surface(const Membrane& m) {
   return s;
 }
 
-Real lateral_stress(Simulation& sim, const Membrane& m) {
-  const std::vector<Vec3> f = sim.wall_forces();
+Real lateral_stress(Simulation& sim, const Membrane& m, const std::vector<Vec3>& f) {
   auto nx = Kokkos::create_mirror_view_and_copy(HostSpace(), m.mesh.node_x);
   auto tri = Kokkos::create_mirror_view_and_copy(HostSpace(), m.mesh.tri);
   auto fixed = Kokkos::create_mirror_view_and_copy(HostSpace(), m.fixed);

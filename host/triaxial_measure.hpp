@@ -2,6 +2,8 @@
 /// What the triaxial test measures beyond the platen forces: the lateral stress the balls receive through
 /// the membrane, the volume of the balls' own envelope, balls that left the membrane, and the membrane as
 /// a surface for the snapshots.
+#include <vector>
+
 #include "host/io_hdf5.hpp"
 #include "kernels/membrane.hpp"
 
@@ -17,7 +19,8 @@ io::SurfaceSnapshot membrane_surface(const Membrane& m);
 /// membrane itself carries (hoop and axial tension of a deforming membrane, inertia). The end bands are left
 /// out: the balls cannot fill the corner between platen and membrane, so there the tied rings and the
 /// platen edge carry part of the pressure, as a lab's platens do.
-Real lateral_stress(Simulation& sim, const Membrane& m);
+/// `wall_forces`: Simulation::wall_forces() of this step.
+Real lateral_stress(Simulation& sim, const Membrane& m, const std::vector<Vec3>& wall_forces);
 
 /// Volume of the balls' envelope (m^3), measured without the membrane: the specimen between the bottom
 /// platen (z = 0) and `top` cut into `slabs` slabs, each slab's cross-section the convex hull of its balls
