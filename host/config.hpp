@@ -107,6 +107,7 @@ struct PeriodicTriaxialParams {
   long max_consolidation_steps = 2000000;
   long check_every = 100;            ///< consolidation: steps between convergence checks
   long stiffness_every = 10;         ///< steps between updates of the servo stiffness K_ii
+  Real membrane_stiffness = 0;       ///< Pa, E_m t / R0 of the membrane extension in shear (0 = none)
   Real record_strain = 0.001;        ///< eps_a between series rows
   std::vector<Real> snapshot_strains{0, 0.01, 0.05, 0.15};  ///< eps_a of particle snapshots (with output)
   bool verbose = true;               ///< progress lines and the summary on stdout

@@ -116,14 +116,8 @@ int run_job(const Config& cfg) {
   }
   out.flush_series();
   out.write_snapshot(take_snapshot(*sim, "final"));
-  const StageTimes& t = sim->times();
-  const double total = t.rebuild + t.forces + t.integrate + t.boundaries;
   progress.finish("");
-  std::printf("stage times: rebuild %.2f s (%ld rebuilds), forces %.2f s, gather+integrate %.2f s, "
-              "boundaries %.2f s\n", t.rebuild, t.rebuilds, t.forces, t.integrate, t.boundaries);
-  std::printf("throughput: %.3g particle-steps/s on %s (%d threads)\n",
-              total > 0 ? sim->particles().n * static_cast<double>(sim->step_count()) / total : 0.0,
-              ExecSpace::name(), ExecSpace().concurrency());
+  std::printf("time loop: %s\n", describe(sim->times(), sim->particles().n, sim->step_count()).c_str());
   std::printf("output: %s/snapshots.xdmf (ParaView), %s/series.csv\n", out.folder().c_str(), out.folder().c_str());
   return 0;
 }

@@ -13,7 +13,8 @@
 ///                                h0 at the start of shear
 ///   eps_v = -(V - V0) / V0       volumetric strain, V = cell volume, V0 at the start of shear
 ///   sigma1 = sigma_zz (axial), sigma2 = sigma_xx, sigma3 = sigma_yy: all three measured from the contacts
-///   q = sigma1 - (sigma2 + sigma3) / 2   (measured lateral stresses, not the applied sigma3)
+///   q = sigma1 - (sigma2 + sigma3) / 2 + membrane   (measured lateral stresses, not the applied sigma3; the
+///                                membrane extension's confinement is counted in q, as in a lab's sigma1 - cell)
 ///   p = (sigma1 + sigma2 + sigma3) / 3
 ///   phi_mob = asin(q / (sigma1 + (sigma2 + sigma3) / 2))   mobilised friction angle
 ///   I = axial_rate d sqrt(rho_eff / p)   inertial number, d = mean diameter, rho_eff = density x mass_scale
@@ -54,6 +55,7 @@ struct PeriodicTriaxialRecord {
   Real unbalanced = 0, kinetic = 0;  ///< unbalanced-force ratio, fluctuating kinetic energy (J)
   Real inertial = 0;                 ///< axial_rate d sqrt(rho_eff / p) at this row's p
   Real rate_x = 0, rate_y = 0;       ///< servoed lateral strain rates (1/s, extension positive)
+  Real membrane = 0;                 ///< Pa, mean lateral confinement of the membrane extension (in sigma2/3, not q)
 };
 
 struct PeriodicTriaxialResult {
@@ -81,6 +83,13 @@ long consolidate_isotropic(Simulation& sim, const PeriodicTriaxialParams& prm);
 /// Stages (a) and (b). With `out`, writes series.csv/.h5 and the snapshots at snapshot_strains.
 PeriodicTriaxialResult run_periodic_triaxial(Simulation& sim, const PeriodicTriaxialParams& prm,
                                              io::Output* out = nullptr);
+
+/// Membrane extension: the extra lateral confinement (Pa) of a membrane of stiffness E_m t / R0 (Pa, its
+/// modulus times thickness over the specimen's radius) at lateral strain eps (extension positive): the hoop
+/// tension E_m t eps of a thin cylinder acting on the radius R0. None in contraction: latex buckles rather
+/// than push. In the periodic cell each lateral axis is servoed to sigma3 plus this, and q is reported
+/// against sigma3, the cell pressure, as a lab does.
+Real membrane_confinement(Real stiffness, Real eps);
 
 /// K_ii = (1/V) sum_c (Fn/overlap) l_i^2 over touching ball-ball contacts (Pa): the servo's stiffness.
 std::array<Real, 3> cell_stiffness(Simulation& sim);

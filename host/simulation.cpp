@@ -1,6 +1,7 @@
 #include "simulation.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <sstream>
 
@@ -48,12 +49,14 @@ Real Simulation::critical_dt() const {
   auto m = p_.mass, in = p_.inertia, r = p_.radius;
   auto mat = p_.material;
   auto params = params_;
+  const Real overlap_max = prm_.overlap_limit;
   Real dt = 0;
   Kokkos::parallel_reduce("dem::sim::critical_dt", RangePolicy(0, p_.n),
       KOKKOS_LAMBDA(const int i, Real& acc) {
         for (int b = 0; b < static_cast<int>(params.extent(1)); ++b) {
           const ContactParams& cp = params(mat(i), b);
-          const Real kn = NormalLinear::stiffness(cp, r(i), 0);  // ball-wall: the stiffest contact
+          // Ball-wall is the stiffest contact; a Hertzian one stiffens up to the overlap guard.
+          const Real kn = NormalElastic::max_stiffness(cp, r(i), 0, overlap_max * r(i));
           const Real ks = kn / cp.kratio;
           const Real krot = ks * r(i) * r(i) + ks * r(i) * r(i);  // shear lever + rolling spring (Rbar = R)
           const Real t = kc::min(kc::sqrt(m(i) / kn), kc::sqrt(in(i) / krot));
@@ -274,6 +277,17 @@ std::array<long, 2> Simulation::touching() const {
     out[q] = c;
   }
   return out;
+}
+
+std::string describe(const StageTimes& t, long particles, long steps) {
+  char line[320];
+  std::snprintf(line, sizeof line,
+                "%ld steps, rebuild %.1f s (%ld rebuilds), forces %.1f s, membrane %.1f s, gather+integrate %.1f s, "
+                "walls %.1f s; %.3g particle-steps/s on %s (%d threads)",
+                steps, t.rebuild, t.rebuilds, t.forces, t.membrane, t.integrate, t.boundaries,
+                particles * static_cast<double>(steps) / std::max(1e-9, t.loop()), ExecSpace::name(),
+                ExecSpace().concurrency());
+  return line;
 }
 
 }  // namespace dem

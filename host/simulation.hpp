@@ -32,7 +32,11 @@ struct StageTimes {
   double rebuild = 0, forces = 0, integrate = 0, boundaries = 0;  ///< integrate includes the gather
   double membrane = 0;  ///< membrane elasticity, pressure, reactions and node integration
   long rebuilds = 0;
+  double loop() const { return rebuild + forces + membrane + integrate + boundaries; }
 };
+
+/// One line for a log: seconds per stage, rebuild count and particle-steps per second of the time loop.
+std::string describe(const StageTimes& t, long particles, long steps);
 
 class Simulation {
  public:

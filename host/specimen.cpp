@@ -118,7 +118,7 @@ Specimen build_specimen(const Config& cfg, bool verbose) {
   const long total = specimen_ball_count(cfg);
   std::mt19937_64 rng(cfg.run.seed);
   Specimen out;
-  ContactParams ball_law = cfg.ball, wall_law = cfg.wall;
+  ContactParams ball_law = cfg.ball.base(), wall_law = cfg.wall.base();
   ball_law.mu_s = sc.compaction_mu_s;
   ball_law.mu_r = 0;  // rolling resistance off too: the specimen does not depend on the test's friction
   wall_law.mu_s = 0;  // a smooth mould, so that walls do not hold the layers up
@@ -149,7 +149,7 @@ Specimen build_specimen(const Config& cfg, bool verbose) {
                    {ball_law, wall_law, wall_law, wall_law}, 2, prm);
     sim.set_dt(cfg.solver.dt > 0 ? cfg.solver.dt : cfg.solver.dt_safety * sim.critical_dt());
     const Real f_limit = 0.01 * cfg.particles.diameter / 2 *
-                         NormalLinear::stiffness(wall_law, cfg.particles.diameter / 2, 0);
+                         NormalElastic::stiffness(wall_law, cfg.particles.diameter / 2, 0);
     Progress progress("specimen layer " + std::to_string(k + 1) + "/" + std::to_string(sc.layers),
                       std::lround((z0 + h_loose - z1) * 1e6));
     ContactParams settle_law = ball_law;
@@ -167,8 +167,9 @@ Specimen build_specimen(const Config& cfg, bool verbose) {
     LayerReport rep{z0, z1, sim.wall_point(kTop).z, slab_void_ratio(out.balls, R, z0, z1), steps, ratio};
     out.layers.push_back(rep);
     if (verbose)
-      std::printf("specimen: layer %ld/%ld: %ld balls, platen at %.3f mm (target %.3f), %ld steps, unbalanced ratio "
-                  "%.1e\n", k + 1, sc.layers, pc.count, rep.z_platen * 1e3, z1 * 1e3, steps, ratio);
+      std::printf("specimen: layer %ld/%ld: %ld balls, platen at %.3f mm (target %.3f), unbalanced ratio %.1e; time "
+                  "loop: %s\n", k + 1, sc.layers, pc.count, rep.z_platen * 1e3, z1 * 1e3, ratio,
+                  describe(sim.times(), static_cast<long>(all.size()), steps).c_str());
   }
   // Later layers press on the earlier ones: report every layer as it is in the finished specimen.
   for (LayerReport& l : out.layers) l.void_ratio = slab_void_ratio(out.balls, R, l.z_bottom, l.z_top);

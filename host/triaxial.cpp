@@ -62,7 +62,7 @@ Cell make_cell(const Config& cfg, const Specimen& sp) {
   c.sim->set_membrane(c.membrane, mp);
   c.sim->set_cell_pressure(cfg.triaxial.sigma3);
   c.sim->set_dt(cfg.solver.dt > 0 ? cfg.solver.dt : cfg.solver.dt_safety * c.sim->critical_dt());
-  c.kn_wall = NormalLinear::stiffness(cfg.wall, cfg.particles.diameter / 2, 0);
+  c.kn_wall = NormalElastic::stiffness(cfg.wall, cfg.particles.diameter / 2, 0);
   for (const BallSpec& b : sp.balls) {
     c.solid_volume += 4.0 / 3.0 * M_PI * b.radius * b.radius * b.radius;
     c.mean_radius += b.radius / sp.balls.size();
@@ -286,13 +286,8 @@ int triaxial_job(const Config& cfg) {
                   r.records[k].q / (cfg.triaxial.sigma3 + r.records[k].q / 3), m.q_over_p, m.q_over_p_sff, m.all.a_c,
                   m.all.a_n, m.all.a_t, m.z.z);
     }
-    const StageTimes& t = r.times;
-    const double loop = t.rebuild + t.forces + t.membrane + t.integrate + t.boundaries;
-    std::printf("time loop (consolidation and shear): %ld steps, rebuild %.1f s (%ld rebuilds), forces %.1f s, "
-                "membrane %.1f s, gather+integrate %.1f s, walls %.1f s; %.3g particle-steps/s; measurements and "
-                "output %.1f s\n",
-                r.steps, t.rebuild, t.rebuilds, t.forces, t.membrane, t.integrate, t.boundaries,
-                r.balls * static_cast<double>(r.steps) / std::max(1e-9, loop), r.wall_seconds - loop);
+    std::printf("time loop (consolidation and shear): %s; measurements and output %.1f s\n",
+                describe(r.times, r.balls, r.steps).c_str(), r.wall_seconds - r.times.loop());
     TestSummary s;
     s.kind = "membrane";
     s.sigma3 = cfg.triaxial.sigma3;

@@ -26,14 +26,15 @@ OverlapStat compute_wall_forces(const Particles& p, ContactList& c, const Adjace
                                 const FacetMesh& mesh, const ParamTableView& params, Real dt);
 
 /// Applies the law to kinematics k of contact slot `s`, stores history, force on particle 1 and the
-/// linear normal force (shared by both kernels), and returns the law's output.
+/// elastic normal force (shared by both kernels), and returns the law's output.
 KOKKOS_FORCEINLINE_FUNCTION ContactOutput apply_law(const ContactList& c, int s, const ContactParams& prm,
                                                const ContactKinematics& k) {
-  ContactHistory h{load(c.fs, s), load(c.mr, s), c.flags(s)};
+  ContactHistory h{load(c.fs, s), load(c.mr, s), c.flags(s), c.slip(s)};
   const ContactOutput out = RRLinear::eval(prm, k, h);
   store(c.fs, s, h.fs);
   store(c.mr, s, h.mr);
   c.flags(s) = h.flags;
+  c.slip(s) = h.slip;
   store(c.fc, s, out.force);
   c.fn(s) = out.fn;
   return out;
@@ -44,6 +45,7 @@ KOKKOS_INLINE_FUNCTION void open_contact(const ContactList& c, int s) {
   store(c.fs, s, Vec3());
   store(c.mr, s, Vec3());
   c.flags(s) = 0;
+  c.slip(s) = 0;
   store(c.fc, s, Vec3());
   store(c.mt, s, Vec3());
   c.fn(s) = 0;

@@ -35,6 +35,7 @@ struct ContactList {
   Vec3View fs;            ///< shear force on particle 1 (N)
   Vec3View mr;            ///< rolling moment on particle 1 (N m)
   FlagView flags;
+  ScalarView slip;        ///< sliding distance accumulated while touching (m)
   // results of the current step
   Vec3View fc;            ///< total contact force on particle 1 (N)
   Vec3View mt;            ///< moment on the gathering side (N m): particle 2 (ball-ball), the ball (ball-wall)

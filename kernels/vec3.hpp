@@ -6,6 +6,7 @@
 namespace dem {
 namespace kc {
 #if KOKKOS_VERSION >= 30700
+using Kokkos::exp;
 using Kokkos::fabs;
 using Kokkos::floor;
 using Kokkos::isfinite;
@@ -13,6 +14,7 @@ using Kokkos::max;
 using Kokkos::min;
 using Kokkos::sqrt;
 #else
+using Kokkos::Experimental::exp;
 using Kokkos::Experimental::fabs;
 using Kokkos::Experimental::floor;
 using Kokkos::Experimental::isfinite;

@@ -57,16 +57,16 @@ TEST(ContactLaw, NormalStiffnessDeformabilityMethod) {
   const ContactParams p = test::law(7.3e7, 1.5, 0.5, 0.1);
   const double R = 1.3e-3;
   // Equal balls: A = pi R^2, L = 2R -> kn = pi R E*/2.
-  EXPECT_NEAR(NormalLinear::stiffness(p, R, R), kPi * R * p.emod / 2, 1e-14 * kPi * R * p.emod / 2);
+  EXPECT_NEAR(NormalElastic::stiffness(p, R, R), kPi * R * p.emod / 2, 1e-14 * kPi * R * p.emod / 2);
   // Ball-wall (r2 = 0): A = pi R^2, L = R -> kn = pi R E*, twice the ball-ball value.
-  EXPECT_NEAR(NormalLinear::stiffness(p, R, 0), kPi * R * p.emod, 1e-14 * kPi * R * p.emod);
+  EXPECT_NEAR(NormalElastic::stiffness(p, R, 0), kPi * R * p.emod, 1e-14 * kPi * R * p.emod);
   // Unequal: r = min(R1, R2), L = R1 + R2, and symmetric in the two radii.
   const double R1 = 0.8e-3, R2 = 1.2e-3;
   const double expect = kPi * R1 * R1 * p.emod / (R1 + R2);
-  EXPECT_NEAR(NormalLinear::stiffness(p, R1, R2), expect, 1e-14 * expect);
-  EXPECT_NEAR(NormalLinear::stiffness(p, R2, R1), expect, 1e-14 * expect);
+  EXPECT_NEAR(NormalElastic::stiffness(p, R1, R2), expect, 1e-14 * expect);
+  EXPECT_NEAR(NormalElastic::stiffness(p, R2, R1), expect, 1e-14 * expect);
   // A ball-wall contact uses the ball's own radius even when it is the larger one.
-  EXPECT_NEAR(NormalLinear::stiffness(p, R2, 0), kPi * R2 * p.emod, 1e-14 * kPi * R2 * p.emod);
+  EXPECT_NEAR(NormalElastic::stiffness(p, R2, 0), kPi * R2 * p.emod, 1e-14 * kPi * R2 * p.emod);
   // The law's stiffness (what the force kernels store in ContactKinematics::kn) is the same.
   EXPECT_NEAR(RRLinear::stiffness(p, R1, R2), expect, 1e-14 * expect);
   EXPECT_NEAR(RRLinear::stiffness(p, R, 0), kPi * R * p.emod, 1e-14 * kPi * R * p.emod);
@@ -352,4 +352,117 @@ TEST(ContactLaw, HistoryFollowsTurningContactPlane) {
     EXPECT_LT(std::fabs(dot(h.mr, k.n)), 1e-12 * mr0);
     EXPECT_NEAR(norm(out.moment - h.mr), 0.0, 1e-15 * mr0);
   }
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Model extensions (issue 5). Each has a closed form written out here; the law's tangent stiffness is
+// also checked against a central difference of its own force, which is what the shear and rolling
+// springs and the dashpot rely on. Central difference with h = 1e-5 overlap: truncation (h/d)^2 f'''/f'
+// ~ 1e-10, rounding 1e-16 / 1e-5 ~ 1e-11; tolerance 1e-7 relative.
+namespace {
+NormalResponse normal_at(const ContactParams& p, double d, double r1, double r2) {
+  return NormalElastic::response(p, kin(p, Vec3(0, 0, 1), d, r1, r2, 1e-7));
+}
+void expect_tangent_is_derivative(const ContactParams& p, double d, double r1, double r2) {
+  const double h = 1e-5 * d;
+  const double fd = (normal_at(p, d + h, r1, r2).fn - normal_at(p, d - h, r1, r2).fn) / (2 * h);
+  const double k = normal_at(p, d, r1, r2).k;
+  EXPECT_NEAR(k, fd, 1e-7 * fd) << "overlap " << d;
+}
+}  // namespace
+
+// Hertz-Mindlin: Fn = kn d^(3/2) / dref^(1/2), dref = hertz_overlap * r; secant = kn at d = dref, tangent
+// 1.5 kn there; Fn(4d) = 8 Fn(d). Pure arithmetic: 1e-13.
+TEST(ContactLaw, HertzForceGrowsAsOverlapToThreeHalves) {
+  ContactParams p = test::law(1e8, 1.5, 0.3, 0.0);
+  p.hertz_overlap = 0.01;
+  const double R = 1e-3, kn = kn_formula(p.emod, R, R), dref = 0.01 * R;
+  for (double d : {1e-7, 3e-6, dref, 4e-5}) {
+    const NormalResponse nr = normal_at(p, d, R, R);
+    EXPECT_NEAR(nr.fn, kn * d * std::sqrt(d / dref), 1e-13 * kn * d);
+    EXPECT_NEAR(nr.k, 1.5 * kn * std::sqrt(d / dref), 1e-13 * kn);
+    expect_tangent_is_derivative(p, d, R, R);
+  }
+  EXPECT_NEAR(normal_at(p, dref, R, R).fn, kn * dref, 1e-13 * kn * dref);
+  EXPECT_NEAR(normal_at(p, 4e-6, R, R).fn / normal_at(p, 1e-6, R, R).fn, 8.0, 1e-12);
+  // At a wall r is the ball's radius.
+  EXPECT_NEAR(normal_at(p, dref, R, 0).fn, kn_formula(p.emod, R, 0) * dref, 1e-13 * kn * dref);
+  // The shear spring follows the tangent stiffness: one step of tangential velocity adds kt/kappa* v dt.
+  ContactKinematics k = kin(p, Vec3(0, 0, 1), 4e-6, R, R, 1e-7);
+  k.vrel = Vec3(0.01, 0, 0);
+  ContactHistory h;
+  RRLinear::eval(p, k, h);
+  const double kt = 1.5 * kn * std::sqrt(4e-6 / dref);
+  EXPECT_NEAR(norm(h.fs), kt / 1.5 * 0.01 * 1e-7, 1e-12 * kt / 1.5 * 1e-9);
+  // The critical time step uses the stiffest contact up to the overlap guard.
+  EXPECT_NEAR(NormalElastic::max_stiffness(p, R, R, 0.25 * R), 1.5 * kn * std::sqrt(25.0), 1e-13 * kn);
+  p.hertz_overlap = 0;
+  EXPECT_EQ(NormalElastic::max_stiffness(p, R, R, 0.25 * R), kn);
+}
+
+// Rough-surface compliance: bulk overlap d^2 / (d + 2 sigma). Soft while d << sigma (Fn ~ kn d^2 / 2 sigma),
+// the smooth law shifted by 2 sigma once d >> sigma, and the stiffness ratio is d (d + 4 sigma) /
+// (d + 2 sigma)^2: exactly 5/9 at d = sigma, above 0.9999 at d = 200 sigma.
+TEST(ContactLaw, RoughSurfaceSoftensSmallOverlaps) {
+  ContactParams p = test::law(1e8, 1.5, 0.3, 0.0);
+  const double R = 1e-3, kn = kn_formula(p.emod, R, R), sigma = 1e-6;
+  p.roughness = sigma / R;
+  for (double d : {1e-8, 1e-7, sigma, 1e-5, 2e-4}) {
+    const NormalResponse nr = normal_at(p, d, R, R);
+    EXPECT_NEAR(nr.fn, kn * d * d / (d + 2 * sigma), 1e-13 * kn * d);
+    EXPECT_LT(nr.fn, kn * d);  // always softer than smooth
+    expect_tangent_is_derivative(p, d, R, R);
+  }
+  EXPECT_NEAR(normal_at(p, sigma, R, R).k / kn, 5.0 / 9.0, 1e-13);
+  EXPECT_GT(normal_at(p, 200 * sigma, R, R).k / kn, 0.9999);
+  EXPECT_LT(normal_at(p, 0.01 * sigma, R, R).k / kn, 0.01);
+  // Large overlaps: the smooth force less kn * 2 sigma (to first order in sigma/d: 4 sigma^2/d = 2% of 2 sigma
+  // at d = 200 sigma).
+  const double d = 200 * sigma;
+  EXPECT_NEAR(normal_at(p, d, R, R).fn, kn * (d - 2 * sigma), 0.03 * kn * 2 * sigma);
+  // With Hertz as well: the bulk overlap goes through the Hertz law.
+  p.hertz_overlap = 0.01;
+  const double de = 3e-6 * 3e-6 / (3e-6 + 2 * sigma);
+  EXPECT_NEAR(normal_at(p, 3e-6, R, R).fn, kn * de * std::sqrt(de / (0.01 * R)), 1e-13 * kn * de);
+  expect_tangent_is_derivative(p, 3e-6, R, R);
+}
+
+// Slip-weakening friction: mu = mu_s (1 - wear (1 - exp(-s / (wear_slip r)))). Constant overlap and a steady
+// tangential velocity: once sliding, the slip s is the tangential travel less the spring's elastic stretch,
+// |fs| / ks (an identity of the incremental spring with a cap, to rounding: 1e-9 of the travel over
+// ~3000 increments), and the force sits between mu(s_before) Fn and mu(s_after) Fn of the step.
+TEST(ContactLaw, FrictionWeakensWithAccumulatedSlip) {
+  ContactParams p = test::law(1e8, 1.5, 0.5, 0.0);
+  p.wear = 0.4;
+  p.wear_slip = 0.01;
+  const double R = 1e-3, d = 5e-6, dt = 1e-7, v = 0.5;
+  const Vec3 n(0, 0, 1);
+  ContactKinematics k = kin(p, n, d, R, R, dt);
+  k.vrel = Vec3(v, 0, 0);
+  const double kn = kn_formula(p.emod, R, R), ks = kn / 1.5, fn = kn * d, sc = 0.01 * R;
+  ContactHistory h;
+  double travel = 0;
+  for (int s = 0; s < 3000; ++s) {
+    const double slip_before = h.slip;
+    RRLinear::eval(p, k, h);
+    travel += v * dt;
+    const double fs = norm(h.fs);
+    EXPECT_NEAR(h.slip, std::max(0.0, travel - fs / ks), 1e-9 * travel) << "step " << s;
+    if (h.flags & kSliding) {
+      const double mu_before = 0.5 * (1 - 0.4 * (1 - std::exp(-slip_before / sc)));
+      const double mu_after = 0.5 * (1 - 0.4 * (1 - std::exp(-h.slip / sc)));
+      EXPECT_LE(fs, mu_before * fn * (1 + 1e-12));
+      EXPECT_GE(fs, mu_after * fn * (1 - 1e-12));
+    }
+  }
+  // 3000 steps of 5e-8 m: 1.5e-4 m of travel, 15 decay lengths: the residual mu_s (1 - wear) = 0.3.
+  EXPECT_NEAR(norm(h.fs) / fn, 0.3, 1e-6);
+  // The formula of the law at one decay length.
+  EXPECT_NEAR(TangentialCoulomb::friction(p, R, sc), 0.5 * (1 - 0.4 * (1 - std::exp(-1.0))), 1e-15);
+  // Without wear the slip is not tracked and the cap is mu_s Fn.
+  p.wear = 0;
+  ContactHistory h0;
+  for (int s = 0; s < 3000; ++s) RRLinear::eval(p, k, h0);
+  EXPECT_EQ(h0.slip, 0.0);
+  EXPECT_NEAR(norm(h0.fs), 0.5 * fn, 1e-12 * fn);
 }

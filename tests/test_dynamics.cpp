@@ -72,9 +72,11 @@ struct HeadOn {
     omega = std::sqrt(kn / mstar);
     T = kPi / omega;
   }
-  /// Runs the collision with dt = T / steps_per_contact; returns the restitution coefficient and the
-  /// number of steps with a touching contact.
-  void run(double beta_n, int steps_per_contact, double& e, long& touching_steps, double& spin) const {
+  /// Runs the collision with dt = duration / steps_per_contact (duration: T by default); returns the
+  /// restitution coefficient and the number of steps with a touching contact. hertz_overlap > 0: the
+  /// Hertz-Mindlin extension.
+  void run(double beta_n, int steps_per_contact, double& e, long& touching_steps, double& spin,
+           double hertz_overlap = 0, double duration = 0) const {
     std::vector<BallSpec> b(2);
     const double gap = 1e-6;  // m, each ball's distance to the contact plane: ~100 steps of approach
     b[0].x = Vec3(-(R + gap), 0, 0);
@@ -84,8 +86,10 @@ struct HeadOn {
     b[0].radius = b[1].radius = R;
     b[0].density = b[1].density = kRho;
     SimParams prm = sim_params(0.1 * R, 0.0, Vec3());
-    Simulation sim(make_particles(b), make_walls({}), FacetMesh(), {test::law(emod, 1.5, 0.0, 0.0, beta_n)}, 1, prm);
-    const double dt = T / steps_per_contact;
+    ContactParams law = test::law(emod, 1.5, 0.0, 0.0, beta_n);
+    law.hertz_overlap = hertz_overlap;
+    Simulation sim(make_particles(b), make_walls({}), FacetMesh(), {law}, 1, prm);
+    const double dt = (duration > 0 ? duration : T) / steps_per_contact;
     ASSERT_LT(dt, 0.5 * sim.critical_dt());
     sim.set_dt(dt);
     touching_steps = 0;
@@ -125,6 +129,34 @@ TEST(Dynamics, HeadOnElasticCollisionDurationAndRestitution) {
   EXPECT_NEAR(e, 1.0, 0.5 * wdt * wdt);
   // Head-on and frictionless: no spin, no sideways motion.
   EXPECT_EQ(spin, 0.0);
+}
+
+// Hertz-Mindlin extension: Fn = K d^(3/2) with K = kn / sqrt(dref). For the relative coordinate (mass m*,
+// impact speed v = 2 v0) the largest overlap is d_m = (5 m* v^2 / (4 K))^(2/5) and the contact lasts
+// t_c = 2 (d_m / v) int_0^1 dx / sqrt(1 - x^(5/2)) (about 2.94 d_m / v, Johnson 1985 sec. 11.4), computed here
+// by quadrature. The rebound is elastic.
+TEST(Dynamics, HeadOnHertzCollisionDuration) {
+  const HeadOn c;
+  const double dref = 0.02 * c.R, K = c.kn / std::sqrt(dref), v = 2 * c.v0;
+  const double dm = std::pow(5 * c.mstar * v * v / (4 * K), 0.4);
+  // x = 1 - u^2 removes the end-point singularity: dx / sqrt(1 - x^2.5) = 2u du / sqrt(1 - (1 - u^2)^2.5).
+  auto g = [](double u) { return u == 0 ? 2 / std::sqrt(2.5) : 2 * u / std::sqrt(1 - std::pow(1 - u * u, 2.5)); };
+  const int n = 2000;  // Simpson, smooth integrand: error ~ 1e-12
+  double integral = g(0) + g(1);
+  for (int i = 1; i < n; ++i) integral += (i % 2 ? 4 : 2) * g(double(i) / n);
+  integral /= 3.0 * n;
+  const double tc = 2 * dm / v * integral;
+  ASSERT_NEAR(2 * integral, 2.94, 0.005);  // Johnson's constant
+  const int N = 1000;
+  double e, spin;
+  long steps;
+  c.run(0.0, N, e, steps, spin, 0.02, tc);
+  // +-1 step at entry and exit: 0.2%; tolerance 0.5%. The force starts and ends at zero (no jump), so the
+  // restitution is 1 to the leapfrog's O((omega dt)^2) ~ 1e-5: tolerance 1e-4.
+  EXPECT_NEAR(steps * tc / N, tc, 0.005 * tc);
+  EXPECT_NEAR(e, 1.0, 1e-4);
+  // A linear contact of the same kn at dref would last pi sqrt(m*/kn): Hertz is not that.
+  EXPECT_GT(std::fabs(tc - c.T), 0.05 * c.T);
 }
 
 // With a normal dashpot (beta_n): the classical spring-dashpot restitution is exp(-pi beta/sqrt(1-beta^2))

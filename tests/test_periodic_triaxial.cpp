@@ -133,6 +133,33 @@ TEST(PeriodicTriaxial, CurveIndependentOfBallAndCellNumbering) {
   EXPECT_GT(a.q_peak, 0.5 * kSigma3);
 }
 
+// Membrane extension: each lateral axis is held at sigma3 + M max(0, eps_lat) (M = E_m t / R0), q is
+// reported against sigma3, so a bulging specimen shows more strength. M = 1 MPa is a stiff membrane
+// (about 40 times the paper's latex over its specimen's radius) so that the effect stands far above the
+// run-to-run scatter (about 2% of q_peak).
+TEST(PeriodicTriaxial, MembraneConfinesWhenTheCellBulges) {
+  EXPECT_EQ(membrane_confinement(1e6, 0.02), 2e4);
+  EXPECT_EQ(membrane_confinement(1e6, -0.02), 0.0);  // slack in contraction
+  const Specimen s = dense_specimen(kBalls, 1);
+  PeriodicTriaxialParams p = quiet(0.04);
+  const PeriodicTriaxialResult bare = shear(s, 0.3, p);
+  p.membrane_stiffness = 1e6;
+  const PeriodicTriaxialResult wrapped = shear(s, 0.3, p);
+  Real last_membrane = 0;
+  for (const PeriodicTriaxialRecord& row : wrapped.series) {
+    // Equal lateral axes: (1 + eps_lat)^2 (1 - eps_a) = 1 - eps_v. The axes differ by a few 1e-4 in strain,
+    // and the mean of max(0, .) differs from max(0, mean) only near zero: 2e-4 M.
+    const Real eps_lat = std::sqrt((1 - row.eps_v) / (1 - row.eps_a)) - 1;
+    EXPECT_NEAR(row.membrane, 1e6 * std::max(eps_lat, Real(0)), 2e-4 * 1e6) << "eps_a " << row.eps_a;
+    const Real target = kSigma3 + row.membrane;
+    EXPECT_NEAR(0.5 * (row.sigma2 + row.sigma3), target, 0.01 * target) << "eps_a " << row.eps_a;
+    last_membrane = row.membrane;
+  }
+  EXPECT_GT(last_membrane, 0.05 * kSigma3);  // the dense specimen dilates: the membrane is stretched
+  EXPECT_GT(wrapped.series.back().q, bare.series.back().q + 0.5 * last_membrane);
+  EXPECT_EQ(bare.series.back().membrane, 0.0);
+}
+
 TEST(PeriodicTriaxial, HigherFrictionGivesHigherPeak) {
   // Same packing, same law but mu_s: observed q_peak 88 kPa (phi 17.8 deg) for 0.1, 195 kPa (29.6 deg) for 0.5.
   const Specimen s = dense_specimen(kBalls, 3);
