@@ -5,7 +5,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <sstream>
 
+#include "host/calibration_jobs.hpp"
+#include "host/measured.hpp"
 #include "host/config.hpp"
 #include "host/job.hpp"
 #include "host/micro_report.hpp"
@@ -56,6 +59,32 @@ int main(int argc, char** argv) {
   micro->add_option("--bins", micro_bins, "rose bins over 0-180 deg (default 18)")->check(CLI::Range(2, 3600));
   micro->add_option("-o,--output", micro_out, "output folder (default: the run folder or the snapshot's)");
 
+  dem::CalibrationOptions cal;
+  std::string free_list;
+  auto add_calibration = [&](CLI::App* c) {
+    c->add_option("data", cal.data, "measured-data CSV (README: measured-data format)")->required()
+        ->check(CLI::ExistingFile);
+    c->add_option("--config", config_path, "base config: a periodic cell ([box], [periodic], [material])")
+        ->required()->check(CLI::ExistingFile);
+    c->add_option("--free", free_list, "free parameters, comma-separated (default mu_s,mu_r)");
+    c->add_option("--material", cal.material, "only this material of the data");
+    c->add_option("-o,--output", cal.output, "parent folder of the dated result folder (default out)");
+  };
+  auto* calibrate = app.add_subcommand("calibrate", "fit the free parameters to measured triaxial data");
+  add_calibration(calibrate);
+  auto* diagnose = app.add_subcommand("diagnose", "calibrate, then find which model extension explains the misfit");
+  add_calibration(diagnose);
+  dem::SynthOptions syn;
+  std::vector<double> syn_kpa;
+  auto* synth = app.add_subcommand("synth", "synthetic measured curves with a hidden model extension");
+  synth->add_option("--config", config_path, "base config (periodic cell)")->required()->check(CLI::ExistingFile);
+  synth->add_option("-o,--output", syn.output, "CSV to write")->required();
+  synth->add_option("--extension", syn.extension, "hertz, roughness, wear, membrane or none");
+  synth->add_option("--strength", syn.strength, "the extension's parameter in its config unit (default: drawn from the seed)");
+  synth->add_option("--seed", syn.seed, "noise and strength seed");
+  synth->add_option("--pressures", syn_kpa, "confining pressures, kPa (default 100 200 300)");
+  synth->add_option("--material", syn.material, "material name in the file");
+
   auto* check = app.add_subcommand("check", "validate a config and print the derived time step");
   check->add_option("config", config_path, "TOML config file")->required()->check(CLI::ExistingFile);
 
@@ -95,7 +124,25 @@ int main(int argc, char** argv) {
     if (specimen->parsed()) return dem::specimen_job(cfg);
     if (triaxial->parsed()) return dem::triaxial_job(cfg);
     if (periodic->parsed()) return dem::run_periodic_job(cfg);
+    if (calibrate->parsed() || diagnose->parsed()) {
+      if (!free_list.empty()) {
+        cal.free.clear();
+        std::stringstream in(free_list);
+        for (std::string f; std::getline(in, f, ',');) cal.free.push_back(f);
+      }
+      return calibrate->parsed() ? dem::calibrate_job(cfg, cal) : dem::diagnose_job(cfg, cal);
+    }
+    if (synth->parsed()) {
+      if (!syn_kpa.empty()) {
+        syn.sigma3.clear();
+        for (double k : syn_kpa) syn.sigma3.push_back(1e3 * k);
+      }
+      return dem::synth_job(cfg, syn);
+    }
     return dem::run_job(cfg);
+  } catch (const dem::DataError& e) {
+    std::fprintf(stderr, "triaxdem: data error: %s\n", e.what());
+    return 1;
   } catch (const dem::ConfigError& e) {
     std::fprintf(stderr, "triaxdem: config error: %s\n", e.what());
     return 1;

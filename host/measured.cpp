@@ -23,7 +23,7 @@ struct ColumnSpec {
 const std::map<std::string, Real> kStressUnits = {{"Pa", 1}, {"kPa", 1e3}, {"MPa", 1e6}};
 const std::map<std::string, Real> kStrainUnits = {{"pct", 1e-2}, {"frac", 1}};
 const std::map<std::string, const std::map<std::string, Real>*> kQuantities = {
-    {"sigma3", &kStressUnits}, {"q", &kStressUnits},         {"q_peak", &kStressUnits}, {"q_end", &kStressUnits},
+    {"sigma3", &kStressUnits}, {"q", &kStressUnits},         {"q_peak", &kStressUnits}, {"q_end", &kStressUnits}, {"e_ini", &kStressUnits},
     {"eps_a", &kStrainUnits},  {"eps_v", &kStrainUnits}, {"eps_a_peak", &kStrainUnits}};
 
 std::string trim(const std::string& s) {
@@ -144,6 +144,7 @@ MeasuredData load_measured(const std::string& path) {
       mt.eps_a_peak = number("eps_a_peak");
       mt.q_end = number("q_end");
       mt.max_dilatancy = number("max_dilatancy");
+      mt.e_ini = number("e_ini");
     }
   }
   if (cols.empty()) throw DataError(path + ": no header line");
@@ -153,15 +154,54 @@ MeasuredData load_measured(const std::string& path) {
   return d;
 }
 
+namespace {
+/// Mean of v over the rows whose axial strain lies within +-h of eps_a[i], h = min(half, distance to either end
+/// of the curve): a window in strain, so that uneven row spacing does not change the smoothing, and symmetric,
+/// so that a straight line comes out unchanged up to the very ends.
+std::vector<Real> smooth(const std::vector<Real>& eps_a, const std::vector<Real>& v, Real half) {
+  std::vector<Real> out(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const Real h = std::min({half, eps_a[i] - eps_a.front(), eps_a.back() - eps_a[i]}) + 1e-12;
+    Real sum = v[i];
+    int n = 1;
+    for (std::size_t j = i; j-- > 0 && eps_a[j] >= eps_a[i] - h;) sum += v[j], ++n;
+    for (std::size_t j = i + 1; j < v.size() && eps_a[j] <= eps_a[i] + h; ++j) sum += v[j], ++n;
+    out[i] = sum / n;
+  }
+  return out;
+}
+}  // namespace
+
 void summarise(MeasuredTest& t) {
   if (t.q.empty()) return;
-  const auto k = std::max_element(t.q.begin(), t.q.end()) - t.q.begin();
-  t.q_peak = t.q[k];
+  const std::vector<Real> q = smooth(t.eps_a, t.q, kSmoothHalfWidth);
+  const auto k = std::max_element(q.begin(), q.end()) - q.begin();
+  t.q_peak = q[k];
   t.eps_a_peak = t.eps_a[k];
-  t.q_end = t.q.back();
-  t.max_dilatancy = t.eps_v.empty() ? kNaN : 0;
-  for (std::size_t i = 1; i < t.eps_v.size(); ++i)
-    t.max_dilatancy = std::max(t.max_dilatancy, -(t.eps_v[i] - t.eps_v[i - 1]) / (t.eps_a[i] - t.eps_a[i - 1]));
+  // q at the end: the mean over the last strain window (one raw row carries the full scatter).
+  Real sum = 0;
+  int n = 0;
+  for (std::size_t i = t.q.size(); i-- > 0 && t.eps_a[i] >= t.eps_a.back() - kEndWindow;) sum += t.q[i], ++n;
+  t.q_end = sum / n;
+  // Initial stiffness: least-squares slope through the first row of q against eps_a over the first
+  // kInitialWindow of strain (raw rows: smoothing would blur the start).
+  Real sxy = 0, sxx = 0;
+  for (std::size_t i = 1; i < t.q.size() && t.eps_a[i] - t.eps_a[0] <= kInitialWindow + 1e-12; ++i) {
+    const Real x = t.eps_a[i] - t.eps_a[0];
+    sxy += x * (t.q[i] - t.q[0]);
+    sxx += x * x;
+  }
+  t.e_ini = sxx > 0 ? sxy / sxx : kNaN;
+  t.max_dilatancy = kNaN;
+  if (t.eps_v.empty()) return;
+  // Maximum dilatancy -d eps_v / d eps_a: the slope of the smoothed eps_v over one window of strain.
+  const std::vector<Real> ev = smooth(t.eps_a, t.eps_v, kSmoothHalfWidth);
+  t.max_dilatancy = 0;
+  for (std::size_t i = 0, j = 0; i < ev.size(); ++i) {
+    while (j < ev.size() && t.eps_a[j] < t.eps_a[i] + 2 * kSmoothHalfWidth - 1e-12) ++j;
+    if (j >= ev.size()) break;
+    t.max_dilatancy = std::max(t.max_dilatancy, -(ev[j] - ev[i]) / (t.eps_a[j] - t.eps_a[i]));
+  }
 }
 
 void check_pressures(const MeasuredData& d, const std::vector<Real>& sigma3) {

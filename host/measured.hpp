@@ -8,7 +8,8 @@
 ///   material            text, e.g. S-1
 ///   sigma3_<unit>       confining pressure: kPa, MPa or Pa
 ///   curves:   eps_a_<u>, q_<stress unit>, and optionally eps_v_<u>   (strain units: pct or frac)
-///   summary:  q_peak_<stress unit>, and optionally eps_a_peak_<u>, q_end_<stress unit>, max_dilatancy
+///   summary:  q_peak_<stress unit>, and optionally eps_a_peak_<u>, q_end_<stress unit>, max_dilatancy,
+///             e_ini_<stress unit> (initial stiffness dq/deps_a over the first 0.2% of axial strain)
 /// A file is a curve file when it has an eps_a column, a summary file when it has q_peak. Within a curve
 /// the axial strain must increase; a material and pressure appear once in a summary file.
 #include <map>
@@ -32,6 +33,7 @@ struct MeasuredTest {
   Real sigma3 = 0;                          ///< Pa
   std::vector<Real> eps_a, q, eps_v;        ///< fractions, Pa, fractions (compression / contraction positive)
   Real q_peak = 0, eps_a_peak = 0, q_end = 0, max_dilatancy = 0;  ///< Pa, -, Pa, -
+  Real e_ini = 0;                           ///< Pa, initial stiffness dq/deps_a (first kInitialWindow of strain)
 };
 
 struct MeasuredData {
@@ -43,8 +45,14 @@ struct MeasuredData {
 /// Reads and validates a measured-data CSV. Throws DataError.
 MeasuredData load_measured(const std::string& path);
 
-/// Fills the summary values of curve tests from their curves (q_peak and its strain, q at the last strain,
-/// maximum of -d eps_v / d eps_a).
+/// Strain windows of summarise: curves are smoothed by a moving mean over +-0.25% axial strain, q at the end
+/// is the mean over the last 1%, the initial stiffness is fitted over the first 0.2% (the elastic range of
+/// bead contacts, overlap / radius ~ 1e-3, lies within it).
+constexpr Real kSmoothHalfWidth = 0.0025, kEndWindow = 0.01, kInitialWindow = 0.002;
+
+/// Fills the summary values of a curve test from its smoothed curves: q_peak and its strain, q at the end,
+/// the initial stiffness (least-squares slope of the raw rows over the first 0.2% of strain) and the maximum dilatancy
+/// -d eps_v / d eps_a (the slope over one 0.5% window). The same function summarises simulated curves.
 void summarise(MeasuredTest& t);
 
 /// Refuses a test whose pressure is not among `sigma3` (Pa): names the file, the material and the pressure.

@@ -399,15 +399,41 @@ std::vector<BallSpec> extract_balls(Simulation& sim, std::array<Real, 3>& cell) 
   return out;
 }
 
-int run_periodic_job(const Config& cfg) {
-  const PeriodicConfig& pc = cfg.periodic;
+void check_periodic_config(const Config& cfg) {
   if (!(cfg.box.periodic[0] && cfg.box.periodic[1] && cfg.box.periodic[2]))
     throw ConfigError(cfg.path + ": [box] periodic: the periodic triaxial needs [true, true, true]");
   if (cfg.solver.gravity[0] != 0 || cfg.solver.gravity[1] != 0 || cfg.solver.gravity[2] != 0)
     throw ConfigError(cfg.path + ": [solver] gravity: must be [0, 0, 0] in a fully periodic cell");
-  std::vector<BallSpec> balls = make_packing(cfg);
-  std::array<Real, 3> cell = cfg.box.size;
-  PeriodicTriaxialParams tp = pc.triax;
+}
+
+void prepare_periodic_specimen(const Config& cfg, std::vector<BallSpec>& balls, std::array<Real, 3>& cell,
+                               bool verbose) {
+  check_periodic_config(cfg);
+  const PeriodicConfig& pc = cfg.periodic;
+  balls = make_packing(cfg);
+  cell = cfg.box.size;
+  ContactParams prep = cfg.ball.base();
+  if (pc.prep_mu_s >= 0) prep.mu_s = pc.prep_mu_s;
+  if (pc.prep_mu_r >= 0) prep.mu_r = pc.prep_mu_r;
+  if (prep.mu_s == cfg.ball.mu_s && prep.mu_r == cfg.ball.mu_r) return;
+  auto sim = make_periodic_simulation(balls, cell, prep, cfg.solver);
+  if (verbose)
+    std::printf("triaxdem: preparation: %zu balls in a periodic cell %.2f x %.2f x %.2f mm, consolidated with "
+                "mu_s = %g, mu_r = %g; dt %.3e s\n", balls.size(), 1e3 * cell[0], 1e3 * cell[1], 1e3 * cell[2],
+                prep.mu_s, prep.mu_r, sim->params().integ.dt);
+  PeriodicTriaxialParams pp = resolve_periodic_params(*sim, pc.triax);
+  pp.name = cfg.run.name + " preparation";
+  pp.verbose = verbose;
+  pp.unbalanced_tolerance = pc.prep_unbalanced_tolerance;
+  consolidate_isotropic(*sim, pp);
+  balls = extract_balls(*sim, cell);
+}
+
+int run_periodic_job(const Config& cfg) {
+  std::vector<BallSpec> balls;
+  std::array<Real, 3> cell{};
+  prepare_periodic_specimen(cfg, balls, cell, true);
+  PeriodicTriaxialParams tp = cfg.periodic.triax;
   tp.name = cfg.run.name;
   io::Output out(cfg.run.output);
   std::unique_ptr<Simulation> sim;
@@ -420,19 +446,6 @@ int run_periodic_job(const Config& cfg) {
                   cfg.solver.mass_scale);
   };
   try {
-    ContactParams prep = cfg.ball;
-    if (pc.prep_mu_s >= 0) prep.mu_s = pc.prep_mu_s;
-    if (pc.prep_mu_r >= 0) prep.mu_r = pc.prep_mu_r;
-    if (prep.mu_s != cfg.ball.mu_s || prep.mu_r != cfg.ball.mu_r) {
-      sim = make_periodic_simulation(balls, cell, prep, cfg.solver);
-      announce("preparation");
-      std::printf("triaxdem: preparatory consolidation with mu_s = %g, mu_r = %g\n", prep.mu_s, prep.mu_r);
-      PeriodicTriaxialParams pp = resolve_periodic_params(*sim, tp);
-      pp.name = tp.name + " preparation";
-      pp.unbalanced_tolerance = pc.prep_unbalanced_tolerance;
-      consolidate_isotropic(*sim, pp);
-      balls = extract_balls(*sim, cell);
-    }
     sim = make_periodic_simulation(balls, cell, cfg.ball, cfg.solver);
     announce("test");
     const PeriodicTriaxialResult r = run_periodic_triaxial(*sim, tp, &out);

@@ -105,6 +105,15 @@ std::unique_ptr<Simulation> make_periodic_simulation(const std::vector<BallSpec>
 std::vector<BallSpec> extract_balls(Simulation& sim, std::array<Real, 3>& cell);
 
 
+/// Refuses a config that is not a fully periodic cell without gravity.
+void check_periodic_config(const Config& cfg);
+
+/// The specimen of a periodic job: the packing of [particles]/[box], consolidated to [periodic] sigma3_kPa
+/// with the preparation friction (prep_mu_s, prep_mu_r) when that differs from the material's, without the
+/// model extensions. `balls` and `cell` receive it.
+void prepare_periodic_specimen(const Config& cfg, std::vector<BallSpec>& balls, std::array<Real, 3>& cell,
+                               bool verbose);
+
 /// The `periodic` job: packing from [particles]/[box] (box.periodic must be all true, gravity zero),
 /// optional preparatory consolidation, then run_periodic_triaxial with output in [run] output.
 /// Returns 0, or 2 on a blow-up (state saved).

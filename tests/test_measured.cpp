@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include "host/measured.hpp"
 
@@ -59,8 +60,42 @@ TEST(Measured, CurvesInOtherUnitsAreSummarised) {
   EXPECT_DOUBLE_EQ(t.sigma3, 100e3);
   EXPECT_DOUBLE_EQ(t.q_peak, 150e3);
   EXPECT_DOUBLE_EQ(t.eps_a_peak, 0.02);
-  EXPECT_DOUBLE_EQ(t.q_end, 140e3);
+  // Rows 1% apart: the +-0.25% smoothing window holds one row, the last 1% of strain two (2% and 3%).
+  EXPECT_DOUBLE_EQ(t.q_end, 145e3);
   EXPECT_NEAR(t.max_dilatancy, 0.4, 1e-12);  // -(-0.003 - 0.001) / 0.01
+  // Initial stiffness over the first 0.2% of strain: no row but the first lies within it.
+  EXPECT_TRUE(std::isnan(t.e_ini));
+}
+
+// Dense rows with alternating scatter: the moving mean over +-0.25% strain removes it, so q_peak is the
+// underlying curve's and not the highest noisy row.
+TEST(Measured, NoisyCurvesAreSmoothedBeforeTheyAreSummarised) {
+  std::ostringstream f;
+  f.precision(15);  // the expected values below are computed from unrounded rows
+  f << "material,sigma3_kPa,eps_a_pct,q_kPa,eps_v_pct\n";
+  for (int i = 0; i <= 1000; ++i) {
+    const double e = 0.01 * i;  // % strain, 0.01% apart: 51 rows per window
+    const double q = 100 * (1 - std::exp(-e)) + (i % 2 ? 5.0 : -5.0);
+    f << "A,100," << e << "," << q << "," << -0.2 * e << "\n";
+  }
+  const MeasuredTest t = load_measured(write("noisy.csv", f.str())).tests[0];
+  // The clean curve peaks at 100 (1 - e^-10) = 99.995 kPa at the end; the window's mean carries at most one
+  // unpaired row: 5/51 ~ 0.1 kPa; the mean of the scatter over the last 1% likewise.
+  EXPECT_NEAR(t.q_peak, 99.995e3, 0.15e3);
+  EXPECT_NEAR(t.q_end, 1e5 * (1 - std::exp(-9.5)), 0.2e3);  // mean of a nearly flat tail
+  EXPECT_NEAR(t.max_dilatancy, 0.2, 1e-9);                  // eps_v = -0.2 eps_a exactly
+  // Initial stiffness: the least-squares slope through the first row over the first 0.2% (rows 1-20), worked
+  // out here from the rows as written (strain as a fraction, stress in Pa); rounding only: 1e-9.
+  double sxy = 0, sxx = 0;
+  auto q_row = [](int i) { return 1e3 * (100 * (1 - std::exp(-0.01 * i)) + (i % 2 ? 5.0 : -5.0)); };
+  for (int i = 1; i <= 20; ++i) {
+    sxy += 1e-4 * i * (q_row(i) - q_row(0));
+    sxx += 1e-8 * i * i;
+  }
+  EXPECT_NEAR(t.e_ini, sxy / sxx, 1e-9 * sxy / sxx);
+  // ... which is the clean initial slope 1e7 Pa lowered ~7% by the curvature and raised ~37% by the -5 kPa
+  // scatter of the first row (a 0.2% window is short: the first row's error weighs on the slope).
+  EXPECT_NEAR(t.e_ini, 1.3e7, 0.05e7);
 }
 
 TEST(Measured, BadFilesAreRefusedWithLineAndColumn) {

@@ -1,0 +1,310 @@
+#include "calibrate.hpp"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "periodic_triaxial.hpp"
+
+namespace dem {
+
+namespace {
+
+constexpr Real kNaN = std::numeric_limits<Real>::quiet_NaN();
+/// Residual of a datum the simulation could not produce (no peak, a blow-up): ten standard deviations.
+constexpr Real kMissing = 10;
+
+}  // namespace
+
+const char* quantity_name(int q) {
+  static const char* names[kQuantities] = {"E_ini", "q_peak", "eps_a_peak", "q_end", "max_dilatancy"};
+  return names[q];
+}
+
+std::array<Real, kQuantities> quantities(const MeasuredTest& t) {
+  return {t.e_ini, t.q_peak, t.eps_a_peak, t.q_end, t.max_dilatancy};
+}
+
+Real NoiseModel::sigma(int q, Real measured) const { return std::max(rel[q] * std::fabs(measured), abs[q]); }
+
+std::vector<Real> residuals(const std::vector<MeasuredTest>& measured, const std::vector<MeasuredTest>& simulated,
+                            const NoiseModel& noise, const std::vector<bool>& use) {
+  std::vector<Real> r;
+  for (std::size_t k = 0; k < measured.size(); ++k) {
+    if (!use.empty() && !use[k]) continue;
+    const auto m = quantities(measured[k]), s = quantities(simulated[k]);
+    for (int q = 0; q < kQuantities; ++q) {
+      if (!std::isfinite(m[q])) continue;
+      r.push_back(std::isfinite(s[q]) ? (s[q] - m[q]) / noise.sigma(q, m[q]) : kMissing);
+    }
+  }
+  return r;
+}
+
+int data_count(const std::vector<MeasuredTest>& measured, const std::vector<bool>& use) {
+  int n = 0;
+  for (std::size_t k = 0; k < measured.size(); ++k) {
+    if (!use.empty() && !use[k]) continue;
+    for (Real v : quantities(measured[k])) n += std::isfinite(v) ? 1 : 0;
+  }
+  return n;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Free parameters
+
+Real FreeParam::value(Real u) const { return log ? lo * std::pow(hi / lo, u) : lo + u * (hi - lo); }
+Real FreeParam::unit(Real v) const {
+  return std::clamp(log ? std::log(v / lo) / std::log(hi / lo) : (v - lo) / (hi - lo), Real(0), Real(1));
+}
+
+namespace {
+struct ParamSpec {
+  FreeParam range;
+  Real ContactParams::*field;  ///< null: the membrane
+};
+const std::vector<ParamSpec>& param_specs() {
+  static const std::vector<ParamSpec> specs = {
+      {{"mu_s", 0.02, 1.0, true}, &ContactParams::mu_s},
+      {{"mu_r", 0.0, 0.2, false}, &ContactParams::mu_r},
+      {{"emod_Pa", 1e6, 1e10, true}, &ContactParams::emod},
+      {{"kratio", 1.0, 4.0, false}, &ContactParams::kratio},
+      {{"hertz_overlap", 3e-4, 0.03, true}, &ContactParams::hertz_overlap},
+      {{"roughness", 1e-4, 5e-2, true}, &ContactParams::roughness},
+      {{"wear", 0.0, 0.9, false}, &ContactParams::wear},
+      {{"wear_slip", 0.005, 0.5, true}, &ContactParams::wear_slip},
+      {{"membrane_kPa", 0.0, 3e6, false, 1e-3}, nullptr},
+  };
+  return specs;
+}
+const ParamSpec& spec(const std::string& name) {
+  std::string names;
+  for (const ParamSpec& s : param_specs()) {
+    if (s.range.name == name) return s;
+    names += (names.empty() ? "" : ", ") + s.range.name;
+  }
+  throw std::invalid_argument("unknown free parameter '" + name + "' (allowed: " + names + ")");
+}
+}  // namespace
+
+FreeParam free_param(const std::string& name) { return spec(name).range; }
+
+FreeParam free_param(const std::string& name, const Model& base) {
+  FreeParam f = free_param(name);
+  const Real v = get_param(base, name);
+  if ((name == "mu_s" || name == "emod_Pa") && v > 0) {
+    f.lo = v / 3;
+    f.hi = 3 * v;
+    f.log = true;
+  } else if (name == "mu_r") {
+    f.lo = 0;
+    f.hi = std::max(4 * v, Real(0.05));
+  }
+  return f;
+}
+
+void set_param(Model& m, const std::string& name, Real v) {
+  const ParamSpec& s = spec(name);
+  if (s.field) m.law.*s.field = v;
+  else m.membrane = v;
+}
+
+Real get_param(const Model& m, const std::string& name) {
+  const ParamSpec& s = spec(name);
+  return s.field ? m.law.*s.field : m.membrane;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Simulator
+
+PeriodicLab::PeriodicLab(const Config& base, bool verbose) : cfg_(base) {
+  prepare_periodic_specimen(cfg_, balls_, cell_, verbose);
+}
+
+MeasuredTest PeriodicLab::run(const Model& m, Real sigma3, const std::string& material) {
+  const auto t0 = std::chrono::steady_clock::now();
+  MeasuredTest t;
+  t.material = material;
+  t.sigma3 = sigma3;
+  PeriodicTriaxialParams p = cfg_.periodic.triax;
+  p.sigma3 = sigma3;
+  p.membrane_stiffness = m.membrane;
+  p.verbose = false;
+  p.snapshot_strains.clear();
+  try {
+    auto sim = make_periodic_simulation(balls_, cell_, m.law, cfg_.solver);
+    const PeriodicTriaxialResult r = run_periodic_triaxial(*sim, p);
+    for (const PeriodicTriaxialRecord& row : r.series) {
+      t.eps_a.push_back(row.eps_a);
+      t.q.push_back(row.q);
+      t.eps_v.push_back(row.eps_v);
+    }
+    summarise(t);
+  } catch (const BlowUp&) {
+    t.q_peak = t.eps_a_peak = t.q_end = t.max_dilatancy = t.e_ini = kNaN;  // counted as missing by residuals()
+  }
+  ++runs_;
+  seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return t;
+}
+
+std::vector<MeasuredTest> PeriodicLab::run_all(const Model& m, const std::vector<MeasuredTest>& like) {
+  std::vector<MeasuredTest> out;
+  for (const MeasuredTest& t : like) out.push_back(run(m, t.sigma3, t.material));
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Surrogate and search
+
+std::vector<Real> QuadraticSurface::basis(const std::vector<Real>& u) {
+  std::vector<Real> b{1};
+  for (Real x : u) b.push_back(x);
+  for (std::size_t i = 0; i < u.size(); ++i)
+    for (std::size_t j = i; j < u.size(); ++j) b.push_back(u[i] * u[j]);
+  return b;
+}
+
+QuadraticSurface::QuadraticSurface(const std::vector<std::vector<Real>>& u, const std::vector<Real>& y,
+                                   const std::vector<Real>& w) {
+  const int n = static_cast<int>(u.size());
+  const int m = static_cast<int>(basis(u.front()).size());
+  Eigen::MatrixXd A(n, m);
+  Eigen::VectorXd b(n);
+  for (int i = 0; i < n; ++i) {
+    const std::vector<Real> row = basis(u[i]);
+    const Real sw = std::sqrt(w[i]);
+    for (int j = 0; j < m; ++j) A(i, j) = sw * row[j];
+    b(i) = sw * y[i];
+  }
+  // Complete orthogonal decomposition: a minimum-norm answer when the design cannot fix every term.
+  const Eigen::VectorXd c = A.completeOrthogonalDecomposition().solve(b);
+  c_.assign(c.data(), c.data() + m);
+}
+
+Real QuadraticSurface::operator()(const std::vector<Real>& u) const {
+  const std::vector<Real> b = basis(u);
+  Real v = 0;
+  for (std::size_t j = 0; j < b.size(); ++j) v += c_[j] * b[j];
+  return v;
+}
+
+std::vector<Real> minimise_unit_box(const std::function<Real(const std::vector<Real>&)>& f, int d, int per_axis) {
+  if (d == 0) return {};
+  const int n = d <= 3 ? per_axis : 7;
+  std::vector<Real> best(d, 0.5), u(d);
+  Real fbest = std::numeric_limits<Real>::infinity();
+  std::vector<int> idx(d, 0);
+  for (;;) {
+    for (int k = 0; k < d; ++k) u[k] = static_cast<Real>(idx[k]) / (n - 1);
+    const Real v = f(u);
+    if (v < fbest) fbest = v, best = u;
+    int k = 0;
+    while (k < d && ++idx[k] == n) idx[k++] = 0;
+    if (k == d) break;
+  }
+  for (Real step = 0.5 / (n - 1); step > 1e-4; step /= 2) {
+    for (bool moved = true; moved;) {
+      moved = false;
+      for (int k = 0; k < d; ++k)
+        for (Real s : {-step, step}) {
+          u = best;
+          u[k] = std::clamp(u[k] + s, Real(0), Real(1));
+          const Real v = f(u);
+          if (v < fbest) fbest = v, best = u, moved = true;
+        }
+    }
+  }
+  return best;
+}
+
+namespace {
+
+Real chi2_of(const std::vector<Real>& r) {
+  Real s = 0;
+  for (Real x : r) s += x * x;
+  return s;
+}
+
+}  // namespace
+
+/// Weights: a Gaussian of width 0.3 in unit coordinates around `centre`, floor 0.1 (far points still hold
+/// the curvature).
+std::vector<QuadraticSurface> response_surfaces(const std::vector<Evaluation>& pts, const std::vector<Real>& centre) {
+  std::vector<std::vector<Real>> u;
+  std::vector<Real> w;
+  for (const Evaluation& e : pts) {
+    u.push_back(e.u);
+    Real d2 = 0;
+    for (std::size_t k = 0; k < centre.size(); ++k) d2 += (e.u[k] - centre[k]) * (e.u[k] - centre[k]);
+    w.push_back(0.1 + std::exp(-d2 / (2 * 0.3 * 0.3)));
+  }
+  std::vector<QuadraticSurface> s;
+  for (std::size_t i = 0; i < pts.front().r.size(); ++i) {
+    std::vector<Real> y;
+    for (const Evaluation& e : pts) y.push_back(e.r[i]);
+    s.emplace_back(u, y, w);
+  }
+  return s;
+}
+
+CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,
+                            const std::vector<MeasuredTest>& measured, const NoiseModel& noise, int rounds,
+                            const CalibrationProgress& progress) {
+  const int d = static_cast<int>(free.size());
+  CalibrationResult res;
+  res.free = free;
+  res.data = data_count(measured);
+  long design_points = 1;
+  for (int k = 0; k < d; ++k) design_points *= 3;
+  const long planned = (design_points + rounds) * static_cast<long>(measured.size());
+  auto model_at = [&](const std::vector<Real>& u) {
+    Model m = base;
+    for (int k = 0; k < d; ++k) set_param(m, free[k].name, free[k].value(u[k]));
+    return m;
+  };
+  auto evaluate = [&](const std::vector<Real>& u) {
+    Evaluation e;
+    e.u = u;
+    e.sim = lab.run_all(model_at(u), measured);
+    e.r = residuals(measured, e.sim, noise);
+    e.chi2 = chi2_of(e.r);
+    res.design.push_back(e);
+    if (res.design.size() == 1 || e.chi2 < res.best.chi2) res.best = e;
+    if (progress) progress(lab.runs(), planned, res.best.chi2);
+  };
+  std::vector<int> idx(d, 0);
+  for (long p = 0; p < design_points; ++p) {
+    std::vector<Real> u(d);
+    long c = p;
+    for (int k = 0; k < d; ++k, c /= 3) u[k] = 0.5 * static_cast<Real>(c % 3);
+    evaluate(u);
+  }
+  for (int round = 0; round < rounds && d > 0; ++round) {
+    const std::vector<QuadraticSurface> s = response_surfaces(res.design, res.best.u);
+    const std::vector<Real> u = minimise_unit_box([&](const std::vector<Real>& x) {
+      Real c = 0;
+      for (const QuadraticSurface& q : s) c += q(x) * q(x);
+      return c;
+    }, d);
+    bool seen = false;
+    for (const Evaluation& e : res.design) {
+      Real d2 = 0;
+      for (int k = 0; k < d; ++k) d2 += (e.u[k] - u[k]) * (e.u[k] - u[k]);
+      seen = seen || d2 < 1e-6;
+    }
+    if (seen) break;  // the surface points at a point already run: converged
+    const Real before = res.best.chi2;
+    evaluate(u);
+    if (round > 0 && res.best.chi2 > 0.98 * before) break;  // stopped improving
+  }
+  res.model = model_at(res.best.u);
+  for (int k = 0; k < d; ++k) res.values.push_back(free[k].value(res.best.u[k]));
+  return res;
+}
+
+}  // namespace dem

@@ -1,0 +1,151 @@
+#pragma once
+/// Calibration against measured triaxial data (issue 5).
+///
+/// The simulator is the periodic-cell triaxial test (host/periodic_triaxial.hpp) on one specimen prepared once
+/// from the base config, so that every run differs from the others only by its parameters (common random
+/// numbers: the response is then a smooth function of the parameters, up to the chaos of a small cell).
+///
+/// Each test (material, sigma3) is reduced to five quantities, the same for measured and simulated curves
+/// (summarise in host/measured.hpp): initial stiffness E_ini, q_peak, eps_a at the peak, q at the end, maximum dilatancy. A summary
+/// file gives those it has. The misfit is a chi-square with a lab-like noise per quantity:
+///   chi2 = sum over tests and present quantities of ((simulated - measured) / s_q)^2,
+///   s_q = max(rel_q |measured|, abs_q)   (NoiseModel: E_ini 10%, q_peak 4%, eps_a at peak 2% strain,
+///                                         q_end 5%, dilatancy 20% or 0.05)
+/// so a model that is right to within the noise has chi2 about the number of data. The levels are a lab's
+/// specimen-to-specimen scatter (2-3% on strength) plus the scatter of a 200-ball cell, whose broad peak
+/// moves by a few % of strain with a small change of parameters.
+///
+/// Search (for d free parameters, each mapped to [0, 1], linearly or logarithmically):
+///   1. a 3^d factorial design (every test of the material at every point);
+///   2. a quadratic response surface per datum (Eigen least squares on the normalised residuals), minimised
+///      by a dense grid and then coordinate refinement;
+///   3. a run at the surrogate's optimum, added to the design; the surface is refitted with weights that
+///      favour points near the optimum; repeated until the run's chi2 stops improving (at most `rounds`).
+/// The reported fit is the best point actually run, never a surrogate value.
+#include <array>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "config.hpp"
+#include "host/builder.hpp"
+#include "measured.hpp"
+
+namespace dem {
+
+enum Quantity : int { kInitialStiffness = 0, kPeak, kStrainAtPeak, kResidual, kDilatancy, kQuantities };
+
+/// Name of a quantity in tables ("E_ini", "q_peak", ...).
+const char* quantity_name(int q);
+
+/// The quantities of a test (NaN where absent).
+std::array<Real, kQuantities> quantities(const MeasuredTest& t);
+
+/// Noise of each quantity: s_q = max(rel_q |measured|, abs_q).
+struct NoiseModel {
+  std::array<Real, kQuantities> rel{0.10, 0.04, 0.0, 0.05, 0.20};
+  std::array<Real, kQuantities> abs{0.0, 0.0, 0.02, 0.0, 0.05};
+  Real sigma(int q, Real measured) const;
+};
+
+/// Normalised residuals (simulated - measured) / s_q of every present quantity, test by test (tests matched
+/// by index); `use[k]` false leaves test k out.
+std::vector<Real> residuals(const std::vector<MeasuredTest>& measured, const std::vector<MeasuredTest>& simulated,
+                            const NoiseModel& noise, const std::vector<bool>& use = {});
+
+/// Number of data (present quantities) in the tests used.
+int data_count(const std::vector<MeasuredTest>& measured, const std::vector<bool>& use = {});
+
+
+/// A model to simulate: contact law (with extensions) and the membrane extension (Pa, E_m t / R0).
+struct Model {
+  ContactParams law;
+  Real membrane = 0;
+};
+
+/// A parameter that calibration may vary: its config key, its range, log or linear search.
+struct FreeParam {
+  std::string name;
+  Real lo = 0, hi = 1;
+  bool log = false;
+  Real value(Real u) const;   ///< u in [0, 1] to the parameter
+  Real unit(Real v) const;    ///< the inverse
+  Real shown = 1;             ///< factor from SI to the config key's unit (1e-3 for membrane_kPa)
+};
+
+/// The parameters triaxdem can free, with their default ranges: mu_s, mu_r, emod_Pa, kratio, hertz_overlap,
+/// roughness, wear, wear_slip, membrane_kPa (in Pa inside). Throws std::invalid_argument naming the allowed
+/// names.
+FreeParam free_param(const std::string& name);
+/// The same, centred on the base model's value where that is set: mu_s and emod_Pa over a factor 3
+/// either way (log), mu_r over [0, max(4 x value, 0.05)]. A 3 x 3 design then lands near a sensible answer.
+FreeParam free_param(const std::string& name, const Model& base);
+void set_param(Model& m, const std::string& name, Real v);
+Real get_param(const Model& m, const std::string& name);
+
+/// The simulator: periodic-cell triaxial runs on one specimen prepared from the base config.
+class PeriodicLab {
+ public:
+  PeriodicLab(const Config& base, bool verbose);
+  /// A simulated test as measured data (curves, summarised), at confining pressure sigma3 (Pa).
+  MeasuredTest run(const Model& m, Real sigma3, const std::string& material = "sim");
+  /// All tests of `like` (same materials and pressures), in order.
+  std::vector<MeasuredTest> run_all(const Model& m, const std::vector<MeasuredTest>& like);
+  const Config& config() const { return cfg_; }
+  long runs() const { return runs_; }
+  double seconds() const { return seconds_; }
+  std::size_t balls() const { return balls_.size(); }
+
+ private:
+  Config cfg_;
+  std::vector<BallSpec> balls_;
+  std::array<Real, 3> cell_{};
+  long runs_ = 0;
+  double seconds_ = 0;
+};
+
+/// One evaluated point of a search.
+struct Evaluation {
+  std::vector<Real> u;                ///< unit coordinates of the free parameters
+  std::vector<MeasuredTest> sim;      ///< simulated tests
+  std::vector<Real> r;                ///< normalised residuals (all tests)
+  Real chi2 = 0;
+};
+
+struct CalibrationResult {
+  Model model;                        ///< base model with the calibrated values
+  std::vector<FreeParam> free;
+  std::vector<Real> values;
+  Evaluation best;                    ///< the best point run
+  std::vector<Evaluation> design;     ///< every point run, in order
+  int data = 0;                       ///< number of data in the misfit
+};
+
+/// Called after each run with (runs done, runs planned, best chi2 so far).
+using CalibrationProgress = std::function<void(long, long, Real)>;
+
+/// Calibrates `free` on `measured` (one material, any number of pressures) from `base`; see the top of the file.
+CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,
+                            const std::vector<MeasuredTest>& measured, const NoiseModel& noise, int rounds = 4,
+                            const CalibrationProgress& progress = {});
+
+/// A quadratic response surface in unit coordinates: value(u) = c . basis(u), fitted by weighted least squares.
+class QuadraticSurface {
+ public:
+  QuadraticSurface() = default;
+  QuadraticSurface(const std::vector<std::vector<Real>>& u, const std::vector<Real>& y, const std::vector<Real>& w);
+  Real operator()(const std::vector<Real>& u) const;
+  static std::vector<Real> basis(const std::vector<Real>& u);
+
+ private:
+  std::vector<Real> c_;
+};
+
+/// One response surface per residual of the evaluations, weighted towards `centre` (unit coordinates).
+std::vector<QuadraticSurface> response_surfaces(const std::vector<Evaluation>& pts, const std::vector<Real>& centre);
+
+/// Minimises f over [0, 1]^d: a grid of `per_axis` points per axis (fewer for d > 3), then coordinate steps
+/// that halve down to 1e-4.
+std::vector<Real> minimise_unit_box(const std::function<Real(const std::vector<Real>&)>& f, int d, int per_axis = 21);
+
+}  // namespace dem

@@ -1,0 +1,247 @@
+#include "calibration_jobs.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <random>
+#include <sstream>
+
+#include "calibrate.hpp"
+#include "diagnose.hpp"
+#include "progress.hpp"
+#include "study.hpp"
+
+namespace dem {
+
+namespace fs = std::filesystem;
+
+std::string new_dated_folder(const std::string& parent, const std::string& prefix) {
+  const std::time_t now = std::time(nullptr);
+  char stamp[32];
+  std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", std::localtime(&now));
+  fs::create_directories(parent);
+  const std::string stem = (fs::path(parent) / (prefix + "_" + stamp)).string();
+  for (int k = 1;; ++k) {
+    const std::string path = k == 1 ? stem : stem + "-" + std::to_string(k);
+    if (fs::create_directory(path)) return path;  // false: it exists; never reuse it
+  }
+}
+
+namespace {
+
+Model model_of(const Config& cfg) {
+  Model m;
+  m.law = cfg.ball;
+  m.membrane = cfg.periodic.triax.membrane_stiffness;
+  return m;
+}
+
+std::vector<FreeParam> free_params(const std::vector<std::string>& names, const Model& base) {
+  std::vector<FreeParam> out;
+  for (const std::string& n : names) out.push_back(free_param(n, base));
+  return out;
+}
+
+/// The tests of the data, material by material (file order), filtered by `only` when it is set.
+std::map<std::string, std::vector<MeasuredTest>> by_material(const MeasuredData& d, const std::string& only) {
+  std::map<std::string, std::vector<MeasuredTest>> out;
+  for (const MeasuredTest& t : d.tests)
+    if (only.empty() || t.material == only) out[t.material].push_back(t);
+  if (out.empty()) throw DataError(d.path + ": no tests of material '" + only + "'");
+  return out;
+}
+
+/// Writes a file through a temporary and a rename, so that nothing half-written is left.
+void write_file(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp);
+    f << text;
+    if (!f) throw std::runtime_error(path + ": write failed");
+  }
+  fs::rename(tmp, path);
+}
+
+std::string fmt(const char* f, double v) {
+  char b[64];
+  std::snprintf(b, sizeof b, f, v);
+  return b;
+}
+
+/// A quantity in the unit of the tables: MPa for the stiffness, kPa for stresses, % for the strain.
+std::pair<double, const char*> in_table_unit(int q, Real v) {
+  if (q == kInitialStiffness) return {1e-6 * v, "MPa"};
+  if (q == kStrainAtPeak) return {100 * v, "pct"};
+  if (q == kDilatancy) return {v, "-"};
+  return {1e-3 * v, "kPa"};
+}
+
+/// The errors table (like the paper's Table 6): measured, simulated and error per test and quantity.
+std::string errors_csv(const std::vector<MeasuredTest>& meas, const std::vector<MeasuredTest>& sim) {
+  std::ostringstream s;
+  s << "material,sigma3_kPa,quantity,unit,measured,simulated,error_pct\n";
+  for (std::size_t k = 0; k < meas.size(); ++k) {
+    const auto m = quantities(meas[k]), q = quantities(sim[k]);
+    for (int i = 0; i < kQuantities; ++i) {
+      if (!std::isfinite(m[i])) continue;
+      s << meas[k].material << "," << fmt("%g", 1e-3 * meas[k].sigma3) << "," << quantity_name(i) << ","
+        << in_table_unit(i, m[i]).second << "," << fmt("%.5g", in_table_unit(i, m[i]).first) << ","
+        << fmt("%.5g", in_table_unit(i, q[i]).first) << "," << fmt("%.2f", 100 * (q[i] - m[i]) / std::fabs(m[i])) << "\n";
+    }
+  }
+  return s.str();
+}
+
+void print_errors(const std::vector<MeasuredTest>& meas, const std::vector<MeasuredTest>& sim) {
+  std::printf("%-10s %7s %-14s %12s %12s %8s\n", "material", "s3 kPa", "quantity", "measured", "simulated", "err %");
+  std::istringstream in(errors_csv(meas, sim));
+  std::string line;
+  std::getline(in, line);
+  while (std::getline(in, line)) {
+    std::vector<std::string> c;
+    std::stringstream ls(line);
+    for (std::string x; std::getline(ls, x, ',');) c.push_back(x);
+    std::printf("%-10s %7s %-14s %12s %12s %8s\n", c[0].c_str(), c[1].c_str(), (c[2] + " " + c[3]).c_str(),
+                c[4].c_str(), c[5].c_str(), c[6].c_str());
+  }
+}
+
+void plot(const std::string& folder) { run_plot_script("plot_calibration.py", {folder}); }
+
+}  // namespace
+
+int calibrate_job(const Config& base, const CalibrationOptions& o) {
+  const MeasuredData data = load_measured(o.data);
+  const std::vector<FreeParam> free = free_params(o.free, model_of(base));
+  PeriodicLab lab(base, true);
+  const std::string folder = new_dated_folder(o.output, "calibrate");
+  std::ostringstream table;
+  table << "material,parameter,value,chi2,data,runs\n";
+  std::vector<MeasuredTest> all_meas, all_sim;
+  for (const auto& [material, tests] : by_material(data, o.material)) {
+    std::printf("calibrate: %s, %zu tests, free %zu parameters, %zu balls in the periodic cell\n", material.c_str(),
+                tests.size(), free.size(), lab.balls());
+    const long planned = (std::lround(std::pow(3.0, free.size())) + 4) * static_cast<long>(tests.size());
+    Progress progress("calibrate " + material, planned);
+    const long runs0 = lab.runs();
+    const CalibrationResult r = calibrate(lab, model_of(base), free, tests, NoiseModel(), 4,
+                                          [&](long done, long, Real chi2) {
+                                            char extra[64];
+                                            std::snprintf(extra, sizeof extra, "runs, best chi2 %.1f", chi2);
+                                            progress.update(std::min(done - runs0, planned), extra);
+                                          });
+    progress.finish("");
+    for (std::size_t k = 0; k < free.size(); ++k) {
+      std::printf("calibrate: %s: %s = %.4g\n", material.c_str(), free[k].name.c_str(), free[k].shown * r.values[k]);
+      table << material << "," << free[k].name << "," << fmt("%.6g", free[k].shown * r.values[k]) << "," << fmt("%.3f", r.best.chi2)
+            << "," << r.data << "," << lab.runs() - runs0 << "\n";
+    }
+    std::printf("calibrate: %s: chi2 %.1f on %d data after %ld runs\n", material.c_str(), r.best.chi2, r.data,
+                lab.runs() - runs0);
+    all_meas.insert(all_meas.end(), tests.begin(), tests.end());
+    all_sim.insert(all_sim.end(), r.best.sim.begin(), r.best.sim.end());
+  }
+  print_errors(all_meas, all_sim);
+  write_file(folder + "/calibrated.csv", table.str());
+  write_file(folder + "/errors.csv", errors_csv(all_meas, all_sim));
+  write_measured_curves(folder + "/simulated_curves.csv", all_sim, "simulated at the calibrated parameters");
+  if (data.curves) write_measured_curves(folder + "/measured_curves.csv", all_meas, "measured: " + o.data);
+  std::printf("calibrate: %ld runs in %s; results in %s (calibrated.csv, errors.csv, simulated_curves.csv)\n",
+              lab.runs(), format_duration(lab.seconds()).c_str(), folder.c_str());
+  plot(folder);
+  return 0;
+}
+
+int diagnose_job(const Config& base, const CalibrationOptions& o) {
+  const MeasuredData data = load_measured(o.data);
+  const std::vector<FreeParam> free = free_params(o.free, model_of(base));
+  PeriodicLab lab(base, true);
+  const std::string folder = new_dated_folder(o.output, "diagnose");
+  std::ostringstream md, csv;
+  md << "# Diagnosis of " << o.data << "\n\n"
+     << "Simulator: periodic-cell triaxial, " << lab.balls() << " balls, one specimen for every run. Free base "
+     << "parameters:";
+  for (const FreeParam& f : free) md << " " << f.name;
+  md << ". Misfit: chi2 over the initial stiffness, q_peak, eps_a at peak, q_end and maximum dilatancy with lab-like noise "
+        "(host/calibrate.hpp).\n\n";
+  csv << "material,model,parameter,value,chi2,bic,heldout_chi2,runs\n";
+  std::vector<MeasuredTest> all_meas, all_sim;
+  for (const auto& [material, tests] : by_material(data, o.material)) {
+    const Diagnosis dg = diagnose(lab, model_of(base), free, tests, NoiseModel(), true);
+    std::printf("diagnose: %s: verdict: %s\n  %s\n", material.c_str(), dg.verdict.c_str(), dg.explanation.c_str());
+    md << "## " << material << "\n\n**Verdict: " << dg.verdict << ".** " << dg.explanation << "\n\n"
+       << "| model | parameters | chi2 | BIC | held-out chi2 | runs |\n|---|---|---|---|---|---|\n| base | ";
+    for (std::size_t k = 0; k < free.size(); ++k) {
+      md << free[k].name << " = " << fmt("%.4g", free[k].shown * dg.base.values[k]) << " ";
+      csv << material << ",base," << free[k].name << "," << fmt("%.6g", free[k].shown * dg.base.values[k]) << ","
+          << fmt("%.3f", dg.base.best.chi2) << "," << fmt("%.3f", dg.base_bic) << "," << fmt("%.3f", dg.base_heldout)
+          << "," << dg.base.design.size() * tests.size() << "\n";
+    }
+    md << "| " << fmt("%.1f", dg.base.best.chi2) << " | " << fmt("%.1f", dg.base_bic) << " | "
+       << fmt("%.1f", dg.base_heldout) << " | " << dg.base.design.size() * tests.size() << " |\n";
+    for (const ExtensionFit& f : dg.fits) {
+      md << "| " << f.ext.name << " | ";
+      for (std::size_t k = 0; k < free.size(); ++k)
+        md << free[k].name << " = " << fmt("%.4g", free[k].shown * f.values[k]) << " ";
+      const Real shown = free_param(f.ext.param).shown;
+      md << f.ext.param << " = " << fmt("%.3g", shown * f.strength) << " | " << fmt("%.1f", f.best.chi2) << " | "
+         << fmt("%.1f", f.bic) << " | " << fmt("%.1f", f.heldout) << " | " << f.runs << " |\n";
+      csv << material << "," << f.ext.name << "," << f.ext.param << "," << fmt("%.6g", shown * f.strength) << ","
+          << fmt("%.3f", f.best.chi2) << "," << fmt("%.3f", f.bic) << "," << fmt("%.3f", f.heldout) << "," << f.runs
+          << "\n";
+    }
+    md << "\nMisfit per test and quantity of the calibrated base model (residual in noise units, "
+          "(simulated - measured) / s):\n\n| sigma3 kPa | quantity | unit | measured | base | residual |\n"
+          "|---|---|---|---|---|---|\n";
+    for (std::size_t k = 0; k < tests.size(); ++k) {
+      const auto m = quantities(tests[k]), s = quantities(dg.base.best.sim[k]);
+      for (int q = 0; q < kQuantities; ++q) {
+        if (!std::isfinite(m[q])) continue;
+        md << "| " << fmt("%g", 1e-3 * tests[k].sigma3) << " | " << quantity_name(q) << " | "
+           << in_table_unit(q, m[q]).second << " | " << fmt("%.4g", in_table_unit(q, m[q]).first) << " | "
+           << fmt("%.4g", in_table_unit(q, s[q]).first) << " | "
+           << fmt("%+.1f", std::isfinite(s[q]) ? (s[q] - m[q]) / NoiseModel().sigma(q, m[q]) : NAN) << " |\n";
+      }
+    }
+    md << "\n";
+    all_meas.insert(all_meas.end(), tests.begin(), tests.end());
+    all_sim.insert(all_sim.end(), dg.base.best.sim.begin(), dg.base.best.sim.end());
+  }
+  write_file(folder + "/diagnosis.md", md.str());
+  write_file(folder + "/models.csv", csv.str());
+  write_file(folder + "/errors.csv", errors_csv(all_meas, all_sim));
+  write_measured_curves(folder + "/simulated_curves.csv", all_sim, "simulated by the calibrated base model");
+  if (data.curves) write_measured_curves(folder + "/measured_curves.csv", all_meas, "measured: " + o.data);
+  std::printf("diagnose: %ld runs in %s; report in %s/diagnosis.md\n", lab.runs(),
+              format_duration(lab.seconds()).c_str(), folder.c_str());
+  plot(folder);
+  return 0;
+}
+
+int synth_job(const Config& base, const SynthOptions& o) {
+  Model truth = model_of(base);
+  std::string comment = "synthetic data from " + base.path + ", seed " + std::to_string(o.seed) + ", extension " +
+                        o.extension;
+  if (o.extension != "none") {
+    const Extension& e = extension(o.extension);
+    Real v = o.strength >= 0 ? o.strength / free_param(e.param).shown : -1;  // given in the key's unit
+    if (v < 0) {  // drawn within the extension's range, log-uniform between its lowest and highest strength
+      std::mt19937_64 rng(o.seed * 7919u + 17u);
+      std::uniform_real_distribution<Real> u(0, 1);
+      v = e.levels.front() * std::pow(e.levels.back() / e.levels.front(), u(rng));
+    }
+    set_param(truth, e.param, v);
+    comment += " (" + e.param + " = " + fmt("%.4g", free_param(e.param).shown * v) + ")";
+  }
+  PeriodicLab lab(base, false);
+  const std::vector<MeasuredTest> tests = synthetic_tests(lab, truth, o.sigma3, o.material, o.seed);
+  write_measured_curves(o.output, tests, comment);
+  std::printf("synth: %s -> %s\n", comment.c_str(), o.output.c_str());
+  return 0;
+}
+
+}  // namespace dem

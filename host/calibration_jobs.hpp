@@ -1,0 +1,39 @@
+#pragma once
+/// The command-line jobs of calibration and diagnosis (issue 5): `triaxdem calibrate`, `triaxdem diagnose` and
+/// `triaxdem synth` (synthetic measured data with a hidden effect, for tests and studies).
+#include <string>
+#include <vector>
+
+#include "config.hpp"
+
+namespace dem {
+
+struct CalibrationOptions {
+  std::string data;                       ///< measured-data CSV
+  std::string output = "out";             ///< parent of the dated result folder
+  std::vector<std::string> free{"mu_s", "mu_r"};
+  std::string material;                   ///< empty: every material of the file
+};
+
+/// Calibrates each material of the data; writes calibrate_<date>/ under options.output. Returns 0.
+int calibrate_job(const Config& base, const CalibrationOptions& o);
+
+/// Diagnoses each material of the data; writes diagnose_<date>/ with diagnosis.md. Returns 0.
+int diagnose_job(const Config& base, const CalibrationOptions& o);
+
+struct SynthOptions {
+  std::string output;                     ///< CSV to write
+  std::string extension = "none";         ///< hertz, roughness, wear, membrane or none
+  Real strength = -1;                     ///< extension parameter; < 0: drawn from the seed within its range
+  unsigned seed = 1;
+  std::vector<Real> sigma3{100e3, 200e3, 300e3};  ///< Pa
+  std::string material = "synthetic";
+};
+
+/// Writes synthetic measured curves of the base config's model with the extension switched on. Returns 0.
+int synth_job(const Config& base, const SynthOptions& o);
+
+/// A new folder `<parent>/<prefix>_<YYYYmmdd-HHMMSS>` (a suffix -2, -3 ... if it exists): never an old one.
+std::string new_dated_folder(const std::string& parent, const std::string& prefix);
+
+}  // namespace dem

@@ -1,0 +1,288 @@
+#include "diagnose.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <random>
+#include <stdexcept>
+
+#include "progress.hpp"
+
+namespace dem {
+
+const std::vector<Extension>& extensions() {
+  // Strengths span the physical range in equal ratios: Hertz reference overlaps of 0.1-1% of the radius
+  // (the overlaps of E* = 1e8 Pa beads at 100-300 kPa); combined roughness 0.1-1% of the radius (1-10 um on
+  // 2 mm beads; Table 2 gives Sq = 5-53 um, but over 1.3 mm areas that include the beads' waviness); 20-60% of the friction lost by wear; a
+  // membrane of 0.1-1 MPa over the specimen's radius (latex, 1.4 MPa x 0.5 mm, on 1.4-7 mm; small cells).
+  static const std::vector<Extension> list = {
+      {"hertz", "hertz_overlap", {1e-3, 3e-3, 1e-2},
+       "initial stiffness that grows faster with confinement than the linear contacts give"},
+      {"roughness", "roughness", {1e-3, 3e-3, 1e-2},
+       "soft initial response, most at low confinement; peak and residual hardly change"},
+      {"wear", "wear", {0.2, 0.4, 0.6}, "a residual strength that falls below the peak more than sliding alone explains"},
+      {"membrane", "membrane_kPa", {1e5, 3e5, 1e6},
+       "extra strength late in the test as the specimen bulges, largest relative to low sigma3"},
+  };
+  return list;
+}
+
+const Extension& extension(const std::string& name) {
+  std::string names;
+  for (const Extension& e : extensions()) {
+    if (e.name == name) return e;
+    names += (names.empty() ? "" : ", ") + e.name;
+  }
+  throw std::invalid_argument("unknown extension '" + name + "' (allowed: " + names + ")");
+}
+
+Real chi2_quantile(Real nu, Real z) {
+  const Real a = 2 / (9 * nu);
+  return nu * std::pow(1 - a + z * std::sqrt(a), 3);
+}
+
+namespace {
+
+constexpr Real kZ99 = 2.326;   // standard normal score of the 99% quantile
+constexpr Real kStrongBIC = 6;  // Kass and Raftery (1995): a BIC difference above 6 is strong evidence
+constexpr Real kTieBIC = 2;     // ... below 2, not worth more than a bare mention
+
+Real sum_sq(const std::vector<Real>& r, std::size_t from = 0, std::size_t to = std::string::npos) {
+  Real s = 0;
+  for (std::size_t i = from; i < std::min(to, r.size()); ++i) s += r[i] * r[i];
+  return s;
+}
+
+/// Residual index range [first, last) of each test.
+std::vector<std::pair<std::size_t, std::size_t>> test_ranges(const std::vector<MeasuredTest>& measured) {
+  std::vector<std::pair<std::size_t, std::size_t>> out;
+  std::size_t at = 0;
+  for (const MeasuredTest& t : measured) {
+    const std::size_t n = static_cast<std::size_t>(data_count({t}));
+    out.emplace_back(at, at + n);
+    at += n;
+  }
+  return out;
+}
+
+/// A residual model r(u) over unit coordinates (base parameters, then perhaps the extension's strength).
+using ResidualModel = std::function<std::vector<Real>(const std::vector<Real>&)>;
+
+/// Held-out chi2: for each test, the model minimised on the others predicts it.
+Real heldout_chi2(const ResidualModel& model, int d, const std::vector<MeasuredTest>& measured) {
+  const auto ranges = test_ranges(measured);
+  if (ranges.size() < 2) return std::numeric_limits<Real>::quiet_NaN();
+  Real total = 0;
+  for (std::size_t k = 0; k < ranges.size(); ++k) {
+    const auto fit = minimise_unit_box([&](const std::vector<Real>& u) {
+      const std::vector<Real> r = model(u);
+      return sum_sq(r) - sum_sq(r, ranges[k].first, ranges[k].second);
+    }, d);
+    total += sum_sq(model(fit), ranges[k].first, ranges[k].second);
+  }
+  return total;
+}
+
+Real bic(Real chi2, int k, int n) { return chi2 + k * std::log(static_cast<Real>(n)); }
+
+std::vector<Real> evaluate_surfaces(const std::vector<QuadraticSurface>& s, const std::vector<Real>& u) {
+  std::vector<Real> r;
+  for (const QuadraticSurface& q : s) r.push_back(q(u));
+  return r;
+}
+
+/// Extension parameter at strength coordinate t in [0, 3]: off at 0, levels[k-1] at k, geometric between levels.
+Real strength_at(const Extension& e, Real t) {
+  if (t <= 1) return t * e.levels[0];
+  const int k = std::min(static_cast<int>(t), 2);
+  return e.levels[k - 1] * std::pow(e.levels[k] / e.levels[k - 1], t - k);
+}
+
+}  // namespace
+
+Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,
+                   const std::vector<MeasuredTest>& measured, const NoiseModel& noise, bool verbose) {
+  Diagnosis dg;
+  const int d = static_cast<int>(free.size());
+  auto say = [&](const char* fmt, auto... a) {
+    if (verbose) std::printf(fmt, a...);
+  };
+  say("diagnose: calibrating the base model (%d free parameters) on %zu tests, then %zu extensions\n", d,
+      measured.size(), extensions().size());
+  long design = 1;
+  for (int k = 0; k < d; ++k) design *= 3;
+  const long planned = static_cast<long>(measured.size()) *
+                       (design + 4 + static_cast<long>(extensions().size()) * 5);  // calibrate(): 4 rounds at most
+  const long runs0 = lab.runs();
+  Progress progress("diagnose", planned);
+  Real best_chi2 = 0;
+  auto report = [&](Real chi2) {
+    if (!verbose) return;
+    char extra[64];
+    std::snprintf(extra, sizeof extra, "runs, best base chi2 %.1f", chi2);
+    progress.update(std::min(lab.runs() - runs0, planned), extra);
+  };
+  dg.base = calibrate(lab, base, free, measured, noise, 4, [&](long, long, Real chi2) { report(best_chi2 = chi2); });
+  const int n = dg.base.data;
+  dg.chi2_limit = chi2_quantile(n - d, kZ99);
+  dg.base_bic = bic(dg.base.best.chi2, d, n);
+  // The base surfaces, shifted to agree with the best run where they are used most.
+  std::vector<QuadraticSurface> surf = response_surfaces(dg.base.design, dg.base.best.u);
+  const std::vector<Real> at_best = evaluate_surfaces(surf, dg.base.best.u);
+  auto base_model = [&](const std::vector<Real>& u) {
+    std::vector<Real> r = evaluate_surfaces(surf, u);
+    for (std::size_t i = 0; i < r.size(); ++i) r[i] += dg.base.best.r[i] - at_best[i];
+    return r;
+  };
+  dg.base_heldout = heldout_chi2(base_model, d, measured);
+  say("diagnose: base chi2 %.1f on %d data (99%% limit for noise alone %.1f), held-out chi2 %.1f\n",
+      dg.base.best.chi2, n, dg.chi2_limit, dg.base_heldout);
+
+  for (const Extension& e : extensions()) {
+    ExtensionFit f;
+    f.ext = e;
+    const long runs0 = lab.runs();
+    // The extension's effect at the base optimum, strength by strength.
+    std::vector<std::vector<Real>> effect{std::vector<Real>(dg.base.best.r.size(), 0.0)};
+    for (Real level : e.levels) {
+      Model m = dg.base.model;
+      set_param(m, e.param, level);
+      const std::vector<Real> r = residuals(measured, lab.run_all(m, measured), noise);
+      report(best_chi2);
+      std::vector<Real> diff(r.size());
+      for (std::size_t i = 0; i < r.size(); ++i) diff[i] = r[i] - dg.base.best.r[i];
+      effect.push_back(diff);
+    }
+    std::vector<Real> correction(dg.base.best.r.size(), 0.0);
+    auto joint = [&](const std::vector<Real>& u) {
+      const std::vector<Real> ub(u.begin(), u.begin() + d);
+      std::vector<Real> r = base_model(ub);
+      const Real t = 3 * u[d];
+      const int k = std::min(static_cast<int>(t), 2);
+      const Real w = t - k;
+      for (std::size_t i = 0; i < r.size(); ++i)
+        r[i] += (1 - w) * effect[k][i] + w * effect[k + 1][i] + correction[i];
+      return r;
+    };
+    auto model_at = [&](const std::vector<Real>& u) {
+      Model m = base;
+      for (int k = 0; k < d; ++k) set_param(m, free[k].name, free[k].value(u[k]));
+      set_param(m, e.param, strength_at(e, 3 * u[d]));
+      return m;
+    };
+    // The base model is the extension at strength 0: its best run is the starting point, so an extended fit
+    // is never reported worse than the base.
+    f.best = dg.base.best;
+    std::vector<Real> best_u = dg.base.best.u;
+    best_u.push_back(0);
+    for (int round = 0; round < 2; ++round) {
+      const std::vector<Real> u = minimise_unit_box([&](const std::vector<Real>& x) { return sum_sq(joint(x)); },
+                                                    d + 1);
+      const std::vector<Real> predicted = joint(u);
+      Evaluation ev;
+      ev.u.assign(u.begin(), u.begin() + d);
+      ev.sim = lab.run_all(model_at(u), measured);
+      ev.r = residuals(measured, ev.sim, noise);
+      ev.chi2 = sum_sq(ev.r);
+      report(best_chi2);
+      if (ev.chi2 < f.best.chi2) f.best = ev, best_u = u;
+      for (std::size_t i = 0; i < correction.size(); ++i) correction[i] += ev.r[i] - predicted[i];
+    }
+    for (int k = 0; k < d; ++k) f.values.push_back(free[k].value(best_u[k]));
+    f.strength = strength_at(e, 3 * best_u[d]);
+    f.values.push_back(f.strength);
+    f.bic = bic(f.best.chi2, d + 1, n);
+    f.heldout = heldout_chi2(joint, d + 1, measured);
+    f.runs = lab.runs() - runs0;
+    say("diagnose: %-9s %s = %.3g: chi2 %.1f, BIC %.1f (base %.1f), held-out chi2 %.1f (base %.1f)\n",
+        e.name.c_str(), e.param.c_str(), free_param(e.param).shown * f.strength, f.best.chi2, f.bic, dg.base_bic, f.heldout, dg.base_heldout);
+    dg.fits.push_back(f);
+  }
+
+  if (verbose) progress.finish("");
+  // Verdict.
+  const ExtensionFit* top = nullptr;
+  for (const ExtensionFit& f : dg.fits)
+    if (!top || f.bic < top->bic) top = &f;
+  char line[400];
+  if (dg.base.best.chi2 <= dg.chi2_limit) {
+    dg.verdict = "none";
+    std::snprintf(line, sizeof line,
+                  "The calibrated base model fits within the data's noise (chi2 %.1f on %d data, below the 99%% "
+                  "limit %.1f): no discrepancy beyond noise, and no extension is called for.",
+                  dg.base.best.chi2, n, dg.chi2_limit);
+    dg.explanation = line;
+    return dg;
+  }
+  const bool strong = top && dg.base_bic - top->bic >= kStrongBIC &&
+                      !(top->heldout > 0.5 * dg.base_heldout);
+  if (!strong) {
+    dg.verdict = "none";
+    std::snprintf(line, sizeof line,
+                  "The base model misses the data (chi2 %.1f on %d data, 99%% limit %.1f), but no extension explains "
+                  "it: the best, %s, lowers BIC by %.1f (6 needed) and the held-out chi2 from %.1f to %.1f.",
+                  dg.base.best.chi2, n, dg.chi2_limit, top ? top->ext.name.c_str() : "-",
+                  top ? dg.base_bic - top->bic : 0.0, dg.base_heldout, top ? top->heldout : 0.0);
+    dg.explanation = line;
+    return dg;
+  }
+  dg.verdict = top->ext.name;
+  std::string ties;
+  for (const ExtensionFit& f : dg.fits)
+    if (&f != top && f.bic - top->bic < kTieBIC) {
+      dg.verdict += " or " + f.ext.name;
+      ties += (ties.empty() ? "" : ", ") + f.ext.name;
+    }
+  std::snprintf(line, sizeof line,
+                "The base model misses the data (chi2 %.1f on %d data, 99%% limit %.1f). %s (%s = %.3g) explains it: "
+                "chi2 %.1f, BIC lower by %.1f, held-out chi2 %.1f -> %.1f. Signature: %s.",
+                dg.base.best.chi2, n, dg.chi2_limit, top->ext.name.c_str(), top->ext.param.c_str(), free_param(top->ext.param).shown * top->strength,
+                top->best.chi2, dg.base_bic - top->bic, dg.base_heldout, top->heldout, top->ext.signature.c_str());
+  dg.explanation = line;
+  if (!ties.empty())
+    dg.explanation += " These data cannot tell it from " + ties + " (BIC within 2).";
+  return dg;
+}
+
+std::vector<MeasuredTest> synthetic_tests(PeriodicLab& lab, const Model& truth, const std::vector<Real>& sigma3,
+                                          const std::string& material, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<Real> gauss(0, 1);
+  std::vector<MeasuredTest> out;
+  for (Real s3 : sigma3) {
+    MeasuredTest t = lab.run(truth, s3, material);
+    const Real factor = 1 + 0.02 * gauss(rng);
+    for (std::size_t i = 0; i < t.q.size(); ++i) {
+      t.q[i] = factor * t.q[i] + 0.005 * s3 * gauss(rng);
+      t.eps_v[i] += 2e-4 * gauss(rng);
+    }
+    summarise(t);
+    out.push_back(t);
+  }
+  return out;
+}
+
+void write_measured_curves(const std::string& path, const std::vector<MeasuredTest>& tests,
+                           const std::string& comment) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp);
+    if (!f) throw std::runtime_error(path + ": cannot write");
+    f << "# " << comment << "\n# triaxdem measured-data format (curves): see host/measured.hpp and the README.\n";
+    f << "material,sigma3_kPa,eps_a_pct,q_kPa,eps_v_pct\n";
+    char row[200];
+    for (const MeasuredTest& t : tests)
+      for (std::size_t i = 0; i < t.q.size(); ++i) {
+        std::snprintf(row, sizeof row, "%s,%.6g,%.6g,%.6g,%.6g\n", t.material.c_str(), 1e-3 * t.sigma3,
+                      100 * t.eps_a[i], 1e-3 * t.q[i], 100 * t.eps_v[i]);
+        f << row;
+      }
+    if (!f) throw std::runtime_error(path + ": write failed");
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+}  // namespace dem

@@ -1,0 +1,73 @@
+#pragma once
+/// Diagnosis (issue 5): what the calibrated base model gets wrong against measured data, which model extension
+/// explains it, and by how much it helps.
+///
+/// 1. The base model (free: mu_s, mu_r by default) is calibrated (host/calibrate.hpp).
+/// 2. Each extension (Hertz-Mindlin stiffness, rough-surface compliance, slip-weakening friction, membrane
+///    confinement; kernels/contact_law.hpp, host/periodic_triaxial.hpp) is run at the base optimum at three
+///    strengths within its physical range. Its residuals are modelled as the base model's response surface
+///    plus the extension's effect there, interpolated between the strengths (off, 1, 2, 3); the joint optimum
+///    over the base parameters and the strength is run, the surrogate corrected by what the run shows, and
+///    run once more. The fit reported is the best point run.
+/// 3. Held-out prediction: for each pressure, the surrogate is fitted to the other pressures and predicts it;
+///    the held-out misfit is the sum of those chi2. Information criterion: BIC = chi2 + k ln n (k free
+///    parameters, n data; the noise is known, so chi2 is -2 log-likelihood up to a constant).
+/// 4. Verdict: the base model is consistent with the data when its chi2 is below the 99% quantile of chi2 with
+///    n - k degrees of freedom; otherwise the extension with the lowest BIC is named when it beats the base by
+///    at least 6 (strong evidence) and halves the held-out misfit; extensions within 2 of its BIC cannot be
+///    told apart from these data and are named with it.
+#include <string>
+#include <vector>
+
+#include "calibrate.hpp"
+
+namespace dem {
+
+/// A model extension the diagnosis tries: its parameter, three strengths within a physical range, and the
+/// signature it leaves in triaxial data (for the report).
+struct Extension {
+  std::string name;       ///< short name: hertz, roughness, wear, membrane
+  std::string param;      ///< its free parameter (host/calibrate.hpp)
+  std::vector<Real> levels;
+  std::string signature;
+};
+
+const std::vector<Extension>& extensions();
+const Extension& extension(const std::string& name);  ///< throws std::invalid_argument naming the allowed ones
+
+struct ExtensionFit {
+  Extension ext;
+  std::vector<Real> values;   ///< base free parameters, then the extension's
+  Real strength = 0;          ///< the extension parameter's fitted value
+  Evaluation best;            ///< best point run (its u has the base coordinates only)
+  Real bic = 0, heldout = 0;  ///< BIC of the fit; held-out chi2 (surrogate)
+  long runs = 0;
+};
+
+struct Diagnosis {
+  CalibrationResult base;
+  Real base_bic = 0, base_heldout = 0;
+  Real chi2_limit = 0;              ///< 99% quantile of chi2 with n - k degrees of freedom
+  std::vector<ExtensionFit> fits;   ///< in the order of extensions()
+  std::string verdict;              ///< name of the extension found, "none", or several joined by " or "
+  std::string explanation;          ///< plain words
+};
+
+/// The upper quantile of chi2 with nu degrees of freedom at standard normal score z (Wilson-Hilferty).
+Real chi2_quantile(Real nu, Real z);
+
+/// Runs the diagnosis of `measured` (one material) from `base` with base parameters `free`.
+Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,
+                   const std::vector<MeasuredTest>& measured, const NoiseModel& noise, bool verbose);
+
+/// Synthetic measured data: the simulator's tests of `truth` at `sigma3` (Pa), with lab-like noise from `seed`:
+/// a specimen-to-specimen factor on q (2% standard deviation), and on each row 0.5% of sigma3 on q and 0.02%
+/// on eps_v. Rows every 0.1% of axial strain, as the simulator records them.
+std::vector<MeasuredTest> synthetic_tests(PeriodicLab& lab, const Model& truth, const std::vector<Real>& sigma3,
+                                          const std::string& material, unsigned seed);
+
+/// Writes tests as a measured-data curve file (kPa, pct), through a temporary file and a rename.
+void write_measured_curves(const std::string& path, const std::vector<MeasuredTest>& tests,
+                           const std::string& comment);
+
+}  // namespace dem

@@ -1,0 +1,138 @@
+/// Calibration machinery (host/calibrate.hpp, host/diagnose.hpp, host/calibration_jobs.hpp) without the
+/// simulator: the response surface, the box minimiser, the misfit, the parameter registry, the chi2 quantile,
+/// dated result folders and the synthetic-data writer.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+#include <unistd.h>
+
+#include "host/calibrate.hpp"
+#include "host/calibration_jobs.hpp"
+#include "host/diagnose.hpp"
+#include "host/measured.hpp"
+
+using namespace dem;
+
+// A quadratic in two variables is reproduced exactly by the surface fitted on a 3 x 3 design (6 terms from 9
+// points, any positive weights): rounding only, 1e-12.
+TEST(Calibrate, QuadraticSurfaceReproducesAQuadratic) {
+  auto f = [](const std::vector<Real>& u) {
+    return 1.5 - 2 * u[0] + 0.5 * u[1] + 3 * u[0] * u[0] - u[0] * u[1] + 0.25 * u[1] * u[1];
+  };
+  std::vector<std::vector<Real>> u;
+  std::vector<Real> y, w;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      u.push_back({0.5 * i, 0.5 * j});
+      y.push_back(f(u.back()));
+      w.push_back(1 + i + 2 * j);
+    }
+  const QuadraticSurface s(u, y, w);
+  for (const std::vector<Real>& p : {std::vector<Real>{0.1, 0.9}, {0.7, 0.3}, {1, 1}})
+    EXPECT_NEAR(s(p), f(p), 1e-12);
+}
+
+// The grid-then-coordinate minimiser finds an interior minimum to its final step (1e-4) and a minimum on the
+// boundary exactly.
+TEST(Calibrate, MinimiserFindsInteriorAndBoundaryMinima) {
+  const std::vector<Real> m = minimise_unit_box([](const std::vector<Real>& u) {
+    return (u[0] - 0.37) * (u[0] - 0.37) + 2 * (u[1] - 0.81) * (u[1] - 0.81) + (u[2] - 0.05) * (u[2] - 0.05);
+  }, 3);
+  EXPECT_NEAR(m[0], 0.37, 2e-4);
+  EXPECT_NEAR(m[1], 0.81, 2e-4);
+  EXPECT_NEAR(m[2], 0.05, 2e-4);
+  const std::vector<Real> b = minimise_unit_box([](const std::vector<Real>& u) { return u[0] - u[1]; }, 2);
+  EXPECT_EQ(b[0], 0.0);
+  EXPECT_EQ(b[1], 1.0);
+}
+
+// Residuals in noise units: relative noise for stresses, absolute for the strain at peak; absent quantities are
+// skipped and a missing simulated value counts ten standard deviations.
+TEST(Calibrate, ResidualsUseTheNoiseModel) {
+  MeasuredTest m, s;
+  m.q_peak = 100e3;
+  m.eps_a_peak = 0.05;
+  m.e_ini = m.q_end = m.max_dilatancy = std::nan("");
+  s = m;
+  s.q_peak = 108e3;
+  s.eps_a_peak = 0.03;
+  const NoiseModel noise;
+  const std::vector<Real> r = residuals({m}, {s}, noise);
+  ASSERT_EQ(r.size(), 2u);
+  EXPECT_NEAR(r[0], 8e3 / (noise.rel[kPeak] * 100e3), 1e-12);
+  EXPECT_NEAR(r[1], -0.02 / noise.abs[kStrainAtPeak], 1e-12);
+  EXPECT_EQ(data_count({m}), 2);
+  s.q_peak = std::nan("");
+  EXPECT_EQ(residuals({m}, {s}, noise)[0], 10.0);
+  EXPECT_TRUE(residuals({m}, {s}, noise, {false}).empty());
+}
+
+TEST(Calibrate, FreeParametersAreNamedAndCentredOnTheBase) {
+  Model base;
+  base.law.mu_s = 0.15;
+  base.law.mu_r = 0.015;
+  const FreeParam mu = free_param("mu_s", base);
+  EXPECT_NEAR(mu.lo, 0.05, 1e-15);
+  EXPECT_NEAR(mu.hi, 0.45, 1e-15);
+  EXPECT_NEAR(mu.value(0.5), 0.15, 1e-12);  // log scale: the middle is the base value
+  EXPECT_NEAR(mu.unit(mu.value(0.3)), 0.3, 1e-12);
+  EXPECT_EQ(free_param("mu_r", base).hi, 0.06);
+  set_param(base, "membrane_kPa", 2e5);
+  EXPECT_EQ(base.membrane, 2e5);
+  EXPECT_EQ(free_param("membrane_kPa").shown, 1e-3);
+  set_param(base, "wear", 0.3);
+  EXPECT_EQ(get_param(base, "wear"), 0.3);
+  try {
+    free_param("friction");
+    FAIL() << "unknown name accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("allowed: mu_s, mu_r"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(extension("creep"), std::invalid_argument);
+  EXPECT_EQ(extension("wear").param, "wear");
+}
+
+// Wilson-Hilferty against tabulated chi2 quantiles (99%: nu = 10 -> 23.209, nu = 40 -> 63.691): within 0.3%.
+TEST(Calibrate, ChiSquareQuantile) {
+  EXPECT_NEAR(chi2_quantile(10, 2.326), 23.209, 0.003 * 23.209);
+  EXPECT_NEAR(chi2_quantile(40, 2.326), 63.691, 0.003 * 63.691);
+}
+
+// Calibration never writes into an earlier result: two folders asked for in the same second differ.
+TEST(Calibrate, DatedFoldersAreNeverReused) {
+  namespace fs = std::filesystem;
+  const std::string parent = (fs::temp_directory_path() / ("triaxdem_dated_" + std::to_string(::getpid()))).string();
+  const std::string a = new_dated_folder(parent, "calibrate"), b = new_dated_folder(parent, "calibrate");
+  EXPECT_NE(a, b);
+  EXPECT_TRUE(fs::is_directory(a));
+  EXPECT_TRUE(fs::is_directory(b));
+  fs::remove_all(parent);
+}
+
+// Curves written by the synthetic generator's writer read back as the same tests (kPa and % in the file).
+TEST(Calibrate, MeasuredCurvesRoundTrip) {
+  MeasuredTest t;
+  t.material = "X";
+  t.sigma3 = 200e3;
+  for (int i = 0; i <= 100; ++i) {
+    t.eps_a.push_back(0.001 * i);
+    t.q.push_back(300e3 * (1 - std::exp(-0.5 * i)));
+    t.eps_v.push_back(-0.0002 * i);
+  }
+  const std::string path =
+      (std::filesystem::temp_directory_path() / ("triaxdem_curves_" + std::to_string(::getpid()) + ".csv")).string();
+  write_measured_curves(path, {t}, "round trip");
+  const MeasuredData d = load_measured(path);
+  std::filesystem::remove(path);
+  ASSERT_TRUE(d.curves);
+  ASSERT_EQ(d.tests.size(), 1u);
+  ASSERT_EQ(d.tests[0].q.size(), t.q.size());
+  for (std::size_t i = 0; i < t.q.size(); ++i) {
+    EXPECT_NEAR(d.tests[0].q[i], t.q[i], 1e-5 * 300e3);  // 6 significant digits in kPa
+    EXPECT_NEAR(d.tests[0].eps_a[i], t.eps_a[i], 1e-9);
+  }
+  EXPECT_EQ(d.tests[0].sigma3, 200e3);
+}
