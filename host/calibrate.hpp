@@ -89,8 +89,13 @@ class PeriodicLab {
   PeriodicLab(const Config& base, bool verbose);
   /// A simulated test as measured data (curves, summarised), at confining pressure sigma3 (Pa).
   MeasuredTest run(const Model& m, Real sigma3, const std::string& material = "sim");
-  /// All tests of `like` (same materials and pressures), in order.
+  /// All tests of `like` (same materials and pressures), in order; up to jobs() at once.
   std::vector<MeasuredTest> run_all(const Model& m, const std::vector<MeasuredTest>& like);
+  /// Runs at once: each in a child process (fork) with the same specimen; the results are the same as one at a
+  /// time, bit for bit. Only where that is safe: a host backend on one thread (OMP_NUM_THREADS=1); otherwise
+  /// the runs go one at a time with all threads. Returns the value in effect.
+  int set_jobs(int jobs);
+  int jobs() const { return jobs_; }
   const Config& config() const { return cfg_; }
   long runs() const { return runs_; }
   double seconds() const { return seconds_; }
@@ -102,6 +107,7 @@ class PeriodicLab {
   std::array<Real, 3> cell_{};
   long runs_ = 0;
   double seconds_ = 0;
+  int jobs_ = 1;
 };
 
 /// One evaluated point of a search.

@@ -118,6 +118,7 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
   const MeasuredData data = load_measured(o.data);
   const std::vector<FreeParam> free = free_params(o.free, model_of(base));
   PeriodicLab lab(base, true);
+  lab.set_jobs(o.jobs);
   const std::string folder = new_dated_folder(o.output, "calibrate");
   std::ostringstream table;
   table << "material,parameter,value,chi2,data,runs\n";
@@ -160,6 +161,7 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
   const MeasuredData data = load_measured(o.data);
   const std::vector<FreeParam> free = free_params(o.free, model_of(base));
   PeriodicLab lab(base, true);
+  lab.set_jobs(o.jobs);
   const std::string folder = new_dated_folder(o.output, "diagnose");
   std::ostringstream md, csv;
   md << "# Diagnosis of " << o.data << "\n\n"

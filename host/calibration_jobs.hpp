@@ -13,6 +13,7 @@ struct CalibrationOptions {
   std::string output = "out";             ///< parent of the dated result folder
   std::vector<std::string> free{"mu_s", "mu_r"};
   std::string material;                   ///< empty: every material of the file
+  int jobs = 1;                           ///< simulator runs at once (PeriodicLab::set_jobs)
 };
 
 /// Calibrates each material of the data; writes calibrate_<date>/ under options.output. Returns 0.

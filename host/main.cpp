@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <iostream>
 #include <sstream>
+#include <thread>
 
 #include "host/calibration_jobs.hpp"
 #include "host/measured.hpp"
@@ -69,6 +70,8 @@ int main(int argc, char** argv) {
     c->add_option("--free", free_list, "free parameters, comma-separated (default mu_s,mu_r)");
     c->add_option("--material", cal.material, "only this material of the data");
     c->add_option("-o,--output", cal.output, "parent folder of the dated result folder (default out)");
+    c->add_option("-j,--jobs", cal.jobs, "simulator runs at once, one thread each (default: one per core)")
+        ->check(CLI::PositiveNumber);
   };
   auto* calibrate = app.add_subcommand("calibrate", "fit the free parameters to measured triaxial data");
   add_calibration(calibrate);
@@ -90,7 +93,11 @@ int main(int argc, char** argv) {
 
   auto* info = app.add_subcommand("info", "print the Kokkos build in use");
 
+  cal.jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   CLI11_PARSE(app, argc, argv);
+  // Parallel calibration runs are child processes of one thread each (PeriodicLab::set_jobs): OpenMP must
+  // start with one thread, before Kokkos does.
+  if ((calibrate->parsed() || diagnose->parsed()) && cal.jobs > 1) setenv("OMP_NUM_THREADS", "1", 1);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // progress reaches a log file as it happens
   if (study->parsed()) {  // the study only starts child processes: no Kokkos of its own
     try {

@@ -27,7 +27,8 @@
 ///     et al. is not reproduced (see the notes); this smooth form keeps one parameter and both limits.
 ///   Slip-weakening friction (wear in [0, 1), wear_slip = s_c / r): mu = mu_s (1 - wear (1 - exp(-s / s_c)))
 ///     with s the sliding distance accumulated by the contact (reset when it opens): asperities worn by
-///     sliding, a lower residual strength after the peak.
+///     sliding, a lower residual strength after the peak. The default s_c is half a radius: much shorter,
+///     the contacts wear before the peak and the effect is a lower mu_s (diagnose cannot tell them apart).
 #include "vec3.hpp"
 
 namespace dem {
@@ -43,7 +44,7 @@ struct ContactParams {
   Real hertz_overlap = 0.0;  ///< Hertz-Mindlin: overlap / r at which the secant stiffness equals kn
   Real roughness = 0.0;      ///< rough-surface compliance: combined rms roughness / r
   Real wear = 0.0;           ///< slip weakening: fraction of mu_s lost after long sliding
-  Real wear_slip = 0.05;     ///< slip weakening: sliding distance / r over which friction decays by 1/e
+  Real wear_slip = 0.5;      ///< slip weakening: sliding distance / r over which friction decays by 1/e
 
   /// The same pair without the extensions (specimen preparation, which must not depend on them).
   ContactParams base() const {

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 
@@ -135,4 +136,45 @@ TEST(Calibrate, MeasuredCurvesRoundTrip) {
     EXPECT_NEAR(d.tests[0].eps_a[i], t.eps_a[i], 1e-9);
   }
   EXPECT_EQ(d.tests[0].sigma3, 200e3);
+}
+
+// Parallel runs (child processes) give the same tests as runs one at a time, bit for bit: each child runs the
+// same specimen and law as the parent would. A tiny cell (64 balls, 1% strain) keeps this to a few seconds.
+// With 2 OpenMP threads set_jobs refuses (forking a multithreaded OpenMP process is unsafe) and both paths
+// are the in-process one.
+TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
+  Config cfg;
+  cfg.particles.count = 64;
+  cfg.particles.diameter = 2e-3;
+  const Real L = std::cbrt(64 * M_PI / 6 * 8e-9 / 0.1);  // loose: insertion keeps off the seams of a small box
+  cfg.box.size = {L, L, L};
+  cfg.box.periodic = {true, true, true};
+  cfg.solver.gravity = {0, 0, 0};
+  cfg.solver.damping = 0.7;
+  cfg.solver.dt_safety = 0.2;
+  cfg.ball.mu_s = 0.3;
+  cfg.periodic.prep_mu_s = 0;
+  cfg.periodic.prep_unbalanced_tolerance = 5e-2;
+  cfg.periodic.triax.consolidation_rate = 100;
+  cfg.periodic.triax.target_strain = 0.01;
+  cfg.periodic.triax.target_inertial = 1e-3;
+  cfg.periodic.triax.record_strain = 0.001;
+  PeriodicLab lab(cfg, false);
+  Model m;
+  m.law = cfg.ball;
+  std::vector<MeasuredTest> like(3);
+  for (int k = 0; k < 3; ++k) like[k].sigma3 = 100e3 * (k + 1);
+  const std::vector<MeasuredTest> one = lab.run_all(m, like);
+  const int jobs = lab.set_jobs(2);
+  EXPECT_EQ(jobs, std::getenv("OMP_NUM_THREADS") && std::string(std::getenv("OMP_NUM_THREADS")) == "1" ? 2 : 1);
+  const std::vector<MeasuredTest> par = lab.run_all(m, like);
+  ASSERT_EQ(par.size(), 3u);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(par[k].sigma3, like[k].sigma3);
+    ASSERT_GT(one[k].q.size(), 5u);
+    EXPECT_EQ(par[k].q, one[k].q) << "sigma3 " << like[k].sigma3;
+    EXPECT_EQ(par[k].eps_v, one[k].eps_v);
+    EXPECT_EQ(par[k].q_peak, one[k].q_peak);
+  }
+  EXPECT_EQ(lab.runs(), 6);
 }
