@@ -46,7 +46,7 @@ std::vector<FreeParam> free_params(const std::vector<std::string>& names, const 
   return out;
 }
 
-/// The tests of the data, material by material (file order), filtered by `only` when it is set.
+/// The tests of the data by material (sorted by name), filtered by `only` when it is set.
 std::map<std::string, std::vector<MeasuredTest>> by_material(const MeasuredData& d, const std::string& only) {
   std::map<std::string, std::vector<MeasuredTest>> out;
   for (const MeasuredTest& t : d.tests)
@@ -110,16 +110,35 @@ void print_errors(const std::vector<MeasuredTest>& meas, const std::vector<Measu
   }
 }
 
-void plot(const std::string& folder) { run_plot_script("plot_calibration.py", {folder}); }
+/// What calibrate and diagnose share: the data, the free parameters, the simulator and a new result folder.
+struct Session {
+  MeasuredData data;
+  std::vector<FreeParam> free;
+  PeriodicLab lab;
+  std::string folder;
+  Session(const Config& base, const CalibrationOptions& o, const std::string& kind)
+      : data(load_measured(o.data)), free(free_params(o.free, model_of(base))), lab(base, true),
+        folder(new_dated_folder(o.output, kind)) {
+    lab.set_jobs(o.jobs);
+  }
+  /// The errors table, the curves in the measured-data format and the figure.
+  void finish(const std::vector<MeasuredTest>& meas, const std::vector<MeasuredTest>& sim,
+              const std::string& what) const {
+    write_file(folder + "/errors.csv", errors_csv(meas, sim));
+    write_measured_curves(folder + "/simulated_curves.csv", sim, "simulated by " + what);
+    if (data.curves) write_measured_curves(folder + "/measured_curves.csv", meas, "measured: " + data.path);
+    run_plot_script("plot_calibration.py", {folder});
+  }
+};
 
 }  // namespace
 
 int calibrate_job(const Config& base, const CalibrationOptions& o) {
-  const MeasuredData data = load_measured(o.data);
-  const std::vector<FreeParam> free = free_params(o.free, model_of(base));
-  PeriodicLab lab(base, true);
-  lab.set_jobs(o.jobs);
-  const std::string folder = new_dated_folder(o.output, "calibrate");
+  Session ss(base, o, "calibrate");
+  const MeasuredData& data = ss.data;
+  const std::vector<FreeParam>& free = ss.free;
+  PeriodicLab& lab = ss.lab;
+  const std::string& folder = ss.folder;
   std::ostringstream table;
   table << "material,parameter,value,chi2,data,runs\n";
   std::vector<MeasuredTest> all_meas, all_sim;
@@ -148,21 +167,18 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
   }
   print_errors(all_meas, all_sim);
   write_file(folder + "/calibrated.csv", table.str());
-  write_file(folder + "/errors.csv", errors_csv(all_meas, all_sim));
-  write_measured_curves(folder + "/simulated_curves.csv", all_sim, "simulated at the calibrated parameters");
-  if (data.curves) write_measured_curves(folder + "/measured_curves.csv", all_meas, "measured: " + o.data);
   std::printf("calibrate: %ld runs in %s; results in %s (calibrated.csv, errors.csv, simulated_curves.csv)\n",
               lab.runs(), format_duration(lab.seconds()).c_str(), folder.c_str());
-  plot(folder);
+  ss.finish(all_meas, all_sim, "the calibrated parameters");
   return 0;
 }
 
 int diagnose_job(const Config& base, const CalibrationOptions& o) {
-  const MeasuredData data = load_measured(o.data);
-  const std::vector<FreeParam> free = free_params(o.free, model_of(base));
-  PeriodicLab lab(base, true);
-  lab.set_jobs(o.jobs);
-  const std::string folder = new_dated_folder(o.output, "diagnose");
+  Session ss(base, o, "diagnose");
+  const MeasuredData& data = ss.data;
+  const std::vector<FreeParam>& free = ss.free;
+  PeriodicLab& lab = ss.lab;
+  const std::string& folder = ss.folder;
   std::ostringstream md, csv;
   md << "# Diagnosis of " << o.data << "\n\n"
      << "Simulator: periodic-cell triaxial, " << lab.balls() << " balls, one specimen for every run. Free base "
@@ -215,12 +231,9 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
   }
   write_file(folder + "/diagnosis.md", md.str());
   write_file(folder + "/models.csv", csv.str());
-  write_file(folder + "/errors.csv", errors_csv(all_meas, all_sim));
-  write_measured_curves(folder + "/simulated_curves.csv", all_sim, "simulated by the calibrated base model");
-  if (data.curves) write_measured_curves(folder + "/measured_curves.csv", all_meas, "measured: " + o.data);
   std::printf("diagnose: %ld runs in %s; report in %s/diagnosis.md\n", lab.runs(),
               format_duration(lab.seconds()).c_str(), folder.c_str());
-  plot(folder);
+  ss.finish(all_meas, all_sim, "the calibrated base model");
   return 0;
 }
 
