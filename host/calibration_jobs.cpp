@@ -90,7 +90,8 @@ std::string errors_csv(const std::vector<MeasuredTest>& meas, const std::vector<
       if (!std::isfinite(m[i])) continue;
       s << meas[k].material << "," << fmt("%g", 1e-3 * meas[k].sigma3) << "," << quantity_name(i) << ","
         << in_table_unit(i, m[i]).second << "," << fmt("%.5g", in_table_unit(i, m[i]).first) << ","
-        << fmt("%.5g", in_table_unit(i, q[i]).first) << "," << fmt("%.2f", 100 * (q[i] - m[i]) / std::fabs(m[i])) << "\n";
+        << fmt("%.5g", in_table_unit(i, q[i]).first) << ","
+        << fmt("%.2f", 100 * (q[i] - m[i]) / std::fabs(m[i])) << "\n";
     }
   }
   return s.str();
@@ -135,67 +136,60 @@ struct Session {
 
 int calibrate_job(const Config& base, const CalibrationOptions& o) {
   Session ss(base, o, "calibrate");
-  const MeasuredData& data = ss.data;
-  const std::vector<FreeParam>& free = ss.free;
-  PeriodicLab& lab = ss.lab;
-  const std::string& folder = ss.folder;
   std::ostringstream table;
   table << "material,parameter,value,chi2,data,runs\n";
   std::vector<MeasuredTest> all_meas, all_sim;
-  for (const auto& [material, tests] : by_material(data, o.material)) {
+  for (const auto& [material, tests] : by_material(ss.data, o.material)) {
     std::printf("calibrate: %s, %zu tests, free %zu parameters, %zu balls in the periodic cell\n", material.c_str(),
-                tests.size(), free.size(), lab.balls());
-    const long planned = (std::lround(std::pow(3.0, free.size())) + 4) * static_cast<long>(tests.size());
+                tests.size(), ss.free.size(), ss.lab.balls());
+    const long planned = (std::lround(std::pow(3.0, ss.free.size())) + 4) * static_cast<long>(tests.size());
     Progress progress("calibrate " + material, planned);
-    const long runs0 = lab.runs();
-    const CalibrationResult r = calibrate(lab, model_of(base), free, tests, NoiseModel(), 4,
+    const long runs0 = ss.lab.runs();
+    const CalibrationResult r = calibrate(ss.lab, model_of(base), ss.free, tests, NoiseModel(), 4,
                                           [&](long done, long, Real chi2) {
                                             char extra[64];
                                             std::snprintf(extra, sizeof extra, "runs, best chi2 %.1f", chi2);
                                             progress.update(std::min(done - runs0, planned), extra);
                                           });
     progress.finish("");
-    for (std::size_t k = 0; k < free.size(); ++k) {
-      std::printf("calibrate: %s: %s = %.4g\n", material.c_str(), free[k].name.c_str(), free[k].shown * r.values[k]);
-      table << material << "," << free[k].name << "," << fmt("%.6g", free[k].shown * r.values[k]) << "," << fmt("%.3f", r.best.chi2)
-            << "," << r.data << "," << lab.runs() - runs0 << "\n";
+    for (std::size_t k = 0; k < ss.free.size(); ++k) {
+      const FreeParam& f = ss.free[k];
+      std::printf("calibrate: %s: %s = %.4g\n", material.c_str(), f.name.c_str(), f.shown * r.values[k]);
+      table << material << "," << f.name << "," << fmt("%.6g", f.shown * r.values[k]) << ","
+            << fmt("%.3f", r.best.chi2) << "," << r.data << "," << ss.lab.runs() - runs0 << "\n";
     }
     std::printf("calibrate: %s: chi2 %.1f on %d data after %ld runs\n", material.c_str(), r.best.chi2, r.data,
-                lab.runs() - runs0);
+                ss.lab.runs() - runs0);
     all_meas.insert(all_meas.end(), tests.begin(), tests.end());
     all_sim.insert(all_sim.end(), r.best.sim.begin(), r.best.sim.end());
   }
   print_errors(all_meas, all_sim);
-  write_file(folder + "/calibrated.csv", table.str());
+  write_file(ss.folder + "/calibrated.csv", table.str());
   std::printf("calibrate: %ld runs in %s; results in %s (calibrated.csv, errors.csv, simulated_curves.csv)\n",
-              lab.runs(), format_duration(lab.seconds()).c_str(), folder.c_str());
+              ss.lab.runs(), format_duration(ss.lab.seconds()).c_str(), ss.folder.c_str());
   ss.finish(all_meas, all_sim, "the calibrated parameters");
   return 0;
 }
 
 int diagnose_job(const Config& base, const CalibrationOptions& o) {
   Session ss(base, o, "diagnose");
-  const MeasuredData& data = ss.data;
-  const std::vector<FreeParam>& free = ss.free;
-  PeriodicLab& lab = ss.lab;
-  const std::string& folder = ss.folder;
   std::ostringstream md, csv;
   md << "# Diagnosis of " << o.data << "\n\n"
-     << "Simulator: periodic-cell triaxial, " << lab.balls() << " balls, one specimen for every run. Free base "
+     << "Simulator: periodic-cell triaxial, " << ss.lab.balls() << " balls, one specimen for every run. Free base "
      << "parameters:";
-  for (const FreeParam& f : free) md << " " << f.name;
-  md << ". Misfit: chi2 over the initial stiffness, q_peak, eps_a at peak, q_end and maximum dilatancy with lab-like noise "
-        "(host/calibrate.hpp).\n\n";
+  for (const FreeParam& f : ss.free) md << " " << f.name;
+  md << ". Misfit: chi2 over the initial stiffness, q_peak, eps_a at peak, q_end and maximum dilatancy with "
+        "lab-like noise (host/calibrate.hpp).\n\n";
   csv << "material,model,parameter,value,chi2,bic,heldout_chi2,runs\n";
   std::vector<MeasuredTest> all_meas, all_sim;
-  for (const auto& [material, tests] : by_material(data, o.material)) {
-    const Diagnosis dg = diagnose(lab, model_of(base), free, tests, NoiseModel(), true);
+  for (const auto& [material, tests] : by_material(ss.data, o.material)) {
+    const Diagnosis dg = diagnose(ss.lab, model_of(base), ss.free, tests, NoiseModel(), true);
     std::printf("diagnose: %s: verdict: %s\n  %s\n", material.c_str(), dg.verdict.c_str(), dg.explanation.c_str());
     md << "## " << material << "\n\n**Verdict: " << dg.verdict << ".** " << dg.explanation << "\n\n"
        << "| model | parameters | chi2 | BIC | held-out chi2 | runs |\n|---|---|---|---|---|---|\n| base | ";
-    for (std::size_t k = 0; k < free.size(); ++k) {
-      md << free[k].name << " = " << fmt("%.4g", free[k].shown * dg.base.values[k]) << " ";
-      csv << material << ",base," << free[k].name << "," << fmt("%.6g", free[k].shown * dg.base.values[k]) << ","
+    for (std::size_t k = 0; k < ss.free.size(); ++k) {
+      md << ss.free[k].name << " = " << fmt("%.4g", ss.free[k].shown * dg.base.values[k]) << " ";
+      csv << material << ",base," << ss.free[k].name << "," << fmt("%.6g", ss.free[k].shown * dg.base.values[k]) << ","
           << fmt("%.3f", dg.base.best.chi2) << "," << fmt("%.3f", dg.base_bic) << "," << fmt("%.3f", dg.base_heldout)
           << "," << dg.base.design.size() * tests.size() << "\n";
     }
@@ -203,8 +197,8 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
        << fmt("%.1f", dg.base_heldout) << " | " << dg.base.design.size() * tests.size() << " |\n";
     for (const ExtensionFit& f : dg.fits) {
       md << "| " << f.ext.name << " | ";
-      for (std::size_t k = 0; k < free.size(); ++k)
-        md << free[k].name << " = " << fmt("%.4g", free[k].shown * f.values[k]) << " ";
+      for (std::size_t k = 0; k < ss.free.size(); ++k)
+        md << ss.free[k].name << " = " << fmt("%.4g", ss.free[k].shown * f.values[k]) << " ";
       const Real shown = free_param(f.ext.param).shown;
       md << f.ext.param << " = " << fmt("%.3g", shown * f.strength) << " | " << fmt("%.1f", f.best.chi2) << " | "
          << fmt("%.1f", f.bic) << " | " << fmt("%.1f", f.heldout) << " | " << f.runs << " |\n";
@@ -229,10 +223,10 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
     all_meas.insert(all_meas.end(), tests.begin(), tests.end());
     all_sim.insert(all_sim.end(), dg.base.best.sim.begin(), dg.base.best.sim.end());
   }
-  write_file(folder + "/diagnosis.md", md.str());
-  write_file(folder + "/models.csv", csv.str());
-  std::printf("diagnose: %ld runs in %s; report in %s/diagnosis.md\n", lab.runs(),
-              format_duration(lab.seconds()).c_str(), folder.c_str());
+  write_file(ss.folder + "/diagnosis.md", md.str());
+  write_file(ss.folder + "/models.csv", csv.str());
+  std::printf("diagnose: %ld runs in %s; report in %s/diagnosis.md\n", ss.lab.runs(),
+              format_duration(ss.lab.seconds()).c_str(), ss.folder.c_str());
   ss.finish(all_meas, all_sim, "the calibrated base model");
   return 0;
 }
