@@ -40,9 +40,17 @@ Model model_of(const Config& cfg) {
   return m;
 }
 
-std::vector<FreeParam> free_params(const std::vector<std::string>& names, const Model& base) {
+/// The free parameters: from the command line, else from the config's [calibrate] free.
+std::vector<FreeParam> free_params(const Config& cfg, const std::vector<std::string>& cli) {
   std::vector<FreeParam> out;
-  for (const std::string& n : names) out.push_back(free_param(n, base));
+  for (const std::string& n : cli.empty() ? cfg.calibrate.free : cli) {
+    try {
+      out.push_back(free_param(n, model_of(cfg)));
+    } catch (const std::invalid_argument& e) {
+      if (!cli.empty()) throw;
+      throw ConfigError(cfg.path + ": [calibrate] free: " + e.what());
+    }
+  }
   return out;
 }
 
@@ -118,7 +126,7 @@ struct Session {
   PeriodicLab lab;
   std::string folder;
   Session(const Config& base, const CalibrationOptions& o, const std::string& kind)
-      : data(load_measured(o.data)), free(free_params(o.free, model_of(base))), lab(base, true),
+      : data(load_measured(o.data)), free(free_params(base, o.free)), lab(base, true),
         folder(new_dated_folder(o.output, kind)) {
     lab.set_jobs(o.jobs);
   }

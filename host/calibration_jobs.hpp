@@ -11,7 +11,7 @@ namespace dem {
 struct CalibrationOptions {
   std::string data;                       ///< measured-data CSV
   std::string output = "out";             ///< parent of the dated result folder
-  std::vector<std::string> free{"mu_s", "mu_r"};
+  std::vector<std::string> free;          ///< empty: the config's [calibrate] free
   std::string material;                   ///< empty: every material of the file
   int jobs = 1;                           ///< simulator runs at once (PeriodicLab::set_jobs)
 };

@@ -65,6 +65,19 @@ class TableReader {
     }
     out = *v;
   }
+  /// An array of strings (at least one).
+  void strings(const std::string& key, std::vector<std::string>& out) {
+    const toml::node* n = get(key);
+    if (!n) return;
+    const toml::array* a = n->as_array();
+    if (!a || a->empty()) fail(key, "expected a non-empty array of strings");
+    out.clear();
+    for (const toml::node& e : *a) {
+      auto v = e.value_exact<std::string>();
+      if (!v) fail(key, "expected a non-empty array of strings");
+      out.push_back(*v);
+    }
+  }
   /// An array of numbers, each in [lo, hi], converted by `scale`.
   void numbers(const std::string& key, std::vector<Real>& out, Real lo, Real hi, Real scale) {
     const toml::node* n = get(key);
@@ -136,12 +149,13 @@ Config load_config(const std::string& path) {
     throw ConfigError(s.str());
   }
   static const std::set<std::string> tables = {"run",    "particles", "box",     "material",
-                                               "wall_material", "solver", "specimen", "triaxial", "micro", "periodic"};
+                                               "wall_material", "solver", "specimen", "triaxial", "micro", "periodic",
+                                               "calibrate"};
   for (const auto& [k, v] : root) {
     if (!tables.count(std::string(k.str())) || !v.is_table())
       throw ConfigError(path + ": [" + std::string(k.str()) +
                         "]: unknown table (allowed: run, particles, box, material, wall_material, solver, specimen, "
-                        "triaxial, micro, periodic)");
+                        "triaxial, micro, periodic, calibrate)");
   }
   auto table = [&](const char* name) { return TableReader(path, name, root[name].as_table()); };
 
@@ -292,6 +306,10 @@ Config load_config(const std::string& path) {
   pr.number("prep_mu_r", c.periodic.prep_mu_r, 0, 10);
   pr.number("prep_unbalanced_tolerance", c.periodic.prep_unbalanced_tolerance, 0, 1, 1, true);
   pr.finish();
+
+  TableReader cal = table("calibrate");
+  cal.strings("free", c.calibrate.free);  // names checked against the registry by the calibration job
+  cal.finish();
 
   for (int d = 0; d < 3; ++d)
     if (c.box.size[d] < 3 * c.particles.diameter)

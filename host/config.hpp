@@ -113,6 +113,11 @@ struct PeriodicTriaxialParams {
   bool verbose = true;               ///< progress lines and the summary on stdout
 };
 
+/// [calibrate]: the parameters `triaxdem calibrate` and `diagnose` free (host/calibrate.hpp lists the names).
+struct CalibrateConfig {
+  std::vector<std::string> free{"mu_s", "mu_r"};
+};
+
 /// The [periodic] table: the periodic-cell triaxial test (host/periodic_triaxial.hpp).
 struct PeriodicConfig {
   PeriodicTriaxialParams triax;
@@ -138,6 +143,7 @@ struct Config {
   MicroConfig micro;
   PeriodicConfig periodic;
   bool has_periodic = false;  ///< the file has a [periodic] table
+  CalibrateConfig calibrate;
 };
 
 /// Reads and validates a config file. Throws ConfigError.

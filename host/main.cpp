@@ -67,7 +67,7 @@ int main(int argc, char** argv) {
         ->check(CLI::ExistingFile);
     c->add_option("--config", config_path, "base config: a periodic cell ([box], [periodic], [material])")
         ->required()->check(CLI::ExistingFile);
-    c->add_option("--free", free_list, "free parameters, comma-separated (default mu_s,mu_r)");
+    c->add_option("--free", free_list, "free parameters, comma-separated (default: the config's [calibrate] free, else mu_s,mu_r)");
     c->add_option("--material", cal.material, "only this material of the data");
     c->add_option("-o,--output", cal.output, "parent folder of the dated result folder (default out)");
     c->add_option("-j,--jobs", cal.jobs, "simulator runs at once, one thread each (default: one per core)")

@@ -140,3 +140,14 @@ TEST(BlowUp, ExcessiveOverlapStopsWithStepParticleAndFix) {
     EXPECT_LT(sim.step_count(), 100);
   }
 }
+
+// [calibrate] free: a list of names (checked against the registry by the calibration job); anything else is
+// refused with the file, table and key.
+TEST(Config, CalibrateFreeListIsRead) {
+  const dem::Config c = dem::load_config(write_config("cal.toml", "[calibrate]\nfree = [\"mu_s\", \"wear\"]\n"));
+  EXPECT_EQ(c.calibrate.free, (std::vector<std::string>{"mu_s", "wear"}));
+  EXPECT_EQ(dem::load_config(write_config("none.toml", "")).calibrate.free, (std::vector<std::string>{"mu_s", "mu_r"}));
+  const std::string e = error_of("[calibrate]\nfree = [\"mu_s\", 3]\n");
+  EXPECT_NE(e.find("bad.toml: [calibrate] free: expected a non-empty array of strings"), std::string::npos) << e;
+  EXPECT_NE(error_of("[calibrate]\nfree = []\n").find("non-empty"), std::string::npos);
+}
