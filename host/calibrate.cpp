@@ -343,6 +343,13 @@ std::vector<QuadraticSurface> response_surfaces(const std::vector<Evaluation>& p
   return s;
 }
 
+std::vector<std::string> CalibrationResult::at_edge() const {
+  std::vector<std::string> out;
+  for (std::size_t k = 0; k < free.size(); ++k)
+    if (best.u[k] < 0.01 || best.u[k] > 0.99) out.push_back(free[k].name);
+  return out;
+}
+
 CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,
                             const std::vector<MeasuredTest>& measured, const NoiseModel& noise, int rounds,
                             const CalibrationProgress& progress) {

@@ -125,6 +125,9 @@ struct CalibrationResult {
   Evaluation best;                    ///< the best point run
   std::vector<Evaluation> design;     ///< every point run, in order
   int data = 0;                       ///< number of data in the misfit
+  /// Names of the parameters whose best value lies on an edge of its range (within 1% of it): the true
+  /// optimum may lie outside, and a misfit found there may be the range's and not the model's.
+  std::vector<std::string> at_edge() const;
 };
 
 /// Called after each run with (runs done, runs planned, best chi2 so far).

@@ -166,6 +166,9 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
       table << material << "," << f.name << "," << fmt("%.6g", f.shown * r.values[k]) << ","
             << fmt("%.3f", r.best.chi2) << "," << r.data << "," << ss.lab.runs() - runs0 << "\n";
     }
+    for (const std::string& name : r.at_edge())
+      std::printf("calibrate: %s: WARNING: %s is at the edge of its range: widen it (the optimum may lie "
+                  "outside)\n", material.c_str(), name.c_str());
     std::printf("calibrate: %s: chi2 %.1f on %d data after %ld runs\n", material.c_str(), r.best.chi2, r.data,
                 ss.lab.runs() - runs0);
     all_meas.insert(all_meas.end(), tests.begin(), tests.end());
@@ -193,7 +196,13 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
   for (const auto& [material, tests] : by_material(ss.data, o.material)) {
     const Diagnosis dg = diagnose(ss.lab, model_of(base), ss.free, tests, NoiseModel(), true);
     std::printf("diagnose: %s: verdict: %s\n  %s\n", material.c_str(), dg.verdict.c_str(), dg.explanation.c_str());
+    std::string edge;
+    for (const std::string& name : dg.base.at_edge()) edge += (edge.empty() ? "" : ", ") + name;
+    if (!edge.empty())
+      std::printf("diagnose: %s: WARNING: %s at the edge of the search range\n", material.c_str(), edge.c_str());
     md << "## " << material << "\n\n**Verdict: " << dg.verdict << ".** " << dg.explanation << "\n\n"
+       << (edge.empty() ? "" : "**Warning:** the base model's " + edge + " lies at the edge of its search range: the "
+                               "optimum may lie outside, and part of the misfit may be the range's, not the model's.\n\n")
        << "| model | parameters | chi2 | BIC | held-out chi2 | runs |\n|---|---|---|---|---|---|\n| base | ";
     for (std::size_t k = 0; k < ss.free.size(); ++k) {
       md << ss.free[k].name << " = " << fmt("%.4g", ss.free[k].shown * dg.base.values[k]) << " ";

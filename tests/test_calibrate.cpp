@@ -178,3 +178,14 @@ TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
   }
   EXPECT_EQ(lab.runs(), 6);
 }
+
+// A best point on the edge of the search range is flagged (the Table 6 fits of S-2 and S-3 ended on mu_s = 3 x
+// the base value and on the mu_r cap, and their misfit was the range's).
+TEST(Calibrate, BestPointOnTheRangeEdgeIsFlagged) {
+  CalibrationResult r;
+  r.free = {free_param("mu_s"), free_param("mu_r"), free_param("wear")};
+  r.best.u = {0.995, 0.5, 0.0};
+  EXPECT_EQ(r.at_edge(), (std::vector<std::string>{"mu_s", "wear"}));
+  r.best.u = {0.02, 0.5, 0.98};
+  EXPECT_TRUE(r.at_edge().empty());
+}
