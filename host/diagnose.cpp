@@ -50,11 +50,13 @@ constexpr Real kZ99 = 2.326;   // standard normal score of the 99% quantile
 constexpr Real kStrongBIC = 6;  // Kass and Raftery (1995): a BIC difference above 6 is strong evidence
 constexpr Real kTieBIC = 2;     // ... below 2, not worth more than a bare mention
 
-Real sum_sq(const std::vector<Real>& r, std::size_t from = 0, std::size_t to = std::string::npos) {
+/// Sum of squares of r[from, to).
+Real sum_sq(const std::vector<Real>& r, std::size_t from, std::size_t to) {
   Real s = 0;
-  for (std::size_t i = from; i < std::min(to, r.size()); ++i) s += r[i] * r[i];
+  for (std::size_t i = from; i < to; ++i) s += r[i] * r[i];
   return s;
 }
+Real sum_sq(const std::vector<Real>& r) { return sum_sq(r, 0, r.size()); }
 
 /// Residual index range [first, last) of each test.
 std::vector<std::pair<std::size_t, std::size_t>> test_ranges(const std::vector<MeasuredTest>& measured) {
