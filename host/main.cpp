@@ -8,6 +8,7 @@
 #include <sstream>
 #include <thread>
 
+#include "host/calibrate.hpp"
 #include "host/calibration_jobs.hpp"
 #include "host/measured.hpp"
 #include "host/config.hpp"
@@ -69,6 +70,8 @@ int main(int argc, char** argv) {
         ->required()->check(CLI::ExistingFile);
     c->add_option("--free", free_list, "free parameters, comma-separated (default: the config's [calibrate] free, else mu_s,mu_r)");
     c->add_option("--material", cal.material, "only this material of the data");
+    c->add_option("--reference", cal.reference, "CSV of reference values (material, then one column per parameter) "
+                  "to set beside the calibrated ones")->check(CLI::ExistingFile);
     c->add_option("-o,--output", cal.output, "parent folder of the dated result folder (default out)");
     c->add_option("-j,--jobs", cal.jobs, "simulator runs at once, one thread each (default: one per core)")
         ->check(CLI::PositiveNumber);
@@ -95,9 +98,8 @@ int main(int argc, char** argv) {
 
   cal.jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   CLI11_PARSE(app, argc, argv);
-  // Parallel calibration runs are child processes of one thread each (PeriodicLab::set_jobs): OpenMP must
-  // start with one thread, before Kokkos does.
-  if ((calibrate->parsed() || diagnose->parsed()) && cal.jobs > 1) setenv("OMP_NUM_THREADS", "1", 1);
+  // Parallel calibration runs are child processes of one thread each (PeriodicLab::set_jobs).
+  if (calibrate->parsed() || diagnose->parsed()) dem::prepare_parallel_runs(cal.jobs);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // progress reaches a log file as it happens
   if (study->parsed()) {  // the study only starts child processes: no Kokkos of its own
     try {

@@ -11,6 +11,11 @@
 #include <stdexcept>
 #include <type_traits>
 
+#include <Kokkos_Core.hpp>
+#if defined(KOKKOS_ENABLE_OPENMP)
+#include <omp.h>
+#endif
+
 #include "periodic_triaxial.hpp"
 
 namespace dem {
@@ -19,7 +24,8 @@ namespace {
 
 /// A run that produced no test (a blow-up): every quantity NaN, counted as missing by residuals().
 void mark_failed(MeasuredTest& t) {
-  t.q_peak = t.eps_a_peak = t.q_end = t.max_dilatancy = t.e_ini = std::numeric_limits<Real>::quiet_NaN();
+  t.q_peak = t.eps_a_peak = t.q_end = t.max_dilatancy = t.e_ini = t.q_1pct = t.q_3pct =
+      std::numeric_limits<Real>::quiet_NaN();
 }
 
 }  // namespace
@@ -56,6 +62,14 @@ MeasuredTest PeriodicLab::run(const Model& m, Real sigma3, const std::string& ma
   ++runs_;
   seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return t;
+}
+
+void prepare_parallel_runs(int jobs) {
+#if defined(KOKKOS_ENABLE_OPENMP)
+  if (jobs > 1) omp_set_num_threads(1);
+#else
+  (void)jobs;
+#endif
 }
 
 int PeriodicLab::set_jobs(int jobs) {
