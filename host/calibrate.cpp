@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <stdexcept>
 
@@ -17,12 +18,13 @@ constexpr Real kMissing = 10;
 }  // namespace
 
 const char* quantity_name(int q) {
-  static const char* names[kQuantities] = {"E_ini", "q_peak", "eps_a_peak", "q_end", "max_dilatancy"};
+  static const char* names[kQuantities] = {"E_ini", "q_1pct", "q_3pct", "q_peak", "eps_a_peak", "q_end",
+                                           "max_dilatancy"};
   return names[q];
 }
 
 std::array<Real, kQuantities> quantities(const MeasuredTest& t) {
-  return {t.e_ini, t.q_peak, t.eps_a_peak, t.q_end, t.max_dilatancy};
+  return {t.e_ini, t.q_1pct, t.q_3pct, t.q_peak, t.eps_a_peak, t.q_end, t.max_dilatancy};
 }
 
 Real NoiseModel::sigma(int q, Real measured) const { return std::max(rel[q] * std::fabs(measured), abs[q]); }
@@ -88,6 +90,13 @@ const ParamSpec& spec(const std::string& name) {
 }  // namespace
 
 FreeParam free_param(const std::string& name) { return spec(name).range; }
+
+Model model_of(const Config& cfg) {
+  Model m;
+  m.law = cfg.ball;
+  m.membrane = cfg.periodic.triax.membrane_stiffness;
+  return m;
+}
 
 FreeParam free_param(const std::string& name, const Model& base) {
   FreeParam f = free_param(name);
@@ -211,13 +220,26 @@ std::vector<QuadraticSurface> response_surfaces(const std::vector<Evaluation>& p
 std::vector<std::string> CalibrationResult::at_edge() const {
   std::vector<std::string> out;
   for (std::size_t k = 0; k < free.size(); ++k)
-    if (best.u[k] < 0.01 || best.u[k] > 0.99) out.push_back(free[k].name);
+    if ((best.u[k] < 0.01 && free[k].lo > 0) || best.u[k] > 0.99) out.push_back(free[k].name);
   return out;
+}
+
+bool recentre(FreeParam& f, Real v) {
+  const FreeParam hard = free_param(f.name);
+  const Real lo = std::max(f.log ? v * std::sqrt(f.lo / f.hi) : v - 0.5 * (f.hi - f.lo), hard.lo);
+  const Real hi = std::min(f.log ? v * std::sqrt(f.hi / f.lo) : v + 0.5 * (f.hi - f.lo), hard.hi);
+  const Real tol = 1e-3 * (f.hi - f.lo);
+  // It moves only outwards, past the edge the value lies on; a range stopped by a hard limit stays.
+  const bool moves = f.unit(v) > 0.5 ? hi > f.hi + tol : lo < f.lo - tol;
+  if (!moves) return false;
+  f.lo = lo;
+  f.hi = hi;
+  return true;
 }
 
 CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,
                             const std::vector<MeasuredTest>& measured, const NoiseModel& noise, int rounds,
-                            const CalibrationProgress& progress) {
+                            const CalibrationProgress& progress, int widen) {
   const int d = static_cast<int>(free.size());
   CalibrationResult res;
   res.free = free;
@@ -267,7 +289,24 @@ CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vect
   }
   res.model = model_at(res.best.u);
   for (int k = 0; k < d; ++k) res.values.push_back(free[k].value(res.best.u[k]));
-  return res;
+  if (widen <= 0) return res;
+  std::vector<FreeParam> moved = free;
+  std::vector<std::string> notes;
+  for (int k = 0; k < d; ++k) {
+    if (res.best.u[k] >= 0.01 && res.best.u[k] <= 0.99) continue;
+    if (!recentre(moved[k], res.values[k])) continue;
+    char line[160];
+    std::snprintf(line, sizeof line, "%s: best %.4g on the edge of [%.4g, %.4g]; searched again over [%.4g, %.4g]",
+                  free[k].name.c_str(), free[k].shown * res.values[k], free[k].shown * free[k].lo,
+                  free[k].shown * free[k].hi, moved[k].shown * moved[k].lo, moved[k].shown * moved[k].hi);
+    notes.push_back(line);
+  }
+  if (notes.empty()) return res;
+  CalibrationResult again = calibrate(lab, base, moved, measured, noise, rounds, progress, widen - 1);
+  if (again.best.chi2 >= res.best.chi2) notes.push_back("the wider search found no better point");
+  CalibrationResult& out = again.best.chi2 < res.best.chi2 ? again : res;
+  out.widened.insert(out.widened.begin(), notes.begin(), notes.end());
+  return out;
 }
 
 }  // namespace dem

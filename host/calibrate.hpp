@@ -5,12 +5,14 @@
 /// from the base config, so that every run differs from the others only by its parameters (common random
 /// numbers: the response is then a smooth function of the parameters, up to the chaos of a small cell).
 ///
-/// Each test (material, sigma3) is reduced to five quantities, the same for measured and simulated curves
-/// (summarise in host/measured.hpp): initial stiffness E_ini, q_peak, eps_a at the peak, q at the end, maximum dilatancy. A summary
-/// file gives those it has. The misfit is a chi-square with a lab-like noise per quantity:
+/// Each test (material, sigma3) is reduced to seven quantities, the same for measured and simulated curves
+/// (summarise in host/measured.hpp): initial stiffness E_ini, q at 1% and at 3% axial strain (the shape of
+/// the hardening: an effect that grows or fades with strain shows there), q_peak, eps_a at the peak, q at the
+/// end, maximum dilatancy. A summary file gives those it has. The misfit is a chi-square with a lab-like noise
+/// per quantity:
 ///   chi2 = sum over tests and present quantities of ((simulated - measured) / s_q)^2,
-///   s_q = max(rel_q |measured|, abs_q)   (NoiseModel: E_ini 10%, q_peak 4%, eps_a at peak 2% strain,
-///                                         q_end 5%, dilatancy 20% or 0.05)
+///   s_q = max(rel_q |measured|, abs_q)   (NoiseModel: E_ini 10%, q at 1% and 3% 6%, q_peak 4%, eps_a at
+///                                         peak 2% strain, q_end 5%, dilatancy 20% or 0.05)
 /// so a model that is right to within the noise has chi2 about the number of data. The levels are a lab's
 /// specimen-to-specimen scatter (2-3% on strength) plus the scatter of a 200-ball cell, whose broad peak
 /// moves by a few % of strain with a small change of parameters.
@@ -20,7 +22,9 @@
 ///   2. a quadratic response surface per datum (Eigen least squares on the normalised residuals), minimised
 ///      by a dense grid and then coordinate refinement;
 ///   3. a run at the surrogate's optimum, added to the design; the surface is refitted with weights that
-///      favour points near the optimum; repeated until the run's chi2 stops improving (at most `rounds`).
+///      favour points near the optimum; repeated until the run's chi2 stops improving (at most `rounds`);
+///   4. when the best point lies on the edge of a range that can move (not a hard limit such as mu_r = 0), the
+///      range is re-centred on it and the search starts again (at most `widen` times); the better answer wins.
 /// The reported fit is the best point actually run, never a surrogate value.
 #include <array>
 #include <functional>
@@ -33,7 +37,7 @@
 
 namespace dem {
 
-enum Quantity : int { kInitialStiffness = 0, kPeak, kStrainAtPeak, kResidual, kDilatancy, kQuantities };
+enum Quantity : int { kInitialStiffness = 0, kEarly, kMid, kPeak, kStrainAtPeak, kResidual, kDilatancy, kQuantities };
 
 /// Name of a quantity in tables ("E_ini", "q_peak", ...).
 const char* quantity_name(int q);
@@ -43,8 +47,8 @@ std::array<Real, kQuantities> quantities(const MeasuredTest& t);
 
 /// Noise of each quantity: s_q = max(rel_q |measured|, abs_q).
 struct NoiseModel {
-  std::array<Real, kQuantities> rel{0.10, 0.04, 0.0, 0.05, 0.20};
-  std::array<Real, kQuantities> abs{0.0, 0.0, 0.02, 0.0, 0.05};
+  std::array<Real, kQuantities> rel{0.10, 0.06, 0.06, 0.04, 0.0, 0.05, 0.20};
+  std::array<Real, kQuantities> abs{0.0, 0.0, 0.0, 0.0, 0.02, 0.0, 0.05};
   Real sigma(int q, Real measured) const;
 };
 
@@ -62,6 +66,9 @@ struct Model {
   ContactParams law;
   Real membrane = 0;
 };
+
+/// The model of a config: its ball law and the periodic cell's membrane.
+Model model_of(const Config& cfg);
 
 /// A parameter that calibration may vary: its config key, its range, log or linear search.
 struct FreeParam {
@@ -110,6 +117,11 @@ class PeriodicLab {
   int jobs_ = 1;
 };
 
+/// Before Kokkos starts, in a program that will run `jobs` > 1 simulator runs at once: sets OpenMP to one
+/// thread (its runtime read OMP_NUM_THREADS when it was loaded, before main, so through its API), as
+/// PeriodicLab::set_jobs requires.
+void prepare_parallel_runs(int jobs);
+
 /// One evaluated point of a search.
 struct Evaluation {
   std::vector<Real> u;                ///< unit coordinates of the free parameters
@@ -126,9 +138,16 @@ struct CalibrationResult {
   std::vector<Evaluation> design;     ///< every point run, in order
   int data = 0;                       ///< number of data in the misfit
   /// Names of the parameters whose best value lies on an edge of its range (within 1% of it): the true
-  /// optimum may lie outside, and a misfit found there may be the range's and not the model's.
+  /// optimum may lie outside, and a misfit found there may be the range's and not the model's. A lower edge
+  /// at zero is not one: nothing lies below it (no rolling resistance, no wear).
   std::vector<std::string> at_edge() const;
+  /// What the search did to ranges whose best value fell on an edge ("mu_s range moved to [0.15, 1.35]").
+  std::vector<std::string> widened;
 };
+
+/// Moves f's range to centre on v, keeping its width (its ratio when logarithmic), inside the registry's range
+/// for the name (free_param(name)); false when it cannot move (v on a hard limit, such as mu_r = 0).
+bool recentre(FreeParam& f, Real v);
 
 /// Called after each run with (runs done, runs planned, best chi2 so far).
 using CalibrationProgress = std::function<void(long, long, Real)>;
@@ -136,7 +155,7 @@ using CalibrationProgress = std::function<void(long, long, Real)>;
 /// Calibrates `free` on `measured` (one material, any number of pressures) from `base`; see the top of the file.
 CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,
                             const std::vector<MeasuredTest>& measured, const NoiseModel& noise, int rounds = 4,
-                            const CalibrationProgress& progress = {});
+                            const CalibrationProgress& progress = {}, int widen = 2);
 
 /// A quadratic response surface in unit coordinates: value(u) = c . basis(u), fitted by weighted least squares.
 class QuadraticSurface {

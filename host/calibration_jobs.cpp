@@ -7,7 +7,6 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <random>
 #include <sstream>
 
 #include "calibrate.hpp"
@@ -32,13 +31,6 @@ std::string new_dated_folder(const std::string& parent, const std::string& prefi
 }
 
 namespace {
-
-Model model_of(const Config& cfg) {
-  Model m;
-  m.law = cfg.ball;
-  m.membrane = cfg.periodic.triax.membrane_stiffness;
-  return m;
-}
 
 /// The free parameters: from the command line, else from the config's [calibrate] free.
 std::vector<FreeParam> free_params(const Config& cfg, const std::vector<std::string>& cli) {
@@ -122,13 +114,23 @@ void print_errors(const std::vector<MeasuredTest>& meas, const std::vector<Measu
 /// What calibrate and diagnose share: the data, the free parameters, the simulator and a new result folder.
 struct Session {
   MeasuredData data;
+  ReferenceValues ref;
   std::vector<FreeParam> free;
   PeriodicLab lab;
   std::string folder;
   Session(const Config& base, const CalibrationOptions& o, const std::string& kind)
-      : data(load_measured(o.data)), free(free_params(base, o.free)), lab(base, true),
-        folder(new_dated_folder(o.output, kind)) {
+      : data(load_measured(o.data)),
+        ref(o.reference.empty() ? ReferenceValues{}
+                                : load_reference(o.reference, [](const std::string& n) { free_param(n); })),
+        free(free_params(base, o.free)), lab(base, true), folder(new_dated_folder(o.output, kind)) {
     lab.set_jobs(o.jobs);
+  }
+  /// The reference value of a parameter for a material, in the key's unit; NaN when there is none.
+  Real reference(const std::string& material, const std::string& name) const {
+    auto m = ref.values.find(material);
+    if (m == ref.values.end()) return std::nan("");
+    auto v = m->second.find(name);
+    return v == m->second.end() ? std::nan("") : v->second;
   }
   /// The errors table, the curves in the measured-data format and the figure.
   void finish(const std::vector<MeasuredTest>& meas, const std::vector<MeasuredTest>& sim,
@@ -145,7 +147,7 @@ struct Session {
 int calibrate_job(const Config& base, const CalibrationOptions& o) {
   Session ss(base, o, "calibrate");
   std::ostringstream table;
-  table << "material,parameter,value,chi2,data,runs\n";
+  table << "material,parameter,value,reference,chi2,data,runs\n";
   std::vector<MeasuredTest> all_meas, all_sim;
   for (const auto& [material, tests] : by_material(ss.data, o.material)) {
     std::printf("calibrate: %s, %zu tests, free %zu parameters, %zu balls in the periodic cell\n", material.c_str(),
@@ -162,10 +164,13 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
     progress.finish("");
     for (std::size_t k = 0; k < ss.free.size(); ++k) {
       const FreeParam& f = ss.free[k];
-      std::printf("calibrate: %s: %s = %.4g\n", material.c_str(), f.name.c_str(), f.shown * r.values[k]);
+      const Real ref = ss.reference(material, f.name);
+      std::printf("calibrate: %s: %s = %.4g%s\n", material.c_str(), f.name.c_str(), f.shown * r.values[k],
+                  std::isfinite(ref) ? fmt(" (reference %g)", ref).c_str() : "");
       table << material << "," << f.name << "," << fmt("%.6g", f.shown * r.values[k]) << ","
-            << fmt("%.3f", r.best.chi2) << "," << r.data << "," << ss.lab.runs() - runs0 << "\n";
+            << (std::isfinite(ref) ? fmt("%g", ref) : "") << "," << fmt("%.3f", r.best.chi2) << "," << r.data << "," << ss.lab.runs() - runs0 << "\n";
     }
+    for (const std::string& note : r.widened) std::printf("calibrate: %s: %s\n", material.c_str(), note.c_str());
     for (const std::string& name : r.at_edge())
       std::printf("calibrate: %s: WARNING: %s is at the edge of its range: widen it (the optimum may lie "
                   "outside)\n", material.c_str(), name.c_str());
@@ -189,18 +194,24 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
      << "Simulator: periodic-cell triaxial, " << ss.lab.balls() << " balls, one specimen for every run. Free base "
      << "parameters:";
   for (const FreeParam& f : ss.free) md << " " << f.name;
-  md << ". Misfit: chi2 over the initial stiffness, q_peak, eps_a at peak, q_end and maximum dilatancy with "
+  md << ". Misfit: chi2 over the initial stiffness, q at 1% and 3% strain, q_peak, eps_a at peak, q_end and "
+        "maximum dilatancy with "
         "lab-like noise (host/calibrate.hpp).\n\n";
   csv << "material,model,parameter,value,chi2,bic,heldout_chi2,runs\n";
   std::vector<MeasuredTest> all_meas, all_sim;
   for (const auto& [material, tests] : by_material(ss.data, o.material)) {
     const Diagnosis dg = diagnose(ss.lab, model_of(base), ss.free, tests, NoiseModel(), true);
     std::printf("diagnose: %s: verdict: %s\n  %s\n", material.c_str(), dg.verdict.c_str(), dg.explanation.c_str());
-    std::string edge;
+    std::string edge, widened;
+    for (const std::string& note : dg.base.widened) {
+      std::printf("diagnose: %s: %s\n", material.c_str(), note.c_str());
+      widened += (widened.empty() ? "" : "; ") + note;
+    }
     for (const std::string& name : dg.base.at_edge()) edge += (edge.empty() ? "" : ", ") + name;
     if (!edge.empty())
       std::printf("diagnose: %s: WARNING: %s at the edge of the search range\n", material.c_str(), edge.c_str());
     md << "## " << material << "\n\n**Verdict: " << dg.verdict << ".** " << dg.explanation << "\n\n"
+       << (widened.empty() ? "" : "Search ranges: " + widened + ".\n\n")
        << (edge.empty() ? "" : "**Warning:** the base model's " + edge + " lies at the edge of its search range: the "
                                "optimum may lie outside, and part of the misfit may be the range's, not the model's.\n\n")
        << "| model | parameters | chi2 | BIC | held-out chi2 | runs |\n|---|---|---|---|---|---|\n| base | ";
@@ -223,6 +234,21 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
           << fmt("%.3f", f.best.chi2) << "," << fmt("%.3f", f.bic) << "," << fmt("%.3f", f.heldout) << "," << f.runs
           << "\n";
     }
+    if (!ss.ref.values.empty()) {
+      const ExtensionFit* named = nullptr;  // the extension the verdict names first, if any
+      for (const ExtensionFit& f : dg.fits)
+        if (dg.verdict.rfind(f.ext.name, 0) == 0) named = &f;
+      md << "\nCalibrated values beside the reference (" << ss.ref.path << (ss.ref.comment.empty() ? "" : ": ")
+         << ss.ref.comment << "):\n\n| parameter | base model | "
+         << (named ? "base + " + named->ext.name + " | " : "") << "reference |\n|---|---|" << (named ? "---|" : "")
+         << "---|\n";
+      for (std::size_t k = 0; k < ss.free.size(); ++k) {
+        const Real ref = ss.reference(material, ss.free[k].name);
+        md << "| " << ss.free[k].name << " | " << fmt("%.4g", ss.free[k].shown * dg.base.values[k]) << " | "
+           << (named ? fmt("%.4g", ss.free[k].shown * named->values[k]) + " | " : "")
+           << (std::isfinite(ref) ? fmt("%g", ref) : std::string("-")) << " |\n";
+      }
+    }
     md << "\nMisfit per test and quantity of the calibrated base model (residual in noise units, "
           "(simulated - measured) / s):\n\n| sigma3 kPa | quantity | unit | measured | base | residual |\n"
           "|---|---|---|---|---|---|\n";
@@ -240,6 +266,7 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
     all_meas.insert(all_meas.end(), tests.begin(), tests.end());
     all_sim.insert(all_sim.end(), dg.base.best.sim.begin(), dg.base.best.sim.end());
   }
+  md << "![measured and simulated](calibration.png)\n";
   write_file(ss.folder + "/diagnosis.md", md.str());
   write_file(ss.folder + "/models.csv", csv.str());
   std::printf("diagnose: %ld runs in %s; report in %s/diagnosis.md\n", ss.lab.runs(),
@@ -254,12 +281,8 @@ int synth_job(const Config& base, const SynthOptions& o) {
                         o.extension;
   if (o.extension != "none") {
     const Extension& e = extension(o.extension);
-    Real v = o.strength >= 0 ? o.strength / free_param(e.param).shown : -1;  // given in the key's unit
-    if (v < 0) {  // drawn within the extension's range, log-uniform between its lowest and highest strength
-      std::mt19937_64 rng(o.seed * 7919u + 17u);
-      std::uniform_real_distribution<Real> u(0, 1);
-      v = e.levels.front() * std::pow(e.levels.back() / e.levels.front(), u(rng));
-    }
+    const Real v = o.strength >= 0 ? o.strength / free_param(e.param).shown  // given in the key's unit
+                                   : draw_strength(e, o.seed);
     set_param(truth, e.param, v);
     comment += " (" + e.param + " = " + fmt("%.4g", free_param(e.param).shown * v) + ")";
   }

@@ -14,6 +14,7 @@ struct CalibrationOptions {
   std::vector<std::string> free;          ///< empty: the config's [calibrate] free
   std::string material;                   ///< empty: every material of the file
   int jobs = 1;                           ///< simulator runs at once (PeriodicLab::set_jobs)
+  std::string reference;                  ///< optional reference values (load_reference) to set beside the fit
 };
 
 /// Calibrates each material of the data; writes calibrate_<date>/ under options.output. Returns 0.

@@ -9,13 +9,14 @@
 ///    plus the extension's effect there, interpolated between the strengths (off, 1, 2, 3); the joint optimum
 ///    over the base parameters and the strength is run, the surrogate corrected by what the run shows, and
 ///    run once more. The fit reported is the best point run.
-/// 3. Held-out prediction: for each pressure, the surrogate is fitted to the other pressures and predicts it;
-///    the held-out misfit is the sum of those chi2. Information criterion: BIC = chi2 + k ln n (k free
+/// 3. Held-out prediction: for each pressure, the surrogate is fitted to the other pressures, and a run with
+///    those parameters predicts it; the held-out misfit is the sum of those chi2 (runs, not surrogate values). Information criterion: BIC = chi2 + k ln n (k free
 ///    parameters, n data; the noise is known, so chi2 is -2 log-likelihood up to a constant).
-/// 4. Verdict: the base model is consistent with the data when its chi2 is below the 99% quantile of chi2 with
-///    n - k degrees of freedom; otherwise the extension with the lowest BIC is named when it beats the base by
-///    at least 6 (strong evidence) and halves the held-out misfit; extensions within 2 of its BIC cannot be
-///    told apart from these data and are named with it.
+/// 4. Verdict: the extension with the lowest BIC is named when it beats the base by at least 6 (strong
+///    evidence: the nested models' likelihood-ratio test) and halves the held-out misfit; extensions within 2
+///    of its BIC cannot be told apart from these data and are named with it. Otherwise "none", and the report
+///    says whether the base model fits within the noise (chi2 below the 99% quantile of chi2 with n - k
+///    degrees of freedom) or misses the data in a way no extension explains.
 #include <string>
 #include <vector>
 
@@ -30,6 +31,7 @@ struct Extension {
   std::string param;      ///< its free parameter (host/calibrate.hpp)
   std::vector<Real> levels;
   std::string signature;
+  bool from_off = true;   ///< the parameter going to 0 turns it off smoothly (not so for Hertz)
 };
 
 const std::vector<Extension>& extensions();
@@ -40,7 +42,7 @@ struct ExtensionFit {
   std::vector<Real> values;   ///< base free parameters, then the extension's
   Real strength = 0;          ///< the extension parameter's fitted value
   Evaluation best;            ///< best point run (its u has the base coordinates only)
-  Real bic = 0, heldout = 0;  ///< BIC of the fit; held-out chi2 (surrogate)
+  Real bic = 0, heldout = 0;  ///< BIC of the fit; held-out chi2 (runs)
   long runs = 0;
 };
 
@@ -59,6 +61,9 @@ Real chi2_quantile(Real nu, Real z);
 /// Runs the diagnosis of `measured` (one material) from `base` with base parameters `free`.
 Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,
                    const std::vector<MeasuredTest>& measured, const NoiseModel& noise, bool verbose);
+
+/// A hidden strength drawn from `seed`: log-uniform between the extension's lowest and highest level.
+Real draw_strength(const Extension& e, unsigned seed);
 
 /// Synthetic measured data: the simulator's tests of `truth` at `sigma3` (Pa), with lab-like noise from `seed`:
 /// a specimen-to-specimen factor on q (2% standard deviation), and on each row 0.5% of sigma3 on q and 0.02%

@@ -24,6 +24,7 @@ const std::map<std::string, Real> kStressUnits = {{"Pa", 1}, {"kPa", 1e3}, {"MPa
 const std::map<std::string, Real> kStrainUnits = {{"pct", 1e-2}, {"frac", 1}};
 const std::map<std::string, const std::map<std::string, Real>*> kQuantities = {
     {"sigma3", &kStressUnits}, {"q", &kStressUnits},         {"q_peak", &kStressUnits}, {"q_end", &kStressUnits}, {"e_ini", &kStressUnits},
+    {"q_1pct", &kStressUnits}, {"q_3pct", &kStressUnits},
     {"eps_a", &kStrainUnits},  {"eps_v", &kStrainUnits}, {"eps_a_peak", &kStrainUnits}};
 
 std::string trim(const std::string& s) {
@@ -63,7 +64,7 @@ ColumnSpec parse_header(const std::string& path, const std::string& name) {
   }
   fail(path, 1, name,
        "unknown column (allowed: material, sigma3_<unit>, eps_a_<unit>, q_<unit>, eps_v_<unit>, q_peak_<unit>, "
-       "eps_a_peak_<unit>, q_end_<unit>, max_dilatancy)");
+       "eps_a_peak_<unit>, q_end_<unit>, max_dilatancy, e_ini_<unit>, q_1pct_<unit>, q_3pct_<unit>)");
 }
 
 }  // namespace
@@ -145,6 +146,8 @@ MeasuredData load_measured(const std::string& path) {
       mt.q_end = number("q_end");
       mt.max_dilatancy = number("max_dilatancy");
       mt.e_ini = number("e_ini");
+      mt.q_1pct = number("q_1pct");
+      mt.q_3pct = number("q_3pct");
     }
   }
   if (cols.empty()) throw DataError(path + ": no header line");
@@ -152,6 +155,50 @@ MeasuredData load_measured(const std::string& path) {
   if (d.curves)
     for (MeasuredTest& t : d.tests) summarise(t);
   return d;
+}
+
+ReferenceValues load_reference(const std::string& path, const std::function<void(const std::string&)>& known) {
+  std::ifstream f(path);
+  if (!f) throw DataError(path + ": cannot be read");
+  ReferenceValues ref;
+  ref.path = path;
+  std::string line;
+  for (long n = 1; std::getline(f, line); ++n) {
+    const std::string t = trim(line);
+    if (t.empty()) continue;
+    if (t[0] == '#') {
+      ref.comment += (ref.comment.empty() ? "" : " ") + trim(t.substr(1));
+      continue;
+    }
+    const std::vector<std::string> cells = split(t);
+    if (ref.parameters.empty()) {
+      if (cells.empty() || cells[0] != "material") fail(path, n, cells.empty() ? "" : cells[0], "the first column must be 'material'");
+      if (cells.size() < 2) fail(path, n, "", "no parameter columns");
+      for (std::size_t c = 1; c < cells.size(); ++c) {
+        try {
+          known(cells[c]);
+        } catch (const std::invalid_argument& e) {
+          fail(path, n, cells[c], e.what());
+        }
+        ref.parameters.push_back(cells[c]);
+      }
+      continue;
+    }
+    if (cells.size() != ref.parameters.size() + 1)
+      fail(path, n, "", "has " + std::to_string(cells.size()) + " cells, the header " +
+                            std::to_string(ref.parameters.size() + 1));
+    if (cells[0].empty()) fail(path, n, "material", "empty");
+    for (std::size_t c = 0; c < ref.parameters.size(); ++c) {
+      const std::string& v = cells[c + 1];
+      char* end = nullptr;
+      const double x = std::strtod(v.c_str(), &end);
+      if (v.empty() || end != v.c_str() + v.size() || !std::isfinite(x))
+        fail(path, n, ref.parameters[c], "'" + v + "' is not a number");
+      ref.values[cells[0]][ref.parameters[c]] = x;
+    }
+  }
+  if (ref.parameters.empty()) throw DataError(path + ": no header line");
+  return ref;
 }
 
 namespace {
@@ -178,6 +225,15 @@ void summarise(MeasuredTest& t) {
   const auto k = std::max_element(q.begin(), q.end()) - q.begin();
   t.q_peak = q[k];
   t.eps_a_peak = t.eps_a[k];
+  auto q_at = [&](Real e) {
+    if (e < t.eps_a.front() || e > t.eps_a.back()) return kNaN;
+    const auto j = std::lower_bound(t.eps_a.begin(), t.eps_a.end(), e) - t.eps_a.begin();
+    if (j == 0) return q[0];
+    const Real w = (e - t.eps_a[j - 1]) / (t.eps_a[j] - t.eps_a[j - 1]);
+    return (1 - w) * q[j - 1] + w * q[j];
+  };
+  t.q_1pct = q_at(kEarlyStrain);
+  t.q_3pct = q_at(kMidStrain);
   // q at the end: the mean over the last strain window (one raw row carries the full scatter).
   Real sum = 0;
   int n = 0;

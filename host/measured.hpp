@@ -9,9 +9,11 @@
 ///   sigma3_<unit>       confining pressure: kPa, MPa or Pa
 ///   curves:   eps_a_<u>, q_<stress unit>, and optionally eps_v_<u>   (strain units: pct or frac)
 ///   summary:  q_peak_<stress unit>, and optionally eps_a_peak_<u>, q_end_<stress unit>, max_dilatancy,
-///             e_ini_<stress unit> (initial stiffness dq/deps_a over the first 0.2% of axial strain)
+///             e_ini_<stress unit> (initial stiffness dq/deps_a over the first 0.2% of axial strain),
+///             q_1pct_<stress unit>, q_3pct_<stress unit> (q at 1% and 3% axial strain)
 /// A file is a curve file when it has an eps_a column, a summary file when it has q_peak. Within a curve
 /// the axial strain must increase; a material and pressure appear once in a summary file.
+#include <functional>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -34,6 +36,7 @@ struct MeasuredTest {
   std::vector<Real> eps_a, q, eps_v;        ///< fractions, Pa, fractions (compression / contraction positive)
   Real q_peak = 0, eps_a_peak = 0, q_end = 0, max_dilatancy = 0;  ///< Pa, -, Pa, -
   Real e_ini = 0;                           ///< Pa, initial stiffness dq/deps_a (first kInitialWindow of strain)
+  Real q_1pct = 0, q_3pct = 0;              ///< Pa, q at kEarlyStrain and kMidStrain (NaN: the curve ends before)
 };
 
 struct MeasuredData {
@@ -49,11 +52,28 @@ MeasuredData load_measured(const std::string& path);
 /// is the mean over the last 1%, the initial stiffness is fitted over the first 0.2% (the elastic range of
 /// bead contacts, overlap / radius ~ 1e-3, lies within it).
 constexpr Real kSmoothHalfWidth = 0.0025, kEndWindow = 0.01, kInitialWindow = 0.002;
+/// The axial strains of the two points on the hardening curve (q_1pct, q_3pct).
+constexpr Real kEarlyStrain = 0.01, kMidStrain = 0.03;
 
-/// Fills the summary values of a curve test from its smoothed curves: q_peak and its strain, q at the end,
+/// Fills the summary values of a curve test from its smoothed curves: q at 1% and 3% strain (interpolated
+/// between rows), q_peak and its strain, q at the end,
 /// the initial stiffness (least-squares slope of the raw rows over the first 0.2% of strain) and the maximum dilatancy
 /// -d eps_v / d eps_a (the slope over one 0.5% window). The same function summarises simulated curves.
 void summarise(MeasuredTest& t);
+
+/// Reference parameter values to set beside calibrated ones (e.g. a paper's own calibration): a CSV with a
+/// `material` column and one column per parameter, named as in [calibrate] free (mu_s, mu_r, ...), in that
+/// key's unit. Comment lines ('#') are kept as the source's description.
+struct ReferenceValues {
+  std::string path;
+  std::string comment;                                          ///< the comment lines, joined
+  std::vector<std::string> parameters;                          ///< column order
+  std::map<std::string, std::map<std::string, Real>> values;    ///< material -> parameter -> value
+};
+
+/// Reads a reference file; `known` checks a parameter name and throws std::invalid_argument when it is not one.
+/// Throws DataError naming the line and column.
+ReferenceValues load_reference(const std::string& path, const std::function<void(const std::string&)>& known);
 
 /// Refuses a test whose pressure is not among `sigma3` (Pa): names the file, the material and the pressure.
 void check_pressures(const MeasuredData& d, const std::vector<Real>& sigma3);

@@ -56,7 +56,7 @@ TEST(Calibrate, ResidualsUseTheNoiseModel) {
   MeasuredTest m, s;
   m.q_peak = 100e3;
   m.eps_a_peak = 0.05;
-  m.e_ini = m.q_end = m.max_dilatancy = std::nan("");
+  m.e_ini = m.q_1pct = m.q_3pct = m.q_end = m.max_dilatancy = std::nan("");
   s = m;
   s.q_peak = 108e3;
   s.eps_a_peak = 0.03;
@@ -180,12 +180,35 @@ TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
 }
 
 // A best point on the edge of the search range is flagged (the Table 6 fits of S-2 and S-3 ended on mu_s = 3 x
-// the base value and on the mu_r cap, and their misfit was the range's).
+// the base value and on the mu_r cap, and their misfit was the range's); a lower edge at zero (no wear) is not one.
 TEST(Calibrate, BestPointOnTheRangeEdgeIsFlagged) {
   CalibrationResult r;
   r.free = {free_param("mu_s"), free_param("mu_r"), free_param("wear")};
-  r.best.u = {0.995, 0.5, 0.0};
+  r.best.u = {0.995, 0.5, 0.005};
+  EXPECT_EQ(r.at_edge(), (std::vector<std::string>{"mu_s"})) << "wear = 0 is a lower edge at zero: nothing below";
+  r.best.u = {0.005, 0.5, 0.995};
   EXPECT_EQ(r.at_edge(), (std::vector<std::string>{"mu_s", "wear"}));
   r.best.u = {0.02, 0.5, 0.98};
   EXPECT_TRUE(r.at_edge().empty());
+}
+
+// A range whose best value fell on its edge moves to centre on it: same width (linear) or ratio (log), clipped
+// to the registry's hard limits; a value on a hard limit (mu_r = 0, mu_s = 1) cannot move it.
+TEST(Calibrate, EdgeRangeIsRecentredWithinHardLimits) {
+  FreeParam s = free_param("mu_s");  // log, [0.02, 1]
+  s.lo = 0.1;
+  s.hi = 0.9;
+  ASSERT_TRUE(recentre(s, 0.9));
+  EXPECT_NEAR(s.lo, 0.3, 1e-12);  // 0.9 / 3: the ratio 9 kept around 0.9 ...
+  EXPECT_EQ(s.hi, 1.0);           // ... up to the hard limit
+  EXPECT_FALSE(recentre(s, 1.0)) << "mu_s = 1 is a hard limit";
+  FreeParam r = free_param("mu_r");  // linear, [0, 0.2]
+  r.lo = 0;
+  r.hi = 0.06;
+  ASSERT_TRUE(recentre(r, 0.06));
+  EXPECT_NEAR(r.lo, 0.03, 1e-12);
+  EXPECT_NEAR(r.hi, 0.09, 1e-12);
+  r.lo = 0;
+  r.hi = 0.06;
+  EXPECT_FALSE(recentre(r, 0.0)) << "mu_r = 0 is a hard limit";
 }

@@ -65,6 +65,9 @@ TEST(Measured, CurvesInOtherUnitsAreSummarised) {
   EXPECT_NEAR(t.max_dilatancy, 0.4, 1e-12);  // -(-0.003 - 0.001) / 0.01
   // Initial stiffness over the first 0.2% of strain: no row but the first lies within it.
   EXPECT_TRUE(std::isnan(t.e_ini));
+  // q at 1% and 3% strain: on a row each (one row per smoothing window: the rows themselves).
+  EXPECT_DOUBLE_EQ(t.q_1pct, 100e3);
+  EXPECT_DOUBLE_EQ(t.q_3pct, 140e3);
 }
 
 // Dense rows with alternating scatter: the moving mean over +-0.25% strain removes it, so q_peak is the
@@ -84,6 +87,10 @@ TEST(Measured, NoisyCurvesAreSmoothedBeforeTheyAreSummarised) {
   EXPECT_NEAR(t.q_peak, 99.995e3, 0.15e3);
   EXPECT_NEAR(t.q_end, 1e5 * (1 - std::exp(-9.5)), 0.2e3);  // mean of a nearly flat tail
   EXPECT_NEAR(t.max_dilatancy, 0.2, 1e-9);                  // eps_v = -0.2 eps_a exactly
+  // q at 1% and 3%: the smoothed curve there (51 rows, one unpaired: 0.1 kPa of scatter; the curvature
+  // over the +-0.25% window moves the mean by 100 e^-e 0.25^2/6 < 0.4 kPa).
+  EXPECT_NEAR(t.q_1pct, 1e5 * (1 - std::exp(-1.0)), 0.5e3);
+  EXPECT_NEAR(t.q_3pct, 1e5 * (1 - std::exp(-3.0)), 0.2e3);
   // Initial stiffness: the least-squares slope through the first row over the first 0.2% (rows 1-20), worked
   // out here from the rows as written (strain as a fraction, stress in Pa); rounding only: 1e-9.
   double sxy = 0, sxx = 0;
@@ -114,4 +121,31 @@ TEST(Measured, BadFilesAreRefusedWithLineAndColumn) {
   e = error_of("material,sigma3_kPa,q_peak_kPa,colour\nS-1,100,1,red\n");
   EXPECT_NE(e.find("bad.csv:1:colour: unknown column"), std::string::npos) << e;
   EXPECT_NE(error_of("# only a comment\n").find("no header line"), std::string::npos);
+}
+
+// Reference values (the paper's Table 5 beside a calibration): the shipped file loads; a parameter the
+// checker does not know, a cell that is not a number and a missing material column are refused with line and
+// column.
+TEST(Measured, ReferenceValuesLoadAndBadOnesAreRefused) {
+  auto known = [](const std::string& n) {
+    if (n != "mu_s" && n != "mu_r") throw std::invalid_argument("unknown free parameter '" + n + "'");
+  };
+  const ReferenceValues t5 = load_reference(std::string(TRIAXDEM_SOURCE_DIR) + "/data/tang2025_table5_friction.csv", known);
+  EXPECT_EQ(t5.parameters, (std::vector<std::string>{"mu_s", "mu_r"}));
+  EXPECT_DOUBLE_EQ(t5.values.at("S-2").at("mu_s"), 0.3);
+  EXPECT_DOUBLE_EQ(t5.values.at("S-3").at("mu_r"), 0.025);
+  EXPECT_NE(t5.comment.find("Table 5"), std::string::npos);
+  auto error = [&](const std::string& text) {
+    try {
+      load_reference(write("ref.csv", text), known);
+    } catch (const DataError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(error("material,mu_s,colour\nS-1,0.1,2\n").find("ref.csv:1:colour: unknown free parameter"),
+            std::string::npos);
+  EXPECT_NE(error("material,mu_s\nS-1,abc\n").find("ref.csv:2:mu_s: 'abc' is not a number"), std::string::npos);
+  EXPECT_NE(error("sample,mu_s\nS-1,0.1\n").find("ref.csv:1:sample: the first column must be 'material'"),
+            std::string::npos);
 }

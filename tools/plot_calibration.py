@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Draws measured against simulated results of `triaxdem calibrate` or `triaxdem diagnose`: with measured
 curves, one column per material and pressure of q and eps_v against axial strain (measured as dots, simulated
-as lines); with summary data only, q_peak against sigma3 per material. Writes FOLDER/calibration.png.
+as lines); with summary data only, q_peak against sigma3 per material and the simulated curves. Writes FOLDER/calibration.png.
 
 Reads FOLDER/simulated_curves.csv, FOLDER/measured_curves.csv (when the data had curves) and FOLDER/errors.csv.
 
@@ -69,16 +69,28 @@ def main():
     else:
         rows = [r for r in read_rows(os.path.join(args.folder, "errors.csv")) if r["quantity"] == "q_peak"]
         materials = sorted({r["material"] for r in rows})
-        fig, ax1 = plt.subplots(figsize=(5.5, 4.2))
+        # Left: q_peak against sigma3; right: the simulated curves, with each measured peak as a mark at the
+        # simulated peak's strain (the data give no strain).
+        fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.2))
         for k, m in enumerate(materials):
             mine = sorted((float(r["sigma3_kPa"]), float(r["measured"]), float(r["simulated"]))
                           for r in rows if r["material"] == m)
             s3 = [x[0] for x in mine]
             ax1.plot(s3, [x[1] for x in mine], "o", color=f"C{k}", label=f"{m} measured")
             ax1.plot(s3, [x[2] for x in mine], "x--", color=f"C{k}", label=f"{m} simulated")
+            for s3k, qm, _ in mine:
+                if (m, s3k) not in sim:
+                    continue
+                es, qs, _ = sim[(m, s3k)]
+                ax2.plot(es, qs, "-", color=f"C{k}", lw=1, label=f"{m}" if s3k == s3[0] else None)
+                ax2.plot([es[qs.index(max(qs))]], [qm], "o", color=f"C{k}", ms=5)
         ax1.set_xlabel("confining pressure sigma3 (kPa)")
         ax1.set_ylabel("peak deviator stress q_peak (kPa)")
         ax1.legend(fontsize=8)
+        ax2.set_xlabel("axial strain eps_a (%)")
+        ax2.set_ylabel("deviator stress q (kPa)")
+        ax2.set_title("calibrated model (lines), measured peaks (dots)", fontsize=9)
+        ax2.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(out, dpi=130)
     print(f"plot_calibration: wrote {out}")
