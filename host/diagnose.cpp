@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <random>
 #include <stdexcept>
 
@@ -304,18 +305,38 @@ std::vector<MeasuredTest> synthetic_tests(PeriodicLab& lab, const Model& truth, 
 
 void write_measured_curves(const std::string& path, const std::vector<MeasuredTest>& tests,
                            const std::string& comment) {
+  const bool volume = std::all_of(tests.begin(), tests.end(), [](const MeasuredTest& t) { return !t.eps_v.empty(); });
+  std::vector<std::string> columns{"sigma3_kPa", "eps_a_pct", "q_kPa"};
+  if (volume) columns.push_back("eps_v_pct");
+  std::map<std::string, std::vector<std::vector<double>>> rows;  // by material
+  std::vector<std::string> order;                                 // materials in file order
+  for (const MeasuredTest& t : tests) {
+    if (!rows.count(t.material)) order.push_back(t.material);
+    for (std::size_t i = 0; i < t.q.size(); ++i) {
+      rows[t.material].push_back({1e-3 * t.sigma3, 100 * t.eps_a[i], 1e-3 * t.q[i]});
+      if (volume) rows[t.material].back().push_back(100 * t.eps_v[i]);
+    }
+  }
+  const auto dot = path.rfind('.');
+  const std::string ext = dot == std::string::npos ? "" : path.substr(dot);
+  if (ext == ".h5" || ext == ".hdf5") return write_measured_h5(path, columns, rows, comment);
   const std::string tmp = path + ".tmp";
   {
     std::ofstream f(tmp);
     if (!f) throw std::runtime_error(path + ": cannot write");
     f << "# " << comment << "\n# triaxdem measured-data format (curves): see host/measured.hpp and the README.\n";
-    f << "material,sigma3_kPa,eps_a_pct,q_kPa,eps_v_pct\n";
-    char row[200];
-    for (const MeasuredTest& t : tests)
-      for (std::size_t i = 0; i < t.q.size(); ++i) {
-        std::snprintf(row, sizeof row, "%s,%.6g,%.6g,%.6g,%.6g\n", t.material.c_str(), 1e-3 * t.sigma3,
-                      100 * t.eps_a[i], 1e-3 * t.q[i], 100 * t.eps_v[i]);
-        f << row;
+    f << "material";
+    for (const std::string& c : columns) f << "," << c;
+    f << "\n";
+    char cell[32];
+    for (const std::string& m : order)
+      for (const std::vector<double>& r : rows[m]) {
+        f << m;
+        for (double v : r) {
+          std::snprintf(cell, sizeof cell, ",%.6g", v);
+          f << cell;
+        }
+        f << "\n";
       }
     if (!f) throw std::runtime_error(path + ": write failed");
   }

@@ -71,7 +71,8 @@ Real draw_strength(const Extension& e, unsigned seed);
 std::vector<MeasuredTest> synthetic_tests(PeriodicLab& lab, const Model& truth, const std::vector<Real>& sigma3,
                                           const std::string& material, unsigned seed);
 
-/// Writes tests as a measured-data curve file (kPa, pct), through a temporary file and a rename.
+/// Writes tests as a measured-data curve file (kPa, pct; eps_v when every test has it): CSV, or HDF5 when the
+/// path ends in .h5 or .hdf5; through a temporary file and a rename.
 void write_measured_curves(const std::string& path, const std::vector<MeasuredTest>& tests,
                            const std::string& comment);
 

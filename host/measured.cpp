@@ -42,11 +42,12 @@ std::vector<std::string> split(const std::string& line) {
   return out;
 }
 
-[[noreturn]] void fail(const std::string& path, long line, const std::string& column, const std::string& what) {
-  throw DataError(path + ":" + std::to_string(line) + (column.empty() ? "" : ":" + column) + ": " + what);
+/// `at` is where in the file: "<path>:<line>" in a CSV, "<path>:/<material>/table row <k>" in HDF5.
+[[noreturn]] void fail(const std::string& at, const std::string& column, const std::string& what) {
+  throw DataError(at + (column.empty() ? "" : ":" + column) + ": " + what);
 }
 
-ColumnSpec parse_header(const std::string& path, const std::string& name) {
+ColumnSpec parse_header(const std::string& at, const std::string& name) {
   if (name == "material" || name == "max_dilatancy") return {name, 1};
   const auto cut = name.rfind('_');
   if (cut != std::string::npos) {
@@ -57,54 +58,69 @@ ColumnSpec parse_header(const std::string& path, const std::string& name) {
       if (u == it->second->end()) {
         std::string allowed;
         for (const auto& [k, v] : *it->second) allowed += (allowed.empty() ? "" : ", ") + k;
-        fail(path, 1, name, "unit '" + unit + "' does not parse for " + q + " (allowed: " + allowed + ")");
+        fail(at, name, "unit '" + unit + "' does not parse for " + q + " (allowed: " + allowed + ")");
       }
       return {q, u->second};
     }
   }
-  fail(path, 1, name,
+  fail(at, name,
        "unknown column (allowed: material, sigma3_<unit>, eps_a_<unit>, q_<unit>, eps_v_<unit>, q_peak_<unit>, "
        "eps_a_peak_<unit>, q_end_<unit>, max_dilatancy, e_ini_<unit>, q_1pct_<unit>, q_3pct_<unit>)");
+}
+
+/// The lines of a CSV file as a table; comment lines and blank lines are skipped.
+MeasuredTextTable read_csv_table(const std::string& path) {
+  std::ifstream f(path);
+  if (!f) throw DataError(path + ": cannot be read");
+  MeasuredTextTable t;
+  std::string line;
+  for (long n = 1; std::getline(f, line); ++n) {
+    const std::string s = trim(line);
+    if (s.empty() || s[0] == '#') continue;
+    if (t.header.empty() && t.header_at.empty()) {
+      t.header = split(s);
+      t.header_at = path + ":" + std::to_string(n);
+    } else {
+      t.rows.push_back({path + ":" + std::to_string(n), split(s)});
+    }
+  }
+  return t;
+}
+
+bool is_hdf5(const std::string& path) {
+  const auto dot = path.rfind('.');
+  const std::string ext = dot == std::string::npos ? "" : path.substr(dot);
+  return ext == ".h5" || ext == ".hdf5";
 }
 
 }  // namespace
 
 MeasuredData load_measured(const std::string& path) {
-  std::ifstream f(path);
-  if (!f) throw DataError(path + ": cannot be read");
+  const MeasuredTextTable table = is_hdf5(path) ? read_measured_h5(path) : read_csv_table(path);
+  if (table.header_at.empty()) throw DataError(path + ": no header line");
   MeasuredData d;
   d.path = path;
-  std::string line;
-  long n = 0;
   std::vector<ColumnSpec> cols;
-  std::vector<std::string> names;
+  const std::vector<std::string>& names = table.header;
   std::map<std::string, int> index;  // quantity -> column
   std::map<std::pair<std::string, Real>, std::size_t> test_of;
-  while (std::getline(f, line)) {
-    ++n;
-    const std::string t = trim(line);
-    if (t.empty() || t[0] == '#') continue;
-    const std::vector<std::string> cells = split(t);
-    if (cols.empty()) {
-      names = cells;
-      for (const std::string& c : cells) {
-        cols.push_back(parse_header(path, c));
-        if (index.count(cols.back().quantity)) fail(path, n, c, "column given twice");
-        index[cols.back().quantity] = static_cast<int>(cols.size()) - 1;
-      }
-      d.curves = index.count("eps_a") > 0;
-      const std::vector<std::string> need =
-          d.curves ? std::vector<std::string>{"material", "sigma3", "eps_a", "q"}
-                   : std::vector<std::string>{"material", "sigma3", "q_peak"};
-      for (const std::string& q : need)
-        if (!index.count(q))
-          fail(path, n, "", "missing column '" + q + "'" + (q == "material" ? "" : " (with its unit, e.g. " + q +
-                                                                                      (q.rfind("eps", 0) == 0 ? "_pct" : "_kPa") + ")"));
-      if (!d.curves && index.count("eps_v")) fail(path, n, names[index["eps_v"]], "eps_v needs curves (an eps_a column)");
-      continue;
-    }
+  for (const std::string& c : names) {
+    cols.push_back(parse_header(table.header_at, c));
+    if (index.count(cols.back().quantity)) fail(table.header_at, c, "column given twice");
+    index[cols.back().quantity] = static_cast<int>(cols.size()) - 1;
+  }
+  d.curves = index.count("eps_a") > 0;
+  const std::vector<std::string> need = d.curves ? std::vector<std::string>{"material", "sigma3", "eps_a", "q"}
+                                                 : std::vector<std::string>{"material", "sigma3", "q_peak"};
+  for (const std::string& q : need)
+    if (!index.count(q))
+      fail(table.header_at, "", "missing column '" + q + "'" + (q == "material" ? "" : " (with its unit, e.g. " + q +
+                                                                (q.rfind("eps", 0) == 0 ? "_pct" : "_kPa") + ")"));
+  if (!d.curves && index.count("eps_v")) fail(table.header_at, names[index["eps_v"]], "eps_v needs curves (an eps_a column)");
+  for (const MeasuredTextTable::Row& row : table.rows) {
+    const std::vector<std::string>& cells = row.cells;
     if (cells.size() != cols.size())
-      fail(path, n, "", "has " + std::to_string(cells.size()) + " cells, the header " + std::to_string(cols.size()));
+      fail(row.at, "", "has " + std::to_string(cells.size()) + " cells, the header " + std::to_string(cols.size()));
     auto number = [&](const std::string& q) {
       auto it = index.find(q);
       if (it == index.end()) return kNaN;
@@ -113,13 +129,13 @@ MeasuredData load_measured(const std::string& path) {
       errno = 0;
       const double v = std::strtod(c.c_str(), &end);
       if (c.empty() || end != c.c_str() + c.size() || errno != 0 || !std::isfinite(v))
-        fail(path, n, names[it->second], "'" + c + "' is not a number");
+        fail(row.at, names[it->second], "'" + c + "' is not a number");
       return v * cols[it->second].scale;
     };
     const std::string material = cells[index["material"]];
-    if (material.empty()) fail(path, n, "material", "empty");
+    if (material.empty()) fail(row.at, "material", "empty");
     const Real sigma3 = number("sigma3");
-    if (!(sigma3 > 0)) fail(path, n, names[index["sigma3"]], "confining pressure must be > 0");
+    if (!(sigma3 > 0)) fail(row.at, names[index["sigma3"]], "confining pressure must be > 0");
     const auto key = std::make_pair(material, sigma3);
     auto it = test_of.find(key);
     if (it == test_of.end()) {
@@ -129,14 +145,14 @@ MeasuredData load_measured(const std::string& path) {
       d.tests.push_back(mt);
       it = test_of.emplace(key, d.tests.size() - 1).first;
     } else if (!d.curves) {
-      fail(path, n, "", "material " + material + " at " + std::to_string(sigma3 / 1e3) + " kPa given twice");
+      fail(row.at, "", "material " + material + " at " + std::to_string(sigma3 / 1e3) + " kPa given twice");
     }
     MeasuredTest& mt = d.tests[it->second];
     if (d.curves) {
       const Real ea = number("eps_a");
       if (!mt.eps_a.empty() && !(ea > mt.eps_a.back()))
-        fail(path, n, names[index["eps_a"]], "axial strain must increase within a test (" + material + " at " +
-                                                 std::to_string(sigma3 / 1e3) + " kPa)");
+        fail(row.at, names[index["eps_a"]], "axial strain must increase within a test (" + material + " at " +
+                                                std::to_string(sigma3 / 1e3) + " kPa)");
       mt.eps_a.push_back(ea);
       mt.q.push_back(number("q"));
       if (index.count("eps_v")) mt.eps_v.push_back(number("eps_v"));
@@ -150,7 +166,6 @@ MeasuredData load_measured(const std::string& path) {
       mt.q_3pct = number("q_3pct");
     }
   }
-  if (cols.empty()) throw DataError(path + ": no header line");
   if (d.tests.empty()) throw DataError(path + ": no data rows");
   if (d.curves)
     for (MeasuredTest& t : d.tests) summarise(t);
@@ -172,28 +187,28 @@ ReferenceValues load_reference(const std::string& path, const std::function<void
     }
     const std::vector<std::string> cells = split(t);
     if (ref.parameters.empty()) {
-      if (cells.empty() || cells[0] != "material") fail(path, n, cells.empty() ? "" : cells[0], "the first column must be 'material'");
-      if (cells.size() < 2) fail(path, n, "", "no parameter columns");
+      if (cells.empty() || cells[0] != "material") fail(path + ":" + std::to_string(n), cells.empty() ? "" : cells[0], "the first column must be 'material'");
+      if (cells.size() < 2) fail(path + ":" + std::to_string(n), "", "no parameter columns");
       for (std::size_t c = 1; c < cells.size(); ++c) {
         try {
           known(cells[c]);
         } catch (const std::invalid_argument& e) {
-          fail(path, n, cells[c], e.what());
+          fail(path + ":" + std::to_string(n), cells[c], e.what());
         }
         ref.parameters.push_back(cells[c]);
       }
       continue;
     }
     if (cells.size() != ref.parameters.size() + 1)
-      fail(path, n, "", "has " + std::to_string(cells.size()) + " cells, the header " +
+      fail(path + ":" + std::to_string(n), "", "has " + std::to_string(cells.size()) + " cells, the header " +
                             std::to_string(ref.parameters.size() + 1));
-    if (cells[0].empty()) fail(path, n, "material", "empty");
+    if (cells[0].empty()) fail(path + ":" + std::to_string(n), "material", "empty");
     for (std::size_t c = 0; c < ref.parameters.size(); ++c) {
       const std::string& v = cells[c + 1];
       char* end = nullptr;
       const double x = std::strtod(v.c_str(), &end);
       if (v.empty() || end != v.c_str() + v.size() || !std::isfinite(x))
-        fail(path, n, ref.parameters[c], "'" + v + "' is not a number");
+        fail(path + ":" + std::to_string(n), ref.parameters[c], "'" + v + "' is not a number");
       ref.values[cells[0]][ref.parameters[c]] = x;
     }
   }

@@ -45,8 +45,31 @@ struct MeasuredData {
   std::vector<MeasuredTest> tests;          ///< in file order of first appearance
 };
 
-/// Reads and validates a measured-data CSV. Throws DataError.
+/// Reads and validates a measured-data file: CSV, or HDF5 (.h5, .hdf5) with the same columns: one group per
+/// material holding a 2-D dataset `table` (rows x columns, numbers) whose string attribute `columns` names
+/// the columns after `material`, comma-separated, units included (e.g. "sigma3_kPa,eps_a_pct,q_kPa,eps_v_pct").
+/// Throws DataError naming the file, the line (CSV) or group and row (HDF5), and the column.
 MeasuredData load_measured(const std::string& path);
+
+/// A measured-data file as text, before validation: the header and each row with where it is in the file.
+struct MeasuredTextTable {
+  struct Row {
+    std::string at;                     ///< "<path>:<line>" or "<path>:/<material>/table row <k>"
+    std::vector<std::string> cells;
+  };
+  std::string header_at;
+  std::vector<std::string> header;
+  std::vector<Row> rows;
+};
+
+/// The HDF5 form as a table (host/measured_h5.cpp). Throws DataError.
+MeasuredTextTable read_measured_h5(const std::string& path);
+
+/// Writes measured data in the HDF5 form, atomically: `columns` after material (units in the names) and, per
+/// material, its rows of numbers in those columns. Throws DataError naming the path.
+void write_measured_h5(const std::string& path, const std::vector<std::string>& columns,
+                       const std::map<std::string, std::vector<std::vector<double>>>& rows,
+                       const std::string& comment);
 
 /// Strain windows of summarise: curves are smoothed by a moving mean over +-0.25% axial strain, q at the end
 /// is the mean over the last 1%, the initial stiffness is fitted over the first 0.2% (the elastic range of

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "host/diagnose.hpp"
 #include "host/measured.hpp"
 
 using namespace dem;
@@ -148,4 +149,43 @@ TEST(Measured, ReferenceValuesLoadAndBadOnesAreRefused) {
   EXPECT_NE(error("material,mu_s\nS-1,abc\n").find("ref.csv:2:mu_s: 'abc' is not a number"), std::string::npos);
   EXPECT_NE(error("sample,mu_s\nS-1,0.1\n").find("ref.csv:1:sample: the first column must be 'material'"),
             std::string::npos);
+}
+
+// The HDF5 form holds the same data as the CSV: curves written both ways read back to the same tests (the CSV
+// keeps 6 digits, hence the tolerance of 1e-5 relative); an HDF5 error names the group, the row and the column.
+TEST(Measured, Hdf5FormReadsLikeTheCsv) {
+  MeasuredTest a;
+  a.material = "S-1";
+  a.sigma3 = 100e3;
+  for (int i = 0; i <= 400; ++i) {
+    a.eps_a.push_back(2.5e-4 * i);
+    a.q.push_back(150e3 * (1 - std::exp(-40.0 * a.eps_a.back())));
+    a.eps_v.push_back(0.3 * a.eps_a.back() * (a.eps_a.back() - 0.02));
+  }
+  MeasuredTest b = a;
+  b.material = "S-2";
+  b.sigma3 = 200e3;
+  const std::string csv = write("curves.csv", ""), h5 = write("curves.h5", "");
+  write_measured_curves(csv, {a, b}, "test");
+  write_measured_curves(h5, {a, b}, "test");
+  const MeasuredData dc = load_measured(csv), dh = load_measured(h5);
+  ASSERT_TRUE(dh.curves);
+  ASSERT_EQ(dh.tests.size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(dh.tests[k].material, dc.tests[k].material);
+    EXPECT_DOUBLE_EQ(dh.tests[k].sigma3, dc.tests[k].sigma3);
+    ASSERT_EQ(dh.tests[k].q.size(), 401u);
+    EXPECT_DOUBLE_EQ(dh.tests[k].q[200], (k ? b : a).q[200]);  // HDF5 keeps every bit
+    EXPECT_NEAR(dh.tests[k].q_peak, dc.tests[k].q_peak, 1e-5 * dc.tests[k].q_peak);
+    EXPECT_NEAR(dh.tests[k].max_dilatancy, dc.tests[k].max_dilatancy, 1e-4);
+  }
+  b.eps_a[7] = b.eps_a[6];  // strain that does not increase
+  write_measured_curves(h5, {a, b}, "test");
+  try {
+    load_measured(h5);
+    ADD_FAILURE() << "accepted a strain that does not increase";
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("curves.h5:/S-2/table row 8:eps_a_pct: axial strain must increase"),
+              std::string::npos) << e.what();
+  }
 }

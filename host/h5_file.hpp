@@ -1,0 +1,169 @@
+#pragma once
+/// HDF5 files written atomically and read with errors that name the file: the small layer under
+/// io_hdf5.cpp (run output) and measured_h5.cpp (measured data). Internal to host/.
+#include <hdf5.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace dem::io::h5 {
+
+namespace fs = std::filesystem;
+
+[[noreturn]] inline void fail(const std::string& path, const std::string& what) {
+  throw std::runtime_error("cannot write '" + path + "': " + what);
+}
+
+/// Writes through "<path>.tmp" so that a crash or a concurrent reader never sees a half-written file under
+/// the final name, and the previous complete version stays in place until the new one is.
+template <class Write>
+void replace_atomically(const std::string& path, Write write) {
+  const std::string tmp = path + ".tmp";
+  std::error_code ec;
+  try {
+    write(tmp);
+    fs::rename(tmp, path, ec);
+    if (ec) fail(path, "rename from '" + tmp + "': " + ec.message());
+  } catch (...) {
+    fs::remove(tmp, ec);
+    throw;
+  }
+}
+
+/// Owns one HDF5 identifier, so that every exit path, exceptions included, releases it.
+class Handle {
+ public:
+  using Closer = herr_t (*)(hid_t);
+  Handle(hid_t id, Closer closer) : id_(id), closer_(closer) {}
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+  ~Handle() { if (id_ >= 0) closer_(id_); }
+  hid_t get() const { return id_; }
+  /// For files, closing is the final flush: its failure must be reported, not ignored as in the destructor.
+  bool close() { return closer_(std::exchange(id_, H5I_INVALID_HID)) >= 0; }
+
+ private:
+  hid_t id_;
+  Closer closer_;
+};
+
+/// One HDF5 file being written under its temporary name; errors name the final path.
+class H5Writer {
+ public:
+  H5Writer(const std::string& tmp, std::string path)
+      : path_(std::move(path)),
+        file_(check(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), "create '" + tmp + "'"),
+              H5Fclose) {}
+
+  hid_t root() const { return file_.get(); }
+
+  hid_t check(hid_t id, const std::string& what) const {
+    if (id < 0) fail(path_, "HDF5 cannot " + what);
+    return id;
+  }
+
+  void dataset(hid_t loc, const std::string& name, hid_t type, const void* data, const std::vector<hsize_t>& d) {
+    Handle space(check(H5Screate_simple(int(d.size()), d.data(), nullptr), "create dataspace for " + name), H5Sclose);
+    const hid_t id = H5Dcreate2(loc, name.c_str(), type, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    Handle set(check(id, "create dataset '" + name + "'"), H5Dclose);
+    // HDF5 refuses a null buffer (an empty vector's data()) even when there is nothing to write.
+    const bool empty = std::find(d.begin(), d.end(), hsize_t(0)) != d.end();
+    if (!empty && H5Dwrite(set.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0)
+      fail(path_, "HDF5 cannot write dataset '" + name + "'");
+  }
+
+  /// Scalar attribute on the object at `object` ("." for the root group).
+  void attribute(const std::string& object, const std::string& name, hid_t type, const void* value) {
+    const std::string what = "attribute '" + name + "' on '" + object + "'";
+    Handle space(check(H5Screate(H5S_SCALAR), "create dataspace for " + what), H5Sclose);
+    const hid_t id = H5Acreate_by_name(root(), object.c_str(), name.c_str(), type, space.get(), H5P_DEFAULT,
+                                       H5P_DEFAULT, H5P_DEFAULT);
+    Handle attr(check(id, "create " + what), H5Aclose);
+    if (H5Awrite(attr.get(), type, value) < 0) fail(path_, "HDF5 cannot write " + what);
+  }
+
+  /// Fixed-length rather than variable-length strings: every reader (h5dump, h5py, ParaView) takes them as is.
+  void string_attribute(const std::string& object, const std::string& name, const std::string& value) {
+    Handle type(check(H5Tcopy(H5T_C_S1), "copy string type"), H5Tclose);
+    if (H5Tset_size(type.get(), value.size() + 1) < 0 || H5Tset_cset(type.get(), H5T_CSET_UTF8) < 0)
+      fail(path_, "HDF5 cannot make a string type for attribute '" + name + "'");
+    attribute(object, name, type.get(), value.c_str());
+  }
+
+  void close() {
+    if (!file_.close()) fail(path_, "HDF5 cannot close (flush) the file");
+  }
+
+ private:
+  std::string path_;
+  Handle file_;
+};
+
+/// One HDF5 file opened for reading; errors name the file.
+class H5Reader {
+ public:
+  explicit H5Reader(std::string path)
+      : path_(std::move(path)), file_(H5Fopen(path_.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose) {
+    if (file_.get() < 0) throw std::runtime_error(path_ + ": not a readable HDF5 file");
+  }
+  bool exists(const std::string& name) const { return H5Lexists(file_.get(), name.c_str(), H5P_DEFAULT) > 0; }
+  template <class T>
+  std::vector<T> read(const std::string& name, hid_t type, std::size_t columns) const {
+    if (!exists(name.substr(0, name.find('/', 1))) || !exists(name))
+      throw std::runtime_error(path_ + ": dataset '" + name + "' missing");
+    Handle set(H5Dopen2(file_.get(), name.c_str(), H5P_DEFAULT), H5Dclose);
+    Handle space(H5Dget_space(set.get()), H5Sclose);
+    hsize_t dims[2] = {0, 0};
+    const int rank = H5Sget_simple_extent_dims(space.get(), dims, nullptr);
+    if (set.get() < 0 || rank < 1 || rank > 2 || (columns > 1 && (rank != 2 || dims[1] != columns)))
+      throw std::runtime_error(path_ + ": dataset '" + name + "' has an unexpected shape");
+    std::vector<T> out(dims[0] * columns);
+    if (!out.empty() && H5Dread(set.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()) < 0)
+      throw std::runtime_error(path_ + ": cannot read dataset '" + name + "'");
+    return out;
+  }
+  /// A fixed-length string attribute of the object at `object` ("/" for the root); "" when absent.
+  std::string string_attribute(const std::string& object, const std::string& name) const {
+    if (H5Aexists_by_name(file_.get(), object.c_str(), name.c_str(), H5P_DEFAULT) <= 0) return "";
+    Handle attr(H5Aopen_by_name(file_.get(), object.c_str(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+    Handle type(H5Aget_type(attr.get()), H5Tclose);
+    std::string text(H5Tget_size(type.get()), '\0');
+    if (H5Aread(attr.get(), type.get(), text.data()) < 0) return "";
+    return text.substr(0, text.find('\0'));
+  }
+  /// Names of the groups directly under the root, in name order.
+  std::vector<std::string> groups() const {
+    std::vector<std::string> out;
+    H5Literate(file_.get(), H5_INDEX_NAME, H5_ITER_INC, nullptr,
+               [](hid_t loc, const char* name, const H5L_info_t*, void* data) -> herr_t {
+                 const hid_t obj = H5Oopen(loc, name, H5P_DEFAULT);  // the same call in HDF5 1.10 and 1.12+
+                 const bool group = obj >= 0 && H5Iget_type(obj) == H5I_GROUP;
+                 if (obj >= 0) H5Oclose(obj);
+                 if (group)
+                   static_cast<std::vector<std::string>*>(data)->push_back(name);
+                 return 0;
+               },
+               &out);
+    return out;
+  }
+  /// A 2-D dataset's column count (0 when it is not 2-D).
+  std::size_t columns(const std::string& name) const {
+    Handle set(H5Dopen2(file_.get(), name.c_str(), H5P_DEFAULT), H5Dclose);
+    Handle space(H5Dget_space(set.get()), H5Sclose);
+    hsize_t dims[2] = {0, 0};
+    return set.get() >= 0 && H5Sget_simple_extent_ndims(space.get()) == 2 &&
+                   H5Sget_simple_extent_dims(space.get(), dims, nullptr) == 2
+               ? dims[1]
+               : 0;
+  }
+
+ private:
+  std::string path_;
+  Handle file_;
+};
+
+}  // namespace dem::io::h5
