@@ -3,7 +3,8 @@
 curves, one column per material and pressure of q and eps_v against axial strain (measured as dots, simulated
 as lines); with summary data only, q_peak against sigma3 per material and the simulated curves. Writes FOLDER/calibration.png.
 
-Reads FOLDER/simulated_curves.csv, FOLDER/measured_curves.csv (when the data had curves) and FOLDER/errors.csv.
+Reads FOLDER/simulated_curves.csv, FOLDER/measured_curves.csv (when the data had curves), FOLDER/errors.csv and,
+from diagnose, FOLDER/extended_curves.csv (the extended model, drawn dashed).
 
     /usr/bin/python3 tools/plot_calibration.py out/calibrate_20261122-181845
 
@@ -46,6 +47,8 @@ def main():
     ap.add_argument("-o", "--output", help="PNG file (default: FOLDER/calibration.png)")
     args = ap.parse_args()
     sim = curves(os.path.join(args.folder, "simulated_curves.csv"))
+    ext_path = os.path.join(args.folder, "extended_curves.csv")  # diagnose: the extended model, dashed
+    ext = curves(ext_path) if os.path.exists(ext_path) else {}
     measured_path = os.path.join(args.folder, "measured_curves.csv")
     out = args.output or os.path.join(args.folder, "calibration.png")
     if os.path.exists(measured_path):
@@ -59,8 +62,12 @@ def main():
             ax[1][c].plot(e[::step], v[::step], ".", ms=3, color="0.45")
             if key in sim:
                 es, qs, vs = sim[key]
-                ax[0][c].plot(es, qs, "-", color="C3", label="simulated")
+                ax[0][c].plot(es, qs, "-", color="C3", label="simulated (base model)" if ext else "simulated")
                 ax[1][c].plot(es, vs, "-", color="C3")
+            if key in ext:
+                es, qs, vs = ext[key]
+                ax[0][c].plot(es, qs, "--", color="C0", label="extended model")
+                ax[1][c].plot(es, vs, "--", color="C0")
             ax[0][c].set_title(f"{key[0]}, sigma3 = {key[1]:g} kPa", fontsize=9)
             ax[1][c].set_xlabel("axial strain eps_a (%)")
         ax[0][0].set_ylabel("deviator stress q (kPa)")
@@ -84,12 +91,14 @@ def main():
                 es, qs, _ = sim[(m, s3k)]
                 ax2.plot(es, qs, "-", color=f"C{k}", lw=1, label=f"{m}" if s3k == s3[0] else None)
                 ax2.plot([es[qs.index(max(qs))]], [qm], "o", color=f"C{k}", ms=5)
+                if (m, s3k) in ext:
+                    ax2.plot(ext[(m, s3k)][0], ext[(m, s3k)][1], "--", color=f"C{k}", lw=0.8)
         ax1.set_xlabel("confining pressure sigma3 (kPa)")
         ax1.set_ylabel("peak deviator stress q_peak (kPa)")
         ax1.legend(fontsize=8)
         ax2.set_xlabel("axial strain eps_a (%)")
         ax2.set_ylabel("deviator stress q (kPa)")
-        ax2.set_title("calibrated model (lines), measured peaks (dots)", fontsize=9)
+        ax2.set_title("calibrated model (lines; extended, dashed), measured peaks (dots)", fontsize=9)
         ax2.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(out, dpi=130)
