@@ -165,7 +165,13 @@ std::string gain_tables(const std::vector<MeasuredTest>& tests, const std::vecto
                         const std::vector<MeasuredTest>& ext, const std::string& name) {
   static const char* range_of[kQuantities] = {"small strain", "small strain", "hardening", "hardening",
                                               "hardening", "large strain", "large strain"};
-  std::map<std::string, std::pair<Real, Real>> by_pressure, by_range, by_quantity;
+  using Groups = std::vector<std::pair<std::string, std::pair<Real, Real>>>;  // in the order first met
+  Groups by_pressure, by_range, by_quantity;
+  auto at = [](Groups& g, const std::string& key) -> std::pair<Real, Real>& {
+    for (auto& [k, v] : g)
+      if (k == key) return v;
+    return g.emplace_back(key, std::pair<Real, Real>{0, 0}).second;
+  };
   std::ostringstream rows;
   for (std::size_t k = 0; k < tests.size(); ++k) {
     const auto m = quantities(tests[k]), b = quantities(base[k]), e = quantities(ext[k]);
@@ -176,8 +182,8 @@ std::string gain_tables(const std::vector<MeasuredTest>& tests, const std::vecto
       const Real cb = std::isfinite(rb) ? rb * rb : 100, ce = std::isfinite(re) ? re * re : 100;  // calibrate.cpp's kMissing
       for (auto* t : {&by_pressure, &by_range, &by_quantity}) {
         const std::string key = t == &by_pressure ? p : t == &by_range ? range_of[q] : quantity_name(q);
-        (*t)[key].first += cb;
-        (*t)[key].second += ce;
+        at(*t, key).first += cb;
+        at(*t, key).second += ce;
       }
       rows << "| " << fmt("%g", 1e-3 * tests[k].sigma3) << " | " << quantity_name(q) << " | "
            << in_table_unit(q, m[q]).second << " | " << fmt("%.4g", in_table_unit(q, m[q]).first) << " | "

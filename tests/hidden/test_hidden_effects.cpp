@@ -8,6 +8,7 @@
 /// range and prints the identification rates.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -53,6 +54,7 @@ TEST_P(HiddenEffect, DiagnosisNamesIt) {
   const Model base = model_of(cfg);
   const Diagnosis dg = diagnose(lab, base, {free_param("mu_s", base), free_param("mu_r", base)}, data.tests,
                                 NoiseModel(), false);
+  std::printf("hidden %s: verdict %s. %s\n", c.extension.c_str(), dg.verdict.c_str(), dg.explanation.c_str());
   EXPECT_EQ(dg.verdict, c.extension) << dg.explanation;
   if (c.extension == "none") return;
   for (const ExtensionFit& f : dg.fits)
