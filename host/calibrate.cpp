@@ -220,7 +220,9 @@ std::vector<QuadraticSurface> response_surfaces(const std::vector<Evaluation>& p
 std::vector<std::string> CalibrationResult::at_edge() const {
   std::vector<std::string> out;
   for (std::size_t k = 0; k < free.size(); ++k)
-    if ((best.u[k] < 0.01 && free[k].lo > 0) || best.u[k] > 0.99) out.push_back(free[k].name);
+    if (((best.u[k] < 0.01 && free[k].lo > 0) || best.u[k] > 0.99) &&
+        std::find(searched_beyond.begin(), searched_beyond.end(), free[k].name) == searched_beyond.end())
+      out.push_back(free[k].name);
   return out;
 }
 
@@ -303,7 +305,11 @@ CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vect
   }
   if (notes.empty()) return res;
   CalibrationResult again = calibrate(lab, base, moved, measured, noise, rounds, progress, widen - 1);
-  if (again.best.chi2 >= res.best.chi2) notes.push_back("the wider search found no better point");
+  if (again.best.chi2 >= res.best.chi2) {
+    notes.push_back("the wider search found no better point");
+    for (int k = 0; k < d; ++k)
+      if (moved[k].lo != free[k].lo || moved[k].hi != free[k].hi) res.searched_beyond.push_back(free[k].name);
+  }
   CalibrationResult& out = again.best.chi2 < res.best.chi2 ? again : res;
   out.widened.insert(out.widened.begin(), notes.begin(), notes.end());
   return out;

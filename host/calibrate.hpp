@@ -143,6 +143,9 @@ struct CalibrationResult {
   std::vector<std::string> at_edge() const;
   /// What the search did to ranges whose best value fell on an edge ("mu_s range moved to [0.15, 1.35]").
   std::vector<std::string> widened;
+  /// Parameters searched beyond the edge their best value lies on, without a better point there: the
+  /// optimum is at the edge within the scatter of the runs, and at_edge() does not flag them.
+  std::vector<std::string> searched_beyond;
 };
 
 /// Moves f's range to centre on v, keeping its width (its ratio when logarithmic), inside the registry's range

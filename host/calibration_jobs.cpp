@@ -259,6 +259,11 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
   md << ". Misfit: chi2 over the initial stiffness, q at 1% and 3% strain, q_peak, eps_a at peak, q_end and "
         "maximum dilatancy with "
         "lab-like noise (host/calibrate.hpp).\n\n";
+  if (!ss.ref.values.empty())
+    md << "Reference values: " << ss.ref.path << (ss.ref.comment.empty() ? "" : ": " + ss.ref.comment)
+       << " The calibrated values belong to this simulator (its cell, density and boundary), the reference values to "
+          "the model they were calibrated with: a difference between them measures the two simulators as much as "
+          "the data.\n\n";
   csv << "material,model,parameter,value,chi2,bic,heldout_chi2,runs\n";
   std::vector<MeasuredTest> all_meas, all_sim, all_ext;
   for (const auto& [material, tests] : by_material(ss.data, o.material)) {
@@ -300,8 +305,7 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
       const ExtensionFit* named = nullptr;  // the extension the verdict names first, if any
       for (const ExtensionFit& f : dg.fits)
         if (dg.verdict.rfind(f.ext.name, 0) == 0) named = &f;
-      md << "\nCalibrated values beside the reference (" << ss.ref.path << (ss.ref.comment.empty() ? "" : ": ")
-         << ss.ref.comment << "):\n\n| parameter | base model | "
+      md << "\nCalibrated values beside the reference (" << ss.ref.path << "):\n\n| parameter | base model | "
          << (named ? "base + " + named->ext.name + " | " : "") << "reference |\n|---|---|" << (named ? "---|" : "")
          << "---|\n";
       for (std::size_t k = 0; k < ss.free.size(); ++k) {

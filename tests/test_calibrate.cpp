@@ -188,6 +188,8 @@ TEST(Calibrate, BestPointOnTheRangeEdgeIsFlagged) {
   EXPECT_EQ(r.at_edge(), (std::vector<std::string>{"mu_s"})) << "wear = 0 is a lower edge at zero: nothing below";
   r.best.u = {0.005, 0.5, 0.995};
   EXPECT_EQ(r.at_edge(), (std::vector<std::string>{"mu_s", "wear"}));
+  r.searched_beyond = {"mu_s"};  // searched past that edge without a better point: the optimum is there
+  EXPECT_EQ(r.at_edge(), (std::vector<std::string>{"wear"}));
   r.best.u = {0.02, 0.5, 0.98};
   EXPECT_TRUE(r.at_edge().empty());
 }
