@@ -5,11 +5,11 @@
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <sstream>
 
 #include "calibrate.hpp"
+#include "host/io_hdf5.hpp"
 #include "diagnose.hpp"
 #include "progress.hpp"
 #include "study.hpp"
@@ -53,17 +53,6 @@ std::map<std::string, std::vector<MeasuredTest>> by_material(const MeasuredData&
     if (only.empty() || t.material == only) out[t.material].push_back(t);
   if (out.empty()) throw DataError(d.path + ": no tests of material '" + only + "'");
   return out;
-}
-
-/// Writes a file through a temporary and a rename, so that nothing half-written is left.
-void write_file(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp);
-    f << text;
-    if (!f) throw std::runtime_error(path + ": write failed");
-  }
-  fs::rename(tmp, path);
 }
 
 std::string fmt(const char* f, double v) {
@@ -135,7 +124,7 @@ struct Session {
   /// The errors table, the curves in the measured-data format and the figure.
   void finish(const std::vector<MeasuredTest>& meas, const std::vector<MeasuredTest>& sim,
               const std::string& what) const {
-    write_file(folder + "/errors.csv", errors_csv(meas, sim));
+    io::write_text_atomic(folder + "/errors.csv", errors_csv(meas, sim));
     write_measured_curves(folder + "/simulated_curves.csv", sim, "simulated by " + what);
     if (data.curves) write_measured_curves(folder + "/measured_curves.csv", meas, "measured: " + data.path);
     run_plot_script("plot_calibration.py", {folder});
@@ -242,7 +231,7 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
     all_sim.insert(all_sim.end(), r.best.sim.begin(), r.best.sim.end());
   }
   print_errors(all_meas, all_sim);
-  write_file(ss.folder + "/calibrated.csv", table.str());
+  io::write_text_atomic(ss.folder + "/calibrated.csv", table.str());
   std::printf("calibrate: %ld runs in %s; results in %s (calibrated.csv, errors.csv, simulated_curves.csv)\n",
               ss.lab.runs(), format_duration(ss.lab.seconds()).c_str(), ss.folder.c_str());
   ss.finish(all_meas, all_sim, "the calibrated parameters");
@@ -331,8 +320,8 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
   md << "![measured and simulated: the base model in full lines, the extended one dashed](calibration.png)\n";
   if (all_ext.size() == all_meas.size())
     write_measured_curves(ss.folder + "/extended_curves.csv", all_ext, "simulated by the extended model of each material");
-  write_file(ss.folder + "/diagnosis.md", md.str());
-  write_file(ss.folder + "/models.csv", csv.str());
+  io::write_text_atomic(ss.folder + "/diagnosis.md", md.str());
+  io::write_text_atomic(ss.folder + "/models.csv", csv.str());
   std::printf("diagnose: %ld runs in %s; report in %s/diagnosis.md\n", ss.lab.runs(),
               format_duration(ss.lab.seconds()).c_str(), ss.folder.c_str());
   ss.finish(all_meas, all_sim, "the calibrated base model");

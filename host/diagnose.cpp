@@ -3,13 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <random>
+#include <sstream>
 #include <stdexcept>
 
+#include "host/io_hdf5.hpp"
 #include "progress.hpp"
 
 namespace dem {
@@ -317,30 +317,23 @@ void write_measured_curves(const std::string& path, const std::vector<MeasuredTe
       if (volume) rows[t.material].back().push_back(100 * t.eps_v[i]);
     }
   }
-  const auto dot = path.rfind('.');
-  const std::string ext = dot == std::string::npos ? "" : path.substr(dot);
-  if (ext == ".h5" || ext == ".hdf5") return write_measured_h5(path, columns, rows, comment);
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp);
-    if (!f) throw std::runtime_error(path + ": cannot write");
-    f << "# " << comment << "\n# triaxdem measured-data format (curves): see host/measured.hpp and the README.\n";
-    f << "material";
-    for (const std::string& c : columns) f << "," << c;
-    f << "\n";
-    char cell[32];
-    for (const std::string& m : order)
-      for (const std::vector<double>& r : rows[m]) {
-        f << m;
-        for (double v : r) {
-          std::snprintf(cell, sizeof cell, ",%.6g", v);
-          f << cell;
-        }
-        f << "\n";
+  if (is_hdf5_path(path)) return write_measured_h5(path, columns, rows, comment);
+  std::ostringstream f;
+  f << "# " << comment << "\n# triaxdem measured-data format (curves): see host/measured.hpp and the README.\n";
+  f << "material";
+  for (const std::string& c : columns) f << "," << c;
+  f << "\n";
+  char cell[32];
+  for (const std::string& m : order)
+    for (const std::vector<double>& r : rows[m]) {
+      f << m;
+      for (double v : r) {
+        std::snprintf(cell, sizeof cell, ",%.6g", v);
+        f << cell;
       }
-    if (!f) throw std::runtime_error(path + ": write failed");
-  }
-  std::filesystem::rename(tmp, path);
+      f << "\n";
+    }
+  io::write_text_atomic(path, f.str());
 }
 
 }  // namespace dem

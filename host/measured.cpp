@@ -87,16 +87,16 @@ MeasuredTextTable read_csv_table(const std::string& path) {
   return t;
 }
 
-bool is_hdf5(const std::string& path) {
+}  // namespace
+
+bool is_hdf5_path(const std::string& path) {
   const auto dot = path.rfind('.');
   const std::string ext = dot == std::string::npos ? "" : path.substr(dot);
   return ext == ".h5" || ext == ".hdf5";
 }
 
-}  // namespace
-
 MeasuredData load_measured(const std::string& path) {
-  const MeasuredTextTable table = is_hdf5(path) ? read_measured_h5(path) : read_csv_table(path);
+  const MeasuredTextTable table = is_hdf5_path(path) ? read_measured_h5(path) : read_csv_table(path);
   if (table.header_at.empty()) throw DataError(path + ": no header line");
   MeasuredData d;
   d.path = path;

@@ -51,6 +51,9 @@ struct MeasuredData {
 /// Throws DataError naming the file, the line (CSV) or group and row (HDF5), and the column.
 MeasuredData load_measured(const std::string& path);
 
+/// True for a path ending in .h5 or .hdf5: the HDF5 form of measured data.
+bool is_hdf5_path(const std::string& path);
+
 /// A measured-data file as text, before validation: the header and each row with where it is in the file.
 struct MeasuredTextTable {
   struct Row {
