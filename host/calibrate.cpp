@@ -10,13 +10,6 @@
 
 namespace dem {
 
-namespace {
-
-/// Residual of a datum the simulation could not produce (no peak, a blow-up): ten standard deviations.
-constexpr Real kMissing = 10;
-
-}  // namespace
-
 const char* quantity_name(int q) {
   static const char* names[kQuantities] = {"E_ini", "q_1pct", "q_3pct", "q_peak", "eps_a_peak", "q_end",
                                            "max_dilatancy"};
@@ -37,7 +30,7 @@ std::vector<Real> residuals(const std::vector<MeasuredTest>& measured, const std
     const auto m = quantities(measured[k]), s = quantities(simulated[k]);
     for (int q = 0; q < kQuantities; ++q) {
       if (!std::isfinite(m[q])) continue;
-      r.push_back(std::isfinite(s[q]) ? (s[q] - m[q]) / noise.sigma(q, m[q]) : kMissing);
+      r.push_back(std::isfinite(s[q]) ? (s[q] - m[q]) / noise.sigma(q, m[q]) : kMissingResidual);
     }
   }
   return r;

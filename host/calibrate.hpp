@@ -52,6 +52,9 @@ struct NoiseModel {
   Real sigma(int q, Real measured) const;
 };
 
+/// Residual of a datum the simulation could not produce (no peak, a blow-up): ten standard deviations.
+constexpr Real kMissingResidual = 10;
+
 /// Normalised residuals (simulated - measured) / s_q of every present quantity, test by test (tests matched
 /// by index); `use[k]` false leaves test k out.
 std::vector<Real> residuals(const std::vector<MeasuredTest>& measured, const std::vector<MeasuredTest>& simulated,

@@ -168,7 +168,8 @@ std::string gain_tables(const std::vector<MeasuredTest>& tests, const std::vecto
     for (int q = 0; q < kQuantities; ++q) {
       if (!std::isfinite(m[q])) continue;
       const Real rb = residual(q, m[q], b[q]), re = residual(q, m[q], e[q]);
-      const Real cb = std::isfinite(rb) ? rb * rb : 100, ce = std::isfinite(re) ? re * re : 100;  // calibrate.cpp's kMissing
+      const Real miss = kMissingResidual * kMissingResidual;
+      const Real cb = std::isfinite(rb) ? rb * rb : miss, ce = std::isfinite(re) ? re * re : miss;
       for (auto* t : {&by_pressure, &by_range, &by_quantity}) {
         const std::string key = t == &by_pressure ? p : t == &by_range ? range_of[q] : quantity_name(q);
         at(*t, key).first += cb;
