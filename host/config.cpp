@@ -168,6 +168,8 @@ Config load_config(const std::string& path) {
   long seed = c.run.seed;
   run.integer("seed", seed, 0, 4294967295L);
   run.number("stop_ratio", c.run.stop_ratio, 0, 1);
+  run.integer("checkpoint_every", c.run.checkpoint_every, 0, 1000000000L);
+  run.number("checkpoint_minutes", c.run.checkpoint_minutes, 0, 1e6);
   c.run.seed = static_cast<unsigned>(seed);
   run.finish();
 

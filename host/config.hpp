@@ -24,6 +24,8 @@ struct RunConfig {
   long snapshot_every = 5000;    ///< steps between particle snapshots (0 = first and last only)
   unsigned seed = 1;             ///< random generator seed (packing)
   Real stop_ratio = 0;           ///< stop early once the unbalanced-force ratio is below this (0 = never)
+  long checkpoint_every = 0;     ///< steps between checkpoints (0 = by time only)
+  Real checkpoint_minutes = 10;  ///< wall-clock minutes between checkpoints (0 = by steps only)
 };
 
 struct ParticleConfig {

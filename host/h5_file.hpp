@@ -119,7 +119,8 @@ class H5Reader {
     Handle space(H5Dget_space(set.get()), H5Sclose);
     hsize_t dims[2] = {0, 0};
     const int rank = H5Sget_simple_extent_dims(space.get(), dims, nullptr);
-    if (set.get() < 0 || rank < 1 || rank > 2 || (columns > 1 && (rank != 2 || dims[1] != columns)))
+    // The buffer holds rows x columns values: a shape that would make HDF5 write more is refused.
+    if (set.get() < 0 || (rank == 1 && columns != 1) || (rank == 2 && dims[1] != columns) || rank < 1 || rank > 2)
       throw std::runtime_error(path_ + ": dataset '" + name + "' has an unexpected shape");
     std::vector<T> out(dims[0] * columns);
     if (!out.empty() && H5Dread(set.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()) < 0)

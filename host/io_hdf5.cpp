@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <numeric>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 #include <tuple>
 #include <utility>
@@ -277,6 +278,37 @@ void Output::write_snapshot(const Snapshot& s, const SurfaceSnapshot* surface, c
 
 /// Particles and surface are two temporal collections: a surface that exists only at some steps then just has
 /// fewer time steps in ParaView, rather than a block that appears and vanishes.
+std::string Output::snapshot_index() const {
+  // One line per snapshot: step, time (round trip), file, balls, surface nodes and triangles, scalar names.
+  std::string text;
+  char line[160];
+  for (const Entry& e : snaps_) {
+    std::snprintf(line, sizeof line, "%ld %.17g %s %ld %ld %ld", e.step, e.time, e.file.c_str(), e.n, e.nsurf_nodes,
+                  e.nsurf_tris);
+    text += line;
+    for (const std::string& name : e.scalars) text += " " + name;
+    text += "\n";
+  }
+  return text;
+}
+
+void Output::resume(const std::vector<double>& rows, const std::string& snapshot_index) {
+  if (columns_.empty() || rows.size() % columns_.size() != 0)
+    throw std::runtime_error("output '" + folder_ + "': the checkpoint's series does not fit the " +
+                             std::to_string(columns_.size()) + " columns of this run");
+  rows_ = rows;
+  snaps_.clear();
+  std::istringstream in(snapshot_index);
+  for (std::string line; std::getline(in, line);) {
+    std::istringstream words(line);
+    Entry e;
+    if (!(words >> e.step >> e.time >> e.file >> e.n >> e.nsurf_nodes >> e.nsurf_tris))
+      throw std::runtime_error("output '" + folder_ + "': the checkpoint's snapshot index has a bad line: " + line);
+    for (std::string name; words >> name;) e.scalars.push_back(name);
+    snaps_.push_back(std::move(e));
+  }
+}
+
 void Output::write_xdmf() const {
   std::string particles, surface;
   // Empty grids are left out: the XDMF readers of ParaView fail on a zero-sized DataItem.

@@ -71,6 +71,14 @@ class Output {
   void write_snapshot(const Snapshot& s, const SurfaceSnapshot* surface = nullptr,
                       const ContactTable* contacts = nullptr);
 
+  /// What a checkpoint keeps of the output, to resume it: the series rows and the snapshot index (text).
+  const std::vector<double>& series_rows() const { return rows_; }
+  std::string snapshot_index() const;
+  /// Continues an output from a checkpoint: the rows and index it kept (later rows and snapshots, written
+  /// by the run after its checkpoint, are replaced as the resumed run reaches them). Columns must be set.
+  /// Throws std::runtime_error on a row length or index line that does not fit.
+  void resume(const std::vector<double>& rows, const std::string& snapshot_index);
+
  private:
   std::string folder_;
   std::vector<std::string> columns_;

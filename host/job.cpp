@@ -1,8 +1,10 @@
 #include "job.hpp"
 
 #include <cstdio>
+#include <filesystem>
 #include <numeric>
 
+#include "checkpoint.hpp"
 #include "packing.hpp"
 #include "specimen.hpp"
 #include "progress.hpp"
@@ -74,11 +76,38 @@ io::Snapshot take_snapshot(Simulation& sim, const std::string& label) {
   return s;
 }
 
-int run_job(const Config& cfg) {
+namespace {
+/// A checkpoint of the run job: the simulation, the series so far and the snapshot index.
+void save_run(const std::string& path, Simulation& sim, const io::Output& out) {
+  Checkpoint c;
+  c.job = "run";
+  c.sim = sim.state();
+  c.numbers["series"] = out.series_rows();
+  c.texts["snapshots"] = out.snapshot_index();
+  write_checkpoint(path, c);
+}
+}  // namespace
+
+int run_job(const Config& cfg, bool resume) {
   io::Output out(cfg.run.output);
   auto sim = build_simulation(cfg, true);
   out.set_series_columns({"step", "time_s", "kinetic_energy_J", "unbalanced_ratio", "contacts_ball_ball",
                           "contacts_ball_wall", "wall_force_sum_N"});
+  const std::string ckpt = checkpoint_path(out.folder());
+  if (resume) {
+    if (!std::filesystem::exists(ckpt))
+      throw std::runtime_error("--resume: no checkpoint " + ckpt + " (run without --resume to start afresh)");
+    const Checkpoint c = read_checkpoint(ckpt);
+    if (c.job != "run") throw std::runtime_error(ckpt + ": written by the '" + c.job + "' job, not by 'run'");
+    sim->restore(c.sim);
+    const auto rows = c.numbers.find("series");
+    const auto index = c.texts.find("snapshots");
+    out.resume(rows == c.numbers.end() ? std::vector<double>{} : rows->second,
+               index == c.texts.end() ? "" : index->second);
+    std::printf("triaxdem: resuming %s at step %ld (t = %.6g s)\n", ckpt.c_str(), sim->step_count(), sim->time());
+  } else {
+    out.write_snapshot(take_snapshot(*sim, "initial"));
+  }
   // One row of the time series; returns the unbalanced-force ratio (the stop criterion reads it too).
   auto record = [&]() {
     const auto c = sim->touching();
@@ -89,10 +118,11 @@ int run_job(const Config& cfg) {
                        static_cast<double>(c[0]), static_cast<double>(c[1]), fw});
     return std::make_pair(ratio, c[0]);
   };
-  out.write_snapshot(take_snapshot(*sim, "initial"));
-  Progress progress(cfg.run.name, cfg.run.steps);
+  Progress progress(cfg.run.name, cfg.run.steps, sim->step_count());
+  CheckpointClock clock(cfg.run.checkpoint_every, cfg.run.checkpoint_minutes);
+  StopSignals signals;
   try {
-    for (long s = 1; s <= cfg.run.steps; ++s) {
+    for (long s = sim->step_count() + 1; s <= cfg.run.steps; ++s) {
       const bool record_now = s % cfg.run.series_every == 0;
       sim->step(record_now);
       if (record_now) {
@@ -107,18 +137,34 @@ int run_job(const Config& cfg) {
       }
       if (cfg.run.snapshot_every > 0 && s % cfg.run.snapshot_every == 0 && s != cfg.run.steps)
         out.write_snapshot(take_snapshot(*sim, "step " + std::to_string(s)));
+      // The series is flushed with every checkpoint, so that a killed run's files agree with its checkpoint.
+      if (clock.due(s) || StopSignals::requested()) {
+        out.flush_series();
+        save_run(ckpt, *sim, out);
+        clock.written();
+      }
+      if (StopSignals::requested()) {
+        std::printf("\ntriaxdem: %s at step %ld: checkpoint %s written; continue with --resume\n",
+                    StopSignals::name(), s, ckpt.c_str());
+        return 128 + StopSignals::signal();
+      }
     }
   } catch (const BlowUp& e) {
     out.flush_series();
     out.write_snapshot(take_snapshot(*sim, "blow-up"));
-    std::fprintf(stderr, "\ntriaxdem: %s\n  state at the blow-up saved in %s\n", e.what(), out.folder().c_str());
+    save_run(blowup_path(out.folder()), *sim, out);
+    std::fprintf(stderr, "\ntriaxdem: %s\n  state at the blow-up saved in %s (snapshot) and %s (for inspection); "
+                 "the last good checkpoint, %s, continues with --resume once the cause is fixed\n",
+                 e.what(), out.folder().c_str(), blowup_path(out.folder()).c_str(), ckpt.c_str());
     return 2;
   }
   out.flush_series();
   out.write_snapshot(take_snapshot(*sim, "final"));
+  save_run(ckpt, *sim, out);
   progress.finish("");
   std::printf("time loop: %s\n", describe(sim->times(), sim->particles().n, sim->step_count()).c_str());
-  std::printf("output: %s/snapshots.xdmf (ParaView), %s/series.csv\n", out.folder().c_str(), out.folder().c_str());
+  std::printf("output: %s/snapshots.xdmf (ParaView), %s/series.csv; checkpoint %s (more steps: --resume -n N)\n",
+              out.folder().c_str(), out.folder().c_str(), ckpt.c_str());
   return 0;
 }
 

@@ -28,6 +28,8 @@ int main(int argc, char** argv) {
   run->add_option("config", config_path, "TOML config file")->required()->check(CLI::ExistingFile);
   run->add_option("-o,--output", output, "output folder (overrides [run] output)");
   run->add_option("-n,--steps", steps, "number of steps (overrides [run] steps)")->check(CLI::NonNegativeNumber);
+  bool resume = false;
+  run->add_flag("--resume", resume, "continue from the output folder's checkpoint.h5 to the step count");
 
   auto* specimen = app.add_subcommand("specimen", "build the [specimen] of a config by multilayer compaction");
   specimen->add_option("config", config_path, "TOML config file")->required()->check(CLI::ExistingFile);
@@ -148,7 +150,7 @@ int main(int argc, char** argv) {
       }
       return dem::synth_job(cfg, syn);
     }
-    return dem::run_job(cfg);
+    return dem::run_job(cfg, resume);
   } catch (const dem::DataError& e) {
     std::fprintf(stderr, "triaxdem: data error: %s\n", e.what());
     return 1;

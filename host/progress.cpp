@@ -14,8 +14,8 @@ std::string format_duration(double s) {
   return buf;
 }
 
-Progress::Progress(std::string what, long total)
-    : what_(std::move(what)), total_(total), tty_(isatty(fileno(stdout)) != 0),
+Progress::Progress(std::string what, long total, long first)
+    : what_(std::move(what)), total_(total), first_(first), tty_(isatty(fileno(stdout)) != 0),
       start_(std::chrono::steady_clock::now()), last_(start_) {}
 
 void Progress::update(long done, const std::string& extra) {
@@ -29,7 +29,8 @@ void Progress::update(long done, const std::string& extra) {
   last_ = now;
   last_decile_ = decile;
   const double elapsed = std::chrono::duration<double>(now - start_).count();
-  const double eta = frac > 0 ? elapsed * (1 - frac) / frac : 0;
+  const long run = done - first_;  // done by this run, at the elapsed time's rate
+  const double eta = run > 0 ? elapsed * static_cast<double>(total_ - done) / run : 0;
   std::printf("%s%s %ld/%ld (%3.0f%%) elapsed %s ETA %s %s%s", tty_ ? "\r" : "", what_.c_str(), done, total_,
               100 * frac, format_duration(elapsed).c_str(), format_duration(eta).c_str(), extra.c_str(),
               tty_ ? "   " : "\n");

@@ -8,14 +8,15 @@ namespace dem {
 
 class Progress {
  public:
-  Progress(std::string what, long total);
+  /// `first`: work already done before this run (a resumed run), left out of the rate behind the ETA.
+  Progress(std::string what, long total, long first = 0);
   /// Reports `done` of `total`; `extra` is appended (e.g. current unbalanced-force ratio).
   void update(long done, const std::string& extra = "");
   void finish(const std::string& extra = "");
 
  private:
   std::string what_;
-  long total_;
+  long total_, first_;
   bool tty_;
   int last_decile_ = -1;
   std::chrono::steady_clock::time_point start_, last_;

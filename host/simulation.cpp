@@ -79,14 +79,18 @@ void Simulation::rebuild() {
   FacetBins fb;
   if (mesh_.ntri > 0) fb = bin_facets(mesh_, cells_.grid, rmax_ + prm_.skin);
   wall_c_ = remap_history(detect_wall_pairs(p_, walls_, mesh_, fb, cells_, prm_.skin), wall_c_, g2l, false);
-  own_ = owner_ranges(p_, balls_);
-  adj_balls_ = build_adjacency(p_.n, balls_, balls_.j);
-  adj_walls_ = build_adjacency(p_.n, wall_c_, wall_c_.i);
-  obj_offsets_ = object_offsets(wall_c_, walls_.n + mesh_.ntri);
+  index_contacts();
   Kokkos::deep_copy(p_.x_ref, p_.x);
   wall_disp_ = 0;
   fresh_ = false;
   ++times_.rebuilds;
+}
+
+void Simulation::index_contacts() {
+  own_ = owner_ranges(p_, balls_);
+  adj_balls_ = build_adjacency(p_.n, balls_, balls_.j);
+  adj_walls_ = build_adjacency(p_.n, wall_c_, wall_c_.i);
+  obj_offsets_ = object_offsets(wall_c_, walls_.n + mesh_.ntri);
 }
 
 void Simulation::step(bool measure) {

@@ -12,6 +12,7 @@
 #include "kernels/contact_force.hpp"
 #include "kernels/integrate.hpp"
 #include "kernels/membrane.hpp"
+#include "sim_state.hpp"
 
 namespace dem {
 
@@ -102,6 +103,13 @@ class Simulation {
   /// Number of touching contacts (ball-ball, ball-wall).
   std::array<long, 2> touching() const;
 
+  /// The whole dynamic state, for a checkpoint (host/sim_state.cpp).
+  SimState state() const;
+  /// Continues from a state taken from a Simulation built the same way (same balls, walls, mesh and laws):
+  /// the next steps are bit for bit those the original would have taken. Throws std::runtime_error when
+  /// the counts of balls, walls or mesh nodes differ.
+  void restore(const SimState& s);
+
  private:
   Particles p_;
   WallSet walls_;
@@ -129,6 +137,7 @@ class Simulation {
 
   bool rebuild_due() const;
   void rebuild();
+  void index_contacts();  ///< owner ranges, adjacency and object offsets of the contact lists
   void move_boundaries();
   void check_blowup(const OverlapStat& ob, const OverlapStat& ow) const;
 };

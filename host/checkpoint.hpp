@@ -1,0 +1,63 @@
+#pragma once
+/// Checkpoints (issue 7): a Simulation's state and what the job steering it needs to go on, in one HDF5 file
+/// written through a temporary file and a rename, so that a run killed at any moment leaves the previous
+/// complete checkpoint in place.
+///
+/// Layout (every dataset at the root): step (int64), time_s, dt_s, cell_pressure_Pa, wall_disp_m,
+/// stats (unbalanced, kinetic, max_disp2), flags (fresh, bad), domain (lo, hi, strain rate: 3 x 3), periodic
+/// (3); per ball (local order) x, v, w, f, m, x_ref (n x 3), radius, mass, inertia, gid, specimen, material;
+/// per contact list (balls_*, walls_*): key, i, j, fs, mr, slip, flags; wall_point, wall_velocity,
+/// node_x, node_v; the job's arrays as number_<name> (double) and text_<name> (bytes), their names in the
+/// root attributes `numbers` and `texts`; the root attributes `format` and `job`.
+#include <map>
+#include <string>
+#include <vector>
+
+#include "sim_state.hpp"
+
+namespace dem {
+
+struct Checkpoint {
+  std::string job;                                      ///< the job that wrote it ("run", ...)
+  SimState sim;
+  std::map<std::string, std::vector<double>> numbers;   ///< the job's state: counters, records so far
+  std::map<std::string, std::string> texts;             ///< the job's state in words (e.g. the snapshot index)
+};
+
+/// Writes atomically; throws std::runtime_error naming the path.
+void write_checkpoint(const std::string& path, const Checkpoint& c);
+/// Throws std::runtime_error naming the file and what is missing or malformed.
+Checkpoint read_checkpoint(const std::string& path);
+
+/// The name of a run folder's checkpoint, and of the state saved at a blow-up (for inspection, never resumed
+/// from by default: the last good checkpoint stays).
+std::string checkpoint_path(const std::string& folder);
+std::string blowup_path(const std::string& folder);
+
+/// When to write the next checkpoint: every `every_steps` steps (0: never by count) or `minutes` of wall
+/// time (0: never by time), whichever comes first.
+class CheckpointClock {
+ public:
+  CheckpointClock(long every_steps, double minutes);
+  bool due(long step) const;
+  void written();               ///< restarts the wall-time interval
+ private:
+  long every_;
+  double seconds_;
+  double last_;
+};
+
+/// SIGINT and SIGTERM, caught for the lifetime of the object: the run loop polls `requested()`, writes a
+/// checkpoint and stops cleanly. The previous handlers come back on destruction.
+class StopSignals {
+ public:
+  StopSignals();
+  ~StopSignals();
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+  static bool requested();
+  static int signal();          ///< the signal caught (0: none)
+  static const char* name();    ///< "SIGINT", "SIGTERM" or ""
+};
+
+}  // namespace dem

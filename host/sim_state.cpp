@@ -1,0 +1,152 @@
+#include <stdexcept>
+#include <string>
+
+#include "simulation.hpp"
+
+namespace dem {
+
+namespace {
+
+template <class View>
+std::vector<double> vec3_out(const View& v, int n) {
+  const auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), v);
+  std::vector<double> out(3 * std::size_t(n));
+  for (int k = 0; k < n; ++k)
+    for (int d = 0; d < 3; ++d) out[3 * std::size_t(k) + d] = h(k, d);
+  return out;
+}
+
+template <class T, class View>
+std::vector<T> scalar_out(const View& v, int n) {
+  const auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), v);
+  std::vector<T> out(n);
+  for (int k = 0; k < n; ++k) out[k] = h(k);
+  return out;
+}
+
+/// Fills the first n rows of an existing View of at least n rows.
+template <class View>
+void vec3_in(const View& v, const std::vector<double>& src, int n) {
+  auto h = Kokkos::create_mirror_view(v);
+  for (int k = 0; k < n; ++k)
+    for (int d = 0; d < 3; ++d) h(k, d) = src[3 * std::size_t(k) + d];
+  Kokkos::deep_copy(v, h);
+}
+
+template <class View, class T>
+void scalar_in(const View& v, const std::vector<T>& src, int n) {
+  auto h = Kokkos::create_mirror_view(v);
+  for (int k = 0; k < n; ++k) h(k) = src[k];
+  Kokkos::deep_copy(v, h);
+}
+
+SavedContacts history_out(const ContactList& c) {
+  SavedContacts h;
+  h.key = scalar_out<std::uint64_t>(c.key, c.n);
+  h.i = scalar_out<int>(c.i, c.n);
+  h.j = scalar_out<int>(c.j, c.n);
+  h.fs = vec3_out(c.fs, c.n);
+  h.mr = vec3_out(c.mr, c.n);
+  h.slip = scalar_out<double>(c.slip, c.n);
+  h.flags = scalar_out<std::uint8_t>(c.flags, c.n);
+  return h;
+}
+
+ContactList history_in(const SavedContacts& h, const char* which) {
+  const std::size_t n = h.key.size();
+  if (h.i.size() != n || h.j.size() != n || h.fs.size() != 3 * n || h.mr.size() != 3 * n || h.slip.size() != n ||
+      h.flags.size() != n)
+    throw std::runtime_error(std::string("state: the ") + which + " contact list has arrays of unequal length");
+  ContactList c(static_cast<int>(n));
+  scalar_in(c.key, h.key, c.n);
+  scalar_in(c.i, h.i, c.n);
+  scalar_in(c.j, h.j, c.n);
+  vec3_in(c.fs, h.fs, c.n);
+  vec3_in(c.mr, h.mr, c.n);
+  scalar_in(c.slip, h.slip, c.n);
+  scalar_in(c.flags, h.flags, c.n);
+  return c;
+}
+
+void check_count(const char* what, std::size_t got, std::size_t want) {
+  if (got != want)
+    throw std::runtime_error(std::string("state: ") + what + ": " + std::to_string(got) + " in the saved state, " +
+                             std::to_string(want) + " in this simulation (the config describes another system)");
+}
+
+}  // namespace
+
+SimState Simulation::state() const {
+  SimState s;
+  s.step = step_;
+  s.time = time_;
+  s.dt = prm_.integ.dt;
+  s.domain = prm_.domain;
+  const int n = p_.n;
+  s.x = vec3_out(p_.x, n);
+  s.v = vec3_out(p_.v, n);
+  s.w = vec3_out(p_.w, n);
+  s.f = vec3_out(p_.f, n);
+  s.m = vec3_out(p_.m, n);
+  s.x_ref = vec3_out(p_.x_ref, n);
+  s.radius = scalar_out<double>(p_.radius, n);
+  s.mass = scalar_out<double>(p_.mass, n);
+  s.inertia = scalar_out<double>(p_.inertia, n);
+  s.gid = scalar_out<std::uint32_t>(p_.gid, n);
+  s.specimen = scalar_out<int>(p_.specimen, n);
+  s.material = scalar_out<int>(p_.material, n);
+  s.balls = history_out(balls_);
+  s.walls = history_out(wall_c_);
+  s.wall_point = vec3_out(hwall_point_, walls_.n);
+  s.wall_velocity = vec3_out(hwall_vel_, walls_.n);
+  s.node_x = vec3_out(mesh_.node_x, mesh_.nnode);
+  s.node_v = vec3_out(mesh_.node_v, mesh_.nnode);
+  s.cell_pressure = cell_pressure_;
+  s.wall_disp = wall_disp_;
+  s.stats = stats_;
+  s.fresh = fresh_;
+  return s;
+}
+
+void Simulation::restore(const SimState& s) {
+  const std::size_t n = p_.n;
+  check_count("balls", s.radius.size(), n);
+  for (const auto* a : {&s.x, &s.v, &s.w, &s.f, &s.m, &s.x_ref}) check_count("ball vectors / 3", a->size() / 3, n);
+  for (std::size_t size : {s.mass.size(), s.inertia.size(), s.gid.size(), s.specimen.size(), s.material.size()})
+    check_count("ball values", size, n);
+  check_count("walls", s.wall_point.size() / 3, walls_.n);
+  check_count("wall velocities", s.wall_velocity.size() / 3, walls_.n);
+  check_count("mesh nodes", s.node_x.size() / 3, mesh_.nnode);
+  check_count("mesh node velocities", s.node_v.size() / 3, mesh_.nnode);
+  step_ = s.step;
+  time_ = s.time;
+  prm_.integ.dt = s.dt;
+  prm_.domain = s.domain;
+  vec3_in(p_.x, s.x, p_.n);
+  vec3_in(p_.v, s.v, p_.n);
+  vec3_in(p_.w, s.w, p_.n);
+  vec3_in(p_.f, s.f, p_.n);
+  vec3_in(p_.m, s.m, p_.n);
+  vec3_in(p_.x_ref, s.x_ref, p_.n);
+  scalar_in(p_.radius, s.radius, p_.n);
+  scalar_in(p_.mass, s.mass, p_.n);
+  scalar_in(p_.inertia, s.inertia, p_.n);
+  scalar_in(p_.gid, s.gid, p_.n);
+  scalar_in(p_.specimen, s.specimen, p_.n);
+  scalar_in(p_.material, s.material, p_.n);
+  balls_ = history_in(s.balls, "ball-ball");
+  wall_c_ = history_in(s.walls, "ball-wall");
+  vec3_in(hwall_point_, s.wall_point, walls_.n);
+  vec3_in(hwall_vel_, s.wall_velocity, walls_.n);
+  Kokkos::deep_copy(walls_.point, hwall_point_);
+  Kokkos::deep_copy(walls_.velocity, hwall_vel_);
+  vec3_in(mesh_.node_x, s.node_x, mesh_.nnode);
+  vec3_in(mesh_.node_v, s.node_v, mesh_.nnode);
+  cell_pressure_ = s.cell_pressure;
+  wall_disp_ = s.wall_disp;
+  stats_ = s.stats;
+  fresh_ = s.fresh;
+  if (!fresh_) index_contacts();
+}
+
+}  // namespace dem
