@@ -83,7 +83,8 @@ void write_checkpoint(const std::string& path, const Checkpoint& c) {
     put(f, "dt_s", H5T_NATIVE_DOUBLE, std::vector<double>{s.dt});
     put(f, "cell_pressure_Pa", H5T_NATIVE_DOUBLE, std::vector<double>{s.cell_pressure});
     put(f, "wall_disp_m", H5T_NATIVE_DOUBLE, std::vector<double>{s.wall_disp});
-    put(f, "stats", H5T_NATIVE_DOUBLE, std::vector<double>{s.stats.unbalanced, s.stats.kinetic, s.stats.max_disp2});
+    put(f, "stats", H5T_NATIVE_DOUBLE, std::vector<double>{s.stats.unbalanced, s.stats.kinetic, s.stats.max_disp2,
+                                                          s.stats.max_move2});
     put(f, "flags", H5T_NATIVE_INT, std::vector<int>{s.fresh ? 1 : 0, s.stats.bad});
     const Domain& d = s.domain;
     put(f, "domain", H5T_NATIVE_DOUBLE,
@@ -135,11 +136,12 @@ Checkpoint read_checkpoint(const std::string& path) {
   const std::vector<int> flags = f.read<int>("/flags", H5T_NATIVE_INT, 1);
   const std::vector<double> dom = f.read<double>("/domain", H5T_NATIVE_DOUBLE, 3);
   const std::vector<int> periodic = f.read<int>("/periodic", H5T_NATIVE_INT, 1);
-  if (stats.size() != 3 || flags.size() != 2 || dom.size() != 9 || periodic.size() != 3)
+  if (stats.size() != 4 || flags.size() != 2 || dom.size() != 9 || periodic.size() != 3)
     throw std::runtime_error(path + ": stats, flags, domain or periodic has the wrong length");
   s.stats.unbalanced = stats[0];
   s.stats.kinetic = stats[1];
   s.stats.max_disp2 = stats[2];
+  s.stats.max_move2 = stats[3];
   s.fresh = flags[0] != 0;
   s.stats.bad = flags[1];
   for (int k = 0; k < 3; ++k) {

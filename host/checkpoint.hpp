@@ -4,7 +4,7 @@
 /// complete checkpoint in place.
 ///
 /// Layout (every dataset at the root): step (int64), time_s, dt_s, cell_pressure_Pa, wall_disp_m,
-/// stats (unbalanced, kinetic, max_disp2), flags (fresh, bad), domain (lo, hi, strain rate: 3 x 3), periodic
+/// stats (unbalanced, kinetic, max_disp2, max_move2), flags (fresh, bad), domain (lo, hi, strain rate: 3 x 3), periodic
 /// (3); per ball (local order) x, v, w, f, m, x_ref (n x 3), radius, mass, inertia, gid, specimen, material;
 /// per contact list (balls_*, walls_*): key, i, j, fs, mr, slip, flags; wall_point, wall_velocity,
 /// node_x, node_v; the job's arrays as number_<name> (double) and text_<name> (bytes), their names in the

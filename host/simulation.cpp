@@ -73,6 +73,21 @@ bool Simulation::rebuild_due() const {
 }
 
 void Simulation::rebuild() {
+  // Balls move less than the skin between rebuilds, so an escape is caught within a rebuild of happening.
+  const int out = ball_outside(p_, prm_.domain, 2);
+  if (out >= 0) {
+    auto hx = Kokkos::create_mirror_view_and_copy(HostSpace(), p_.x);
+    auto hg = Kokkos::create_mirror_view_and_copy(HostSpace(), p_.gid);
+    const Domain& d = prm_.domain;
+    std::ostringstream msg;
+    msg << "blow-up at step " << step_ << ": particle " << hg(out) << " left the domain (centre at (" << hx(out, 0)
+        << ", " << hx(out, 1) << ", " << hx(out, 2) << ") m, domain (" << d.lo[0] << ", " << d.lo[1] << ", "
+        << d.lo[2] << ") to (" << d.hi[0] << ", " << d.hi[1] << ", " << d.hi[2]
+        << ") m). Likely cause: it passed through a wall or the membrane (a time step too large for the wall "
+           "stiffness, or a wall moving too fast); suggested fix: lower [solver] dt_safety or the wall speed, "
+           "or stiffen the wall material";
+    throw BlowUp(msg.str());
+  }
   bin_particles(p_, prm_.domain, 2 * rmax_ + prm_.skin, cells_);
   const IndexView g2l = gid_to_local(p_);
   balls_ = remap_history(detect_pairs(p_, prm_.domain, cells_, prm_.skin), balls_, g2l, true);
@@ -112,7 +127,7 @@ void Simulation::step(bool measure) {
   prm_.integ.measure = measure;
   stats_ = integrate(p_, prm_.integ, make_gather(p_, balls_, adj_balls_, wall_c_, adj_walls_));
   times_.integrate += seconds_since(t);
-  if (stats_.bad >= 0) check_blowup(ob, ow);
+  if (stats_.bad >= 0 || stats_.max_move2 > prm_.overlap_limit * prm_.overlap_limit) check_blowup(ob, ow);
   move_boundaries();
   times_.boundaries += seconds_since(t);
   time_ += dt;
@@ -173,6 +188,25 @@ void Simulation::check_blowup(const OverlapStat& ob, const OverlapStat& ow) cons
         << " has a non-finite position. Likely cause: time step above the critical one or a servo gain too high; "
            "suggested fix: lower [solver] dt_safety (now dt = "
         << prm_.integ.dt << " s, critical " << critical_dt() << " s)";
+    throw BlowUp(msg.str());
+  }
+  if (stats_.max_move2 > prm_.overlap_limit * prm_.overlap_limit) {
+    // A ball that moves this far in one step would overlap anything it meets by more than the overlap limit.
+    auto hv = Kokkos::create_mirror_view_and_copy(HostSpace(), p_.v);
+    auto hr = Kokkos::create_mirror_view_and_copy(HostSpace(), p_.radius);
+    auto hg = Kokkos::create_mirror_view_and_copy(HostSpace(), p_.gid);
+    int fast = 0;
+    Real worst_move = -1;
+    for (int i = 0; i < p_.n; ++i) {
+      const Real move = norm(load(hv, i)) * prm_.integ.dt / hr(i);
+      if (move > worst_move) worst_move = move, fast = i;
+    }
+    msg << "blow-up at step " << step_ << ": particle " << hg(fast) << " moved " << worst_move * 100
+        << "% of its radius in one step (limit " << prm_.overlap_limit * 100
+        << "%, the overlap limit): its kinetic energy jumped beyond what the loads can give. Likely cause: a time "
+           "step above the critical one for the stiffness reached, or a servo gain or wall speed too high; "
+           "suggested fix: lower [solver] dt_safety (now dt = "
+        << prm_.integ.dt << " s, critical " << critical_dt() << " s) or the servo gain";
     throw BlowUp(msg.str());
   }
   const OverlapStat& worst = ob.ratio >= ow.ratio ? ob : ow;

@@ -52,7 +52,11 @@ Cell make_cell(const Config& cfg, const Specimen& sp) {
   w[kTopPlaten].point = Vec3(0, 0, sp.height);
   w[kTopPlaten].normal = Vec3(0, 0, -1);
   for (auto& x : w) x.material = 1;
-  const SimParams prm = solver_params(cfg);
+  SimParams prm = solver_params(cfg);
+  // Bounds far outside anything the membrane can bulge to: a ball beyond them has escaped (a blow-up).
+  for (int d = 0; d < 2; ++d) prm.domain.lo[d] = -2 * c.radius, prm.domain.hi[d] = 2 * c.radius;
+  prm.domain.lo[2] = -0.5 * sp.height;
+  prm.domain.hi[2] = 1.5 * sp.height;
   c.sim = std::make_unique<Simulation>(make_particles(sp.balls), make_walls(w), c.membrane.mesh,
                                        std::vector<ContactParams>{cfg.ball, cfg.wall, cfg.wall, cfg.wall}, 2, prm);
   MembraneIntegrateParams mp;

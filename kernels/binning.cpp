@@ -108,4 +108,22 @@ void bin_particles(Particles& p, const Domain& dom, Real cell_min, CellList& cel
   cells.cell_start = start;
 }
 
+int ball_outside(const Particles& p, const Domain& dom, Real margin) {
+  bool bounded[3];
+  for (int d = 0; d < 3; ++d) bounded[d] = !dom.periodic[d] && dom.hi[d] > dom.lo[d];
+  if (!bounded[0] && !bounded[1] && !bounded[2]) return -1;
+  auto x = p.x;
+  auto r = p.radius;
+  const Domain dm = dom;
+  int worst = -1;
+  Kokkos::parallel_reduce("dem::binning::outside", RangePolicy(0, p.n),
+      KOKKOS_LAMBDA(const int i, int& acc) {
+        bool out = false;
+        for (int d = 0; d < 3; ++d)
+          out = out || (bounded[d] && (x(i, d) < dm.lo[d] - margin * r(i) || x(i, d) > dm.hi[d] + margin * r(i)));
+        if (out && i > acc) acc = i;
+      }, Kokkos::Max<int>(worst));
+  return worst >= 0 ? worst : -1;  // the reduction starts at INT_MIN
+}
+
 }  // namespace dem

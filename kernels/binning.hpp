@@ -42,4 +42,9 @@ struct CellList {
 /// periodic length holds fewer than 3 cells (the minimum image would then be ambiguous).
 void bin_particles(Particles& p, const Domain& dom, Real cell_min, CellList& cells);
 
+/// A ball whose centre lies more than `margin` times its radius outside the domain along a non-periodic axis
+/// that has bounds (hi > lo; an axis without them is sized to the balls): its local index (the largest
+/// such), or -1.
+int ball_outside(const Particles& p, const Domain& dom, Real margin);
+
 }  // namespace dem

@@ -9,11 +9,12 @@ namespace {
 struct Leapfrog {
   Vec3View x, v, w, f, m;
   ConstVec3View x_ref;
-  ConstScalarView mass, inertia;
+  ConstScalarView mass, inertia, radius;
   Gather gather;
   IntegrateParams prm;
 
-  /// Advances particle i; vals = {|F + m g|, kinetic energy, non-finite flag, displacement^2 since rebuild}.
+  /// Advances particle i; vals = {|F + m g|, kinetic energy, non-finite flag, displacement^2 since rebuild,
+  /// (move this step / radius)^2}.
   KOKKOS_INLINE_FUNCTION void operator()(const int i, Real* vals) const {
     const Real mi = mass(i), ii = inertia(i);
     Vec3 fc, moment;
@@ -38,20 +39,22 @@ struct Leapfrog {
     }
     vals[2] = (kc::isfinite(xi.x) && kc::isfinite(xi.y) && kc::isfinite(xi.z)) ? Real(0) : Real(1);
     vals[3] = norm2(xi - load(x_ref, i));
+    vals[4] = norm2(vi) * (prm.dt * prm.dt) / (radius(i) * radius(i));
   }
 };
 
 }  // namespace
 
 StepStats integrate(Particles& p, const IntegrateParams& prm, const Gather& gather) {
-  const Leapfrog lf{p.x, p.v, p.w, p.f, p.m, p.x_ref, p.mass, p.inertia, gather, prm};
-  Real sums[4];
-  deterministic_reduce<3, 1>("dem::integrate::leapfrog", p.n,
+  const Leapfrog lf{p.x, p.v, p.w, p.f, p.m, p.x_ref, p.mass, p.inertia, p.radius, gather, prm};
+  Real sums[5];
+  deterministic_reduce<3, 2>("dem::integrate::leapfrog", p.n,
                              KOKKOS_LAMBDA(const int i, Real* vals) { lf(i, vals); }, sums);
   StepStats st;
   st.unbalanced = sums[0];
   st.kinetic = sums[1];
   st.max_disp2 = sums[3];
+  st.max_move2 = sums[4];
   auto x = p.x;
   if (sums[2] > 0) {
     int bad = -1;

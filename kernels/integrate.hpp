@@ -22,6 +22,7 @@ struct StepStats {
   Real unbalanced = 0;    ///< sum |F + m g| before damping (N), on measured steps
   Real kinetic = 0;       ///< translational + rotational kinetic energy (J), at t + dt/2, on measured steps
   Real max_disp2 = 0;     ///< largest squared displacement since the last rebuild (m^2)
+  Real max_move2 = 0;     ///< largest (distance moved this step / radius)^2
   int bad = -1;           ///< a particle with a non-finite position, or -1
 };
 

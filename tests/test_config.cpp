@@ -141,6 +141,57 @@ TEST(BlowUp, ExcessiveOverlapStopsWithStepParticleAndFix) {
   }
 }
 
+// A ball at 200 m/s with dt = 1 us moves 0.2 mm = 20% of its 1 mm radius in a step, above the 10% limit:
+// stopped at the first step, with the fraction moved (exact: 20%).
+TEST(BlowUp, BallMovingTooFarInOneStepStops) {
+  std::vector<dem::BallSpec> b(1);
+  b[0].radius = 1e-3;
+  b[0].v = dem::Vec3(0, 200, 0);
+  dem::SimParams prm;
+  prm.integ.gravity = dem::Vec3();
+  prm.skin = 0.4e-3;
+  dem::Simulation sim(dem::make_particles(b), dem::WallSet(), dem::FacetMesh(), {dem::ContactParams()}, 1, prm);
+  sim.set_dt(1e-6);
+  try {
+    sim.run(10);
+    FAIL() << "expected a blow-up";
+  } catch (const dem::BlowUp& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("at step 0: particle 0 moved 20% of its radius in one step"), std::string::npos) << m;
+    EXPECT_NE(m.find("suggested fix"), std::string::npos) << m;
+  }
+  // 99 m/s (9.9%, under the limit) goes on.
+  b[0].v = dem::Vec3(0, 99, 0);
+  dem::Simulation slow(dem::make_particles(b), dem::WallSet(), dem::FacetMesh(), {dem::ContactParams()}, 1, prm);
+  slow.set_dt(1e-6);
+  EXPECT_NO_THROW(slow.run(10));
+}
+
+// A ball leaving a bounded box at 5 m/s: its centre passes two radii beyond the edge (x > 12 mm, from 5 mm)
+// after 1400 steps of 5 um, and the check at the next rebuild (every 40 steps: half the 0.4 mm skin) stops it.
+TEST(BlowUp, BallLeavingTheDomainStops) {
+  std::vector<dem::BallSpec> b(1);
+  b[0].radius = 1e-3;
+  b[0].x = dem::Vec3(5e-3, 5e-3, 5e-3);
+  b[0].v = dem::Vec3(5, 0, 0);
+  dem::SimParams prm;
+  prm.integ.gravity = dem::Vec3();
+  prm.integ.alpha = 0;
+  prm.skin = 0.4e-3;
+  for (int d = 0; d < 3; ++d) prm.domain.hi[d] = 10e-3;
+  dem::Simulation sim(dem::make_particles(b), dem::WallSet(), dem::FacetMesh(), {dem::ContactParams()}, 1, prm);
+  sim.set_dt(1e-6);
+  try {
+    sim.run(3000);
+    FAIL() << "expected a blow-up";
+  } catch (const dem::BlowUp& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("particle 0 left the domain"), std::string::npos) << m;
+    EXPECT_GE(sim.step_count(), 1400);
+    EXPECT_LE(sim.step_count(), 1441);
+  }
+}
+
 // [calibrate] free: a list of names (checked against the registry by the calibration job); anything else is
 // refused with the file, table and key.
 TEST(Config, CalibrateFreeListIsRead) {
