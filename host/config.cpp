@@ -3,6 +3,7 @@
 #include <toml++/toml.h>
 
 #include <cmath>
+#include <fstream>
 #include <set>
 #include <sstream>
 
@@ -137,12 +138,58 @@ void read_contact(TableReader& r, ContactParams& c) {
 
 }  // namespace
 
+Real time_step(const SolverConfig& solver, Real critical, const std::string& path) {
+  if (solver.dt > critical) {
+    std::ostringstream m;
+    m << path << ": [solver] dt_s: " << solver.dt << " s is above the critical time step " << critical
+      << " s of these balls and contact laws (allowed: (0, " << critical
+      << "]; leave dt_s out to use dt_safety x critical)";
+    throw ConfigError(m.str());
+  }
+  return solver.dt > 0 ? solver.dt : solver.dt_safety * critical;
+}
+
+double run_memory_bytes(long balls) { return kBytesPerBall * static_cast<double>(balls); }
+
+namespace {
+/// MemAvailable of /proc/meminfo (bytes), 0 when unknown.
+double available_memory() {
+  std::ifstream in("/proc/meminfo");
+  std::string key;
+  double kb = 0;
+  std::string unit;
+  while (in >> key >> kb >> unit)
+    if (key == "MemAvailable:") return kb * 1024;
+  return 0;
+}
+
+/// Refuses a ball count whose run cannot fit in memory, before anything is allocated.
+void check_memory(TableReader& t, const std::string& key, long balls) {
+  const double need = run_memory_bytes(balls), have = available_memory();
+  if (have > 0 && need > 0.8 * have) {
+    std::ostringstream m;
+    m << balls << " balls need about " << need / 1e9 << " GB (" << kBytesPerBall
+      << " bytes per ball), more than 80% of the " << have / 1e9 << " GB available (allowed: up to "
+      << static_cast<long>(0.8 * have / kBytesPerBall) << " balls on this machine)";
+    t.fail(key, m.str());
+  }
+}
+}  // namespace
+
 Config load_config(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ConfigError(path + ": cannot be read");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_config(text.str(), path);
+}
+
+Config parse_config(const std::string& text, const std::string& path) {
   Config c;
   c.path = path;
   toml::table root;
   try {
-    root = toml::parse_file(path);
+    root = toml::parse(text, path);
   } catch (const toml::parse_error& e) {
     std::ostringstream s;
     s << path << ":" << e.source().begin.line << ":" << e.source().begin.column << ": " << e.description();
@@ -175,6 +222,7 @@ Config load_config(const std::string& path) {
 
   TableReader pt = table("particles");
   pt.integer("count", c.particles.count, 1, 2000000000L);
+  check_memory(pt, "count", c.particles.count);
   pt.number("diameter_mm", c.particles.diameter, 1e-6, 1e6, 1e-3, true);
   pt.number("diameter_ratio", c.particles.diameter_ratio, 1, 10);
   pt.number("density_kg_m3", c.particles.density, 0, 1e6, 1, true);
@@ -242,6 +290,13 @@ Config load_config(const std::string& path) {
         << std::floor(cylinder / (1.5625 * M_PI / 6 * d * d * d)) << " balls)";
       sp.fail("ball_count", r.str());
     }
+  }
+  if (c.has_specimen) {
+    const Real d = c.particles.diameter;
+    const Real cylinder = M_PI / 4 * c.specimen.diameter * c.specimen.diameter * c.specimen.height;
+    const double balls = cylinder / ((1 + c.specimen.void_ratio) * M_PI / 6 * d * d * d);
+    check_memory(sp, c.specimen.ball_count > 0 ? "ball_count" : "void_ratio",
+                 static_cast<long>(std::min(balls, 4e18)));
   }
   if (c.has_specimen && c.specimen.diameter < 4 * c.particles.diameter)
     throw ConfigError(path + ": [specimen] diameter_mm: must be at least 4 particle diameters (" +

@@ -148,7 +148,19 @@ struct Config {
   CalibrateConfig calibrate;
 };
 
+/// The time step of a run: [solver] dt_s when set, else dt_safety x `critical` (s). Throws ConfigError naming
+/// `path`, the key and the allowed range when dt_s is above the critical step.
+Real time_step(const SolverConfig& solver, Real critical, const std::string& path);
+
+/// Memory a run of `balls` balls needs at its peak (bytes): 571 bytes per ball measured in steady state
+/// (perf/bench_engine: particle arrays and contact lists at 6-7 contacts per ball), doubled for the rebuild,
+/// when the old and the new contact lists live side by side.
+constexpr double kBytesPerBall = 2 * 571;
+double run_memory_bytes(long balls);
+
 /// Reads and validates a config file. Throws ConfigError.
 Config load_config(const std::string& path);
+/// The same from the file's text; `path` names it in errors.
+Config parse_config(const std::string& text, const std::string& path);
 
 }  // namespace dem

@@ -34,10 +34,7 @@ std::unique_ptr<Simulation> build_simulation(const Config& cfg, bool verbose) {
   const std::vector<ContactParams> table = {cfg.ball, cfg.wall, cfg.wall, cfg.wall};
   auto sim = std::make_unique<Simulation>(make_particles(balls), make_walls(walls), FacetMesh(), table, 2, prm);
   const Real crit = sim->critical_dt();
-  const Real dt = cfg.solver.dt > 0 ? cfg.solver.dt : cfg.solver.dt_safety * crit;
-  if (dt > crit)
-    throw ConfigError(cfg.path + ": [solver] dt_s: " + std::to_string(dt) + " s is above the critical time step " +
-                      std::to_string(crit) + " s (allowed: (0, critical])");
+  const Real dt = time_step(cfg.solver, crit, cfg.path);
   sim->set_dt(dt);
   if (verbose) {
     std::printf("triaxdem: %zu balls, %zu walls; critical dt %.3e s, dt %.3e s (%s)\n", balls.size(), walls.size(),

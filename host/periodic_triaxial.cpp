@@ -363,12 +363,7 @@ std::unique_ptr<Simulation> make_periodic_simulation(const std::vector<BallSpec>
   for (BallSpec& s : b) s.material = 0;
   auto sim = std::make_unique<Simulation>(make_particles(b), WallSet(), FacetMesh(), std::vector<ContactParams>{law},
                                           1, prm);
-  const Real crit = sim->critical_dt();
-  const Real dt = solver.dt > 0 ? solver.dt : solver.dt_safety * crit;
-  if (dt > crit)
-    throw std::invalid_argument("periodic triaxial: dt " + std::to_string(dt) + " s is above the critical " +
-                                std::to_string(crit) + " s");
-  sim->set_dt(dt);
+  sim->set_dt(time_step(solver, sim->critical_dt(), "the periodic cell's config"));
   return sim;
 }
 

@@ -147,7 +147,7 @@ Specimen build_specimen(const Config& cfg, bool verbose) {
     const SimParams prm = solver_params(cfg);
     Simulation sim(make_particles(all), make_walls(mould(R, z0 + h_loose)), FacetMesh(),
                    {ball_law, wall_law, wall_law, wall_law}, 2, prm);
-    sim.set_dt(cfg.solver.dt > 0 ? cfg.solver.dt : cfg.solver.dt_safety * sim.critical_dt());
+    sim.set_dt(time_step(cfg.solver, sim.critical_dt(), cfg.path));
     const Real f_limit = 0.01 * cfg.particles.diameter / 2 *
                          NormalElastic::stiffness(wall_law, cfg.particles.diameter / 2, 0);
     Progress progress("specimen layer " + std::to_string(k + 1) + "/" + std::to_string(sc.layers),

@@ -65,7 +65,7 @@ Cell make_cell(const Config& cfg, const Specimen& sp) {
   mp.mass_scale = cfg.solver.mass_scale;
   c.sim->set_membrane(c.membrane, mp);
   c.sim->set_cell_pressure(cfg.triaxial.sigma3);
-  c.sim->set_dt(cfg.solver.dt > 0 ? cfg.solver.dt : cfg.solver.dt_safety * c.sim->critical_dt());
+  c.sim->set_dt(time_step(cfg.solver, c.sim->critical_dt(), cfg.path));
   c.kn_wall = NormalElastic::stiffness(cfg.wall, cfg.particles.diameter / 2, 0);
   for (const BallSpec& b : sp.balls) {
     c.solid_volume += 4.0 / 3.0 * M_PI * b.radius * b.radius * b.radius;

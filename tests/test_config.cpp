@@ -72,6 +72,34 @@ TEST(Config, TimeStepAboveCriticalRefused) {
   }
 }
 
+// The same rule for every job (run, specimen, triaxial, periodic): dt_s above the critical step is refused
+// with the key and the allowed range; without dt_s the step is dt_safety x critical.
+TEST(Config, TimeStepRuleNamesKeyAndRange) {
+  dem::SolverConfig s;
+  s.dt = 2e-6;
+  try {
+    dem::time_step(s, 1e-6, "x.toml");
+    FAIL() << "2 us above a critical 1 us";
+  } catch (const dem::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("x.toml: [solver] dt_s: 2e-06 s"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("allowed: (0, 1e-06]"), std::string::npos) << e.what();
+  }
+  s.dt = 0;
+  s.dt_safety = 0.25;
+  EXPECT_EQ(dem::time_step(s, 1e-6, "x.toml"), 0.25e-6);
+}
+
+// A run that cannot fit in memory is refused when the config is read, before any allocation: 2e9 balls
+// need 2.3 TB at 1,142 bytes each, more than any machine this runs on has available.
+TEST(Config, RunThatCannotFitInMemoryRefused) {
+  std::string e = error_of("[particles]\ncount = 2000000000\n");
+  EXPECT_NE(e.find("[particles] count: 2000000000 balls need about"), std::string::npos) << e;
+  EXPECT_NE(e.find("GB available (allowed: up to"), std::string::npos) << e;
+  e = error_of("[specimen]\ndiameter_mm = 20000.0\nheight_mm = 20000.0\n");
+  EXPECT_NE(e.find("[specimen] void_ratio"), std::string::npos) << e;
+  EXPECT_NE(e.find("GB available"), std::string::npos) << e;
+}
+
 TEST(Config, UnplaceableCountRefused) {
   // 2,000 balls of 2 mm (8.4 cm^3 of solid) cannot be inserted at random into a 1 cm^3 box.
   dem::Config c = dem::load_config(write_config("full.toml", "[box]\nsize_mm = [10.0, 10.0, 10.0]\n"));
