@@ -33,6 +33,9 @@ void put_history(H5Writer& f, const std::string& prefix, const SavedContacts& h)
   put(f, prefix + "mr", H5T_NATIVE_DOUBLE, h.mr, 3);
   put(f, prefix + "slip", H5T_NATIVE_DOUBLE, h.slip);
   put(f, prefix + "flags", H5T_NATIVE_UINT8, h.flags);
+  put(f, prefix + "fc", H5T_NATIVE_DOUBLE, h.fc, 3);
+  put(f, prefix + "mt", H5T_NATIVE_DOUBLE, h.mt, 3);
+  put(f, prefix + "fn", H5T_NATIVE_DOUBLE, h.fn);
 }
 
 SavedContacts get_history(const H5Reader& f, const std::string& prefix) {
@@ -44,6 +47,9 @@ SavedContacts get_history(const H5Reader& f, const std::string& prefix) {
   h.mr = f.read<double>("/" + prefix + "mr", H5T_NATIVE_DOUBLE, 3);
   h.slip = f.read<double>("/" + prefix + "slip", H5T_NATIVE_DOUBLE, 1);
   h.flags = f.read<std::uint8_t>("/" + prefix + "flags", H5T_NATIVE_UINT8, 1);
+  h.fc = f.read<double>("/" + prefix + "fc", H5T_NATIVE_DOUBLE, 3);
+  h.mt = f.read<double>("/" + prefix + "mt", H5T_NATIVE_DOUBLE, 3);
+  h.fn = f.read<double>("/" + prefix + "fn", H5T_NATIVE_DOUBLE, 1);
   return h;
 }
 
@@ -192,6 +198,19 @@ bool CheckpointClock::due(long step) const {
 }
 
 void CheckpointClock::written() { last_ = now_seconds(); }
+
+bool CheckpointPlan::due(long step) const {
+  return !path.empty() && (clock.due(step) || stop(step));
+}
+
+bool CheckpointPlan::stop(long step) const { return StopSignals::requested() || step == stop_at_step; }
+
+RunStopped run_stopped(const CheckpointPlan& plan, long step) {
+  const bool signal = StopSignals::requested();
+  return RunStopped(std::string(signal ? StopSignals::name() : "stop_at_step") + " at step " + std::to_string(step) +
+                        ": checkpoint " + plan.path + " written; continue with --resume",
+                    signal ? 128 + StopSignals::signal() : 3);
+}
 
 namespace {
 volatile std::sig_atomic_t g_signal = 0;

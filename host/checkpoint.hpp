@@ -6,10 +6,11 @@
 /// Layout (every dataset at the root): step (int64), time_s, dt_s, cell_pressure_Pa, wall_disp_m,
 /// stats (unbalanced, kinetic, max_disp2, max_move2), flags (fresh, bad), domain (lo, hi, strain rate: 3 x 3), periodic
 /// (3); per ball (local order) x, v, w, f, m, x_ref (n x 3), radius, mass, inertia, gid, specimen, material;
-/// per contact list (balls_*, walls_*): key, i, j, fs, mr, slip, flags; wall_point, wall_velocity,
+/// per contact list (balls_*, walls_*): key, i, j, fs, mr, slip, flags, fc, mt, fn; wall_point, wall_velocity,
 /// node_x, node_v; the job's arrays as number_<name> (double) and text_<name> (bytes), their names in the
 /// root attributes `numbers` and `texts`; the root attributes `format` and `job`.
 #include <map>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,27 @@ class CheckpointClock {
   double seconds_;
   double last_;
 };
+
+/// How a long job checkpoints: where, how often, whether it continues from a checkpoint, and where to stop.
+struct CheckpointPlan {
+  std::string path;                    ///< the checkpoint file ("": none is written)
+  CheckpointClock clock{0, 0};
+  const Checkpoint* from = nullptr;    ///< continue from this
+  long stop_at_step = -1;              ///< write a checkpoint after this step and stop (a batch slot's end)
+  /// Due now, after step `step` has been taken: by the clock, a signal or stop_at_step.
+  bool due(long step) const;
+  /// Whether the job must stop after this checkpoint.
+  bool stop(long step) const;
+};
+
+/// Thrown by a job that stopped after writing a checkpoint (a signal or stop_at_step); what() says where and
+/// how to go on; `code` is the exit status (128 + signal, or 3).
+struct RunStopped : std::runtime_error {
+  RunStopped(const std::string& what, int code) : std::runtime_error(what), code(code) {}
+  int code;
+};
+/// The RunStopped of a plan that stopped after `step`.
+RunStopped run_stopped(const CheckpointPlan& plan, long step);
 
 /// SIGINT and SIGTERM, caught for the lifetime of the object: the run loop polls `requested()`, writes a
 /// checkpoint and stops cleanly. The previous handlers come back on destruction.

@@ -85,7 +85,7 @@ void save_run(const std::string& path, Simulation& sim, const io::Output& out) {
 }
 }  // namespace
 
-int run_job(const Config& cfg, bool resume) {
+int run_job(const Config& cfg, bool resume, long stop_at_step) {
   io::Output out(cfg.run.output);
   auto sim = build_simulation(cfg, true);
   out.set_series_columns({"step", "time_s", "kinetic_energy_J", "unbalanced_ratio", "contacts_ball_ball",
@@ -116,7 +116,8 @@ int run_job(const Config& cfg, bool resume) {
     return std::make_pair(ratio, c[0]);
   };
   Progress progress(cfg.run.name, cfg.run.steps, sim->step_count());
-  CheckpointClock clock(cfg.run.checkpoint_every, cfg.run.checkpoint_minutes);
+  CheckpointPlan plan{ckpt, CheckpointClock(cfg.run.checkpoint_every, cfg.run.checkpoint_minutes), nullptr,
+                      stop_at_step};
   StopSignals signals;
   try {
     for (long s = sim->step_count() + 1; s <= cfg.run.steps; ++s) {
@@ -135,15 +136,15 @@ int run_job(const Config& cfg, bool resume) {
       if (cfg.run.snapshot_every > 0 && s % cfg.run.snapshot_every == 0 && s != cfg.run.steps)
         out.write_snapshot(take_snapshot(*sim, "step " + std::to_string(s)));
       // The series is flushed with every checkpoint, so that a killed run's files agree with its checkpoint.
-      if (clock.due(s) || StopSignals::requested()) {
+      if (plan.due(s)) {
         out.flush_series();
         save_run(ckpt, *sim, out);
-        clock.written();
+        plan.clock.written();
       }
-      if (StopSignals::requested()) {
-        std::printf("\ntriaxdem: %s at step %ld: checkpoint %s written; continue with --resume\n",
-                    StopSignals::name(), s, ckpt.c_str());
-        return 128 + StopSignals::signal();
+      if (plan.stop(s)) {
+        const RunStopped stopped = run_stopped(plan, s);
+        std::printf("\ntriaxdem: %s\n", stopped.what());
+        return stopped.code;
       }
     }
   } catch (const BlowUp& e) {

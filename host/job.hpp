@@ -23,9 +23,10 @@ io::Snapshot take_snapshot(Simulation& sim, const std::string& label);
 
 /// Runs the job, writing OUT/checkpoint.h5 every [run] checkpoint_every steps or checkpoint_minutes, at a
 /// SIGINT or SIGTERM and at the end. `resume`: continues from that checkpoint to [run] steps, bit for bit
-/// the run that was not stopped. Returns 0 on success, 2 on a blow-up (after saving a snapshot and the state
-/// for inspection), 128 + the signal when stopped by one.
-int run_job(const Config& cfg, bool resume = false);
+/// the run that was not stopped. `stop_at_step` >= 0: stop with a checkpoint after that step. Returns 0 on
+/// success, 2 on a blow-up (after saving a snapshot and the state for inspection), 128 + the signal when
+/// stopped by one, 3 at stop_at_step.
+int run_job(const Config& cfg, bool resume = false, long stop_at_step = -1);
 
 /// Writes layers.csv (each layer's void ratio in the finished specimen) and porosity_profile.csv.
 void write_specimen_report(const std::string& folder, const Config& cfg, const Specimen& sp);

@@ -29,7 +29,10 @@ int main(int argc, char** argv) {
   run->add_option("-o,--output", output, "output folder (overrides [run] output)");
   run->add_option("-n,--steps", steps, "number of steps (overrides [run] steps)")->check(CLI::NonNegativeNumber);
   bool resume = false;
+  long stop_at = -1;
   run->add_flag("--resume", resume, "continue from the output folder's checkpoint.h5 to the step count");
+  run->add_option("--stop-at-step", stop_at, "write a checkpoint after this step and stop (exit status 3)")
+      ->check(CLI::NonNegativeNumber);
 
   auto* specimen = app.add_subcommand("specimen", "build the [specimen] of a config by multilayer compaction");
   specimen->add_option("config", config_path, "TOML config file")->required()->check(CLI::ExistingFile);
@@ -38,6 +41,9 @@ int main(int argc, char** argv) {
   auto* triaxial = app.add_subcommand("triaxial", "specimen, membrane, consolidation and shear (drained triaxial test)");
   triaxial->add_option("config", config_path, "TOML config file")->required()->check(CLI::ExistingFile);
   triaxial->add_option("-o,--output", output, "output folder (overrides [run] output)");
+  triaxial->add_flag("--resume", resume, "continue from the output folder's checkpoint.h5");
+  triaxial->add_option("--stop-at-step", stop_at, "write a checkpoint after this step and stop (exit status 3)")
+      ->check(CLI::NonNegativeNumber);
 
   auto* periodic = app.add_subcommand("periodic", "periodic-cell drained triaxial test (no platens, no membrane)");
   periodic->add_option("config", config_path, "TOML config file")->required()->check(CLI::ExistingFile);
@@ -133,7 +139,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (specimen->parsed()) return dem::specimen_job(cfg);
-    if (triaxial->parsed()) return dem::triaxial_job(cfg);
+    if (triaxial->parsed()) return dem::triaxial_job(cfg, resume, stop_at);
     if (periodic->parsed()) return dem::run_periodic_job(cfg);
     if (calibrate->parsed() || diagnose->parsed()) {
       if (!free_list.empty()) {
@@ -150,7 +156,7 @@ int main(int argc, char** argv) {
       }
       return dem::synth_job(cfg, syn);
     }
-    return dem::run_job(cfg, resume);
+    return dem::run_job(cfg, resume, stop_at);
   } catch (const dem::DataError& e) {
     std::fprintf(stderr, "triaxdem: data error: %s\n", e.what());
     return 1;

@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <stdexcept>
+#include <type_traits>
 
 #include "io_hdf5.hpp"
 
@@ -37,6 +38,55 @@ std::vector<std::string> micro_columns(const std::string& prefix) {
     c.emplace_back(x);
   for (std::string& name : c) name = prefix + name;
   return c;
+}
+
+namespace {
+/// Calls f on every field of a row, in one fixed order: the single list that saving and reading share.
+template <class Row, class F>
+void each_field(Row& r, F&& f) {
+  f(r.z.z), f(r.z.z_balls), f(r.z.z_mech), f(r.z.on);
+  f(r.net.threshold), f(r.net.fn_ratio), f(r.net.ft_ratio);
+  for (auto* n : {&r.net.all, &r.net.strong, &r.net.weak})
+    f(n->contacts), f(n->particles), f(n->mean_fn), f(n->mean_ft), f(n->stress);
+  for (auto* a : {&r.all, &r.strong, &r.weak})
+    f(a->contacts), f(a->fabric), f(a->ac), f(a->an), f(a->at), f(a->f0), f(a->a_c), f(a->a_n), f(a->a_t);
+  f(r.stress), f(r.q_over_p), f(r.q_over_p_sff);
+}
+}  // namespace
+
+void append_micro_state(const MicroRow& r, std::vector<double>& v) {
+  MicroRow copy = r;
+  each_field(copy, [&](auto& x) {
+    using T = std::decay_t<decltype(x)>;
+    if constexpr (std::is_same_v<T, std::vector<long>>) {
+      v.push_back(static_cast<double>(x.size()));
+      for (long n : x) v.push_back(static_cast<double>(n));
+    } else if constexpr (std::is_same_v<T, Tensor>) {
+      v.insert(v.end(), x.begin(), x.end());
+    } else {
+      v.push_back(static_cast<double>(x));
+    }
+  });
+}
+
+MicroRow micro_row_from(const std::vector<double>& v, std::size_t& at) {
+  auto next = [&]() {
+    if (at >= v.size()) throw std::runtime_error("checkpoint: the micro rows end early");
+    return v[at++];
+  };
+  MicroRow r;
+  each_field(r, [&](auto& x) {
+    using T = std::decay_t<decltype(x)>;
+    if constexpr (std::is_same_v<T, std::vector<long>>) {
+      x.resize(static_cast<std::size_t>(next()));
+      for (long& n : x) n = static_cast<long>(next());
+    } else if constexpr (std::is_same_v<T, Tensor>) {
+      for (Real& e : x) e = next();
+    } else {
+      x = static_cast<T>(next());
+    }
+  });
+  return r;
 }
 
 std::vector<double> micro_values(const MicroRow& r) {

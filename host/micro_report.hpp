@@ -21,6 +21,12 @@ struct MicroRow {
 };
 MicroRow micro_row(const ContactSet& s, Real volume);
 
+/// Every field of a row as numbers (the coordination histogram with its length first), and back: what a
+/// checkpoint keeps. micro_row_from reads one row from `v` at `at` and advances it; throws std::runtime_error
+/// when `v` ends early.
+void append_micro_state(const MicroRow& r, std::vector<double>& v);
+MicroRow micro_row_from(const std::vector<double>& v, std::size_t& at);
+
 /// Column names and values of a row, in the same order.
 std::vector<std::string> micro_columns(const std::string& prefix = "");
 std::vector<double> micro_values(const MicroRow& r);

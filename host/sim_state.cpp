@@ -49,13 +49,16 @@ SavedContacts history_out(const ContactList& c) {
   h.mr = vec3_out(c.mr, c.n);
   h.slip = scalar_out<double>(c.slip, c.n);
   h.flags = scalar_out<std::uint8_t>(c.flags, c.n);
+  h.fc = vec3_out(c.fc, c.n);
+  h.mt = vec3_out(c.mt, c.n);
+  h.fn = scalar_out<double>(c.fn, c.n);
   return h;
 }
 
 ContactList history_in(const SavedContacts& h, const char* which) {
   const std::size_t n = h.key.size();
   if (h.i.size() != n || h.j.size() != n || h.fs.size() != 3 * n || h.mr.size() != 3 * n || h.slip.size() != n ||
-      h.flags.size() != n)
+      h.flags.size() != n || h.fc.size() != 3 * n || h.mt.size() != 3 * n || h.fn.size() != n)
     throw std::runtime_error(std::string("state: the ") + which + " contact list has arrays of unequal length");
   ContactList c(static_cast<int>(n));
   scalar_in(c.key, h.key, c.n);
@@ -65,6 +68,9 @@ ContactList history_in(const SavedContacts& h, const char* which) {
   vec3_in(c.mr, h.mr, c.n);
   scalar_in(c.slip, h.slip, c.n);
   scalar_in(c.flags, h.flags, c.n);
+  vec3_in(c.fc, h.fc, c.n);
+  vec3_in(c.mt, h.mt, c.n);
+  scalar_in(c.fn, h.fn, c.n);
   return c;
 }
 

@@ -15,8 +15,9 @@ namespace dem {
 struct SavedContacts {
   std::vector<std::uint64_t> key;
   std::vector<int> i, j;
-  std::vector<double> fs, mr, slip;   ///< N, N m, m
+  std::vector<double> fs, mr, slip;   ///< history: N, N m, m
   std::vector<std::uint8_t> flags;
+  std::vector<double> fc, mt, fn;     ///< the last step's forces (N, N m, N): what wall forces and records read
 };
 
 struct SimState {

@@ -95,55 +95,152 @@ Real specimen_volume(const Cell& c) { return enclosed_volume(c.membrane, 0, c.si
 
 }  // namespace
 
-TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* out, bool verbose) {
+namespace {
+
+/// Where a triaxial run stands, besides the simulation: what its checkpoint holds.
+struct Stage {
+  Real shear = 0;            ///< 0 consolidation, 1 shear
+  Real step = 0;             ///< the next loop step of the stage
+  Real h0 = 0, v0 = 0, v0_envelope = 0, void_ratio = 0, consolidation_steps = 0;
+  Real q_max = -INFINITY, next_snap = 0, next_record = 0;
+  std::vector<double> numbers() const {
+    return {shear, step, h0, v0, v0_envelope, void_ratio, consolidation_steps, q_max, next_snap, next_record};
+  }
+  static Stage of(const std::vector<double>& v) {
+    if (v.size() != 10) throw std::runtime_error("checkpoint: the triaxial stage has " + std::to_string(v.size()) +
+                                                 " values, not 10");
+    return Stage{v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9]};
+  }
+};
+
+constexpr int kRecordValues = 9;
+std::vector<double> record_numbers(const std::vector<TriaxialRecord>& rs) {
+  std::vector<double> v;
+  for (const TriaxialRecord& r : rs)
+    v.insert(v.end(), {r.eps_a, r.eps_v, r.sigma1, r.sigma1_bottom, r.q, r.sigma3_balls, r.eps_v_envelope,
+                       r.unbalanced, r.kinetic});
+  return v;
+}
+std::vector<TriaxialRecord> records_of(const std::vector<double>& v) {
+  std::vector<TriaxialRecord> rs(v.size() / kRecordValues);
+  for (std::size_t i = 0; i < rs.size(); ++i) {
+    const double* x = &v[kRecordValues * i];
+    rs[i] = TriaxialRecord{x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], x[8]};
+  }
+  return rs;
+}
+void save_triaxial(const CheckpointPlan& plan, Simulation& sim, const io::Output* out, const Stage& st,
+                   const TriaxialResult& res) {
+  Checkpoint c;
+  c.job = "triaxial";
+  c.sim = sim.state();
+  c.numbers["stage"] = st.numbers();
+  c.numbers["records"] = record_numbers(res.records);
+  std::vector<double>& micro = c.numbers["micro"];
+  for (const MicroRow& m : res.micro) append_micro_state(m, micro);
+  if (out) {
+    c.numbers["series"] = out->series_rows();
+    c.texts["snapshots"] = out->snapshot_index();
+  }
+  write_checkpoint(plan.path, c);
+}
+
+}  // namespace
+
+TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* out, bool verbose,
+                            CheckpointPlan* plan) {
   const auto t0 = std::chrono::steady_clock::now();
   const TriaxialConfig& tc = cfg.triaxial;
   Cell cell = make_cell(cfg, sp);
   Simulation& sim = *cell.sim;
   const Real dt = sim.params().integ.dt;
   TriaxialResult res;
+  const MicroConfig& mc = cfg.micro;
+  std::vector<std::string> columns = {"eps_a_pct",        "eps_v_pct",          "q_kPa",
+                                      "sigma1_kPa",       "sigma1_bottom_kPa",  "sigma3_kPa",
+                                      "sigma3_balls_kPa", "eps_v_envelope_pct", "unbalanced_ratio",
+                                      "kinetic_energy_J"};
+  if (mc.enabled)
+    for (const std::string& prefix : {std::string(), std::string("rve_")})
+      for (const std::string& c : micro_columns(prefix)) columns.push_back(c);
+  if (out) out->set_series_columns(columns);
+  Stage st;
+  if (plan && plan->from) {
+    const Checkpoint& c = *plan->from;
+    if (c.job != "triaxial") throw std::runtime_error(plan->path + ": written by the '" + c.job + "' job");
+    sim.restore(c.sim);
+    st = Stage::of(c.numbers.at("stage"));
+    res.records = records_of(c.numbers.at("records"));
+    if (c.numbers.count("micro"))
+      for (std::size_t at = 0; at < c.numbers.at("micro").size();)
+        res.micro.push_back(micro_row_from(c.numbers.at("micro"), at));
+    if (out)
+      out->resume(c.numbers.count("series") ? c.numbers.at("series") : std::vector<double>{},
+                  c.texts.count("snapshots") ? c.texts.at("snapshots") : "");
+    if (verbose)
+      std::printf("triaxial: resuming %s at step %ld (%s)\n", plan->path.c_str(), sim.step_count(),
+                  st.shear != 0 ? "shear" : "consolidation");
+  }
+  // After each loop step: a checkpoint when due, and a stop when asked for.
+  auto checkpoint = [&](const Stage& now) {
+    if (!plan || !plan->due(sim.step_count())) return;
+    if (out) out->flush_series();
+    save_triaxial(*plan, sim, out, now, res);
+    plan->clock.written();
+    if (plan->stop(sim.step_count())) throw run_stopped(*plan, sim.step_count());
+  };
 
   // A blow-up saves the state it happened in (balls, membrane, contacts) and the curve so far, then stops.
   try {
-    // Isotropic consolidation: cell pressure on the membrane, stress servo on the top platen.
-    StressServo servo;
-    servo.target = tc.sigma3;
-    servo.area = cell.area;
-    servo.v_max = 0.05 * sp.height / (2000 * dt);  // at most 5% of the height in 2000 steps
-    Progress cons("consolidation (ETA to the step cap)", tc.max_consolidation_steps);
-    long s = 0;
-    for (; s < tc.max_consolidation_steps; ++s) {
-      const auto [top, bottom] = platen_stresses(cell, sim.wall_forces());
-      const int n = sim.wall_contact_counts()[kTopPlaten];
-      set_top_velocity(cell, -servo.speed(top, n * cell.kn_wall, dt));
-      const bool check = (s + 1) % 200 == 0;
-      sim.step(check);
-      if (!check) continue;
-      const Real ratio = sim.unbalanced_ratio();
-      // The servo holds the top platen; the bottom one differs by what the membrane carries through
-      // friction and its own axial stiffness, so only the controlled stress decides.
-      const Real err = std::fabs(top - tc.sigma3) / tc.sigma3;
-      if (verbose) {
-        char extra[96];
-        std::snprintf(extra, sizeof extra, "sigma_top %.1f kPa, sigma_bottom %.1f kPa, unbalanced %.1e", top / 1e3,
-                      bottom / 1e3, ratio);
-        cons.update(s + 1, extra);
+    if (st.shear == 0) {
+      // Isotropic consolidation: cell pressure on the membrane, stress servo on the top platen.
+      StressServo servo;
+      servo.target = tc.sigma3;
+      servo.area = cell.area;
+      servo.v_max = 0.05 * sp.height / (2000 * dt);  // at most 5% of the height in 2000 steps
+      long s = static_cast<long>(st.step);
+      Progress cons("consolidation (ETA to the step cap)", tc.max_consolidation_steps, s);
+      for (; s < tc.max_consolidation_steps; ++s) {
+        const auto [top, bottom] = platen_stresses(cell, sim.wall_forces());
+        const int n = sim.wall_contact_counts()[kTopPlaten];
+        set_top_velocity(cell, -servo.speed(top, n * cell.kn_wall, dt));
+        const bool check = (s + 1) % 200 == 0;
+        sim.step(check);
+        if (check) {
+          const Real ratio = sim.unbalanced_ratio();
+          // The servo holds the top platen; the bottom one differs by what the membrane carries through
+          // friction and its own axial stiffness, so only the controlled stress decides.
+          const Real err = std::fabs(top - tc.sigma3) / tc.sigma3;
+          if (verbose) {
+            char extra[96];
+            std::snprintf(extra, sizeof extra, "sigma_top %.1f kPa, sigma_bottom %.1f kPa, unbalanced %.1e",
+                          top / 1e3, bottom / 1e3, ratio);
+            cons.update(s + 1, extra);
+          }
+          if (err < tc.consolidation_tol && ratio < tc.stop_ratio) break;
+        }
+        st.step = static_cast<Real>(s + 1);
+        checkpoint(st);
       }
-      if (err < tc.consolidation_tol && ratio < tc.stop_ratio) break;
+      if (s >= tc.max_consolidation_steps)
+        throw ConfigError(cfg.path + ": [triaxial] max_consolidation_steps: consolidation to " +
+                          std::to_string(tc.sigma3 / 1e3) + " kPa did not settle within " +
+                          std::to_string(tc.max_consolidation_steps) + " steps");
+      st.shear = 1;
+      st.step = 0;
+      st.consolidation_steps = static_cast<Real>(s + 1);
+      st.h0 = sim.wall_point(kTopPlaten).z;
+      st.v0 = specimen_volume(cell);
+      st.v0_envelope = envelope_volume(sim, st.h0, cell.mean_radius, tc.membrane_segments);
+      st.void_ratio = st.v0 / cell.solid_volume - 1;
+      if (verbose)
+        std::printf("\nconsolidated at %.0f kPa: e = %.4f, height %.3f mm after %ld steps\n", tc.sigma3 / 1e3,
+                    st.void_ratio, st.h0 * 1e3, static_cast<long>(st.consolidation_steps));
     }
-    if (s >= tc.max_consolidation_steps)
-      throw ConfigError(cfg.path + ": [triaxial] max_consolidation_steps: consolidation to " +
-                        std::to_string(tc.sigma3 / 1e3) + " kPa did not settle within " +
-                        std::to_string(tc.max_consolidation_steps) + " steps");
-    res.consolidation_steps = s + 1;
-    const Real h0 = sim.wall_point(kTopPlaten).z;
-    const Real v0 = specimen_volume(cell);
+    res.consolidation_steps = static_cast<long>(st.consolidation_steps);
+    res.void_ratio_consolidated = st.void_ratio;
+    const Real h0 = st.h0, v0 = st.v0, v0_envelope = st.v0_envelope;
     const int env_slabs = tc.membrane_segments;
-    const Real v0_envelope = envelope_volume(sim, sim.wall_point(kTopPlaten).z, cell.mean_radius, env_slabs);
-    res.void_ratio_consolidated = v0 / cell.solid_volume - 1;
-    if (verbose)
-      std::printf("\nconsolidated at %.0f kPa: e = %.4f, height %.3f mm after %ld steps\n", tc.sigma3 / 1e3,
-                  res.void_ratio_consolidated, h0 * 1e3, res.consolidation_steps);
 
     // Shear: constant platen speed from the inertial number (density scaling counts in rho).
     const Real rho = cfg.particles.density * cfg.solver.mass_scale;
@@ -156,26 +253,14 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
     constexpr Real kRampStrain = 0.005;
     const long ramp = std::max(1L, std::lround(kRampStrain / (res.shear_rate * dt)));
     const long steps = static_cast<long>(std::ceil(tc.axial_strain_end / (res.shear_rate * dt))) + ramp / 2;
-    if (verbose)
+    if (verbose && st.step == 0)
       std::printf("shear: strain rate %.3g 1/s (inertial number %.1e%s), %ld steps to %.0f%%\n", res.shear_rate,
                   tc.inertial_number, cfg.solver.mass_scale != 1 ? ", with density scaling" : "", steps,
                   tc.axial_strain_end * 100);
-    std::vector<std::string> columns = {"eps_a_pct",        "eps_v_pct",          "q_kPa",
-                                        "sigma1_kPa",       "sigma1_bottom_kPa",  "sigma3_kPa",
-                                        "sigma3_balls_kPa", "eps_v_envelope_pct", "unbalanced_ratio",
-                                        "kinetic_energy_J"};
-    const MicroConfig& mc = cfg.micro;
-    if (mc.enabled)
-      for (const std::string& prefix : {std::string(), std::string("rve_")})
-        for (const std::string& c : micro_columns(prefix)) columns.push_back(c);
-    if (out) out->set_series_columns(columns);
     const Real snaps[] = {0.0, 0.01, 0.05, tc.axial_strain_end};
     const char* snap_labels[] = {"A", "B", "C", "D"};  // the paper's points A-D (Figure 8)
-    Real q_max = -INFINITY;
-    int next_snap = 0;
-    Real next_record = 0;
-    Progress shear("shear", steps);
-    for (long k = 0; k <= steps; ++k) {
+    Progress shear("shear", steps, static_cast<long>(st.step));
+    for (long k = static_cast<long>(st.step); k <= steps; ++k) {
       const Real eps_a = (h0 - sim.wall_point(kTopPlaten).z) / h0;
       // The contacts are copied to the host at most once a step, for the record and the snapshot alike.
       std::optional<ContactSet> contacts;
@@ -183,7 +268,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
         if (!contacts) contacts = contact_set(sim);
         return *contacts;
       };
-      if (eps_a >= next_record - 1e-12 || k == steps) {
+      if (eps_a >= st.next_record - 1e-12 || k == steps) {
         TriaxialRecord r;
         const std::vector<Vec3> wall_f = sim.wall_forces();
         const auto [top, bottom] = platen_stresses(cell, wall_f);
@@ -201,6 +286,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
         std::vector<double> row = {100 * r.eps_a,        100 * r.eps_v,          r.q / 1e3,    r.sigma1 / 1e3,
                                    r.sigma1_bottom / 1e3, tc.sigma3 / 1e3,        r.sigma3_balls / 1e3,
                                    100 * r.eps_v_envelope, r.unbalanced,          r.kinetic};
+        const int next_snap = static_cast<int>(st.next_snap);
         if (mc.enabled) {
           const ContactSet& cs = contacts_now();
           const ContactSet rve = restrict_to_cube(cs, Vec3(0, 0, top_z / 2), mc.rve_edge);
@@ -210,32 +296,36 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
             for (double v : micro_values(x)) row.push_back(v);
           const bool snap_due = next_snap < 4 && eps_a >= snaps[next_snap] - 1e-12;
           if (out && snap_due) write_micro_state(out->folder(), snap_labels[next_snap], cs, rve, mc.rose_bins);
-          if (out && r.q > q_max) write_micro_state(out->folder(), "peak", cs, rve, mc.rose_bins);
+          if (out && r.q > st.q_max) write_micro_state(out->folder(), "peak", cs, rve, mc.rose_bins);
         }
-        q_max = std::max(q_max, r.q);
+        st.q_max = std::max(st.q_max, r.q);
         if (out) {
           out->append_series(row);
           if (res.records.size() % 25 == 0) out->flush_series();  // a crash keeps the curve so far
         }
-        next_record += tc.record_every;
+        st.next_record += tc.record_every;
         if (verbose) {
           char extra[64];
           std::snprintf(extra, sizeof extra, "eps_a %.2f%%, q %.1f kPa", 100 * eps_a, r.q / 1e3);
           shear.update(k, extra);
         }
       }
+      const int next_snap = static_cast<int>(st.next_snap);
       if (out && next_snap < 4 && eps_a >= snaps[next_snap] - 1e-12) {
         char label[48];
         std::snprintf(label, sizeof label, "shear eps_a=%.0f%%", 100 * snaps[next_snap]);
         const io::SurfaceSnapshot surface = membrane_surface(cell.membrane);
         const io::ContactTable table = mc.enabled ? contact_table(contacts_now()) : io::ContactTable();
         out->write_snapshot(take_snapshot(sim, label), &surface, mc.enabled ? &table : nullptr);
-        ++next_snap;
+        st.next_snap += 1;
       }
       if (k == steps) break;
       if (k < ramp) set_top_velocity(cell, -res.shear_rate * h0 * static_cast<Real>(k + 1) / ramp);
       // The unbalanced ratio and kinetic energy cost a pass: measured on the steps before a record only.
-      sim.step((h0 - sim.wall_point(kTopPlaten).z) / h0 + res.shear_rate * dt >= next_record - 1e-12 || k + 1 == steps);
+      sim.step((h0 - sim.wall_point(kTopPlaten).z) / h0 + res.shear_rate * dt >= st.next_record - 1e-12 ||
+               k + 1 == steps);
+      st.step = static_cast<Real>(k + 1);
+      checkpoint(st);
     }
   } catch (const BlowUp&) {
     if (out) {
@@ -243,8 +333,9 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
       const io::SurfaceSnapshot surface = membrane_surface(cell.membrane);
       const io::ContactTable contacts = contact_table(contact_set(sim));
       out->write_snapshot(take_snapshot(sim, "blow-up"), &surface, &contacts);
-      std::fprintf(stderr, "triaxdem: state at the blow-up saved in %s (snapshots.xdmf, last entry)\n",
-                   out->folder().c_str());
+      if (plan) save_triaxial(CheckpointPlan{blowup_path(out->folder())}, sim, out, st, res);
+      std::fprintf(stderr, "triaxdem: state at the blow-up saved in %s (snapshots.xdmf, last entry; %s)\n",
+                   out->folder().c_str(), blowup_path(out->folder()).c_str());
     }
     throw;
   }
@@ -269,9 +360,19 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
   return res;
 }
 
-int triaxial_job(const Config& cfg) {
+int triaxial_job(const Config& cfg, bool resume, long stop_at_step) {
   if (!cfg.has_specimen) throw ConfigError(cfg.path + ": [specimen]: table missing (the triaxial job needs it)");
   io::Output out(cfg.run.output);
+  CheckpointPlan plan{checkpoint_path(out.folder()), CheckpointClock(cfg.run.checkpoint_every,
+                      cfg.run.checkpoint_minutes), nullptr, stop_at_step};
+  Checkpoint from;
+  if (resume) {
+    if (!std::filesystem::exists(plan.path))
+      throw std::runtime_error("--resume: no checkpoint " + plan.path + " (run without --resume to start afresh)");
+    from = read_checkpoint(plan.path);
+    plan.from = &from;
+  }
+  StopSignals signals;
   try {
     // Specimens are shared through a cache beside the output folder (the nine paper cases build one).
     const Specimen sp =
@@ -279,7 +380,7 @@ int triaxial_job(const Config& cfg) {
     std::printf("specimen: %zu balls, e = %.4f, height %.3f mm (layers.csv, porosity_profile.csv)\n",
                 sp.balls.size(), sp.void_ratio, sp.height * 1e3);
     write_specimen_report(out.folder(), cfg, sp);
-    const TriaxialResult r = run_triaxial(cfg, sp, &out, true);
+    const TriaxialResult r = run_triaxial(cfg, sp, &out, true, &plan);
     std::printf("\nresult: q_peak %.1f kPa at eps_a %.2f%%, peak friction angle %.1f deg, q at %.0f%% %.1f kPa, "
                 "max dilatancy %.3f, wall time %s\n",
                 r.q_peak / 1e3, 100 * r.eps_a_peak, r.phi_peak_deg, 100 * cfg.triaxial.axial_strain_end,
@@ -321,6 +422,9 @@ int triaxial_job(const Config& cfg) {
   } catch (const BlowUp& e) {
     std::fprintf(stderr, "\ntriaxdem: %s\n", e.what());
     return 2;
+  } catch (const RunStopped& e) {
+    std::printf("\ntriaxdem: %s\n", e.what());
+    return e.code;
   }
   return 0;
 }

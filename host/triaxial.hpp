@@ -5,6 +5,7 @@
 /// top platen at constant velocity and the cell pressure held, to the end strain.
 #include <vector>
 
+#include "checkpoint.hpp"
 #include "config.hpp"
 #include "host/micro_report.hpp"
 #include "host/specimen.hpp"
@@ -42,10 +43,16 @@ struct TriaxialResult {
   long balls = 0;
 };
 
-/// Runs consolidation and shear on `specimen`; writes series and snapshots to `out` when given.
-TriaxialResult run_triaxial(const Config& cfg, const Specimen& specimen, io::Output* out, bool verbose);
+/// Runs consolidation and shear on `specimen`; writes series and snapshots to `out` when given. With a
+/// `plan`: checkpoints (the simulation, the stage, the records and the output so far) as it says, continues
+/// from plan->from when set (bit for bit the run that was not stopped), and throws RunStopped after the
+/// checkpoint of a signal or of plan->stop_at_step.
+TriaxialResult run_triaxial(const Config& cfg, const Specimen& specimen, io::Output* out, bool verbose,
+                            CheckpointPlan* plan = nullptr);
 
-/// The `triaxial` CLI job: specimen, then run_triaxial, outputs and a summary. Returns 0, or 2 on a blow-up.
-int triaxial_job(const Config& cfg);
+/// The `triaxial` CLI job: specimen, then run_triaxial with checkpoints in OUT/checkpoint.h5 ([run]
+/// checkpoint_every, checkpoint_minutes, SIGINT, SIGTERM), outputs and a summary. `resume`: continue from the
+/// checkpoint. Returns 0, 2 on a blow-up, 128 + the signal or 3 (stop_at_step) when stopped with a checkpoint.
+int triaxial_job(const Config& cfg, bool resume = false, long stop_at_step = -1);
 
 }  // namespace dem

@@ -162,3 +162,61 @@ TEST_F(Triaxial, MicromechanicsFromSavedStatesAndClearRefusals) {
     EXPECT_NE(std::string(e.what()).find("holds no contacts"), std::string::npos) << e.what();
   }
 }
+
+// Checkpoint and resume of the triaxial test: stopped once in consolidation (servo on the platen) and once in
+// shear (platen ramp, records, micromechanics), resumed each time from the checkpoint file, it ends with
+// the records and the series of the run that was never stopped, compared with == (bit for bit).
+TEST_F(Triaxial, StoppedInEachStageAndResumedMatchesTheUnstoppedRun) {
+  const auto dir = std::filesystem::path(::testing::TempDir()) / ("triaxdem_tx_ckpt_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  Config c = tiny_config(0.3, 0.02);
+  c.triaxial.axial_strain_end = 0.03;
+  c.micro.enabled = true;
+  TriaxialResult whole;
+  {
+    io::Output out((dir / "whole").string());
+    CheckpointPlan plan{checkpoint_path((dir / "whole").string())};
+    whole = run_triaxial(c, *specimen_, &out, false, &plan);
+  }
+  ASSERT_GT(whole.consolidation_steps, 2);
+  const long in_consolidation = whole.consolidation_steps / 2;
+  const long in_shear = whole.consolidation_steps + (whole.steps - whole.consolidation_steps) / 2;
+  const std::string folder = (dir / "stopped").string();
+  Checkpoint from;
+  for (long stop : {in_consolidation, in_shear}) {
+    io::Output out(folder);
+    CheckpointPlan plan{checkpoint_path(folder), CheckpointClock(0, 0), stop == in_shear ? &from : nullptr, stop};
+    try {
+      run_triaxial(c, *specimen_, &out, false, &plan);
+      FAIL() << "did not stop at step " << stop;
+    } catch (const RunStopped& e) {
+      EXPECT_EQ(e.code, 3);
+      EXPECT_NE(std::string(e.what()).find("at step " + std::to_string(stop)), std::string::npos) << e.what();
+    }
+    from = read_checkpoint(checkpoint_path(folder));
+    EXPECT_EQ(from.sim.step, stop);
+  }
+  TriaxialResult resumed;
+  {
+    io::Output out(folder);
+    CheckpointPlan plan{checkpoint_path(folder), CheckpointClock(0, 0), &from};
+    resumed = run_triaxial(c, *specimen_, &out, false, &plan);
+  }
+  EXPECT_EQ(resumed.consolidation_steps, whole.consolidation_steps);
+  EXPECT_EQ(resumed.steps, whole.steps);
+  ASSERT_EQ(resumed.records.size(), whole.records.size());
+  for (std::size_t i = 0; i < whole.records.size(); ++i) {
+    EXPECT_EQ(resumed.records[i].eps_a, whole.records[i].eps_a) << i;
+    EXPECT_EQ(resumed.records[i].q, whole.records[i].q) << i;
+    EXPECT_EQ(resumed.records[i].eps_v, whole.records[i].eps_v) << i;
+    EXPECT_EQ(resumed.records[i].sigma3_balls, whole.records[i].sigma3_balls) << i;
+  }
+  ASSERT_EQ(resumed.micro.size(), whole.micro.size());
+  for (std::size_t i = 0; i < whole.micro.size(); ++i) EXPECT_EQ(resumed.micro[i].q_over_p, whole.micro[i].q_over_p);
+  auto text = [](const std::filesystem::path& p) {
+    std::ifstream in(p);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  EXPECT_TRUE(text(dir / "whole" / "series.csv") == text(dir / "stopped" / "series.csv"));
+  EXPECT_GT(text(dir / "whole" / "series.csv").size(), 100u);
+}
