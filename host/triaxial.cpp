@@ -15,6 +15,7 @@
 #include "servo.hpp"
 #include "study.hpp"
 #include "triaxial_measure.hpp"
+#include "triaxial_state.hpp"
 #include "simulation.hpp"
 
 namespace dem {
@@ -95,58 +96,6 @@ Real specimen_volume(const Cell& c) { return enclosed_volume(c.membrane, 0, c.si
 
 }  // namespace
 
-namespace {
-
-/// Where a triaxial run stands, besides the simulation: what its checkpoint holds.
-struct Stage {
-  Real shear = 0;            ///< 0 consolidation, 1 shear
-  Real step = 0;             ///< the next loop step of the stage
-  Real h0 = 0, v0 = 0, v0_envelope = 0, void_ratio = 0, consolidation_steps = 0;
-  Real q_max = -INFINITY, next_snap = 0, next_record = 0;
-  std::vector<double> numbers() const {
-    return {shear, step, h0, v0, v0_envelope, void_ratio, consolidation_steps, q_max, next_snap, next_record};
-  }
-  static Stage of(const std::vector<double>& v) {
-    if (v.size() != 10) throw std::runtime_error("checkpoint: the triaxial stage has " + std::to_string(v.size()) +
-                                                 " values, not 10");
-    return Stage{v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9]};
-  }
-};
-
-constexpr int kRecordValues = 9;
-std::vector<double> record_numbers(const std::vector<TriaxialRecord>& rs) {
-  std::vector<double> v;
-  for (const TriaxialRecord& r : rs)
-    v.insert(v.end(), {r.eps_a, r.eps_v, r.sigma1, r.sigma1_bottom, r.q, r.sigma3_balls, r.eps_v_envelope,
-                       r.unbalanced, r.kinetic});
-  return v;
-}
-std::vector<TriaxialRecord> records_of(const std::vector<double>& v) {
-  std::vector<TriaxialRecord> rs(v.size() / kRecordValues);
-  for (std::size_t i = 0; i < rs.size(); ++i) {
-    const double* x = &v[kRecordValues * i];
-    rs[i] = TriaxialRecord{x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], x[8]};
-  }
-  return rs;
-}
-void save_triaxial(const CheckpointPlan& plan, Simulation& sim, const io::Output* out, const Stage& st,
-                   const TriaxialResult& res) {
-  Checkpoint c;
-  c.job = "triaxial";
-  c.sim = sim.state();
-  c.numbers["stage"] = st.numbers();
-  c.numbers["records"] = record_numbers(res.records);
-  std::vector<double>& micro = c.numbers["micro"];
-  for (const MicroRow& m : res.micro) append_micro_state(m, micro);
-  if (out) {
-    c.numbers["series"] = out->series_rows();
-    c.texts["snapshots"] = out->snapshot_index();
-  }
-  write_checkpoint(plan.path, c);
-}
-
-}  // namespace
-
 TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* out, bool verbose,
                             CheckpointPlan* plan) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -166,17 +115,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
   if (out) out->set_series_columns(columns);
   Stage st;
   if (plan && plan->from) {
-    const Checkpoint& c = *plan->from;
-    if (c.job != "triaxial") throw std::runtime_error(plan->path + ": written by the '" + c.job + "' job");
-    sim.restore(c.sim);
-    st = Stage::of(c.numbers.at("stage"));
-    res.records = records_of(c.numbers.at("records"));
-    if (c.numbers.count("micro"))
-      for (std::size_t at = 0; at < c.numbers.at("micro").size();)
-        res.micro.push_back(micro_row_from(c.numbers.at("micro"), at));
-    if (out)
-      out->resume(c.numbers.count("series") ? c.numbers.at("series") : std::vector<double>{},
-                  c.texts.count("snapshots") ? c.texts.at("snapshots") : "");
+    restore_triaxial(*plan->from, plan->path, sim, out, st, res);
     if (verbose)
       std::printf("triaxial: resuming %s at step %ld (%s)\n", plan->path.c_str(), sim.step_count(),
                   st.shear != 0 ? "shear" : "consolidation");

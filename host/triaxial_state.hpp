@@ -1,0 +1,30 @@
+#pragma once
+/// What a triaxial run's checkpoint holds besides the simulation (host/triaxial.cpp): the stage and its step,
+/// the references fixed at the end of consolidation, the records and micromechanics so far, the output.
+#include <string>
+#include <vector>
+
+#include "checkpoint.hpp"
+#include "io_hdf5.hpp"
+#include "simulation.hpp"
+#include "triaxial.hpp"
+
+namespace dem {
+
+/// Where a triaxial run stands. Numbers only (counters as Real), so that the stage is one array of the file.
+struct Stage {
+  Real shear = 0;            ///< 0 consolidation, 1 shear
+  Real step = 0;             ///< the next loop step of the stage
+  Real h0 = 0, v0 = 0, v0_envelope = 0, void_ratio = 0, consolidation_steps = 0;  ///< m, m^3, m^3, -, steps
+  Real q_max = -INFINITY, next_snap = 0, next_record = 0;                         ///< Pa, index, strain
+};
+
+/// Writes the checkpoint of a triaxial run to plan.path.
+void save_triaxial(const CheckpointPlan& plan, Simulation& sim, const io::Output* out, const Stage& st,
+                   const TriaxialResult& res);
+/// Continues from a checkpoint: the simulation, the stage, the records and micromechanics, the output.
+/// Throws std::runtime_error naming `path` when it is not a triaxial checkpoint or is malformed.
+void restore_triaxial(const Checkpoint& c, const std::string& path, Simulation& sim, io::Output* out, Stage& st,
+                      TriaxialResult& res);
+
+}  // namespace dem
