@@ -62,6 +62,17 @@ TEST(Config, WrongTypeUnknownTableAndSyntaxError) {
   EXPECT_NE(error_of("[box]\nfill = \"hexagonal\"\n").find("allowed: lattice, random"), std::string::npos);
 }
 
+// Non-ASCII characters: fine in strings and comments, refused elsewhere with the line and column (the fuzzer
+// found that Debian's toml++ 3.3.0 reaches undefined behaviour on U+0409 after a value: the input below).
+TEST(Config, NonAsciiOutsideStringsAndCommentsRefused) {
+  EXPECT_EQ(error_of("[run]  # \u03c3_3 = 100 kPa\nname = \"\u03c3\u2083 \\\" test\"\n"
+                     "output = '''out/\u03bc'''\n"), "");
+  std::string e = error_of("[run]\nseed = 1 \u0409\n");
+  EXPECT_NE(e.find("bad.toml:2:10: a non-ASCII character"), std::string::npos) << e;
+  e = error_of("[triaxial]\n\u03c33_kPa = 100.0\n");
+  EXPECT_NE(e.find("bad.toml:2:1: a non-ASCII character"), std::string::npos) << e;
+}
+
 TEST(Config, TimeStepAboveCriticalRefused) {
   dem::Config c = dem::load_config(write_config("dt.toml", "[particles]\ncount = 50\n[solver]\ndt_s = 1e-3\n"));
   try {
