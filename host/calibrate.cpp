@@ -22,16 +22,49 @@ std::array<Real, kQuantities> quantities(const MeasuredTest& t) {
 
 Real NoiseModel::sigma(int q, Real measured) const { return std::max(rel[q] * std::fabs(measured), abs[q]); }
 
+bool NoiseModel::is_stress(int q) { return q != kStrainAtPeak && q != kDilatancy; }
+
+std::array<Real, kQuantities> test_residuals(const MeasuredTest& measured, const MeasuredTest& simulated,
+                                             const NoiseModel& noise) {
+  const auto m = quantities(measured), s = quantities(simulated);
+  std::array<Real, kQuantities> r;
+  r.fill(std::numeric_limits<Real>::quiet_NaN());
+  std::vector<int> idx;  // quantities measured and simulated: the whitened block
+  for (int q = 0; q < kQuantities; ++q) {
+    if (!std::isfinite(m[q])) continue;
+    if (std::isfinite(s[q]))
+      idx.push_back(q);
+    else
+      r[q] = kMissingResidual;
+  }
+  const int n = static_cast<int>(idx.size());
+  Eigen::MatrixXd cov(n, n);
+  Eigen::VectorXd diff(n), shared(n);
+  for (int i = 0; i < n; ++i) {
+    const int q = idx[i];
+    shared(i) = NoiseModel::is_stress(q) ? noise.specimen * m[q] : 0.0;
+    diff(i) = s[q] - m[q];
+  }
+  cov = shared * shared.transpose();
+  for (int i = 0; i < n; ++i) {
+    const Real total = noise.sigma(idx[i], m[idx[i]]);
+    // The shared part cannot exceed the whole scatter; the floor keeps C positive definite when it nearly does.
+    cov(i, i) = std::max(total * total, cov(i, i) + 0.01 * total * total);
+  }
+  const Eigen::LLT<Eigen::MatrixXd> llt(cov);
+  if (llt.info() != Eigen::Success) throw std::logic_error("test_residuals: noise covariance not positive definite");
+  const Eigen::VectorXd w = llt.matrixL().solve(diff);
+  for (int i = 0; i < n; ++i) r[idx[i]] = w(i);
+  return r;
+}
+
 std::vector<Real> residuals(const std::vector<MeasuredTest>& measured, const std::vector<MeasuredTest>& simulated,
                             const NoiseModel& noise, const std::vector<bool>& use) {
   std::vector<Real> r;
   for (std::size_t k = 0; k < measured.size(); ++k) {
     if (!use.empty() && !use[k]) continue;
-    const auto m = quantities(measured[k]), s = quantities(simulated[k]);
-    for (int q = 0; q < kQuantities; ++q) {
-      if (!std::isfinite(m[q])) continue;
-      r.push_back(std::isfinite(s[q]) ? (s[q] - m[q]) / noise.sigma(q, m[q]) : kMissingResidual);
-    }
+    for (Real v : test_residuals(measured[k], simulated[k], noise))
+      if (!std::isnan(v)) r.push_back(v);
   }
   return r;
 }

@@ -45,18 +45,33 @@ const char* quantity_name(int q);
 /// The quantities of a test (NaN where absent).
 std::array<Real, kQuantities> quantities(const MeasuredTest& t);
 
-/// Noise of each quantity: s_q = max(rel_q |measured|, abs_q).
+/// Noise of each quantity: s_q = max(rel_q |measured|, abs_q), its whole scatter. Part of it is shared by the
+/// stress quantities of one test (E_ini, q at 1% and 3%, q_peak, q_end): a specimen that is a little denser
+/// or stiffer than the next raises all its stresses together, by a factor of standard deviation `specimen`.
+/// The residuals of a test are therefore correlated, with covariance
+///   C = diag(s_q^2 - (specimen m_q)^2) + specimen^2 m m^T,   m_q = measured stress quantity (0 for the others),
+/// and treating them as independent lets one lucky specimen look like a systematic effect.
 struct NoiseModel {
   std::array<Real, kQuantities> rel{0.10, 0.06, 0.06, 0.04, 0.0, 0.05, 0.20};
   std::array<Real, kQuantities> abs{0.0, 0.0, 0.0, 0.0, 0.02, 0.0, 0.05};
+  Real specimen = 0.02;                     ///< shared relative scatter of a test's stresses (<= every stress rel_q)
   Real sigma(int q, Real measured) const;
+  static bool is_stress(int q);             ///< scaled by the specimen factor
 };
 
 /// Residual of a datum the simulation could not produce (no peak, a blow-up): ten standard deviations.
 constexpr Real kMissingResidual = 10;
 
-/// Normalised residuals (simulated - measured) / s_q of every present quantity, test by test (tests matched
-/// by index); `use[k]` false leaves test k out.
+/// Whitened residuals of one test, one per quantity (NaN where the measured test lacks it): r = L^-1 (s - m)
+/// with C = L L^T over the quantities present (NoiseModel), so that sum r^2 = (s - m)^T C^-1 (s - m). L is
+/// lower triangular in quantity order: r_q is what datum q says beyond the quantities before it (E_ini
+/// first), the shared specimen factor counted once. A quantity the simulation could not produce counts
+/// kMissingResidual and leaves the others' covariance.
+std::array<Real, kQuantities> test_residuals(const MeasuredTest& measured, const MeasuredTest& simulated,
+                                             const NoiseModel& noise);
+
+/// The whitened residuals of every present quantity, test by test (tests matched by index), concatenated;
+/// `use[k]` false leaves test k out.
 std::vector<Real> residuals(const std::vector<MeasuredTest>& measured, const std::vector<MeasuredTest>& simulated,
                             const NoiseModel& noise, const std::vector<bool>& use = {});
 

@@ -164,12 +164,12 @@ std::string gain_tables(const std::vector<MeasuredTest>& tests, const std::vecto
   std::ostringstream rows;
   for (std::size_t k = 0; k < tests.size(); ++k) {
     const auto m = quantities(tests[k]), b = quantities(base[k]), e = quantities(ext[k]);
+    const auto wb = test_residuals(tests[k], base[k], NoiseModel()), we = test_residuals(tests[k], ext[k], NoiseModel());
     const std::string p = fmt("%g kPa", 1e-3 * tests[k].sigma3);
     for (int q = 0; q < kQuantities; ++q) {
       if (!std::isfinite(m[q])) continue;
       const Real rb = residual(q, m[q], b[q]), re = residual(q, m[q], e[q]);
-      const Real miss = kMissingResidual * kMissingResidual;
-      const Real cb = std::isfinite(rb) ? rb * rb : miss, ce = std::isfinite(re) ? re * re : miss;
+      const Real cb = wb[q] * wb[q], ce = we[q] * we[q];
       for (auto* t : {&by_pressure, &by_range, &by_quantity}) {
         const std::string key = t == &by_pressure ? p : t == &by_range ? range_of[q] : quantity_name(q);
         at(*t, key).first += cb;
@@ -182,13 +182,16 @@ std::string gain_tables(const std::vector<MeasuredTest>& tests, const std::vecto
     }
   }
   std::ostringstream md;
-  md << "\nMisfit (chi2) of the base model and of the base + " << name << " model:\n\n| by | group | base | + " << name
+  md << "\nMisfit (chi2) of the base model and of the base + " << name
+     << " model, from the whitened residuals (a test's shared specimen factor counted once; each quantity "
+        "counts what it says beyond those before it, E_ini first), so that the groups add up to chi2:\n\n"
+        "| by | group | base | + " << name
      << " |\n|---|---|---|---|\n";
   for (const auto& [what, table] : {std::make_pair("pressure", &by_pressure), std::make_pair("strain range", &by_range),
                                     std::make_pair("quantity", &by_quantity)})
     for (const auto& [key, c] : *table)
       md << "| " << what << " | " << key << " | " << fmt("%.1f", c.first) << " | " << fmt("%.1f", c.second) << " |\n";
-  md << "\nEvery datum (residual in noise units, (simulated - measured) / s):\n\n| sigma3 kPa | quantity | unit | "
+  md << "\nEvery datum (plain residual in noise units, (simulated - measured) / s):\n\n| sigma3 kPa | quantity | unit | "
         "measured | base | residual | + " << name << " | residual |\n|---|---|---|---|---|---|---|---|\n"
      << rows.str();
   return md.str();
@@ -248,7 +251,7 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
   for (const FreeParam& f : ss.free) md << " " << f.name;
   md << ". Misfit: chi2 over the initial stiffness, q at 1% and 3% strain, q_peak, eps_a at peak, q_end and "
         "maximum dilatancy with "
-        "lab-like noise (host/calibrate.hpp).\n\n";
+        "lab-like noise, a test's stresses sharing a specimen factor (host/calibrate.hpp).\n\n";
   if (!ss.ref.values.empty())
     md << "Reference values: " << ss.ref.path << (ss.ref.comment.empty() ? "" : ": " + ss.ref.comment)
        << " The calibrated values belong to this simulator (its cell, density and boundary), the reference values to "

@@ -13,7 +13,8 @@
 ///    those parameters predicts it; the held-out misfit is the sum of those chi2 (runs, not surrogate values). Information criterion: BIC = chi2 + k ln n (k free
 ///    parameters, n data; the noise is known, so chi2 is -2 log-likelihood up to a constant).
 /// 4. Verdict: the extension with the lowest BIC is named when it beats the base by at least 6 (strong
-///    evidence: the nested models' likelihood-ratio test) and halves the held-out misfit; extensions within 2
+///    evidence: the nested models' likelihood-ratio test) and lowers the held-out chi2 by at least 6 too (the
+///    same evidence on data the fit did not see); extensions within 2
 ///    of its BIC cannot be told apart from these data and are named with it. Otherwise "none", and the report
 ///    says whether the base model fits within the noise (chi2 below the 99% quantile of chi2 with n - k
 ///    degrees of freedom) or misses the data in a way no extension explains.
@@ -23,6 +24,9 @@
 #include "calibrate.hpp"
 
 namespace dem {
+
+/// Strong evidence (Kass and Raftery 1995): a drop of BIC, and of the held-out chi2, by at least 6.
+constexpr Real kStrongEvidence = 6;
 
 /// A model extension the diagnosis tries: its parameter, three strengths within a physical range, and the
 /// signature it leaves in triaxial data (for the report).

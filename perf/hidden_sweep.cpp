@@ -48,7 +48,10 @@ int main(int argc, char** argv) {
   for (const Extension& e : extensions()) hidden.push_back(e.name);
   std::map<std::string, std::map<std::string, int>> confusion;
   std::ofstream csv(out);
-  csv << "hidden,strength,seed,verdict,base_chi2,chi2_limit,base_heldout,true_heldout\n";
+  // Every extension's BIC gain and held-out chi2 too, so that a decision rule can be judged on the whole sweep.
+  csv << "hidden,strength,seed,verdict,base_chi2,chi2_limit,base_heldout,true_heldout";
+  for (const Extension& e : extensions()) csv << "," << e.name << "_bic_gain," << e.name << "_heldout";
+  csv << "\n";
   PeriodicLab lab(cfg, false);
   lab.set_jobs(jobs);
   std::vector<unsigned> seeds = listed;
@@ -69,9 +72,14 @@ int main(int argc, char** argv) {
       const std::string named = dg.verdict.substr(0, dg.verdict.find(' '));
       ++confusion[h][named];
       char row[256];
-      std::snprintf(row, sizeof row, "%s,%.4g,%u,%s,%.2f,%.2f,%.2f,%.2f\n", h.c_str(), strength, seed,
+      std::snprintf(row, sizeof row, "%s,%.4g,%u,%s,%.2f,%.2f,%.2f,%.2f", h.c_str(), strength, seed,
                     dg.verdict.c_str(), dg.base.best.chi2, dg.chi2_limit, dg.base_heldout, true_heldout);
-      csv << row << std::flush;
+      csv << row;
+      for (const ExtensionFit& f : dg.fits) {
+        std::snprintf(row, sizeof row, ",%.2f,%.2f", dg.base_bic - f.bic, f.heldout);
+        csv << row;
+      }
+      csv << "\n" << std::flush;
       progress.update(++done, h + " -> " + dg.verdict);
     }
   progress.finish("");

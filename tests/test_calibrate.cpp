@@ -51,7 +51,8 @@ TEST(Calibrate, MinimiserFindsInteriorAndBoundaryMinima) {
 }
 
 // Residuals in noise units: relative noise for stresses, absolute for the strain at peak; absent quantities are
-// skipped and a missing simulated value counts ten standard deviations.
+// skipped and a missing simulated value counts ten standard deviations. One stress alone is not whitened by
+// anything (its residual is the plain one), and the strain at peak shares no specimen factor.
 TEST(Calibrate, ResidualsUseTheNoiseModel) {
   MeasuredTest m, s;
   m.q_peak = 100e3;
@@ -69,6 +70,48 @@ TEST(Calibrate, ResidualsUseTheNoiseModel) {
   s.q_peak = std::nan("");
   EXPECT_EQ(residuals({m}, {s}, noise)[0], 10.0);
   EXPECT_TRUE(residuals({m}, {s}, noise, {false}).empty());
+}
+
+// The shared specimen factor. A simulated test that is the measured one scaled by (1 + d) on every stress
+// differs from it by a specimen factor alone: with covariance C = diag(s^2 - f^2 m^2) + f^2 m m^T its
+// chi2 is analytic. By the Sherman-Morrison formula, for a difference x = d m (all five stresses, rel r_q),
+//   x^T C^-1 x = d^2 S / (1 + f^2 S),   S = sum_q m_q^2 / (s_q^2 - f^2 m_q^2) = sum_q 1 / (r_q^2 - f^2),
+// bounded by (d / f)^2 however many stresses share the factor, where independent ones would count
+// sum (d / r_q)^2, growing with every stress (1.01 against 1.51 here). The analytic value is checked to 1e-9
+// (rounding only). With specimen = 0 the whitened residuals are the plain ones.
+TEST(Calibrate, ResidualsCountASharedSpecimenFactorOnce) {
+  MeasuredTest m;
+  m.e_ini = 50e6;
+  m.q_1pct = 150e3;
+  m.q_3pct = 200e3;
+  m.q_peak = 220e3;
+  m.eps_a_peak = 0.04;
+  m.q_end = 180e3;
+  m.max_dilatancy = 0.3;
+  MeasuredTest s = m;
+  const Real d = 0.03;
+  for (Real* v : {&s.e_ini, &s.q_1pct, &s.q_3pct, &s.q_peak, &s.q_end}) *v *= 1 + d;
+  const NoiseModel noise;
+  Real S = 0, independent = 0;
+  for (int q = 0; q < kQuantities; ++q)
+    if (NoiseModel::is_stress(q)) {
+      S += 1 / (noise.rel[q] * noise.rel[q] - noise.specimen * noise.specimen);
+      independent += d * d / (noise.rel[q] * noise.rel[q]);
+    }
+  const auto r = test_residuals(m, s, noise);
+  Real chi2 = 0;
+  for (Real v : r) chi2 += v * v;
+  EXPECT_NEAR(chi2, d * d * S / (1 + noise.specimen * noise.specimen * S), 1e-9);
+  EXPECT_LT(chi2, independent);
+  EXPECT_LT(chi2, (d / noise.specimen) * (d / noise.specimen));
+  EXPECT_EQ(r[kStrainAtPeak], 0.0);
+  EXPECT_EQ(r[kDilatancy], 0.0);
+
+  NoiseModel plain;
+  plain.specimen = 0;
+  const auto p = test_residuals(m, s, plain);
+  for (int q = 0; q < kQuantities; ++q)
+    EXPECT_NEAR(p[q], (quantities(s)[q] - quantities(m)[q]) / plain.sigma(q, quantities(m)[q]), 1e-12);
 }
 
 TEST(Calibrate, FreeParametersAreNamedAndCentredOnTheBase) {
