@@ -58,6 +58,8 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   study->add_option("-t,--threads", study_opt.threads, "OpenMP threads per case (default: the cores shared out)")
       ->check(CLI::NonNegativeNumber);
+  study->add_flag("--resume", study_opt.resume,
+                  "keep the cases that finished (summary.csv), continue the triaxial cases from their checkpoints");
 
   std::string micro_source, micro_out;
   double micro_at = 0, micro_rve = 20;

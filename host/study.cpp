@@ -16,6 +16,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "checkpoint.hpp"
 #include "io_hdf5.hpp"
 #include "progress.hpp"
 
@@ -85,13 +86,14 @@ struct Running {
 };
 
 /// Starts `self job config -o folder` with its output in folder/log.txt and `threads` OpenMP threads.
-pid_t launch(const char* self, const StudyCase& c, const std::string& folder, int threads) {
+/// `resume`: the case continues from its checkpoint, and its log goes on.
+pid_t launch(const char* self, const StudyCase& c, const std::string& folder, int threads, bool resume) {
   fs::create_directories(folder);
   const std::string log = folder + "/log.txt";
   const pid_t pid = fork();
   if (pid < 0) throw std::runtime_error("study: cannot start a process for " + c.config);
   if (pid == 0) {
-    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | (resume ? O_APPEND : O_TRUNC), 0644);
     if (fd >= 0) {
       dup2(fd, 1);
       dup2(fd, 2);
@@ -99,7 +101,8 @@ pid_t launch(const char* self, const StudyCase& c, const std::string& folder, in
     }
     setenv("OMP_NUM_THREADS", std::to_string(threads).c_str(), 1);
     setenv("OMP_PROC_BIND", "false", 0);
-    execl(self, self, c.job.c_str(), c.config.c_str(), "-o", folder.c_str(), static_cast<char*>(nullptr));
+    execl(self, self, c.job.c_str(), c.config.c_str(), "-o", folder.c_str(), resume ? "--resume" : nullptr,
+          static_cast<char*>(nullptr));
     std::perror("study: exec");
     _exit(127);
   }
@@ -182,11 +185,22 @@ int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, c
   Progress progress("study", static_cast<long>(cases.size()));
   while (done < cases.size()) {
     while (next < cases.size() && static_cast<int>(running.size()) < jobs) {
-      const pid_t pid = launch(self_exe, cases[next], opt.output + "/" + cases[next].name, threads);
+      const std::string folder = opt.output + "/" + cases[next].name;
+      if (opt.resume && fs::exists(folder + "/summary.csv")) {
+        std::printf("study: %s finished before (summary.csv): kept\n", cases[next].name.c_str());
+        status[next++] = 0;
+        progress.update(static_cast<long>(++done));
+        continue;
+      }
+      // Only the triaxial job checkpoints; a periodic case (minutes) starts again.
+      const bool go_on = opt.resume && cases[next].job == "triaxial" && fs::exists(checkpoint_path(folder));
+      const pid_t pid = launch(self_exe, cases[next], folder, threads, go_on);
       running[pid] = {next, std::chrono::steady_clock::now()};
-      std::printf("study: started %s (%s)\n", cases[next].name.c_str(), cases[next].config.c_str());
+      std::printf("study: %s %s (%s)\n", go_on ? "resumed" : "started", cases[next].name.c_str(),
+                  cases[next].config.c_str());
       ++next;
     }
+    if (running.empty()) break;
     int ws = 0;
     const pid_t pid = waitpid(-1, &ws, 0);
     if (pid < 0) throw std::runtime_error("study: lost track of the running cases");

@@ -46,6 +46,7 @@ struct StudyOptions {
   std::string output = "out/study";  ///< the summary and one subfolder per case
   int jobs = 0;                      ///< cases run at once; 0: one per two cores (at least one)
   int threads = 0;                   ///< OpenMP threads per case; 0: the cores shared out among the jobs
+  bool resume = false;               ///< skip the cases with a summary.csv; continue those with a checkpoint.h5
 };
 
 /// Runs the study; returns 0 when every case finished, 1 otherwise (the summary then lists the failures).

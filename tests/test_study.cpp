@@ -63,3 +63,32 @@ TEST(Study, SummaryRoundTripsInFileUnits) {
     EXPECT_NE(std::string(e.what()).find("wall_s"), std::string::npos) << e.what();
   }
 }
+
+// `study --resume`: a case that left a summary.csv is kept as it is (its value below is not one a run could
+// produce, so seeing it proves the case did not run again), the other runs; without --resume both run.
+TEST(Study, ResumeKeepsFinishedCasesAndRunsTheRest) {
+  const auto dir = std::filesystem::path(::testing::TempDir()) / ("triaxdem_study_resume_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir / "configs");
+  for (const char* name : {"a", "b"})
+    std::filesystem::copy_file(std::string(TRIAXDEM_SOURCE_DIR) + "/tests/data/hidden_effects.toml",
+                               dir / "configs" / (std::string(name) + ".toml"));
+  StudyOptions opt;
+  opt.output = (dir / "out").string();
+  opt.jobs = 1;
+  opt.threads = 1;
+  opt.resume = true;
+  TestSummary done;
+  done.kind = "periodic";
+  done.q_peak = 12345e3;
+  std::filesystem::create_directories(dir / "out" / "a");
+  write_summary((dir / "out" / "a").string(), done);
+  ASSERT_EQ(study_job({(dir / "configs").string()}, opt, TRIAXDEM_BINARY), 0);
+  EXPECT_NEAR(read_summary((dir / "out" / "a" / "summary.csv").string()).q_peak, 12345e3, 1);
+  const double b = read_summary((dir / "out" / "b" / "summary.csv").string()).q_peak;
+  EXPECT_GT(b, 10e3);
+  EXPECT_LT(b, 1000e3);
+  std::ifstream table(dir / "out" / "study_summary.csv");
+  const std::string text((std::istreambuf_iterator<char>(table)), {});
+  EXPECT_NE(text.find("12345"), std::string::npos) << text;
+}
