@@ -1,0 +1,154 @@
+/// The periodic cell's set-up (a Simulation on a periodic box, its specimen, the balls back out of it) and the
+/// `periodic` CLI job; the test itself is in periodic_triaxial.cpp.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+#include "checkpoint.hpp"
+#include "job.hpp"
+#include "packing.hpp"
+#include "periodic_triaxial.hpp"
+#include "study.hpp"
+
+namespace dem {
+
+std::unique_ptr<Simulation> make_periodic_simulation(const std::vector<BallSpec>& balls,
+                                                     const std::array<Real, 3>& cell, const ContactParams& law,
+                                                     const SolverConfig& solver) {
+  if (balls.empty()) throw std::invalid_argument("periodic triaxial: no balls");
+  Real dmean = 0;
+  for (const BallSpec& b : balls) dmean += 2 * b.radius;
+  dmean /= static_cast<Real>(balls.size());
+  SimParams prm;
+  for (int k = 0; k < 3; ++k) {
+    prm.domain.lo[k] = 0;
+    prm.domain.hi[k] = cell[k];
+    prm.domain.periodic[k] = true;
+  }
+  prm.integ.gravity = Vec3();
+  prm.integ.alpha = solver.damping;
+  prm.integ.mass_scale = solver.mass_scale;
+  prm.skin = solver.skin * dmean;
+  prm.overlap_limit = solver.overlap_limit;
+  std::vector<BallSpec> b = balls;
+  for (BallSpec& s : b) s.material = 0;
+  auto sim = std::make_unique<Simulation>(make_particles(b), WallSet(), FacetMesh(), std::vector<ContactParams>{law},
+                                          1, prm);
+  sim->set_dt(time_step(solver, sim->critical_dt(), "the periodic cell's config"));
+  return sim;
+}
+
+std::vector<BallSpec> extract_balls(Simulation& sim, std::array<Real, 3>& cell) {
+  Particles& p = sim.particles();
+  const HostParticles h = to_host_by_gid(p);
+  auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), p.gid);
+  auto rad = Kokkos::create_mirror_view_and_copy(HostSpace(), p.radius);
+  auto mass = Kokkos::create_mirror_view_and_copy(HostSpace(), p.mass);
+  auto spec = Kokkos::create_mirror_view_and_copy(HostSpace(), p.specimen);
+  auto mat = Kokkos::create_mirror_view_and_copy(HostSpace(), p.material);
+  const Domain& dom = sim.domain();
+  std::vector<BallSpec> out(p.n);
+  for (int i = 0; i < p.n; ++i) {
+    BallSpec& b = out[gid(i)];
+    b.radius = rad(i);
+    b.density = mass(i) / (4.0 / 3.0 * M_PI * rad(i) * rad(i) * rad(i));
+    b.specimen = spec(i);
+    b.material = mat(i);
+  }
+  for (int k = 0; k < p.n; ++k) {
+    const Vec3 x = dom.wrap(h.x[k]);
+    out[k].x = Vec3(x.x - dom.lo[0], x.y - dom.lo[1], x.z - dom.lo[2]);
+    out[k].v = h.v[k];
+    out[k].w = h.w[k];
+  }
+  for (int d = 0; d < 3; ++d) cell[d] = dom.length(d);
+  return out;
+}
+
+void check_periodic_config(const Config& cfg) {
+  if (!(cfg.box.periodic[0] && cfg.box.periodic[1] && cfg.box.periodic[2]))
+    throw ConfigError(cfg.path + ": [box] periodic: the periodic triaxial needs [true, true, true]");
+  if (cfg.solver.gravity[0] != 0 || cfg.solver.gravity[1] != 0 || cfg.solver.gravity[2] != 0)
+    throw ConfigError(cfg.path + ": [solver] gravity: must be [0, 0, 0] in a fully periodic cell");
+}
+
+void prepare_periodic_specimen(const Config& cfg, std::vector<BallSpec>& balls, std::array<Real, 3>& cell,
+                               bool verbose) {
+  check_periodic_config(cfg);
+  const PeriodicConfig& pc = cfg.periodic;
+  balls = make_packing(cfg);
+  cell = cfg.box.size;
+  ContactParams prep = cfg.ball.base();
+  if (pc.prep_mu_s >= 0) prep.mu_s = pc.prep_mu_s;
+  if (pc.prep_mu_r >= 0) prep.mu_r = pc.prep_mu_r;
+  if (prep.mu_s == cfg.ball.mu_s && prep.mu_r == cfg.ball.mu_r) return;
+  auto sim = make_periodic_simulation(balls, cell, prep, cfg.solver);
+  if (verbose)
+    std::printf("triaxdem: preparation: %zu balls in a periodic cell %.2f x %.2f x %.2f mm, consolidated with "
+                "mu_s = %g, mu_r = %g; dt %.3e s\n", balls.size(), 1e3 * cell[0], 1e3 * cell[1], 1e3 * cell[2],
+                prep.mu_s, prep.mu_r, sim->params().integ.dt);
+  PeriodicTriaxialParams pp = resolve_periodic_params(*sim, pc.triax);
+  pp.name = cfg.run.name + " preparation";
+  pp.verbose = verbose;
+  pp.unbalanced_tolerance = pc.prep_unbalanced_tolerance;
+  consolidate_isotropic(*sim, pp);
+  balls = extract_balls(*sim, cell);
+}
+
+int run_periodic_job(const Config& cfg) {
+  std::vector<BallSpec> balls;
+  std::array<Real, 3> cell{};
+  prepare_periodic_specimen(cfg, balls, cell, true);
+  PeriodicTriaxialParams tp = cfg.periodic.triax;
+  tp.name = cfg.run.name;
+  io::Output out(cfg.run.output);
+  std::unique_ptr<Simulation> sim;
+  auto announce = [&](const char* what) {
+    std::printf("triaxdem: %s: %zu balls in a periodic cell %.2f x %.2f x %.2f mm; critical dt %.3e s, dt %.3e s\n",
+                what, balls.size(), 1e3 * sim->domain().length(0), 1e3 * sim->domain().length(1),
+                1e3 * sim->domain().length(2), sim->critical_dt(), sim->params().integ.dt);
+    if (cfg.solver.mass_scale != 1)
+      std::printf("triaxdem: DENSITY SCALING x%g is on: inertia is not physical (quasi-static runs only)\n",
+                  cfg.solver.mass_scale);
+  };
+  try {
+    sim = make_periodic_simulation(balls, cell, cfg.ball, cfg.solver);
+    announce("test");
+    const PeriodicTriaxialResult r = run_periodic_triaxial(*sim, tp, &out);
+    TestSummary su;
+    su.kind = "periodic";
+    su.sigma3 = r.params.sigma3;
+    su.mu_s = cfg.ball.mu_s;
+    su.mu_r = cfg.ball.mu_r;
+    su.balls = static_cast<long>(balls.size());
+    su.void_ratio0 = r.void_ratio0;
+    su.q_peak = r.q_peak;
+    su.phi_peak_deg = r.phi_peak_deg;
+    su.eps_a_peak = r.eps_a_peak;
+    su.q_end = r.series.back().q;
+    su.eps_a_end = r.series.back().eps_a;
+    for (std::size_t i = 1; i < r.series.size(); ++i) {
+      const Real de = r.series[i].eps_a - r.series[i - 1].eps_a;
+      if (de > 0) su.max_dilatancy = std::max(su.max_dilatancy, -(r.series[i].eps_v - r.series[i - 1].eps_v) / de);
+    }
+    su.inertial_number = r.inertial;
+    su.wall_seconds = r.wall_seconds;
+    write_summary(out.folder(), su);
+  } catch (const BlowUp& e) {
+    out.flush_series();
+    if (sim) {
+      out.write_snapshot(take_snapshot(*sim, "blow-up"));
+      write_checkpoint(blowup_path(out.folder()), Checkpoint{"periodic", sim->state(), {}, {}});
+    }
+    std::fprintf(stderr, "\ntriaxdem: %s\n  state at the blow-up saved in %s (snapshot and %s)\n", e.what(),
+                 out.folder().c_str(), blowup_path(out.folder()).c_str());
+    return 2;
+  }
+  std::printf("time loop (test): %s\n", describe(sim->times(), sim->particles().n, sim->step_count()).c_str());
+  std::printf("output: %s/series.csv, summary.csv, snapshots.xdmf\n", out.folder().c_str());
+  run_plot_script("plot_triaxial.py", {out.folder(), "--title", cfg.run.name});
+  return 0;
+}
+
+}  // namespace dem
