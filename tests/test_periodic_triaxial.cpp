@@ -218,3 +218,28 @@ TEST(PeriodicTriaxial, RefusesFastRatesAndReportsUnconvergedConsolidation) {
     EXPECT_NE(std::string(e.what()).find("did not converge in 300 steps"), std::string::npos) << e.what();
   }
 }
+
+// A periodic cell must keep 3 contact cut-offs on every side through consolidation and shear. 64 balls of
+// 2 mm at solid fraction 0.64 make a cube of 7.48 mm, 7.40 mm axially after 1% strain, under 1.05 x 3 x 2.4 mm
+// = 7.56 mm: refused with the key and the smallest count that fits (64 x (7.56 / 7.40)^3 = 69). 100 balls
+// (8.59 mm) pass.
+TEST(PeriodicCell, TooFewBallsForTheCellAreRefused) {
+  Config cfg;
+  cfg.path = "cell.toml";
+  cfg.particles.count = 64;
+  cfg.particles.diameter = 2e-3;
+  cfg.box.size = {20e-3, 20e-3, 20e-3};
+  cfg.box.periodic = {true, true, true};
+  cfg.solver.gravity = {0, 0, 0};
+  cfg.periodic.triax.target_strain = 0.01;
+  try {
+    check_periodic_config(cfg);
+    FAIL() << "64 balls accepted";
+  } catch (const ConfigError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("cell.toml: [particles] count: 64 balls"), std::string::npos) << m;
+    EXPECT_NE(m.find("allowed: at least 69 balls"), std::string::npos) << m;
+  }
+  cfg.particles.count = 100;
+  EXPECT_NO_THROW(check_periodic_config(cfg));
+}
