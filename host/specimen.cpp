@@ -166,6 +166,11 @@ Specimen build_specimen(const Config& cfg, bool verbose) {
     out.balls = all;
     LayerReport rep{z0, z1, sim.wall_point(kTop).z, slab_void_ratio(out.balls, R, z0, z1), steps, ratio};
     out.layers.push_back(rep);
+    if (steps >= sc.max_steps_per_layer && ratio >= sc.stop_ratio)
+      std::fprintf(stderr, "specimen: WARNING: layer %ld/%ld stopped at [specimen] max_steps_per_layer = %ld with "
+                   "the unbalanced ratio at %.1e, above stop_ratio = %.0e: it is not at rest (raise "
+                   "max_steps_per_layer, or accept it)\n", k + 1, sc.layers, sc.max_steps_per_layer, ratio,
+                   sc.stop_ratio);
     if (verbose)
       std::printf("specimen: layer %ld/%ld: %ld balls, platen at %.3f mm (target %.3f), unbalanced ratio %.1e; time "
                   "loop: %s\n", k + 1, sc.layers, pc.count, rep.z_platen * 1e3, z1 * 1e3, ratio,
