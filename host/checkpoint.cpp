@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <csignal>
+#include <filesystem>
 #include <cstdint>
 #include <sstream>
 
@@ -177,6 +178,34 @@ Checkpoint read_checkpoint(const std::string& path) {
     c.texts[name] = std::string(bytes.begin(), bytes.end());
   }
   return c;
+}
+
+Checkpoint checkpoint_of(const std::string& job, const Simulation& sim, const io::Output* out) {
+  Checkpoint c;
+  c.job = job;
+  c.sim = sim.state();
+  if (out) {
+    c.numbers["series"] = out->series_rows();
+    c.texts["snapshots"] = out->snapshot_index();
+  }
+  return c;
+}
+
+Checkpoint resume_checkpoint(const std::string& path, const std::string& job) {
+  if (!std::filesystem::exists(path))
+    throw std::runtime_error("--resume: no checkpoint " + path + " (run without --resume to start afresh)");
+  Checkpoint c = read_checkpoint(path);
+  if (c.job != job) throw std::runtime_error(path + ": written by the '" + c.job + "' job, not by '" + job + "'");
+  return c;
+}
+
+void resume_from(const Checkpoint& c, Simulation& sim, io::Output* out) {
+  sim.restore(c.sim);
+  if (!out) return;
+  const auto rows = c.numbers.find("series");
+  const auto index = c.texts.find("snapshots");
+  out->resume(rows == c.numbers.end() ? std::vector<double>{} : rows->second,
+              index == c.texts.end() ? "" : index->second);
 }
 
 std::string checkpoint_path(const std::string& folder) { return folder + "/checkpoint.h5"; }

@@ -14,7 +14,9 @@
 #include <string>
 #include <vector>
 
+#include "io_hdf5.hpp"
 #include "sim_state.hpp"
+#include "simulation.hpp"
 
 namespace dem {
 
@@ -24,6 +26,15 @@ struct Checkpoint {
   std::map<std::string, std::vector<double>> numbers;   ///< the job's state: counters, records so far
   std::map<std::string, std::string> texts;             ///< the job's state in words (e.g. the snapshot index)
 };
+
+/// The part every job's checkpoint shares: the job name, the simulation's state and, when `out` is given, the
+/// output's series rows and snapshot index.
+Checkpoint checkpoint_of(const std::string& job, const Simulation& sim, const io::Output* out);
+/// The checkpoint a `--resume` continues from: refuses a missing file (saying how to start afresh) and one
+/// written by another job.
+Checkpoint resume_checkpoint(const std::string& path, const std::string& job);
+/// Puts a simulation and an output (may be null) back where the checkpoint left them.
+void resume_from(const Checkpoint& c, Simulation& sim, io::Output* out);
 
 /// Writes atomically; throws std::runtime_error naming the path.
 void write_checkpoint(const std::string& path, const Checkpoint& c);

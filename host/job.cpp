@@ -73,18 +73,6 @@ io::Snapshot take_snapshot(Simulation& sim, const std::string& label) {
   return s;
 }
 
-namespace {
-/// A checkpoint of the run job: the simulation, the series so far and the snapshot index.
-void save_run(const std::string& path, Simulation& sim, const io::Output& out) {
-  Checkpoint c;
-  c.job = "run";
-  c.sim = sim.state();
-  c.numbers["series"] = out.series_rows();
-  c.texts["snapshots"] = out.snapshot_index();
-  write_checkpoint(path, c);
-}
-}  // namespace
-
 int run_job(const Config& cfg, bool resume, long stop_at_step) {
   io::Output out(cfg.run.output);
   auto sim = build_simulation(cfg, true);
@@ -92,15 +80,7 @@ int run_job(const Config& cfg, bool resume, long stop_at_step) {
                           "contacts_ball_wall", "wall_force_sum_N"});
   const std::string ckpt = checkpoint_path(out.folder());
   if (resume) {
-    if (!std::filesystem::exists(ckpt))
-      throw std::runtime_error("--resume: no checkpoint " + ckpt + " (run without --resume to start afresh)");
-    const Checkpoint c = read_checkpoint(ckpt);
-    if (c.job != "run") throw std::runtime_error(ckpt + ": written by the '" + c.job + "' job, not by 'run'");
-    sim->restore(c.sim);
-    const auto rows = c.numbers.find("series");
-    const auto index = c.texts.find("snapshots");
-    out.resume(rows == c.numbers.end() ? std::vector<double>{} : rows->second,
-               index == c.texts.end() ? "" : index->second);
+    resume_from(resume_checkpoint(ckpt, "run"), *sim, &out);
     std::printf("triaxdem: resuming %s at step %ld (t = %.6g s)\n", ckpt.c_str(), sim->step_count(), sim->time());
   } else {
     out.write_snapshot(take_snapshot(*sim, "initial"));
@@ -138,7 +118,7 @@ int run_job(const Config& cfg, bool resume, long stop_at_step) {
       // The series is flushed with every checkpoint, so that a killed run's files agree with its checkpoint.
       if (plan.due(s)) {
         out.flush_series();
-        save_run(ckpt, *sim, out);
+        write_checkpoint(ckpt, checkpoint_of("run", *sim, &out));
         plan.clock.written();
       }
       if (plan.stop(s)) {
@@ -150,7 +130,7 @@ int run_job(const Config& cfg, bool resume, long stop_at_step) {
   } catch (const BlowUp& e) {
     out.flush_series();
     out.write_snapshot(take_snapshot(*sim, "blow-up"));
-    save_run(blowup_path(out.folder()), *sim, out);
+    write_checkpoint(blowup_path(out.folder()), checkpoint_of("run", *sim, &out));
     std::fprintf(stderr, "\ntriaxdem: %s\n  state at the blow-up saved in %s (snapshot) and %s (for inspection); "
                  "the last good checkpoint, %s, continues with --resume once the cause is fixed\n",
                  e.what(), out.folder().c_str(), blowup_path(out.folder()).c_str(), ckpt.c_str());
@@ -158,7 +138,7 @@ int run_job(const Config& cfg, bool resume, long stop_at_step) {
   }
   out.flush_series();
   out.write_snapshot(take_snapshot(*sim, "final"));
-  save_run(ckpt, *sim, out);
+  write_checkpoint(ckpt, checkpoint_of("run", *sim, &out));
   progress.finish("");
   std::printf("time loop: %s\n", describe(sim->times(), sim->particles().n, sim->step_count()).c_str());
   std::printf("output: %s/snapshots.xdmf (ParaView), %s/series.csv; checkpoint %s (more steps: --resume -n N)\n",

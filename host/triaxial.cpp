@@ -124,7 +124,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
   auto checkpoint = [&](const Stage& now) {
     if (!plan || !plan->due(sim.step_count())) return;
     if (out) out->flush_series();
-    save_triaxial(*plan, sim, out, now, res);
+    save_triaxial(plan->path, sim, out, now, res);
     plan->clock.written();
     if (plan->stop(sim.step_count())) throw run_stopped(*plan, sim.step_count());
   };
@@ -272,7 +272,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
       const io::SurfaceSnapshot surface = membrane_surface(cell.membrane);
       const io::ContactTable contacts = contact_table(contact_set(sim));
       out->write_snapshot(take_snapshot(sim, "blow-up"), &surface, &contacts);
-      if (plan) save_triaxial(CheckpointPlan{blowup_path(out->folder())}, sim, out, st, res);
+      if (plan) save_triaxial(blowup_path(out->folder()), sim, out, st, res);
       std::fprintf(stderr, "triaxdem: state at the blow-up saved in %s (snapshots.xdmf, last entry; %s)\n",
                    out->folder().c_str(), blowup_path(out->folder()).c_str());
     }
@@ -306,9 +306,7 @@ int triaxial_job(const Config& cfg, bool resume, long stop_at_step) {
                       cfg.run.checkpoint_minutes), nullptr, stop_at_step};
   Checkpoint from;
   if (resume) {
-    if (!std::filesystem::exists(plan.path))
-      throw std::runtime_error("--resume: no checkpoint " + plan.path + " (run without --resume to start afresh)");
-    from = read_checkpoint(plan.path);
+    from = resume_checkpoint(plan.path, "triaxial");
     plan.from = &from;
   }
   StopSignals signals;

@@ -36,20 +36,14 @@ std::vector<TriaxialRecord> records_of(const std::vector<double>& v) {
 }
 }  // namespace
 
-void save_triaxial(const CheckpointPlan& plan, Simulation& sim, const io::Output* out, const Stage& st,
+void save_triaxial(const std::string& path, const Simulation& sim, const io::Output* out, const Stage& st,
                    const TriaxialResult& res) {
-  Checkpoint c;
-  c.job = "triaxial";
-  c.sim = sim.state();
+  Checkpoint c = checkpoint_of("triaxial", sim, out);
   c.numbers["stage"] = stage_numbers(st);
   c.numbers["records"] = record_numbers(res.records);
   std::vector<double>& micro = c.numbers["micro"];
   for (const MicroRow& m : res.micro) append_micro_state(m, micro);
-  if (out) {
-    c.numbers["series"] = out->series_rows();
-    c.texts["snapshots"] = out->snapshot_index();
-  }
-  write_checkpoint(plan.path, c);
+  write_checkpoint(path, c);
 }
 
 void restore_triaxial(const Checkpoint& c, const std::string& path, Simulation& sim, io::Output* out, Stage& st,
@@ -57,15 +51,12 @@ void restore_triaxial(const Checkpoint& c, const std::string& path, Simulation& 
   if (c.job != "triaxial") throw std::runtime_error(path + ": written by the '" + c.job + "' job, not 'triaxial'");
   for (const char* key : {"stage", "records"})
     if (!c.numbers.count(key)) throw std::runtime_error(path + ": the triaxial '" + std::string(key) + "' is missing");
-  sim.restore(c.sim);
+  resume_from(c, sim, out);
   st = stage_of(c.numbers.at("stage"), path);
   res.records = records_of(c.numbers.at("records"));
   if (c.numbers.count("micro"))
     for (std::size_t at = 0; at < c.numbers.at("micro").size();)
       res.micro.push_back(micro_row_from(c.numbers.at("micro"), at));
-  if (out)
-    out->resume(c.numbers.count("series") ? c.numbers.at("series") : std::vector<double>{},
-                c.texts.count("snapshots") ? c.texts.at("snapshots") : "");
 }
 
 }  // namespace dem

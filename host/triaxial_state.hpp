@@ -19,8 +19,8 @@ struct Stage {
   Real q_max = -INFINITY, next_snap = 0, next_record = 0;                         ///< Pa, index, strain
 };
 
-/// Writes the checkpoint of a triaxial run to plan.path.
-void save_triaxial(const CheckpointPlan& plan, Simulation& sim, const io::Output* out, const Stage& st,
+/// Writes the checkpoint of a triaxial run to `path`.
+void save_triaxial(const std::string& path, const Simulation& sim, const io::Output* out, const Stage& st,
                    const TriaxialResult& res);
 /// Continues from a checkpoint: the simulation, the stage, the records and micromechanics, the output.
 /// Throws std::runtime_error naming `path` when it is not a triaxial checkpoint or is malformed.
