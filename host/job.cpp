@@ -1,7 +1,6 @@
 #include "job.hpp"
 
 #include <cstdio>
-#include <filesystem>
 #include <numeric>
 
 #include "checkpoint.hpp"
