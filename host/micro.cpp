@@ -228,6 +228,11 @@ Tensor love_weber(const ContactSet& s, Real volume, bool include_boundary) {
   return t;
 }
 
+Real stress_ratio(const Tensor& s) {
+  const Real p = (s[0] + s[4] + s[8]) / 3;
+  return p > 0 ? (s[8] - (s[0] + s[4]) / 2) / p : 0;
+}
+
 ContactSet restrict_to_cube(const ContactSet& s, const Vec3& centre, Real edge) {
   Real lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
   for (int d = 0; d < 3 && !s.x.empty(); ++d) lo[d] = hi[d] = s.x[0][d];

@@ -99,6 +99,10 @@ std::vector<RoseBin> rose(const ContactSet& s, int bins, Network net = Network::
 /// With boundary contacts included it is the specimen's mean stress.
 Tensor love_weber(const ContactSet& s, Real volume, bool include_boundary);
 
+/// Triaxial stress ratio q/p of a stress tensor with z the axis: q = s_zz - (s_xx + s_yy)/2, p = tr/3;
+/// zero when p <= 0.
+Real stress_ratio(const Tensor& s);
+
 /// The cube of side `edge` centred at `centre`: balls by centre, contacts by contact point. Contact
 /// averages (2 Nc / Np, forces, fabric, stress) use the contacts inside; per-ball counts (O_n, Z_mech) use
 /// every contact of the balls inside, so balls at the faces are not undercounted. Throws

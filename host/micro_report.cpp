@@ -20,9 +20,7 @@ MicroRow micro_row(const ContactSet& s, Real volume) {
   r.all = anisotropy(s, Network::kAll, r.stress);
   r.strong = anisotropy(s, Network::kStrong, r.stress);
   r.weak = anisotropy(s, Network::kWeak, r.stress);
-  const Real p = (r.stress[0] + r.stress[4] + r.stress[8]) / 3;
-  const Real q = r.stress[8] - (r.stress[0] + r.stress[4]) / 2;
-  r.q_over_p = p > 0 ? q / p : 0;
+  r.q_over_p = stress_ratio(r.stress);
   r.q_over_p_sff = 0.4 * (r.all.a_c + r.all.a_n + 1.5 * r.all.a_t);
   return r;
 }

@@ -8,12 +8,11 @@
 #include <filesystem>
 #include <string>
 
-#include <unistd.h>
-
 #include "host/calibrate.hpp"
 #include "host/calibration_jobs.hpp"
 #include "host/diagnose.hpp"
 #include "host/measured.hpp"
+#include "test_util.hpp"
 
 using namespace dem;
 
@@ -148,12 +147,11 @@ TEST(Calibrate, ChiSquareQuantile) {
 // Calibration never writes into an earlier result: two folders asked for in the same second differ.
 TEST(Calibrate, DatedFoldersAreNeverReused) {
   namespace fs = std::filesystem;
-  const std::string parent = (fs::temp_directory_path() / ("triaxdem_dated_" + std::to_string(::getpid()))).string();
+  const std::string parent = dem::test::scratch_dir("dated").string();
   const std::string a = new_dated_folder(parent, "calibrate"), b = new_dated_folder(parent, "calibrate");
   EXPECT_NE(a, b);
   EXPECT_TRUE(fs::is_directory(a));
   EXPECT_TRUE(fs::is_directory(b));
-  fs::remove_all(parent);
 }
 
 // Curves written by the synthetic generator's writer read back as the same tests (kPa and % in the file).
@@ -166,11 +164,9 @@ TEST(Calibrate, MeasuredCurvesRoundTrip) {
     t.q.push_back(300e3 * (1 - std::exp(-0.5 * i)));
     t.eps_v.push_back(-0.0002 * i);
   }
-  const std::string path =
-      (std::filesystem::temp_directory_path() / ("triaxdem_curves_" + std::to_string(::getpid()) + ".csv")).string();
+  const std::string path = (dem::test::scratch_dir("curves") / "curves.csv").string();
   write_measured_curves(path, {t}, "round trip");
   const MeasuredData d = load_measured(path);
-  std::filesystem::remove(path);
   ASSERT_TRUE(d.curves);
   ASSERT_EQ(d.tests.size(), 1u);
   ASSERT_EQ(d.tests[0].q.size(), t.q.size());

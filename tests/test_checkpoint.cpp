@@ -6,7 +6,6 @@
 #include <fcntl.h>
 #include <spawn.h>
 #include <sys/wait.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <csignal>
@@ -20,6 +19,7 @@
 #include "host/config.hpp"
 #include "host/io_hdf5.hpp"
 #include "host/job.hpp"
+#include "test_util.hpp"
 
 extern char** environ;
 
@@ -28,12 +28,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::path(::testing::TempDir()) / ("triaxdem_ckpt_" + std::to_string(::getpid())) / name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+fs::path scratch(const std::string& name) { return dem::test::scratch_dir("checkpoint/" + name); }
 
 /// 300 beads poured into a box under a strong gravity (200 g, so that they land within a few thousand
 /// steps) with sliding and rolling friction: by step 4000 the contacts carry shear and rolling history.

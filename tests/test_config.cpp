@@ -7,14 +7,13 @@
 #include "host/config.hpp"
 #include "host/builder.hpp"
 #include "host/job.hpp"
+#include "test_util.hpp"
 
-#include <unistd.h>
 
 namespace {
 
 std::string write_config(const std::string& name, const std::string& text) {
-  const auto dir = std::filesystem::path(::testing::TempDir()) / ("triaxdem_cfg_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
+  static const auto dir = dem::test::scratch_dir("config");
   const auto path = dir / name;
   std::ofstream(path) << text;
   return path.string();

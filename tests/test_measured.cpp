@@ -1,8 +1,6 @@
 // Measured triaxial data (host/measured.hpp): the shipped Table 6, curves, and refusals with line and column.
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -10,14 +8,14 @@
 
 #include "host/diagnose.hpp"
 #include "host/measured.hpp"
+#include "test_util.hpp"
 
 using namespace dem;
 
 namespace {
 
 std::string write(const std::string& name, const std::string& text) {
-  const auto dir = std::filesystem::path(::testing::TempDir()) / ("triaxdem_data_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
+  static const auto dir = dem::test::scratch_dir("measured");
   std::ofstream(dir / name) << text;
   return (dir / name).string();
 }

@@ -2,8 +2,6 @@
 // contact sets, coordination and networks on hand-built graphs, the cube cut and the force-chain file.
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -12,6 +10,7 @@
 
 #include "host/micro.hpp"
 #include "host/micro_report.hpp"
+#include "test_util.hpp"
 
 using namespace dem;
 
@@ -193,7 +192,7 @@ TEST(Micro, ForceChainFileListsEverySegment) {
   s.x = {Vec3(0, 0, 0), Vec3(0, 0, 2e-3), Vec3(0, 0, 4e-3)};
   s.radius.assign(3, 1e-3);
   s.contacts = {contact(0, 1, 1), contact(1, 2, 3), contact(2, -1, 9, Boundary::kPlaten)};
-  const auto path = std::filesystem::path(::testing::TempDir()) / ("chains_" + std::to_string(::getpid()) + ".vtk");
+  const auto path = dem::test::scratch_dir("chains") / "chains.vtk";
   write_force_chains_vtk(path.string(), s);
   std::ifstream f(path);
   const std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());

@@ -1,8 +1,6 @@
 // Multilayer compaction of a cylindrical specimen, and the exact sphere-slab volumes it is measured with.
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
 #include <filesystem>
 #include <fstream>
 
@@ -35,8 +33,7 @@ TEST(Specimen, CacheRoundTripsBitForBitAndRefusesOtherKeys) {
   b.density = 2500;
   sp.balls = {b, b};
   sp.balls[1].x.z = 7.123456789e-3;
-  const auto dir = std::filesystem::path(::testing::TempDir()) / ("triaxdem_sp_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
+  const auto dir = dem::test::scratch_dir("specimen");
   const std::string path = (dir / "s.csv").string();
   save_specimen(path, sp, "key A");
   Specimen back;

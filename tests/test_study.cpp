@@ -5,8 +5,7 @@
 #include <fstream>
 
 #include "host/study.hpp"
-
-#include <unistd.h>
+#include "test_util.hpp"
 
 using namespace dem;
 
@@ -31,8 +30,7 @@ TEST(Study, ConfigWithoutATestIsRefusedByName) {
 }
 
 TEST(Study, SummaryRoundTripsInFileUnits) {
-  const auto dir = std::filesystem::path(::testing::TempDir()) / ("triaxdem_study_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
+  const auto dir = dem::test::scratch_dir("study");
   TestSummary s;
   s.kind = "membrane";
   s.sigma3 = 200e3;
@@ -67,8 +65,7 @@ TEST(Study, SummaryRoundTripsInFileUnits) {
 // `study --resume`: a case that left a summary.csv is kept as it is (its value below is not one a run could
 // produce, so seeing it proves the case did not run again), the other runs; without --resume both run.
 TEST(Study, ResumeKeepsFinishedCasesAndRunsTheRest) {
-  const auto dir = std::filesystem::path(::testing::TempDir()) / ("triaxdem_study_resume_" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
+  const auto dir = dem::test::scratch_dir("study_resume");
   std::filesystem::create_directories(dir / "configs");
   for (const char* name : {"a", "b"})
     std::filesystem::copy_file(std::string(TRIAXDEM_SOURCE_DIR) + "/tests/data/hidden_effects.toml",

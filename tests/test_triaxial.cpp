@@ -3,8 +3,6 @@
 // 24 x 8 membrane) so that each run takes seconds; the physics checked is qualitative and robust at this size.
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -65,9 +63,12 @@ TEST_F(Triaxial, DenseFrictionalSpecimenContractsThenDilatesInsideTheMembrane) {
   const TriaxialRecord& r0 = r.records.front();
   EXPECT_NEAR(m0.stress[8], 0.5 * (r0.sigma1 + r0.sigma1_bottom), 0.02 * c.triaxial.sigma3);
   EXPECT_NEAR(0.5 * (m0.stress[0] + m0.stress[4]), c.triaxial.sigma3, 0.02 * c.triaxial.sigma3);
-  // Stress-force-fabric: q/p from the anisotropies tracks the contacts' q/p (the relation neglects
-  // branch-length anisotropy and cross terms: 0.1 in q/p, about 8% of its peak here).
-  for (const MicroRow& m : r.micro) EXPECT_NEAR(m.q_over_p_sff, m.q_over_p, 0.1);
+  // Stress-force-fabric: q/p from the anisotropies tracks q/p of the same contacts, the ball-ball ones
+  // (platen and membrane contacts are no part of the anisotropies; in 452 balls they carry enough to
+  // shift q/p by 0.2 when the specimen is isotropic). The relation neglects branch-length anisotropy and
+  // cross terms: 0.1 in q/p, about 8% of its peak here.
+  for (const MicroRow& m : r.micro)
+    EXPECT_NEAR(m.q_over_p_sff, stress_ratio(m.net.all.stress), 0.1) << "q/p with the boundary " << m.q_over_p;
   EXPECT_GT(r.micro[r.micro.size() / 3].all.a_c, r.micro.front().all.a_c);  // shear aligns the contacts
   EXPECT_GT(r.micro.front().z.z, 4.0);  // a consolidated frictional packing
   // The membrane's volume change against the balls' own envelope (convex hull of each slab's balls): they
@@ -105,8 +106,7 @@ TEST_F(Triaxial, HigherFrictionGivesHigherPeakStrength) {
 }
 
 TEST_F(Triaxial, MicromechanicsFromSavedStatesAndClearRefusals) {
-  const auto dir = std::filesystem::path(::testing::TempDir()) / ("triaxdem_micro_" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
+  const auto dir = dem::test::scratch_dir("micro");
   Config c = tiny_config(0.3, 0.02);
   c.triaxial.axial_strain_end = 0.05;  // snapshots A (0%), B (1%) and D = C (5%)
   {
@@ -167,8 +167,7 @@ TEST_F(Triaxial, MicromechanicsFromSavedStatesAndClearRefusals) {
 // shear (platen ramp, records, micromechanics), resumed each time from the checkpoint file, it ends with
 // the records and the series of the run that was never stopped, compared with == (bit for bit).
 TEST_F(Triaxial, StoppedInEachStageAndResumedMatchesTheUnstoppedRun) {
-  const auto dir = std::filesystem::path(::testing::TempDir()) / ("triaxdem_tx_ckpt_" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
+  const auto dir = dem::test::scratch_dir("triaxial_checkpoint");
   Config c = tiny_config(0.3, 0.02);
   c.triaxial.axial_strain_end = 0.03;
   c.micro.enabled = true;

@@ -1,11 +1,36 @@
 #pragma once
 /// Small helpers shared by the test files.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+
 #include "host/config.hpp"
 #include "kernels/contact_law.hpp"
 
 namespace dem::test {
 
 constexpr double kPi = 3.14159265358979323846;
+
+/// An empty folder `name` (nested names allowed) of this test process's own: ctest runs every test at 1 and
+/// 2 threads, possibly at once, so the root carries the pid. The root goes when the process exits, so a
+/// test run leaves nothing behind in the temporary folder.
+inline std::filesystem::path scratch_dir(const std::string& name) {
+  namespace fs = std::filesystem;
+  struct Root {
+    fs::path path = fs::path(::testing::TempDir()) / ("triaxdem_test_" + std::to_string(::getpid()));
+    ~Root() {
+      std::error_code ignored;  // a folder a child process still holds is not worth a failure at exit
+      fs::remove_all(path, ignored);
+    }
+  };
+  static const Root root;
+  const fs::path dir = root.path / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
 
 /// Contact parameters in one line: E* (Pa), kn/ks, mu_s, mu_r, normal damping ratio.
 inline ContactParams law(double emod, double kratio, double mu_s, double mu_r, double beta_n = 0) {

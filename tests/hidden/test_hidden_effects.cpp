@@ -13,12 +13,11 @@
 #include <string>
 #include <vector>
 
-#include <unistd.h>
-
 #include "host/calibrate.hpp"
 #include "host/config.hpp"
 #include "host/diagnose.hpp"
 #include "host/measured.hpp"
+#include "tests/test_util.hpp"
 
 using namespace dem;
 
@@ -37,9 +36,7 @@ class HiddenEffect : public ::testing::TestWithParam<HiddenCase> {};
 TEST_P(HiddenEffect, DiagnosisNamesIt) {
   const HiddenCase c = GetParam();
   const Config cfg = load_config(std::string(TRIAXDEM_SOURCE_DIR) + "/tests/data/hidden_effects.toml");
-  const std::string file =
-      (std::filesystem::temp_directory_path() / ("triaxdem_hidden_" + c.extension + "_" +
-                                                  std::to_string(::getpid()) + ".csv")).string();
+  const std::string file = (test::scratch_dir("hidden_" + c.extension) / "curves.csv").string();
   {  // The generator: its model and lab go out of scope; only the file remains.
     Model truth = model_of(cfg);
     if (c.extension != "none") set_param(truth, extension(c.extension).param, c.strength);
@@ -48,7 +45,6 @@ TEST_P(HiddenEffect, DiagnosisNamesIt) {
                           "hidden-effect test");
   }
   const MeasuredData data = load_measured(file);
-  std::filesystem::remove(file);
   PeriodicLab lab(cfg, false);
   lab.set_jobs(2);
   const Model base = model_of(cfg);
