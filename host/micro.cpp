@@ -228,9 +228,17 @@ Tensor love_weber(const ContactSet& s, Real volume, bool include_boundary) {
   return t;
 }
 
+Real axial_deviator(const Tensor& t) { return t[8] - (t[0] + t[4]) / 2; }
+
 Real stress_ratio(const Tensor& s) {
   const Real p = (s[0] + s[4] + s[8]) / 3;
-  return p > 0 ? (s[8] - (s[0] + s[4]) / 2) / p : 0;
+  return p > 0 ? axial_deviator(s) / p : 0;
+}
+
+Real sff_stress_ratio(const Anisotropy& a) {
+  Tensor sum;
+  for (int q = 0; q < 9; ++q) sum[q] = a.ac[q] + a.an[q] + 1.5 * a.at[q];
+  return 0.4 * axial_deviator(sum);
 }
 
 ContactSet restrict_to_cube(const ContactSet& s, const Vec3& centre, Real edge) {

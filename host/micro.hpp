@@ -99,9 +99,14 @@ std::vector<RoseBin> rose(const ContactSet& s, int bins, Network net = Network::
 /// With boundary contacts included it is the specimen's mean stress.
 Tensor love_weber(const ContactSet& s, Real volume, bool include_boundary);
 
-/// Triaxial stress ratio q/p of a stress tensor with z the axis: q = s_zz - (s_xx + s_yy)/2, p = tr/3;
-/// zero when p <= 0.
+/// Axial deviator t_zz - (t_xx + t_yy)/2 of a tensor, z the specimen's axis: q of a stress.
+Real axial_deviator(const Tensor& t);
+/// Triaxial stress ratio q/p of a stress tensor (p = tr/3); zero when p <= 0.
 Real stress_ratio(const Tensor& s);
+/// q/p of the stress-force-fabric relation, sigma / p = I + (2/5)(a^c + a^n + 3/2 a^t), taken with the
+/// tensors: for tensors coaxial with the stress it is (2/5)(a_c + a_n + 3/2 a_t), and where they are not
+/// (an isotropic state, whose anisotropies point anywhere) the scalars' signs mean nothing.
+Real sff_stress_ratio(const Anisotropy& a);
 
 /// The cube of side `edge` centred at `centre`: balls by centre, contacts by contact point. Contact
 /// averages (2 Nc / Np, forces, fabric, stress) use the contacts inside; per-ball counts (O_n, Z_mech) use

@@ -21,7 +21,7 @@ MicroRow micro_row(const ContactSet& s, Real volume) {
   r.strong = anisotropy(s, Network::kStrong, r.stress);
   r.weak = anisotropy(s, Network::kWeak, r.stress);
   r.q_over_p = stress_ratio(r.stress);
-  r.q_over_p_sff = 0.4 * (r.all.a_c + r.all.a_n + 1.5 * r.all.a_t);
+  r.q_over_p_sff = sff_stress_ratio(r.all);
   return r;
 }
 

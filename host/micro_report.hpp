@@ -17,7 +17,7 @@ struct MicroRow {
   Anisotropy all, strong, weak;
   Tensor stress{};        ///< Love-Weber, boundary contacts included: the specimen's mean stress (Pa)
   Real q_over_p = 0;      ///< from `stress`
-  Real q_over_p_sff = 0;  ///< (2/5)(a_c + a_n + 3/2 a_t): the stress-force-fabric estimate
+  Real q_over_p_sff = 0;  ///< the stress-force-fabric estimate (sff_stress_ratio)
 };
 MicroRow micro_row(const ContactSet& s, Real volume);
 

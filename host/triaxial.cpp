@@ -330,7 +330,7 @@ int triaxial_job(const Config& cfg, bool resume, long stop_at_step) {
         if (r.records[i].q > r.records[k].q) k = i;
       const MicroRow& m = r.micro[k];
       std::printf("at peak: q/p %.3f at the boundary, %.3f from the contacts (Love-Weber), %.3f from "
-                  "(2/5)(a_c + a_n + 3/2 a_t) with a_c %.3f, a_n %.3f, a_t %.3f; Z %.2f\n",
+                  "the stress-force-fabric relation, with a_c %.3f, a_n %.3f, a_t %.3f; Z %.2f\n",
                   r.records[k].q / (cfg.triaxial.sigma3 + r.records[k].q / 3), m.q_over_p, m.q_over_p_sff, m.all.a_c,
                   m.all.a_n, m.all.a_t, m.z.z);
     }
