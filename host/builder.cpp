@@ -1,6 +1,8 @@
 #include "builder.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <tuple>
 
 namespace dem {
 
@@ -28,6 +30,16 @@ Particles make_particles(const std::vector<BallSpec>& balls) {
   Kokkos::deep_copy(p.gid, gid); Kokkos::deep_copy(p.specimen, spec); Kokkos::deep_copy(p.material, mat);
   Kokkos::deep_copy(p.x_ref, p.x);
   return p;
+}
+
+void sort_like_cells(std::vector<BallSpec>& balls, Real cell) {
+  if (balls.empty()) return;
+  Vec3 lo = balls[0].x;
+  for (const BallSpec& b : balls) lo = Vec3(std::min(lo.x, b.x.x), std::min(lo.y, b.x.y), std::min(lo.z, b.x.z));
+  auto key = [&](const BallSpec& b) {
+    return std::make_tuple(std::floor((b.x.z - lo.z) / cell), std::floor((b.x.y - lo.y) / cell), b.x.x);
+  };
+  std::stable_sort(balls.begin(), balls.end(), [&](const BallSpec& a, const BallSpec& b) { return key(a) < key(b); });
 }
 
 WallSet make_walls(const std::vector<WallSpec>& walls) {

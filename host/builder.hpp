@@ -26,6 +26,12 @@ struct WallSpec {
 
 /// Particles with gids 0..n-1 in the given order.
 Particles make_particles(const std::vector<BallSpec>& balls);
+
+/// Puts balls in the cell list's own order (slabs of `cell` along z, rows of `cell` along y, then x), so
+/// that gids given in this order follow space. Contacts are stored by gid and balls visited in cell order:
+/// when the two agree the force loop streams through memory; a specimen poured at random visits its
+/// contacts at random (half the throughput at 54,000 balls). Stable, so equal keys keep their order.
+void sort_like_cells(std::vector<BallSpec>& balls, Real cell);
 WallSet make_walls(const std::vector<WallSpec>& walls);
 /// nodes: n*3 coordinates (m); tris: m*3 node indices.
 FacetMesh make_mesh(const std::vector<Real>& nodes, const std::vector<int>& tris, int material);

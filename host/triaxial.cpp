@@ -58,7 +58,11 @@ Cell make_cell(const Config& cfg, const Specimen& sp) {
   for (int d = 0; d < 2; ++d) prm.domain.lo[d] = -2 * c.radius, prm.domain.hi[d] = 2 * c.radius;
   prm.domain.lo[2] = -0.5 * sp.height;
   prm.domain.hi[2] = 1.5 * sp.height;
-  c.sim = std::make_unique<Simulation>(make_particles(sp.balls), make_walls(w), c.membrane.mesh,
+  std::vector<BallSpec> balls = sp.balls;
+  Real r_max = 0;
+  for (const BallSpec& b : balls) r_max = std::max(r_max, b.radius);
+  sort_like_cells(balls, 2 * r_max);
+  c.sim = std::make_unique<Simulation>(make_particles(balls), make_walls(w), c.membrane.mesh,
                                        std::vector<ContactParams>{cfg.ball, cfg.wall, cfg.wall, cfg.wall}, 2, prm);
   MembraneIntegrateParams mp;
   mp.gravity = prm.integ.gravity;
