@@ -184,6 +184,9 @@ Checkpoint checkpoint_of(const std::string& job, const Simulation& sim, const io
   Checkpoint c;
   c.job = job;
   c.sim = sim.state();
+  const StageTimes& t = sim.times();
+  c.numbers["stage_times_s"] = {t.rebuild, t.forces, t.integrate, t.boundaries, t.membrane,
+                                static_cast<double>(t.rebuilds)};
   if (out) {
     c.numbers["series"] = out->series_rows();
     c.texts["snapshots"] = out->snapshot_index();
@@ -201,6 +204,11 @@ Checkpoint resume_checkpoint(const std::string& path, const std::string& job) {
 
 void resume_from(const Checkpoint& c, Simulation& sim, io::Output* out) {
   sim.restore(c.sim);
+  const auto times = c.numbers.find("stage_times_s");
+  if (times != c.numbers.end() && times->second.size() == 6) {
+    const std::vector<double>& t = times->second;
+    sim.set_times(StageTimes{t[0], t[1], t[2], t[3], t[4], static_cast<long>(t[5])});
+  }
   if (!out) return;
   const auto rows = c.numbers.find("series");
   const auto index = c.texts.find("snapshots");

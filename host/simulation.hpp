@@ -56,6 +56,8 @@ class Simulation {
   const ContactList& wall_contacts() const { return wall_c_; }
   const StepStats& stats() const { return stats_; }
   const StageTimes& times() const { return times_; }
+  /// The stage times of the run segments before a resume, so that reports cover the whole run.
+  void set_times(const StageTimes& t) { times_ = t; }
   const SimParams& params() const { return prm_; }
   long step_count() const { return step_; }
   Real time() const { return time_; }

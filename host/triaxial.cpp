@@ -118,8 +118,12 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
       for (const std::string& c : micro_columns(prefix)) columns.push_back(c);
   if (out) out->set_series_columns(columns);
   Stage st;
+  // Wall time of the whole test: a resumed run adds what the segments before it took.
+  double wall_before = 0;
+  auto elapsed = [&] { return wall_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
   if (plan && plan->from) {
     restore_triaxial(*plan->from, plan->path, sim, out, st, res);
+    wall_before = res.wall_seconds;
     if (verbose)
       std::printf("triaxial: resuming %s at step %ld (%s)\n", plan->path.c_str(), sim.step_count(),
                   st.shear != 0 ? "shear" : "consolidation");
@@ -128,6 +132,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
   auto checkpoint = [&](const Stage& now) {
     if (!plan || !plan->due(sim.step_count())) return;
     if (out) out->flush_series();
+    res.wall_seconds = elapsed();
     save_triaxial(plan->path, sim, out, now, res);
     plan->clock.written();
     if (plan->stop(sim.step_count())) throw run_stopped(*plan, sim.step_count());
@@ -296,7 +301,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
   }
   if (!res.records.empty()) res.q_end = res.records.back().q;
   res.escaped = count_escaped(sim, cell.membrane, sim.wall_point(kTopPlaten).z);
-  res.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  res.wall_seconds = elapsed();
   res.times = sim.times();
   res.steps = sim.step_count();
   res.balls = sim.particles().n;

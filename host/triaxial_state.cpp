@@ -41,6 +41,7 @@ void save_triaxial(const std::string& path, const Simulation& sim, const io::Out
   Checkpoint c = checkpoint_of("triaxial", sim, out);
   c.numbers["stage"] = stage_numbers(st);
   c.numbers["records"] = record_numbers(res.records);
+  c.numbers["wall_s"] = {res.wall_seconds};
   std::vector<double>& micro = c.numbers["micro"];
   for (const MicroRow& m : res.micro) append_micro_state(m, micro);
   write_checkpoint(path, c);
@@ -54,6 +55,7 @@ void restore_triaxial(const Checkpoint& c, const std::string& path, Simulation& 
   resume_from(c, sim, out);
   st = stage_of(c.numbers.at("stage"), path);
   res.records = records_of(c.numbers.at("records"));
+  if (c.numbers.count("wall_s") && c.numbers.at("wall_s").size() == 1) res.wall_seconds = c.numbers.at("wall_s")[0];
   if (c.numbers.count("micro"))
     for (std::size_t at = 0; at < c.numbers.at("micro").size();)
       res.micro.push_back(micro_row_from(c.numbers.at("micro"), at));

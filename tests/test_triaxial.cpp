@@ -204,6 +204,12 @@ TEST_F(Triaxial, StoppedInEachStageAndResumedMatchesTheUnstoppedRun) {
   }
   EXPECT_EQ(resumed.consolidation_steps, whole.consolidation_steps);
   EXPECT_EQ(resumed.steps, whole.steps);
+  // The report covers the whole test, not the last segment: the rebuild count is the unstopped run's, and
+  // the wall time includes what the checkpoint says the segments before took.
+  EXPECT_EQ(resumed.times.rebuilds, whole.times.rebuilds);
+  ASSERT_EQ(from.numbers.count("wall_s"), 1u);
+  EXPECT_GT(from.numbers.at("wall_s")[0], 0.0);
+  EXPECT_GT(resumed.wall_seconds, from.numbers.at("wall_s")[0]);
   ASSERT_EQ(resumed.records.size(), whole.records.size());
   for (std::size_t i = 0; i < whole.records.size(); ++i) {
     EXPECT_EQ(resumed.records[i].eps_a, whole.records[i].eps_a) << i;
