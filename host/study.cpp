@@ -182,14 +182,20 @@ int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, c
   std::vector<int> status(cases.size(), -1);
   std::map<pid_t, Running> running;
   std::size_t next = 0, done = 0;
-  Progress progress("study", static_cast<long>(cases.size()));
+  auto finished_before = [&](std::size_t k) {
+    return opt.resume && fs::exists(opt.output + "/" + cases[k].name + "/summary.csv");
+  };
+  long kept = 0;
+  for (std::size_t k = 0; k < cases.size(); ++k) kept += finished_before(k);
+  // Kept cases took no time in this run: left out of the rate behind the ETA.
+  Progress progress("study", static_cast<long>(cases.size()), kept);
   while (done < cases.size()) {
     while (next < cases.size() && static_cast<int>(running.size()) < jobs) {
       const std::string folder = opt.output + "/" + cases[next].name;
-      if (opt.resume && fs::exists(folder + "/summary.csv")) {
+      if (finished_before(next)) {
         std::printf("study: %s finished before (summary.csv): kept\n", cases[next].name.c_str());
         status[next++] = 0;
-        progress.update(static_cast<long>(++done));
+        ++done;
         continue;
       }
       // Only the triaxial job checkpoints; a periodic case (minutes) starts again.
