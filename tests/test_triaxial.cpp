@@ -64,12 +64,18 @@ TEST_F(Triaxial, DenseFrictionalSpecimenContractsThenDilatesInsideTheMembrane) {
   EXPECT_NEAR(m0.stress[8], 0.5 * (r0.sigma1 + r0.sigma1_bottom), 0.02 * c.triaxial.sigma3);
   EXPECT_NEAR(0.5 * (m0.stress[0] + m0.stress[4]), c.triaxial.sigma3, 0.02 * c.triaxial.sigma3);
   // Stress-force-fabric: q/p from the anisotropy tensors tracks q/p of the same contacts, the ball-ball
-  // ones (the platen and membrane contacts are no part of the anisotropies). The relation neglects
-  // branch-length anisotropy and cross terms: 0.1 in q/p, about 8% of its peak here. (Its scalar form
-  // failed at the isotropic start of another trajectory, 0.23 against 0.01: there the anisotropies are
-  // not coaxial with the stress and their signs are noise.)
+  // ones (the platen and membrane contacts are no part of the anisotropies). The relation truncates the
+  // directional distributions at second order and neglects branch-length anisotropy; the truncation errs
+  // more the more anisotropic the packing, so the allowance is 8% of the run's peak q/p (the notes say
+  // 5-10%): 0.104 on the release build's trajectory (peak 1.30, largest gap 0.047), 0.135 on the sanitizer
+  // build's, whose specimen peaks at 1.69 with gaps of 0.11 there. (The scalar form failed at the isotropic
+  // start of that trajectory, 0.23 against 0.01: there the anisotropies are not coaxial with the stress and
+  // their signs are noise.)
+  double peak_ratio = 0;
+  for (const MicroRow& m : r.micro) peak_ratio = std::max(peak_ratio, stress_ratio(m.net.all.stress));
   for (const MicroRow& m : r.micro)
-    EXPECT_NEAR(m.q_over_p_sff, stress_ratio(m.net.all.stress), 0.1) << "q/p with the boundary " << m.q_over_p;
+    EXPECT_NEAR(m.q_over_p_sff, stress_ratio(m.net.all.stress), 0.08 * peak_ratio)
+        << "q/p with the boundary " << m.q_over_p;
   EXPECT_GT(r.micro[r.micro.size() / 3].all.a_c, r.micro.front().all.a_c);  // shear aligns the contacts
   EXPECT_GT(r.micro.front().z.z, 4.0);  // a consolidated frictional packing
   // The membrane's volume change against the balls' own envelope (convex hull of each slab's balls): they
