@@ -234,6 +234,8 @@ std::vector<Real> smooth(const std::vector<Real>& eps_a, const std::vector<Real>
 }
 }  // namespace
 
+Real friction_angle_deg(Real q, Real sigma3) { return std::asin(q / (q + 2 * sigma3)) * 180 / M_PI; }
+
 void summarise(MeasuredTest& t) {
   if (t.q.empty()) return;
   const std::vector<Real> q = smooth(t.eps_a, t.q, kSmoothHalfWidth);

@@ -87,6 +87,25 @@ constexpr Real kEarlyStrain = 0.01, kMidStrain = 0.03;
 /// -d eps_v / d eps_a (the slope over one 0.5% window). The same function summarises simulated curves.
 void summarise(MeasuredTest& t);
 
+/// A simulated test's rows (any type with eps_a, q and eps_v) as a curve test, summarised like measured curves:
+/// its peak is the peak of the moving mean, not the highest single row (rows of a full-scale specimen scatter
+/// by about 4% of q), so that simulated and measured peaks compare like with like.
+template <class Row>
+MeasuredTest summarised(const std::vector<Row>& rows, Real sigma3) {
+  MeasuredTest t;
+  t.sigma3 = sigma3;
+  for (const Row& r : rows) {
+    t.eps_a.push_back(r.eps_a);
+    t.q.push_back(r.q);
+    t.eps_v.push_back(r.eps_v);
+  }
+  summarise(t);
+  return t;
+}
+
+/// Peak friction angle (degrees) of a deviator q at confining pressure sigma3: asin(q / (q + 2 sigma3)).
+Real friction_angle_deg(Real q, Real sigma3);
+
 /// Reference parameter values to set beside calibrated ones (e.g. a paper's own calibration): a CSV with a
 /// `material` column and one column per parameter, named as in [calibrate] free (mu_s, mu_r, ...), in that
 /// key's unit. Comment lines ('#') are kept as the source's description.

@@ -145,12 +145,9 @@ int run_periodic_job(const Config& cfg) {
     su.q_peak = r.q_peak;
     su.phi_peak_deg = r.phi_peak_deg;
     su.eps_a_peak = r.eps_a_peak;
-    su.q_end = r.series.back().q;
+    su.q_end = r.q_end;
     su.eps_a_end = r.series.back().eps_a;
-    for (std::size_t i = 1; i < r.series.size(); ++i) {
-      const Real de = r.series[i].eps_a - r.series[i - 1].eps_a;
-      if (de > 0) su.max_dilatancy = std::max(su.max_dilatancy, -(r.series[i].eps_v - r.series[i - 1].eps_v) / de);
-    }
+    su.max_dilatancy = r.max_dilatancy;
     su.inertial_number = r.inertial;
     su.wall_seconds = r.wall_seconds;
     write_summary(out.folder(), su);

@@ -40,8 +40,6 @@ PeriodicLab::PeriodicLab(const Config& base, bool verbose) : cfg_(base) {
 MeasuredTest PeriodicLab::run(const Model& m, Real sigma3, const std::string& material) {
   const auto t0 = std::chrono::steady_clock::now();
   MeasuredTest t;
-  t.material = material;
-  t.sigma3 = sigma3;
   PeriodicTriaxialParams p = cfg_.periodic.triax;
   p.sigma3 = sigma3;
   p.membrane_stiffness = m.membrane;
@@ -49,16 +47,12 @@ MeasuredTest PeriodicLab::run(const Model& m, Real sigma3, const std::string& ma
   p.snapshot_strains.clear();
   try {
     auto sim = make_periodic_simulation(balls_, cell_, m.law, cfg_.solver);
-    const PeriodicTriaxialResult r = run_periodic_triaxial(*sim, p);
-    for (const PeriodicTriaxialRecord& row : r.series) {
-      t.eps_a.push_back(row.eps_a);
-      t.q.push_back(row.q);
-      t.eps_v.push_back(row.eps_v);
-    }
-    summarise(t);
+    t = summarised(run_periodic_triaxial(*sim, p).series, sigma3);
   } catch (const BlowUp&) {
+    t.sigma3 = sigma3;
     mark_failed(t);
   }
+  t.material = material;
   ++runs_;
   seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return t;

@@ -11,6 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "measured.hpp"
 #include "kernels/reduce.hpp"
 #include "job.hpp"
 #include "progress.hpp"
@@ -313,9 +314,13 @@ PeriodicTriaxialResult run_periodic_triaxial(Simulation& sim, const PeriodicTria
   sim.set_strain_rate(Vec3());
   if (out) out->flush_series();
 
+  const MeasuredTest curve = summarised(res.series, prm.sigma3);
+  res.q_peak = curve.q_peak;
+  res.eps_a_peak = curve.eps_a_peak;
+  res.phi_peak_deg = friction_angle_deg(curve.q_peak, prm.sigma3);
+  res.q_end = curve.q_end;
+  res.max_dilatancy = curve.max_dilatancy;
   for (const PeriodicTriaxialRecord& r : res.series) {
-    if (r.q > res.q_peak) res.q_peak = r.q, res.eps_a_peak = r.eps_a;
-    res.phi_peak_deg = std::max(res.phi_peak_deg, r.phi_mob_deg);
     // The membrane's share is the same on both axes to rounding (they stretch alike on average); its
     // mean is recorded.
     const Real target = prm.sigma3 + r.membrane;
@@ -330,8 +335,9 @@ PeriodicTriaxialResult run_periodic_triaxial(Simulation& sim, const PeriodicTria
     std::printf("periodic triaxial: consolidated in %ld steps to void ratio %.4f (Z = %.2f); sheared to eps_a = %.2f%% "
                 "in %ld steps\n", res.consolidation_steps, res.void_ratio0, res.series.front().coordination,
                 100 * f.eps_a, sim.step_count() - res.series.front().step);
-    std::printf("peak q = %.2f kPa at eps_a = %.2f%%; peak friction angle phi = asin((s1-s3)/(s1+s3)) = %.2f deg\n",
-                1e-3 * res.q_peak, 100 * res.eps_a_peak, res.phi_peak_deg);
+    std::printf("peak q = %.2f kPa at eps_a = %.2f%% (moving mean over +-%.2f%% strain); peak friction angle "
+                "phi = asin((s1-s3)/(s1+s3)) = %.2f deg\n",
+                1e-3 * res.q_peak, 100 * res.eps_a_peak, 100 * kSmoothHalfWidth, res.phi_peak_deg);
     std::printf("end: q = %.2f kPa, eps_v = %.2f%%, void ratio %.4f; lateral stress within %.2f%% of sigma3; "
                 "wall time %s\n", 1e-3 * f.q, 100 * f.eps_v, f.void_ratio, 100 * res.max_lateral_error,
                 format_duration(res.wall_seconds).c_str());

@@ -65,7 +65,9 @@ struct PeriodicTriaxialResult {
   Real inertial = 0;                 ///< I of the axial rate at p = sigma3
   Real h0 = 0, V0 = 0, void_ratio0 = 0;      ///< cell at the start of shear
   std::vector<PeriodicTriaxialRecord> series;
-  Real q_peak = 0, eps_a_peak = 0, phi_peak_deg = 0;
+  /// Summarised like measured curves (summarised, host/measured.hpp): the peak of the moving mean of q, q_end
+  /// the mean over the last 1% of strain, the dilatancy over 0.5% windows.
+  Real q_peak = 0, eps_a_peak = 0, phi_peak_deg = 0, q_end = 0, max_dilatancy = 0;
   Real max_lateral_error = 0;        ///< max over rows of |sigma2 or sigma3 - applied| / applied
   Real max_kinetic = 0;              ///< J, over rows
   double wall_seconds = 0;

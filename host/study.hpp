@@ -16,10 +16,10 @@ struct TestSummary {
   Real mu_s = 0, mu_r = 0;      ///< ball-ball friction of the test
   long balls = 0;
   Real void_ratio0 = 0;         ///< at the start of shear
-  Real q_peak = 0;              ///< Pa
+  Real q_peak = 0;              ///< Pa, peak of the moving mean of q (summarise, host/measured.hpp)
   Real phi_peak_deg = 0;        ///< asin(q / (q + 2 sigma3)) at the peak
   Real eps_a_peak = 0;          ///< axial strain at the peak
-  Real q_end = 0;               ///< Pa, q at the end strain
+  Real q_end = 0;               ///< Pa, mean q over the last 1% of strain
   Real eps_a_end = 0;
   Real max_dilatancy = 0;       ///< max of -d eps_v / d eps_a
   Real inertial_number = 0;

@@ -10,6 +10,7 @@
 
 #include "host/membrane_mesh.hpp"
 #include "job.hpp"
+#include "measured.hpp"
 #include "micro_report.hpp"
 #include "progress.hpp"
 #include "servo.hpp"
@@ -288,18 +289,15 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
     throw;
   }
   if (out) out->flush_series();
-  for (std::size_t i = 0; i < res.records.size(); ++i) {
-    const TriaxialRecord& r = res.records[i];
-    if (r.q > res.q_peak) {
-      res.q_peak = r.q;
-      res.eps_a_peak = r.eps_a;
-      res.phi_peak_deg = std::asin(r.q / (r.q + 2 * tc.sigma3)) * 180 / M_PI;
-    }
-    if (i > 0 && r.eps_a > res.records[i - 1].eps_a)
-      res.max_dilatancy = std::max(res.max_dilatancy, -(r.eps_v - res.records[i - 1].eps_v) /
-                                                          (r.eps_a - res.records[i - 1].eps_a));
+  if (!res.records.empty()) {
+    const MeasuredTest curve = summarised(res.records, tc.sigma3);
+    res.q_peak = curve.q_peak;
+    res.eps_a_peak = curve.eps_a_peak;
+    res.phi_peak_deg = friction_angle_deg(curve.q_peak, tc.sigma3);
+    res.q_end = curve.q_end;
+    res.max_dilatancy = curve.max_dilatancy;
+    for (const TriaxialRecord& r : res.records) res.q_peak_record = std::max(res.q_peak_record, r.q);
   }
-  if (!res.records.empty()) res.q_end = res.records.back().q;
   res.escaped = count_escaped(sim, cell.membrane, sim.wall_point(kTopPlaten).z);
   res.wall_seconds = elapsed();
   res.times = sim.times();
@@ -327,10 +325,12 @@ int triaxial_job(const Config& cfg, bool resume, long stop_at_step) {
                 sp.balls.size(), sp.void_ratio, sp.height * 1e3);
     write_specimen_report(out.folder(), cfg, sp);
     const TriaxialResult r = run_triaxial(cfg, sp, &out, true, &plan);
-    std::printf("\nresult: q_peak %.1f kPa at eps_a %.2f%%, peak friction angle %.1f deg, q at %.0f%% %.1f kPa, "
-                "max dilatancy %.3f, wall time %s\n",
-                r.q_peak / 1e3, 100 * r.eps_a_peak, r.phi_peak_deg, 100 * cfg.triaxial.axial_strain_end,
-                r.q_end / 1e3, r.max_dilatancy, format_duration(r.wall_seconds).c_str());
+    std::printf("\nresult: q_peak %.1f kPa at eps_a %.2f%% (moving mean over +-%.2f%% strain; highest record %.1f kPa), "
+                "peak friction angle %.1f deg, q at %.0f%% %.1f kPa (mean over the last %.0f%%), max dilatancy %.3f, "
+                "wall time %s\n",
+                r.q_peak / 1e3, 100 * r.eps_a_peak, 100 * kSmoothHalfWidth, r.q_peak_record / 1e3, r.phi_peak_deg,
+                100 * cfg.triaxial.axial_strain_end, r.q_end / 1e3, 100 * kEndWindow, r.max_dilatancy,
+                format_duration(r.wall_seconds).c_str());
     if (r.escaped > 0) std::printf("WARNING: %d balls ended outside the membrane\n", r.escaped);
     if (!r.micro.empty()) {
       // The stress-force-fabric relation beside the boundary's q/p at the peak (p = sigma3 + q/3).
