@@ -184,6 +184,7 @@ Config parse_config(const std::string& text, const std::string& path) {
 
   TableReader run = table("run");
   run.string("name", c.run.name);
+  run.string("material", c.run.material);
   run.integer("steps", c.run.steps, 0, 1000000000L);
   run.string("output", c.run.output);
   run.integer("series_every", c.run.series_every, 1, 1000000000L);

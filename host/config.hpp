@@ -18,6 +18,7 @@ struct ConfigError : std::runtime_error {
 
 struct RunConfig {
   std::string name = "run";
+  std::string material;          ///< the lab material the run stands for (e.g. "S-1"): `study --compare` matches it
   long steps = 20000;            ///< time steps of the run
   std::string output = "out";    ///< output folder
   long series_every = 100;       ///< steps between time-series rows

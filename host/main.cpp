@@ -60,6 +60,11 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   study->add_flag("--resume", study_opt.resume,
                   "keep the cases that finished (summary.csv), continue the triaxial cases from their checkpoints");
+  study->add_option("--compare", study_opt.compare,
+                    "measured data (README: measured-data format) whose q_peak goes beside each case's, matched by "
+                    "[run] material and sigma3; repeat for several files")
+      ->allow_extra_args(false)
+      ->check(CLI::ExistingFile);
 
   std::string micro_source, micro_out;
   double micro_at = 0, micro_rve = 20;

@@ -6,11 +6,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <stdexcept>
@@ -25,6 +27,8 @@ namespace dem {
 namespace fs = std::filesystem;
 
 namespace {
+
+constexpr Real kNaN = std::numeric_limits<Real>::quiet_NaN();
 
 // Column names and scales of summary.csv: one place for the writer and the reader.
 struct Column {
@@ -160,6 +164,7 @@ std::vector<StudyCase> study_cases(const std::vector<std::string>& inputs) {
     const Config cfg = load_config(f);  // a bad file stops the study before anything runs
     StudyCase c;
     c.config = f;
+    c.material = cfg.run.material;
     c.name = fs::path(f).stem().string();
     if (cfg.has_periodic) c.job = "periodic";
     else if (cfg.has_specimen) c.job = "triaxial";
@@ -171,8 +176,31 @@ std::vector<StudyCase> study_cases(const std::vector<std::string>& inputs) {
   return cases;
 }
 
+PeakComparison compare_peaks(const MeasuredData& data, const std::vector<StudyCase>& cases,
+                             const std::vector<TestSummary>& summaries) {
+  PeakComparison c;
+  c.source = data.path;
+  c.measured.assign(cases.size(), kNaN);
+  c.error.assign(cases.size(), kNaN);
+  Real sum = 0;
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    for (const MeasuredTest& t : data.tests)
+      if (t.material == cases[k].material && std::fabs(t.sigma3 - summaries[k].sigma3) <= 1e-6 * t.sigma3)
+        c.measured[k] = t.q_peak;
+    if (!(std::isfinite(c.measured[k]) && std::isfinite(summaries[k].q_peak))) continue;
+    c.error[k] = (summaries[k].q_peak - c.measured[k]) / c.measured[k];
+    sum += std::fabs(c.error[k]);
+    if (c.matched == 0 || std::fabs(c.error[k]) > c.max_abs_error) c.max_abs_error = std::fabs(c.error[k]), c.worst = k;
+    ++c.matched;
+  }
+  if (c.matched > 0) c.mean_abs_error = sum / c.matched;
+  return c;
+}
+
 int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, const char* self_exe) {
   const std::vector<StudyCase> cases = study_cases(inputs);
+  std::vector<MeasuredData> compare;  // read before anything runs: a bad file stops the study at once
+  for (const std::string& f : opt.compare) compare.push_back(load_measured(f));
   const int cores = std::max(1u, std::thread::hardware_concurrency());
   const int jobs = std::clamp(opt.jobs > 0 ? opt.jobs : cores / 2, 1, static_cast<int>(cases.size()));
   const int threads = opt.threads > 0 ? opt.threads : std::max(1, cores / jobs);
@@ -224,23 +252,60 @@ int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, c
   }
   progress.finish("");
 
-  std::string table = "case,config,job,status," + summary_header() + "\n";
+  std::vector<TestSummary> summaries(cases.size());
+  std::vector<bool> ok(cases.size(), false);
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    const std::string path = opt.output + "/" + cases[k].name + "/summary.csv";
+    ok[k] = status[k] == 0 && fs::exists(path);
+    if (ok[k]) summaries[k] = read_summary(path);
+    else summaries[k].q_peak = kNaN;
+  }
+  std::vector<PeakComparison> cmp;
+  for (const MeasuredData& d : compare) cmp.push_back(compare_peaks(d, cases, summaries));
+
+  std::string table = "case,config,job,status,material," + summary_header();
+  for (const PeakComparison& c : cmp) {
+    const std::string stem = fs::path(c.source).stem().string();
+    table += ",q_peak_" + stem + "_kPa,error_" + stem + "_pct";
+  }
+  table += "\n";
   int failed = 0;
-  std::printf("\n%-14s %8s %6s %6s %10s %9s %10s %10s %8s\n", "case", "s3 kPa", "mu_s", "mu_r", "q_peak kPa",
+  std::printf("\n%-14s %8s %6s %6s %10s %9s %10s %10s %8s", "case", "s3 kPa", "mu_s", "mu_r", "q_peak kPa",
               "phi deg", "eps_pk %", "q_end kPa", "max dil");
+  for (std::size_t j = 0; j < cmp.size(); ++j) std::printf(" %7s%zu %6s%zu", "ref kPa ", j + 1, "err % ", j + 1);
+  std::printf("\n");
   for (std::size_t k = 0; k < cases.size(); ++k) {
     const StudyCase& c = cases[k];
-    const std::string path = opt.output + "/" + c.name + "/summary.csv";
-    if (status[k] != 0 || !fs::exists(path)) {
+    if (!ok[k]) {
       ++failed;
-      table += c.name + "," + c.config + "," + c.job + ",failed\n";
+      table += c.name + "," + c.config + "," + c.job + ",failed," + c.material + "\n";
       std::printf("%-14s FAILED: see %s/%s/log.txt\n", c.name.c_str(), opt.output.c_str(), c.name.c_str());
       continue;
     }
-    const TestSummary s = read_summary(path);
-    table += c.name + "," + c.config + "," + c.job + ",ok," + summary_values(s) + "\n";
-    std::printf("%-14s %8.0f %6.3f %6.3f %10.1f %9.2f %10.2f %10.1f %8.3f\n", c.name.c_str(), s.sigma3 / 1e3, s.mu_s,
+    const TestSummary& s = summaries[k];
+    table += c.name + "," + c.config + "," + c.job + ",ok," + c.material + "," + summary_values(s);
+    std::printf("%-14s %8.0f %6.3f %6.3f %10.1f %9.2f %10.2f %10.1f %8.3f", c.name.c_str(), s.sigma3 / 1e3, s.mu_s,
                 s.mu_r, s.q_peak / 1e3, s.phi_peak_deg, 100 * s.eps_a_peak, s.q_end / 1e3, s.max_dilatancy);
+    for (const PeakComparison& p : cmp) {
+      char b[64];
+      std::snprintf(b, sizeof b, ",%.2f,%.2f", p.measured[k] / 1e3, 100 * p.error[k]);
+      table += std::isfinite(p.error[k]) ? std::string(b) : std::string(",,");
+      if (std::isfinite(p.error[k])) std::printf(" %9.1f %8.1f", p.measured[k] / 1e3, 100 * p.error[k]);
+      else std::printf(" %9s %8s", "-", "-");
+    }
+    table += "\n";
+    std::printf("\n");
+  }
+  for (std::size_t j = 0; j < cmp.size(); ++j) {
+    const PeakComparison& p = cmp[j];
+    if (p.matched == 0) {
+      std::printf("ref %zu, %s: no case matched (a case needs [run] material and its sigma3 in the file)\n", j + 1,
+                  p.source.c_str());
+      continue;
+    }
+    std::printf("ref %zu, %s: %d of %zu cases matched; q_peak off by %.1f%% on average (|error|), %.1f%% at most "
+                "(%s)\n", j + 1, p.source.c_str(), p.matched, cases.size(), 100 * p.mean_abs_error,
+                100 * p.max_abs_error, cases[p.worst].name.c_str());
   }
   io::write_text_atomic(opt.output + "/study_summary.csv", table);
   std::printf("\nstudy: summary in %s/study_summary.csv\n", opt.output.c_str());

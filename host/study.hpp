@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "config.hpp"
+#include "measured.hpp"
 
 namespace dem {
 
@@ -36,6 +37,7 @@ struct StudyCase {
   std::string config;           ///< path of the TOML file
   std::string name;             ///< file stem, also the output subfolder
   std::string job;              ///< "triaxial" ([specimen] + [triaxial]) or "periodic" ([periodic])
+  std::string material;         ///< [run] material ("" when the config names none)
 };
 
 /// The cases of `inputs` (folders, whose *.toml files are taken in name order, or single files). Every file
@@ -47,7 +49,22 @@ struct StudyOptions {
   int jobs = 0;                      ///< cases run at once; 0: one per two cores (at least one)
   int threads = 0;                   ///< OpenMP threads per case; 0: the cores shared out among the jobs
   bool resume = false;               ///< skip the cases with a summary.csv; continue those with a checkpoint.h5
+  std::vector<std::string> compare;  ///< measured-data files whose peaks are set beside the cases'
 };
+
+/// The cases' peaks beside one measured-data file's: a case is matched by its [run] material and sigma3.
+struct PeakComparison {
+  std::string source;                ///< the file
+  std::vector<Real> measured;        ///< Pa, per case; NaN where the file has no such test or the case failed
+  std::vector<Real> error;           ///< (simulated - measured) / measured, per case; NaN where unmatched
+  int matched = 0;
+  Real mean_abs_error = 0, max_abs_error = 0;  ///< over the matched cases
+  std::size_t worst = 0;             ///< case of the largest |error|
+};
+
+/// Compares `summaries` (one per case, q_peak NaN for a failed case) with `data`'s q_peak.
+PeakComparison compare_peaks(const MeasuredData& data, const std::vector<StudyCase>& cases,
+                             const std::vector<TestSummary>& summaries);
 
 /// Runs the study; returns 0 when every case finished, 1 otherwise (the summary then lists the failures).
 int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, const char* self_exe);

@@ -41,6 +41,7 @@ TEMPLATE = """# Drained triaxial test of Tang et al. (2025), {mat_name} beads at
 #   scaling would multiply it by 100.
 [run]
 name = "{name}"
+material = "{mat_name}"          # Table 6's sample: `triaxdem study --compare data/tang2025_table6_peak.csv` matches it
 output = "out/{outdir}"
 seed = 1
 

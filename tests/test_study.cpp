@@ -2,19 +2,29 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <cmath>
 #include <fstream>
+#include <limits>
+#include <tuple>
 
 #include "host/study.hpp"
 #include "test_util.hpp"
 
 using namespace dem;
 
+namespace {
+constexpr Real kNaNForTest = std::numeric_limits<Real>::quiet_NaN();
+}
+
 TEST(Study, ThePaperFolderHoldsNineMembraneCases) {
   const auto cases = study_cases({std::string(TRIAXDEM_SOURCE_DIR) + "/configs/paper"});
   ASSERT_EQ(cases.size(), 9u);
   EXPECT_EQ(cases.front().name, "S1_100kPa");
   EXPECT_EQ(cases.back().name, "S3_300kPa");
-  for (const StudyCase& c : cases) EXPECT_EQ(c.job, "triaxial") << c.config;
+  for (const StudyCase& c : cases) {
+    EXPECT_EQ(c.job, "triaxial") << c.config;
+    EXPECT_EQ(c.material, "S-" + c.name.substr(1, 1)) << c.config;  // Table 6's sample, for study --compare
+  }
   const auto periodic = study_cases({std::string(TRIAXDEM_SOURCE_DIR) + "/configs/periodic"});
   for (const StudyCase& c : periodic) EXPECT_EQ(c.job, "periodic") << c.config;
 }
@@ -88,4 +98,42 @@ TEST(Study, ResumeKeepsFinishedCasesAndRunsTheRest) {
   std::ifstream table(dir / "out" / "study_summary.csv");
   const std::string text((std::istreambuf_iterator<char>(table)), {});
   EXPECT_NE(text.find("12345"), std::string::npos) << text;
+}
+
+// study --compare: cases are matched by material and sigma3; the error is relative to the measured peak, the mean
+// and the largest over the matched cases only (an unmatched material, an absent pressure and a failed case are
+// left out, not counted as zero error).
+TEST(Study, PeaksAreComparedByMaterialAndPressure) {
+  MeasuredData d;
+  d.path = "lab.csv";
+  for (const auto& [material, sigma3, q] : std::vector<std::tuple<std::string, Real, Real>>{
+           {"S-1", 100e3, 140e3}, {"S-1", 200e3, 250e3}, {"S-2", 100e3, 200e3}}) {
+    MeasuredTest t;
+    t.material = material;
+    t.sigma3 = sigma3;
+    t.q_peak = q;
+    d.tests.push_back(t);
+  }
+  std::vector<StudyCase> cases(5);
+  std::vector<TestSummary> s(5);
+  const std::vector<std::tuple<std::string, Real, Real>> runs = {
+      {"S-1", 200e3, 260e3},  // +4%
+      {"S-2", 100e3, 180e3},  // -10%
+      {"S-3", 100e3, 1e3},    // no such material in the file
+      {"S-1", 300e3, 1e3},    // no such pressure
+      {"S-1", 100e3, kNaNForTest}};  // failed
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    cases[k].material = std::get<0>(runs[k]);
+    s[k].sigma3 = std::get<1>(runs[k]);
+    s[k].q_peak = std::get<2>(runs[k]);
+  }
+  const PeakComparison c = compare_peaks(d, cases, s);
+  EXPECT_EQ(c.matched, 2);
+  EXPECT_NEAR(c.error[0], 0.04, 1e-12);
+  EXPECT_NEAR(c.error[1], -0.10, 1e-12);
+  for (std::size_t k : {2, 3, 4}) EXPECT_TRUE(std::isnan(c.error[k])) << k;
+  EXPECT_NEAR(c.measured[4], 140e3, 1e-9);  // the lab value is shown beside a failed case too
+  EXPECT_NEAR(c.mean_abs_error, 0.07, 1e-12);
+  EXPECT_NEAR(c.max_abs_error, 0.10, 1e-12);
+  EXPECT_EQ(c.worst, 1u);
 }
