@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Draws a study's figure like Figure 8 of Tang et al. (2025): one column per confining pressure, deviator
 stress q (top) and volumetric strain eps_v (bottom, contraction positive) against axial strain, one curve per
-case, and writes STUDY/study.png; with the runs' micro columns also STUDY/study_networks.png (Figure 10).
+case (with the peaks of `study --compare` files as horizontal lines), and writes STUDY/study.png; with the
+runs' micro columns also STUDY/study_networks.png (Figure 10).
 
 Reads STUDY/study_summary.csv (written by `triaxdem study`) and each case's STUDY/<case>/series.csv.
 
@@ -40,6 +41,7 @@ def main():
     pressures = sorted({float(r["sigma3_kPa"]) for r in cases})
     materials = sorted({(float(r["mu_s"]), float(r["mu_r"])) for r in cases})
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    compared = [k[len("q_peak_"):-len("_kPa")] for k in cases[0] if k.startswith("q_peak_") and k != "q_peak_kPa"]
     fig, axes = plt.subplots(2, len(pressures), figsize=(4.2 * len(pressures), 7), squeeze=False,
                              constrained_layout=True)
     for r in cases:
@@ -52,6 +54,12 @@ def main():
         label = f"{r['case']}: mu_s {float(r['mu_s']):g}, mu_r {float(r['mu_r']):g}"
         axes[0][col].plot(ea, q, color=colour, lw=1.3, label=f"{label} (q_peak {float(r['q_peak_kPa']):.0f} kPa)")
         axes[1][col].plot(ea, ev, color=colour, lw=1.3, label=label)
+        # Peaks of the files given to `study --compare`, as horizontal lines in the case's colour.
+        for stem, style in zip(compared, ("--", ":", "-.")):
+            value = r.get(f"q_peak_{stem}_kPa", "")
+            if value:
+                axes[0][col].axhline(float(value), color=colour, ls=style, lw=0.9,
+                                     label=f"{r['case']}, {stem}: {float(value):.0f} kPa")
     for col, p in enumerate(pressures):
         axes[0][col].set_title(f"sigma3 = {p:g} kPa", fontsize=10)
         axes[0][col].set_ylabel("deviator stress q (kPa)")
