@@ -143,6 +143,40 @@ TestSummary read_summary(const std::string& path) {
   return s;
 }
 
+bool summarise_series(const std::string& folder, TestSummary& s) {
+  std::ifstream f(folder + "/series.csv");
+  std::string line;
+  if (!f || !std::getline(f, line)) return false;
+  const std::vector<std::string> names = split_csv(line);
+  auto column = [&](const char* name) {
+    return static_cast<long>(std::find(names.begin(), names.end(), name) - names.begin());
+  };
+  const long ke = column("eps_a_pct"), kq = column("q_kPa"), kv = column("eps_v_pct");
+  const long n = static_cast<long>(names.size());
+  if (ke == n || kq == n || kv == n) return false;
+  struct Row {
+    Real eps_a, q, eps_v;
+  };
+  std::vector<Row> rows;
+  while (std::getline(f, line)) {
+    const std::vector<std::string> cells = split_csv(line);
+    if (static_cast<long>(cells.size()) != n) return false;
+    try {
+      rows.push_back({std::stod(cells[ke]) / 100, std::stod(cells[kq]) * 1e3, std::stod(cells[kv]) / 100});
+    } catch (const std::exception&) {
+      return false;
+    }
+  }
+  if (rows.empty()) return false;
+  const MeasuredTest t = summarised(rows, s.sigma3);
+  s.q_peak = t.q_peak;
+  s.eps_a_peak = t.eps_a_peak;
+  s.phi_peak_deg = friction_angle_deg(t.q_peak, s.sigma3);
+  s.q_end = t.q_end;
+  s.max_dilatancy = t.max_dilatancy;
+  return true;
+}
+
 std::vector<StudyCase> study_cases(const std::vector<std::string>& inputs) {
   std::vector<std::string> files;
   for (const std::string& in : inputs) {
@@ -257,8 +291,13 @@ int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, c
   for (std::size_t k = 0; k < cases.size(); ++k) {
     const std::string path = opt.output + "/" + cases[k].name + "/summary.csv";
     ok[k] = status[k] == 0 && fs::exists(path);
-    if (ok[k]) summaries[k] = read_summary(path);
-    else summaries[k].q_peak = kNaN;
+    if (ok[k]) {
+      summaries[k] = read_summary(path);
+      // Kept cases may come from a program that summarised differently: the curve values are taken afresh.
+      summarise_series(opt.output + "/" + cases[k].name, summaries[k]);
+    } else {
+      summaries[k].q_peak = kNaN;
+    }
   }
   std::vector<PeakComparison> cmp;
   for (const MeasuredData& d : compare) cmp.push_back(compare_peaks(d, cases, summaries));

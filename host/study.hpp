@@ -32,6 +32,11 @@ void write_summary(const std::string& folder, const TestSummary& s);
 /// Reads it back; throws std::runtime_error naming the file and the missing column.
 TestSummary read_summary(const std::string& path);
 
+/// Recomputes the curve values of s (q_peak, its strain and friction angle, q_end, max dilatancy) from
+/// folder/series.csv as summarise does (s.sigma3 must be set). False, s unchanged, when the file is missing or
+/// lacks the eps_a_pct, q_kPa and eps_v_pct columns.
+bool summarise_series(const std::string& folder, TestSummary& s);
+
 /// One case of a study: the config, which job runs it, and where its output goes.
 struct StudyCase {
   std::string config;           ///< path of the TOML file

@@ -137,3 +137,27 @@ TEST(Study, PeaksAreComparedByMaterialAndPressure) {
   EXPECT_NEAR(c.max_abs_error, 0.10, 1e-12);
   EXPECT_EQ(c.worst, 1u);
 }
+
+// A kept case's curve values come from its series.csv through the same summary as measured curves: rows that
+// alternate by +-8 kPa about 100 kPa have a raw maximum of 108 kPa, but a moving-mean peak within 2 kPa of 100.
+TEST(Study, KeptCasesAreSummarisedAfreshFromTheirSeries) {
+  const auto dir = dem::test::scratch_dir("study_series");
+  {
+    std::ofstream f(dir / "series.csv");
+    f << "eps_a_pct,q_kPa,sigma3_kPa,eps_v_pct\n";
+    for (int k = 0; k <= 50; ++k)
+      f << 0.1 * k << "," << (k == 0 ? 0.0 : 100.0 + (k % 2 ? 8.0 : -8.0)) << ",100," << -0.02 * k << "\n";
+  }
+  TestSummary s;
+  s.sigma3 = 100e3;
+  s.q_peak = 999e3;
+  ASSERT_TRUE(summarise_series(dir.string(), s));
+  EXPECT_GT(s.q_peak, 98e3);
+  EXPECT_LT(s.q_peak, 102e3);
+  EXPECT_NEAR(s.max_dilatancy, 0.2, 1e-9);  // eps_v = -0.2 eps_a
+  EXPECT_NEAR(s.phi_peak_deg, friction_angle_deg(s.q_peak, 100e3), 1e-12);
+  TestSummary untouched;
+  untouched.q_peak = 7;
+  EXPECT_FALSE(summarise_series((dir / "nothing_here").string(), untouched));
+  EXPECT_EQ(untouched.q_peak, 7);
+}
