@@ -51,7 +51,7 @@ struct PairSearch : CountFill<PairSearch> {
   GidView gid;
   IndexView cell_start;
   CellGrid g;
-  Domain dom;
+  MinImage image;
   Real skin;
 
   template <class Visit>
@@ -71,7 +71,7 @@ struct PairSearch : CountFill<PairSearch> {
           for (int j = cell_start(cell); j < cell_start(cell + 1); ++j) {
             if (j <= i) continue;
             const Real reach = radius(i) + radius(j) + skin;
-            if (norm2(dom.min_image(load(x, j) - xi)) < reach * reach) f(j);
+            if (norm2(image(load(x, j) - xi)) < reach * reach) f(j);
           }
         }
       }
@@ -165,7 +165,7 @@ FacetBins bin_facets(const FacetMesh& mesh, const CellGrid& g, Real reach) {
 PairKeyView detect_pairs(const Particles& p, const Domain& dom, const CellList& cells, Real skin) {
   PairSearch s;
   s.x = p.x; s.radius = p.radius; s.gid = p.gid; s.cell_start = cells.cell_start;
-  s.g = cells.grid; s.dom = dom; s.skin = skin;
+  s.g = cells.grid; s.image = MinImage(dom); s.skin = skin;
   return run_search(s, p.n, "dem::detect::pairs");
 }
 

@@ -27,6 +27,7 @@ struct BallForce : MaxOverlap {
   Index2View own;
   ParamTableView params;
   Domain dom;
+  MinImage image;
   Real dt;
 
   KOKKOS_INLINE_FUNCTION void operator()(const int i, value_type& worst) const {
@@ -35,7 +36,7 @@ struct BallForce : MaxOverlap {
     Vec3 fi, mi;
     for (int s = own(i, 0); s < own(i, 1); ++s) {
       const int j = c.j(s);
-      const Vec3 d = dom.min_image(load(x, j) - xi);
+      const Vec3 d = image(load(x, j) - xi);
       const Real dist = norm(d);
       const Real rj = radius(j);
       const Real overlap = ri + rj - dist;
@@ -162,7 +163,7 @@ OverlapStat compute_ball_forces(Particles& p, ContactList& c, const Index2View& 
   BallForce k;
   bind_particles(k, p);
   k.f = p.f; k.m = p.m;
-  k.c = c; k.own = own; k.params = params; k.dom = dom; k.dt = dt;
+  k.c = c; k.own = own; k.params = params; k.dom = dom; k.image = MinImage(dom); k.dt = dt;
   OverlapStat worst;
   Kokkos::parallel_reduce("dem::force::balls", RangePolicy(0, p.n), k, worst);
   return worst;

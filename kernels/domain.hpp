@@ -14,18 +14,8 @@ struct Domain {
 
   KOKKOS_INLINE_FUNCTION Real length(int d) const { return hi[d] - lo[d]; }
 
-  /// Minimum-image separation for periodic axes (orthorhombic cell). Positions are wrapped at every
-  /// rebuild and move less than the skin in between, so one shift always suffices (no floor call).
-  KOKKOS_INLINE_FUNCTION Vec3 min_image(Vec3 d) const {
-    Real c[3] = {d.x, d.y, d.z};
-    for (int k = 0; k < 3; ++k) {
-      if (!periodic[k]) continue;
-      const Real L = length(k);
-      if (c[k] > Real(0.5) * L) c[k] -= L;
-      else if (c[k] < Real(-0.5) * L) c[k] += L;
-    }
-    return Vec3(c[0], c[1], c[2]);
-  }
+  /// Minimum-image separation for periodic axes (orthorhombic cell); see MinImage.
+  KOKKOS_INLINE_FUNCTION Vec3 min_image(const Vec3& d) const;
 
   /// Velocity of the affine field at separation d (m/s).
   KOKKOS_INLINE_FUNCTION Vec3 affine_velocity(const Vec3& d) const {
@@ -45,5 +35,33 @@ struct Domain {
     return Vec3(c[0], c[1], c[2]);
   }
 };
+
+/// The minimum-image shift of a domain, with the cell lengths worked out once: pair loops build one per
+/// launch instead of re-reading the bounds for every pair (same arithmetic, same bits). Positions are
+/// wrapped at every rebuild and move less than the skin in between, so one shift always suffices (no floor
+/// call).
+struct MinImage {
+  Real len[3] = {0, 0, 0};   ///< cell length of a periodic axis, 0 on an open one
+  Real half[3] = {0, 0, 0};  ///< len / 2
+
+  MinImage() = default;
+  KOKKOS_INLINE_FUNCTION explicit MinImage(const Domain& dom) {
+    for (int k = 0; k < 3; ++k) {
+      len[k] = dom.periodic[k] ? dom.length(k) : Real(0);
+      half[k] = Real(0.5) * len[k];
+    }
+  }
+  KOKKOS_INLINE_FUNCTION Vec3 operator()(const Vec3& d) const {
+    Real c[3] = {d.x, d.y, d.z};
+    for (int k = 0; k < 3; ++k) {
+      if (len[k] == Real(0)) continue;
+      if (c[k] > half[k]) c[k] -= len[k];
+      else if (c[k] < -half[k]) c[k] += len[k];
+    }
+    return Vec3(c[0], c[1], c[2]);
+  }
+};
+
+KOKKOS_INLINE_FUNCTION Vec3 Domain::min_image(const Vec3& d) const { return MinImage(*this)(d); }
 
 }  // namespace dem
