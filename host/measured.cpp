@@ -239,7 +239,14 @@ Real friction_angle_deg(Real q, Real sigma3) { return std::asin(q / (q + 2 * sig
 void summarise(MeasuredTest& t) {
   if (t.q.empty()) return;
   const std::vector<Real> q = smooth(t.eps_a, t.q, kSmoothHalfWidth);
-  const auto k = std::max_element(q.begin(), q.end()) - q.begin();
+  // The peak is sought where the window is whole: towards either end it shrinks to the end row alone, whose
+  // scatter would pass for a peak (the last record of a plateau often does). A curve shorter than one window
+  // is searched whole.
+  std::size_t lo = 0, hi = q.size();
+  while (lo < hi && t.eps_a[lo] - t.eps_a.front() < kSmoothHalfWidth - 1e-12) ++lo;
+  while (hi > lo && t.eps_a.back() - t.eps_a[hi - 1] < kSmoothHalfWidth - 1e-12) --hi;
+  if (lo >= hi) lo = 0, hi = q.size();
+  const auto k = std::max_element(q.begin() + lo, q.begin() + hi) - q.begin();
   t.q_peak = q[k];
   t.eps_a_peak = t.eps_a[k];
   auto q_at = [&](Real e) {

@@ -48,6 +48,19 @@ TEST(Measured, ShippedTable6Loads) {
   }
 }
 
+// A plateau whose last record is a spike: towards the end the moving mean's window shrinks to that record,
+// so the peak is sought only where the window is whole (the full-scale S-1 at 100 kPa reported its last
+// record, 144.1 kPa, as the peak of a plateau near 138 kPa before this).
+TEST(Measured, AnEndRecordIsNotTakenForThePeak) {
+  std::ostringstream f;
+  f << "material,sigma3_kPa,eps_a_pct,q_kPa\n";
+  for (int i = 0; i <= 50; ++i) f << "A,100," << 0.1 * i << "," << (i == 50 ? 120.0 : 100.0 + (i % 2 ? 3 : -3)) << "\n";
+  const MeasuredTest t = load_measured(write("spike.csv", f.str())).tests[0];
+  EXPECT_LT(t.q_peak, 102e3);  // 100 kPa and the mean of the +-3 kPa scatter over 5 or 6 rows
+  EXPECT_GT(t.q_peak, 99e3);
+  EXPECT_LE(t.eps_a_peak, 0.0475 + 1e-12);
+}
+
 TEST(Measured, CurvesInOtherUnitsAreSummarised) {
   const MeasuredData d = load_measured(write("curve.csv",
                                              "# a test\nmaterial,sigma3_MPa,eps_a_frac,q_kPa,eps_v_pct\n"
@@ -81,9 +94,14 @@ TEST(Measured, NoisyCurvesAreSmoothedBeforeTheyAreSummarised) {
     f << "A,100," << e << "," << q << "," << -0.2 * e << "\n";
   }
   const MeasuredTest t = load_measured(write("noisy.csv", f.str())).tests[0];
-  // The clean curve peaks at 100 (1 - e^-10) = 99.995 kPa at the end; the window's mean carries at most one
-  // unpaired row: 5/51 ~ 0.1 kPa; the mean of the scatter over the last 1% likewise.
-  EXPECT_NEAR(t.q_peak, 99.995e3, 0.15e3);
+  // The clean curve rises to the end; the peak is sought where the window is whole, up to 9.75%, where it is
+  // 100 (1 - e^-9.75) = 99.994 kPa; the window's mean carries at most one unpaired row: 5/51 ~ 0.1 kPa; the
+  // mean of the scatter over the last 1% likewise.
+  EXPECT_NEAR(t.q_peak, 99.994e3, 0.15e3);
+  // Where in the flat tail: the clean curve gains 100 e^-9.75 * 0.01% = 6e-7 kPa per row, far below the 0.1 kPa
+  // of scatter, so anywhere near the end of the searched range, never in the shrunken end window.
+  EXPECT_LE(t.eps_a_peak, 0.0975 + 1e-12);
+  EXPECT_GT(t.eps_a_peak, 0.09);
   EXPECT_NEAR(t.q_end, 1e5 * (1 - std::exp(-9.5)), 0.2e3);  // mean of a nearly flat tail
   EXPECT_NEAR(t.max_dilatancy, 0.2, 1e-9);                  // eps_v = -0.2 eps_a exactly
   // q at 1% and 3%: the smoothed curve there (51 rows, one unpaired: 0.1 kPa of scatter; the curvature
