@@ -293,8 +293,10 @@ int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, c
     ok[k] = status[k] == 0 && fs::exists(path);
     if (ok[k]) {
       summaries[k] = read_summary(path);
-      // Kept cases may come from a program that summarised differently: the curve values are taken afresh.
-      summarise_series(opt.output + "/" + cases[k].name, summaries[k]);
+      // Kept cases may come from a program that summarised differently: the curve values are taken afresh,
+      // and the case's summary.csv follows.
+      if (summarise_series(opt.output + "/" + cases[k].name, summaries[k]))
+        write_summary(opt.output + "/" + cases[k].name, summaries[k]);
     } else {
       summaries[k].q_peak = kNaN;
     }

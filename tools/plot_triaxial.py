@@ -44,6 +44,16 @@ def read_series(run):
     return path, {name: data[:, k] for k, name in enumerate(header)}
 
 
+def summary_peak(series_path):
+    """(q_peak kPa, eps_a at peak %) from the summary.csv beside a series.csv, None when there is none."""
+    try:
+        with open(os.path.join(os.path.dirname(series_path), "summary.csv"), newline="") as f:
+            row = next(csv.DictReader(f))
+        return float(row["q_peak_kPa"]), float(row["eps_a_peak_pct"])
+    except (OSError, StopIteration, KeyError, ValueError):
+        return None
+
+
 def value_at(x, y, x0):
     return float(np.interp(x0, x, y))
 
@@ -68,9 +78,15 @@ def main():
         first_path = first_path or path
         ea, q, ev = s["eps_a_pct"], s["q_kPa"], s["eps_v_pct"]
         name = args.labels[k] if args.labels else os.path.basename(os.path.dirname(os.path.abspath(path)))
-        ipk = int(np.argmax(q))
-        line, = ax_q.plot(ea, q, lw=1.4, label=f"{name}: q_peak {q[ipk]:.1f} kPa at {ea[ipk]:.1f}%")
-        ax_q.plot(ea[ipk], q[ipk], "o", ms=4, color=line.get_color())
+        peak = summary_peak(path)
+        if peak:  # the program's peak: of the moving mean over +-0.25% strain, as measured curves are summarised
+            label = f"{name}: q_peak {peak[0]:.1f} kPa at {peak[1]:.1f}% (moving mean)"
+        else:
+            ipk = int(np.argmax(q))
+            peak = (q[ipk], ea[ipk])
+            label = f"{name}: highest record {peak[0]:.1f} kPa at {peak[1]:.1f}%"
+        line, = ax_q.plot(ea, q, lw=1.4, label=label)
+        ax_q.plot(peak[1], peak[0], "o", ms=4, color=line.get_color())
         ax_v.plot(ea, ev, lw=1.4, color=line.get_color(), label=name)
         if k == 0 and args.marks:
             for j, m in enumerate(float(v) for v in args.marks.split(",")):
