@@ -106,6 +106,17 @@ MeasuredTest summarised(const std::vector<Row>& rows, Real sigma3) {
 /// Peak friction angle (degrees) of a deviator q at confining pressure sigma3: asin(q / (q + 2 sigma3)).
 Real friction_angle_deg(Real q, Real sigma3);
 
+/// Copies a summarised test's curve values into a result with the same field names (q_peak, eps_a_peak,
+/// phi_peak_deg, q_end, max_dilatancy), the friction angle from q_peak at the test's sigma3.
+template <class Result>
+void take_curve_values(Result& r, const MeasuredTest& t) {
+  r.q_peak = t.q_peak;
+  r.eps_a_peak = t.eps_a_peak;
+  r.phi_peak_deg = friction_angle_deg(t.q_peak, t.sigma3);
+  r.q_end = t.q_end;
+  r.max_dilatancy = t.max_dilatancy;
+}
+
 /// Reference parameter values to set beside calibrated ones (e.g. a paper's own calibration): a CSV with a
 /// `material` column and one column per parameter, named as in [calibrate] free (mu_s, mu_r, ...), in that
 /// key's unit. Comment lines ('#') are kept as the source's description.

@@ -314,12 +314,7 @@ PeriodicTriaxialResult run_periodic_triaxial(Simulation& sim, const PeriodicTria
   sim.set_strain_rate(Vec3());
   if (out) out->flush_series();
 
-  const MeasuredTest curve = summarised(res.series, prm.sigma3);
-  res.q_peak = curve.q_peak;
-  res.eps_a_peak = curve.eps_a_peak;
-  res.phi_peak_deg = friction_angle_deg(curve.q_peak, prm.sigma3);
-  res.q_end = curve.q_end;
-  res.max_dilatancy = curve.max_dilatancy;
+  take_curve_values(res, summarised(res.series, prm.sigma3));
   for (const PeriodicTriaxialRecord& r : res.series) {
     // The membrane's share is the same on both axes to rounding (they stretch alike on average); its
     // mean is recorded.

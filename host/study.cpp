@@ -168,12 +168,7 @@ bool summarise_series(const std::string& folder, TestSummary& s) {
     }
   }
   if (rows.empty()) return false;
-  const MeasuredTest t = summarised(rows, s.sigma3);
-  s.q_peak = t.q_peak;
-  s.eps_a_peak = t.eps_a_peak;
-  s.phi_peak_deg = friction_angle_deg(t.q_peak, s.sigma3);
-  s.q_end = t.q_end;
-  s.max_dilatancy = t.max_dilatancy;
+  take_curve_values(s, summarised(rows, s.sigma3));
   return true;
 }
 

@@ -290,12 +290,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
   }
   if (out) out->flush_series();
   if (!res.records.empty()) {
-    const MeasuredTest curve = summarised(res.records, tc.sigma3);
-    res.q_peak = curve.q_peak;
-    res.eps_a_peak = curve.eps_a_peak;
-    res.phi_peak_deg = friction_angle_deg(curve.q_peak, tc.sigma3);
-    res.q_end = curve.q_end;
-    res.max_dilatancy = curve.max_dilatancy;
+    take_curve_values(res, summarised(res.records, tc.sigma3));
     for (const TriaxialRecord& r : res.records) res.q_peak_record = std::max(res.q_peak_record, r.q);
   }
   res.escaped = count_escaped(sim, cell.membrane, sim.wall_point(kTopPlaten).z);
