@@ -328,13 +328,15 @@ int triaxial_job(const Config& cfg, bool resume, long stop_at_step) {
                 format_duration(r.wall_seconds).c_str());
     if (r.escaped > 0) std::printf("WARNING: %d balls ended outside the membrane\n", r.escaped);
     if (!r.micro.empty()) {
-      // The stress-force-fabric relation beside the boundary's q/p at the peak (p = sigma3 + q/3).
+      // The stress-force-fabric relation beside the boundary's q/p (p = sigma3 + q/3) at the highest record,
+      // where the run wrote its micro_*_peak files (the smoothed peak is known only at the end).
       std::size_t k = 0;
       for (std::size_t i = 0; i < r.records.size(); ++i)
         if (r.records[i].q > r.records[k].q) k = i;
       const MicroRow& m = r.micro[k];
-      std::printf("at peak: q/p %.3f at the boundary, %.3f from the contacts (Love-Weber), %.3f from "
-                  "the stress-force-fabric relation, with a_c %.3f, a_n %.3f, a_t %.3f; Z %.2f\n",
+      std::printf("at the highest record (micro_*_peak.csv): q/p %.3f at the boundary, %.3f from the contacts "
+                  "(Love-Weber), %.3f from the stress-force-fabric relation, with a_c %.3f, a_n %.3f, a_t %.3f; "
+                  "Z %.2f\n",
                   r.records[k].q / (cfg.triaxial.sigma3 + r.records[k].q / 3), m.q_over_p, m.q_over_p_sff, m.all.a_c,
                   m.all.a_n, m.all.a_t, m.z.z);
     }
