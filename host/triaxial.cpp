@@ -291,7 +291,10 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
   if (out) out->flush_series();
   if (!res.records.empty()) {
     take_curve_values(res, summarised(res.records, tc.sigma3));
-    for (const TriaxialRecord& r : res.records) res.q_peak_record = std::max(res.q_peak_record, r.q);
+    res.highest_record = static_cast<std::size_t>(
+        std::max_element(res.records.begin(), res.records.end(),
+                         [](const TriaxialRecord& a, const TriaxialRecord& b) { return a.q < b.q; }) -
+        res.records.begin());
   }
   res.escaped = count_escaped(sim, cell.membrane, sim.wall_point(kTopPlaten).z);
   res.wall_seconds = elapsed();
@@ -320,19 +323,18 @@ int triaxial_job(const Config& cfg, bool resume, long stop_at_step) {
                 sp.balls.size(), sp.void_ratio, sp.height * 1e3);
     write_specimen_report(out.folder(), cfg, sp);
     const TriaxialResult r = run_triaxial(cfg, sp, &out, true, &plan);
+    const Real q_highest = r.records.empty() ? 0 : r.records[r.highest_record].q;
     std::printf("\nresult: q_peak %.1f kPa at eps_a %.2f%% (moving mean over +-%.2f%% strain; highest record %.1f kPa), "
                 "peak friction angle %.1f deg, q at %.0f%% %.1f kPa (mean over the last %.0f%%), max dilatancy %.3f, "
                 "wall time %s\n",
-                r.q_peak / 1e3, 100 * r.eps_a_peak, 100 * kSmoothHalfWidth, r.q_peak_record / 1e3, r.phi_peak_deg,
+                r.q_peak / 1e3, 100 * r.eps_a_peak, 100 * kSmoothHalfWidth, q_highest / 1e3, r.phi_peak_deg,
                 100 * cfg.triaxial.axial_strain_end, r.q_end / 1e3, 100 * kEndWindow, r.max_dilatancy,
                 format_duration(r.wall_seconds).c_str());
     if (r.escaped > 0) std::printf("WARNING: %d balls ended outside the membrane\n", r.escaped);
     if (!r.micro.empty()) {
       // The stress-force-fabric relation beside the boundary's q/p (p = sigma3 + q/3) at the highest record,
       // where the run wrote its micro_*_peak files (the smoothed peak is known only at the end).
-      std::size_t k = 0;
-      for (std::size_t i = 0; i < r.records.size(); ++i)
-        if (r.records[i].q > r.records[k].q) k = i;
+      const std::size_t k = r.highest_record;
       const MicroRow& m = r.micro[k];
       std::printf("at the highest record (micro_*_peak.csv): q/p %.3f at the boundary, %.3f from the contacts "
                   "(Love-Weber), %.3f from the stress-force-fabric relation, with a_c %.3f, a_n %.3f, a_t %.3f; "

@@ -38,7 +38,7 @@ struct TriaxialResult {
   /// moving mean of q, q_end the mean over the last 1% of strain, the dilatancy over 0.5% windows.
   Real q_peak = 0, eps_a_peak = 0, phi_peak_deg = 0;
   Real q_end = 0, max_dilatancy = 0;  ///< max of -d eps_v / d eps_a
-  Real q_peak_record = 0;      ///< Pa, the highest single record
+  std::size_t highest_record = 0;  ///< index of the highest q in records (where micro_*_peak was written)
   int escaped = 0;             ///< balls whose centre ended outside the membrane (should be 0)
   double wall_seconds = 0;
   StageTimes times;            ///< time loop of consolidation and shear, per stage
