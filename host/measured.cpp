@@ -68,7 +68,8 @@ ColumnSpec parse_header(const std::string& at, const std::string& name) {
        "eps_a_peak_<unit>, q_end_<unit>, max_dilatancy, e_ini_<unit>, q_1pct_<unit>, q_3pct_<unit>)");
 }
 
-/// The lines of a CSV file as a table; comment lines and blank lines are skipped.
+}  // namespace
+
 MeasuredTextTable read_csv_table(const std::string& path) {
   std::ifstream f(path);
   if (!f) throw DataError(path + ": cannot be read");
@@ -86,8 +87,6 @@ MeasuredTextTable read_csv_table(const std::string& path) {
   }
   return t;
 }
-
-}  // namespace
 
 bool is_hdf5_path(const std::string& path) {
   const auto dot = path.rfind('.');

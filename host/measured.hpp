@@ -65,6 +65,10 @@ struct MeasuredTextTable {
   std::vector<Row> rows;
 };
 
+/// The lines of a CSV file as a table, cells trimmed; comment ('#') and blank lines skipped. Throws DataError
+/// when the file cannot be read.
+MeasuredTextTable read_csv_table(const std::string& path);
+
 /// The HDF5 form as a table (host/measured_h5.cpp). Throws DataError.
 MeasuredTextTable read_measured_h5(const std::string& path);
 

@@ -144,30 +144,27 @@ TestSummary read_summary(const std::string& path) {
 }
 
 bool summarise_series(const std::string& folder, TestSummary& s) {
-  std::ifstream f(folder + "/series.csv");
-  std::string line;
-  if (!f || !std::getline(f, line)) return false;
-  const std::vector<std::string> names = split_csv(line);
-  auto column = [&](const char* name) {
-    return static_cast<long>(std::find(names.begin(), names.end(), name) - names.begin());
-  };
-  const long ke = column("eps_a_pct"), kq = column("q_kPa"), kv = column("eps_v_pct");
-  const long n = static_cast<long>(names.size());
-  if (ke == n || kq == n || kv == n) return false;
+  const std::string path = folder + "/series.csv";
+  if (!fs::exists(path)) return false;
+  const MeasuredTextTable t = read_csv_table(path);
+  const auto& h = t.header;
+  const auto ke = std::find(h.begin(), h.end(), "eps_a_pct") - h.begin();
+  const auto kq = std::find(h.begin(), h.end(), "q_kPa") - h.begin();
+  const auto kv = std::find(h.begin(), h.end(), "eps_v_pct") - h.begin();
+  const auto n = static_cast<std::ptrdiff_t>(h.size());
+  if (ke == n || kq == n || kv == n || t.rows.empty()) return false;
   struct Row {
     Real eps_a, q, eps_v;
   };
   std::vector<Row> rows;
-  while (std::getline(f, line)) {
-    const std::vector<std::string> cells = split_csv(line);
-    if (static_cast<long>(cells.size()) != n) return false;
+  for (const MeasuredTextTable::Row& r : t.rows) {
+    if (static_cast<std::ptrdiff_t>(r.cells.size()) != n) return false;
     try {
-      rows.push_back({std::stod(cells[ke]) / 100, std::stod(cells[kq]) * 1e3, std::stod(cells[kv]) / 100});
+      rows.push_back({std::stod(r.cells[ke]) / 100, std::stod(r.cells[kq]) * 1e3, std::stod(r.cells[kv]) / 100});
     } catch (const std::exception&) {
       return false;
     }
   }
-  if (rows.empty()) return false;
   take_curve_values(s, summarised(rows, s.sigma3));
   return true;
 }
