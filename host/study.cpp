@@ -223,6 +223,45 @@ PeakComparison compare_peaks(const MeasuredData& data, const std::vector<StudyCa
   return c;
 }
 
+StudyTable study_table(const std::vector<StudyCase>& cases, const std::vector<int>& status, const std::string& output,
+                       const std::vector<MeasuredData>& compare) {
+  StudyTable t;
+  t.summaries.resize(cases.size());
+  t.ok.assign(cases.size(), false);
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    const std::string folder = output + "/" + cases[k].name;
+    t.ok[k] = status[k] == 0 && fs::exists(folder + "/summary.csv");
+    if (!t.ok[k]) {
+      t.summaries[k].q_peak = kNaN;
+      continue;
+    }
+    t.summaries[k] = read_summary(folder + "/summary.csv");
+    if (summarise_series(folder, t.summaries[k])) write_summary(folder, t.summaries[k]);
+  }
+  for (const MeasuredData& d : compare) t.cmp.push_back(compare_peaks(d, cases, t.summaries));
+  t.csv = "case,config,job,status,material," + summary_header();
+  for (const PeakComparison& c : t.cmp) {
+    const std::string stem = fs::path(c.source).stem().string();
+    t.csv += ",q_peak_" + stem + "_kPa,error_" + stem + "_pct";
+  }
+  t.csv += "\n";
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    const StudyCase& c = cases[k];
+    if (!t.ok[k]) {
+      t.csv += c.name + "," + c.config + "," + c.job + "," + (status[k] < 0 ? "pending," : "failed,") + c.material + "\n";
+      continue;
+    }
+    t.csv += c.name + "," + c.config + "," + c.job + ",ok," + c.material + "," + summary_values(t.summaries[k]);
+    for (const PeakComparison& p : t.cmp) {
+      char b[64];
+      std::snprintf(b, sizeof b, ",%.2f,%.2f", p.measured[k] / 1e3, 100 * p.error[k]);
+      t.csv += std::isfinite(p.error[k]) ? std::string(b) : std::string(",,");
+    }
+    t.csv += "\n";
+  }
+  return t;
+}
+
 int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, const char* self_exe) {
   const std::vector<StudyCase> cases = study_cases(inputs);
   std::vector<MeasuredData> compare;  // read before anything runs: a bad file stops the study at once
@@ -274,34 +313,13 @@ int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, c
     std::printf("study: %s %s after %s\n", cases[k].name.c_str(),
                 status[k] == 0 ? "finished" : ("FAILED (exit " + std::to_string(status[k]) + ", see its log.txt)").c_str(),
                 format_duration(secs).c_str());
+    io::write_text_atomic(opt.output + "/study_summary.csv", study_table(cases, status, opt.output, compare).csv);
     progress.update(static_cast<long>(done));
   }
   progress.finish("");
 
-  std::vector<TestSummary> summaries(cases.size());
-  std::vector<bool> ok(cases.size(), false);
-  for (std::size_t k = 0; k < cases.size(); ++k) {
-    const std::string path = opt.output + "/" + cases[k].name + "/summary.csv";
-    ok[k] = status[k] == 0 && fs::exists(path);
-    if (ok[k]) {
-      summaries[k] = read_summary(path);
-      // Kept cases may come from a program that summarised differently: the curve values are taken afresh,
-      // and the case's summary.csv follows.
-      if (summarise_series(opt.output + "/" + cases[k].name, summaries[k]))
-        write_summary(opt.output + "/" + cases[k].name, summaries[k]);
-    } else {
-      summaries[k].q_peak = kNaN;
-    }
-  }
-  std::vector<PeakComparison> cmp;
-  for (const MeasuredData& d : compare) cmp.push_back(compare_peaks(d, cases, summaries));
-
-  std::string table = "case,config,job,status,material," + summary_header();
-  for (const PeakComparison& c : cmp) {
-    const std::string stem = fs::path(c.source).stem().string();
-    table += ",q_peak_" + stem + "_kPa,error_" + stem + "_pct";
-  }
-  table += "\n";
+  const StudyTable table = study_table(cases, status, opt.output, compare);
+  const std::vector<PeakComparison>& cmp = table.cmp;
   int failed = 0;
   std::printf("\n%-14s %8s %6s %6s %10s %9s %10s %10s %8s", "case", "s3 kPa", "mu_s", "mu_r", "q_peak kPa",
               "phi deg", "eps_pk %", "q_end kPa", "max dil");
@@ -309,24 +327,18 @@ int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, c
   std::printf("\n");
   for (std::size_t k = 0; k < cases.size(); ++k) {
     const StudyCase& c = cases[k];
-    if (!ok[k]) {
+    if (!table.ok[k]) {
       ++failed;
-      table += c.name + "," + c.config + "," + c.job + ",failed," + c.material + "\n";
       std::printf("%-14s FAILED: see %s/%s/log.txt\n", c.name.c_str(), opt.output.c_str(), c.name.c_str());
       continue;
     }
-    const TestSummary& s = summaries[k];
-    table += c.name + "," + c.config + "," + c.job + ",ok," + c.material + "," + summary_values(s);
+    const TestSummary& s = table.summaries[k];
     std::printf("%-14s %8.0f %6.3f %6.3f %10.1f %9.2f %10.2f %10.1f %8.3f", c.name.c_str(), s.sigma3 / 1e3, s.mu_s,
                 s.mu_r, s.q_peak / 1e3, s.phi_peak_deg, 100 * s.eps_a_peak, s.q_end / 1e3, s.max_dilatancy);
     for (const PeakComparison& p : cmp) {
-      char b[64];
-      std::snprintf(b, sizeof b, ",%.2f,%.2f", p.measured[k] / 1e3, 100 * p.error[k]);
-      table += std::isfinite(p.error[k]) ? std::string(b) : std::string(",,");
       if (std::isfinite(p.error[k])) std::printf(" %9.1f %8.1f", p.measured[k] / 1e3, 100 * p.error[k]);
       else std::printf(" %9s %8s", "-", "-");
     }
-    table += "\n";
     std::printf("\n");
   }
   for (std::size_t j = 0; j < cmp.size(); ++j) {
@@ -340,7 +352,7 @@ int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, c
                 "(%s)\n", j + 1, p.source.c_str(), p.matched, cases.size(), 100 * p.mean_abs_error,
                 100 * p.max_abs_error, cases[p.worst].name.c_str());
   }
-  io::write_text_atomic(opt.output + "/study_summary.csv", table);
+  io::write_text_atomic(opt.output + "/study_summary.csv", table.csv);
   std::printf("\nstudy: summary in %s/study_summary.csv\n", opt.output.c_str());
   if (run_plot_script("plot_study.py", {opt.output}))
     std::printf("study: figure in %s/study.png\n", opt.output.c_str());

@@ -71,7 +71,24 @@ struct PeakComparison {
 PeakComparison compare_peaks(const MeasuredData& data, const std::vector<StudyCase>& cases,
                              const std::vector<TestSummary>& summaries);
 
+/// What a study has so far: each case's summary (q_peak NaN unless it finished), the comparisons, and the
+/// text of study_summary.csv, where a case not finished yet reads "pending" and a failed one "failed".
+struct StudyTable {
+  std::vector<TestSummary> summaries;
+  std::vector<bool> ok;
+  std::vector<PeakComparison> cmp;
+  std::string csv;
+};
+
+/// The table from the cases' summary.csv files under `output`; status per case: -1 not finished yet, 0
+/// finished, other values the exit status of a failed case. A finished case's curve values are taken afresh
+/// from its series.csv (a kept case may come from a program that summarised differently), and its
+/// summary.csv follows.
+StudyTable study_table(const std::vector<StudyCase>& cases, const std::vector<int>& status, const std::string& output,
+                       const std::vector<MeasuredData>& compare);
+
 /// Runs the study; returns 0 when every case finished, 1 otherwise (the summary then lists the failures).
+/// study_summary.csv is rewritten whenever a case finishes, so a study stopped half-way leaves its table.
 int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, const char* self_exe);
 
 /// Runs tools/<script> with python3 on `args` (found beside the executable or in the source tree). Returns

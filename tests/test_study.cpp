@@ -100,6 +100,42 @@ TEST(Study, ResumeKeepsFinishedCasesAndRunsTheRest) {
   EXPECT_NE(text.find("12345"), std::string::npos) << text;
 }
 
+// The table a study rewrites after every case: finished cases with their values, the others marked pending
+// or failed, so a study stopped half-way leaves a table of what it finished.
+TEST(Study, TableMarksPendingAndFailedCases) {
+  const auto dir = dem::test::scratch_dir("study_table");
+  std::vector<StudyCase> cases(3);
+  const char* names[] = {"done", "waiting", "broken"};
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    cases[k].name = names[k];
+    cases[k].config = std::string(names[k]) + ".toml";
+    cases[k].job = "triaxial";
+    cases[k].material = "S-1";
+  }
+  TestSummary done;
+  done.kind = "membrane";
+  done.sigma3 = 100e3;
+  done.q_peak = 150e3;
+  std::filesystem::create_directories(dir / "done");
+  write_summary((dir / "done").string(), done);
+  MeasuredData lab;
+  lab.path = "lab.csv";
+  MeasuredTest t;
+  t.material = "S-1";
+  t.sigma3 = 100e3;
+  t.q_peak = 120e3;
+  lab.tests.push_back(t);
+  const StudyTable table = study_table(cases, {0, -1, 2}, dir.string(), {lab});
+  EXPECT_TRUE(table.ok[0]);
+  EXPECT_FALSE(table.ok[1]);
+  EXPECT_FALSE(table.ok[2]);
+  EXPECT_NE(table.csv.find("done,done.toml,triaxial,ok,S-1,"), std::string::npos) << table.csv;
+  EXPECT_NE(table.csv.find(",120.00,25.00\n"), std::string::npos) << table.csv;  // (150 - 120) / 120
+  EXPECT_NE(table.csv.find("waiting,waiting.toml,triaxial,pending,S-1\n"), std::string::npos) << table.csv;
+  EXPECT_NE(table.csv.find("broken,broken.toml,triaxial,failed,S-1\n"), std::string::npos) << table.csv;
+  EXPECT_EQ(table.cmp[0].matched, 1);
+}
+
 // study --compare: cases are matched by material and sigma3; the error is relative to the measured peak, the mean
 // and the largest over the matched cases only (an unmatched material, an absent pressure and a failed case are
 // left out, not counted as zero error).
