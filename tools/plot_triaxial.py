@@ -2,7 +2,8 @@
 """Plots triaxial runs like Figure 8 of Tang et al. (2025): deviator stress q and volumetric strain eps_v
 against axial strain eps_a, in two panels, for one run or several overlaid.
 
-Reads the series.csv of a run (columns eps_a_pct, q_kPa, eps_v_pct, as `triaxdem triaxial` and `periodic` write);
+Reads the series.csv of a run (columns eps_a_pct, q_kPa, eps_v_pct, as `triaxdem triaxial` and `periodic` write;
+with sigma1_bottom_kPa, as the membrane test writes, q from the bottom platen is drawn dashed);
 a RUN argument may be the output folder or the CSV file itself. Conventions: eps_a = (h0 - h)/h0,
 eps_v = -(V - V0)/V0 (contraction positive); q = sigma1 - sigma3 with the cell pressure (membrane test) or
 sigma1 - (sigma2 + sigma3)/2 with the lateral stresses measured from the contacts (periodic cell).
@@ -87,6 +88,11 @@ def main():
             label = f"{name}: highest record {peak[0]:.1f} kPa at {peak[1]:.1f}%"
         line, = ax_q.plot(ea, q, lw=1.4, label=label)
         ax_q.plot(peak[1], peak[0], "o", ms=4, color=line.get_color())
+        if "sigma1_bottom_kPa" in s and "sigma3_kPa" in s:
+            # q is read at the top platen, which drives the test; the bottom platen shows what reaches the far
+            # end (they differ by what the balls' local damping takes out of the axial flow: README).
+            ax_q.plot(ea, s["sigma1_bottom_kPa"] - s["sigma3_kPa"], lw=0.8, ls="--", color=line.get_color(),
+                      label=f"{name}: bottom platen")
         ax_v.plot(ea, ev, lw=1.4, color=line.get_color(), label=name)
         if k == 0 and args.marks:
             for j, m in enumerate(float(v) for v in args.marks.split(",")):
