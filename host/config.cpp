@@ -296,6 +296,7 @@ Config parse_config(const std::string& text, const std::string& path) {
   tx.number("membrane_poisson", c.triaxial.membrane_poisson, -0.99, 0.499);
   tx.number("membrane_thickness_mm", c.triaxial.membrane_thickness, 0, 100, 1e-3, true);
   tx.number("membrane_density_kg_m3", c.triaxial.membrane_density, 0, 1e5, 1, true);
+  tx.boolean("damping_about_flow", c.triaxial.damping_about_flow);
   tx.finish();
 
   TableReader mi = table("micro");

@@ -84,6 +84,9 @@ struct TriaxialConfig {
   Real membrane_poisson = 0.49;
   Real membrane_thickness = 0.5e-3;  ///< m (file: membrane_thickness_mm)
   Real membrane_density = 930;    ///< kg/m^3
+  /// Local damping during shear about the platens' axial flow (v_z = v_top z / h) instead of the absolute
+  /// velocity; false is PFC's (and the paper's) way, whose drag the top platen reads (README).
+  bool damping_about_flow = false;
 };
 
 /// Micromechanics recorded during a triaxial test ([micro] table; host/micro_report.hpp).

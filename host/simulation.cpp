@@ -256,6 +256,8 @@ void Simulation::set_wall_velocity(int w, const Vec3& v) {
   Kokkos::deep_copy(walls_.velocity, hwall_vel_);
 }
 
+Vec3 Simulation::wall_velocity(int w) const { return load(hwall_vel_, w); }
+
 Vec3 Simulation::wall_point(int w) const { return load(hwall_point_, w); }
 
 void Simulation::set_wall_point(int w, const Vec3& p) {

@@ -71,6 +71,12 @@ class Simulation {
   /// Replaces the contact laws (same nmat x nmat layout as the constructor's); contact history is kept.
   void set_contact_params(const std::vector<ContactParams>& table);
   void set_dt(Real dt) { prm_.integ.dt = dt; }
+  /// Local damping about the mean flow v = rate (x - origin) from now on (IntegrateParams::about_flow).
+  void set_damping_flow(const Vec3& rate, const Vec3& origin) {
+    prm_.integ.about_flow = true;
+    prm_.integ.flow_rate = rate;
+    prm_.integ.flow_origin = origin;
+  }
 
   /// Makes the facet mesh a flexible membrane (m.mesh must be the mesh given to the constructor: the
   /// Views are shared). Each step then loads its nodes with CST elasticity, the cell pressure and the
@@ -91,6 +97,7 @@ class Simulation {
 
   /// Rigid wall velocity (m/s) and position (m) control.
   void set_wall_velocity(int w, const Vec3& v);
+  Vec3 wall_velocity(int w) const;
   Vec3 wall_point(int w) const;
   void set_wall_point(int w, const Vec3& p);
   /// Force exerted by the balls on wall object `obj` (analytic walls first, then facets), N.

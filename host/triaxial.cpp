@@ -270,6 +270,10 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
       }
       if (k == steps) break;
       if (k < ramp) set_top_velocity(cell, -res.shear_rate * h0 * static_cast<Real>(k + 1) / ramp);
+      if (tc.damping_about_flow) {  // the bottom platen rests at z = 0: the flow is v_z = v_top z / h
+        const Real h = sim.wall_point(kTopPlaten).z;
+        sim.set_damping_flow(Vec3(0, 0, sim.wall_velocity(kTopPlaten).z / h), Vec3());
+      }
       // The unbalanced ratio and kinetic energy cost a pass: measured on the steps before a record only.
       sim.step((h0 - sim.wall_point(kTopPlaten).z) / h0 + res.shear_rate * dt >= st.next_record - 1e-12 ||
                k + 1 == steps);

@@ -1,6 +1,7 @@
 #pragma once
 /// Centred-difference (leapfrog) integration as in PFC, with gravity and local (Cundall) damping:
-///   F_d = -alpha |F| sign(v), component-wise on forces and on moments (PFC manual; sign(0) = 0),
+///   F_d = -alpha |F| sign(v), component-wise on forces and on moments (PFC manual; sign(0) = 0; v may be
+///   taken about a mean flow, IntegrateParams::about_flow),
 ///   v(t + dt/2) = v(t - dt/2) + (F + F_d) / m dt,   x(t + dt) = x(t) + v(t + dt/2) dt.
 /// Density scaling multiplies inertial mass and moment of inertia (not weight) by `mass_scale`.
 #include "accumulate.hpp"
@@ -15,6 +16,12 @@ struct IntegrateParams {
   Real mass_scale = 1.0;  ///< density scaling factor for quasi-static runs (1 = physical)
   Real dt = 0;            ///< s
   bool measure = true;    ///< fill StepStats::unbalanced and ::kinetic (skipped on unmeasured steps)
+  /// With about_flow, local damping acts on v - flow_rate (x - flow_origin), component by component: the
+  /// velocity about the test's imposed mean flow. On the absolute velocity (PFC, the default) a steady flow
+  /// turns the damping of the balls' fluctuating forces into a net drag against it (README: The triaxial test).
+  bool about_flow = false;
+  Vec3 flow_rate;         ///< 1/s, diagonal of the mean flow's velocity gradient
+  Vec3 flow_origin;       ///< m, where the mean flow is at rest
 };
 
 /// Per-step sums over particles, for the unbalanced-force ratio and energy.
@@ -34,6 +41,13 @@ StepStats integrate(Particles& p, const IntegrateParams& prm, const Gather& gath
 KOKKOS_INLINE_FUNCTION Real local_damping(Real f, Real v, Real alpha) {
   const Real s = v > 0 ? Real(1) : (v < 0 ? Real(-1) : Real(0));
   return -alpha * kc::fabs(f) * s;
+}
+
+/// The velocity local damping is measured against (IntegrateParams::about_flow): v, or v less the mean flow at x.
+KOKKOS_INLINE_FUNCTION Vec3 damped_velocity(const IntegrateParams& prm, const Vec3& v, const Vec3& x) {
+  if (!prm.about_flow) return v;
+  const Vec3 d = x - prm.flow_origin;
+  return v - Vec3(prm.flow_rate.x * d.x, prm.flow_rate.y * d.y, prm.flow_rate.z * d.z);
 }
 
 }  // namespace dem

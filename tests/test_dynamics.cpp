@@ -498,3 +498,26 @@ TEST(Dynamics, StaticLoadOnPlaneEqualsWeight) {
   const double d = R - h.x[0].z;
   EXPECT_NEAR(d, m * kG / (kPi * R * emod), 1e-5 * m * kG / (kPi * R * emod));
 }
+
+// ---------------------------------------------------------------------------------------------------
+// Local damping about a mean flow (IntegrateParams::about_flow). A free ball under gravity, at rest where the
+// flow moves down at 1 m/s: it moves up relative to the flow, so the damping pushes it down with it and it
+// falls at (1 + alpha) g for as long as it stays slower than the flow, v_n = -n (1 + alpha) g dt. Measured
+// on the absolute velocity (PFC), the first step has v = 0 (sign 0, no damping) and every later one resists
+// the fall: v_n = -g dt (1 + (n - 1)(1 - alpha)). Exact sums of equal increments: the tolerance is rounding.
+TEST(Dynamics, LocalDampingAboutAMeanFlow) {
+  const double R = 1e-3, alpha = 0.7, dt = 1e-5;
+  const int n = 200;
+  for (const bool about : {false, true}) {
+    std::vector<BallSpec> b(1);
+    b[0].radius = R;
+    Simulation sim(make_particles(b), make_walls({}), FacetMesh(), {test::law(1e8, 1.5, 0.5, 0.1, 0.0)}, 1,
+                   sim_params(0.1 * R, alpha, Vec3(0, 0, -kG)));
+    sim.set_dt(dt);
+    if (about) sim.set_damping_flow(Vec3(0, 0, 1.0), Vec3(0, 0, 1.0));  // v_flow = (z - 1 m) / s: -1 m/s here
+    sim.run(n);
+    const double v = to_host_by_gid(sim.particles()).v[0].z;
+    const double expected = about ? -n * (1 + alpha) * kG * dt : -kG * dt * (1 + (n - 1) * (1 - alpha));
+    EXPECT_NEAR(v, expected, 1e-12 * std::fabs(expected)) << (about ? "about the flow" : "absolute");
+  }
+}
