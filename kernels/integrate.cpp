@@ -23,14 +23,15 @@ struct Leapfrog {
     store(m, i, moment);
     const Vec3 force = fc + mi * prm.gravity;
     Vec3 vi = load(v, i), wi = load(w, i);
+    const Vec3 x0 = load(x, i);
     const Real a = prm.dt / (mi * prm.mass_scale), b = prm.dt / (ii * prm.mass_scale);
-    const Vec3 vd = damped_velocity(prm, vi, load(x, i));
+    const Vec3 vd = damped_velocity(prm, vi, x0);
     vi = vi + a * Vec3(force.x + local_damping(force.x, vd.x, prm.alpha), force.y + local_damping(force.y, vd.y, prm.alpha),
                        force.z + local_damping(force.z, vd.z, prm.alpha));
     wi = wi + b * Vec3(moment.x + local_damping(moment.x, wi.x, prm.alpha),
                        moment.y + local_damping(moment.y, wi.y, prm.alpha),
                        moment.z + local_damping(moment.z, wi.z, prm.alpha));
-    const Vec3 xi = load(x, i) + prm.dt * vi;
+    const Vec3 xi = x0 + prm.dt * vi;
     store(v, i, vi);
     store(w, i, wi);
     store(x, i, xi);
