@@ -113,7 +113,7 @@ void Simulation::step(bool measure) {
   if (rebuild_due()) rebuild();
   times_.rebuild += seconds_since(t);
   const Real dt = prm_.integ.dt;
-  const OverlapStat ob = compute_ball_forces(p_, balls_, own_, params_, prm_.domain, dt);
+  const OverlapStat ob = compute_ball_forces(p_, balls_, params_, prm_.domain, dt);
   const OverlapStat ow = compute_wall_forces(p_, wall_c_, adj_walls_, walls_, mesh_, params_, dt);
   times_.forces += seconds_since(t);
   check_blowup(ob, ow);
@@ -125,7 +125,7 @@ void Simulation::step(bool measure) {
     times_.membrane += seconds_since(t);
   }
   prm_.integ.measure = measure;
-  stats_ = integrate(p_, prm_.integ, make_gather(p_, balls_, adj_balls_, wall_c_, adj_walls_));
+  stats_ = integrate(p_, prm_.integ, make_gather(balls_, own_, adj_balls_, wall_c_, adj_walls_));
   times_.integrate += seconds_since(t);
   if (stats_.bad >= 0 || stats_.max_move2 > prm_.overlap_limit * prm_.overlap_limit) check_blowup(ob, ow);
   move_boundaries();

@@ -44,9 +44,9 @@ Index2View owner_ranges(const Particles& p, const ContactList& balls) {
   return own;
 }
 
-Gather make_gather(const Particles& p, const ContactList& balls, const Adjacency& ab, const ContactList& walls,
+Gather make_gather(const ContactList& balls, const Index2View& own, const Adjacency& ab, const ContactList& walls,
                    const Adjacency& aw) {
-  return Gather{p.f, p.m, balls.fc, balls.mt, walls.fc, walls.mt, ab.offset, ab.entry, aw.offset, aw.entry};
+  return Gather{balls.fc, balls.mo, balls.mt, walls.fc, walls.mt, own, ab.offset, ab.entry, aw.offset, aw.entry};
 }
 
 IndexView object_offsets(const ContactList& walls, int nobj) {

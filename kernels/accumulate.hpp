@@ -1,10 +1,11 @@
 #pragma once
 /// Deterministic accumulation, no floating-point atomics, so a run is bit-for-bit the same for any
 /// thread count:
-///  - a ball-ball contact is evaluated by its owner, particle 1 (the lower gid): the owner sums its own
-///    side in key order while the kernel runs, and stores the reaction for particle 2;
-///  - every particle then gathers the reactions of the contacts it does not own, and its wall contacts,
-///    through a particle -> contact list sorted by contact index (Gather, called inside integration).
+///  - a ball-ball contact is evaluated once and stores both sides: the force and moment on its owner, particle 1
+///    (the lower gid), and the reaction moment on particle 2;
+///  - every particle then sums, inside integration (Gather), the owner's side of the contacts it owns in key
+///    order, the reactions of the contacts it does not own and its wall contacts, through particle -> contact
+///    lists sorted by contact index.
 #include "contact_list.hpp"
 #include "particles.hpp"
 #include "vec3.hpp"
@@ -25,16 +26,20 @@ Adjacency build_adjacency(int n, const ContactList& c, const IndexView& side);
 /// because keys start with the owner's gid.
 Index2View owner_ranges(const Particles& p, const ContactList& balls);
 
-/// Completes a particle's force and moment: its own side (already in p.f, p.m), minus the reactions of
-/// ball-ball contacts it is particle 2 of, plus its wall contacts.
+/// A particle's force and moment: the owner's side of the ball-ball contacts it owns (contiguous, in key order),
+/// minus the reactions of those it is particle 2 of, plus its wall contacts.
 struct Gather {
-  ConstVec3View own_f, own_m;
-  ConstVec3View bfc, bmt, wfc, wmt;
+  ConstVec3View bfc, bmo, bmt, wfc, wmt;
+  Index2View own;
   ConstIndexView boff, bent, woff, went;
 
   KOKKOS_INLINE_FUNCTION void operator()(const int i, Vec3& f, Vec3& m) const {
-    f = load(own_f, i);
-    m = load(own_m, i);
+    f = Vec3();
+    m = Vec3();
+    for (int s = own(i, 0); s < own(i, 1); ++s) {
+      f += load(bfc, s);
+      m += load(bmo, s);
+    }
     for (int a = boff(i); a < boff(i + 1); ++a) {
       f -= load(bfc, bent(a));
       m += load(bmt, bent(a));
@@ -46,8 +51,8 @@ struct Gather {
   }
 };
 
-Gather make_gather(const Particles& p, const ContactList& balls, const Adjacency& adj_balls, const ContactList& walls,
-                   const Adjacency& adj_walls);
+Gather make_gather(const ContactList& balls, const Index2View& own, const Adjacency& adj_balls,
+                   const ContactList& walls, const Adjacency& adj_walls);
 
 /// Offsets of each wall object's contacts in the (key-sorted) ball-wall list: nobj + 1 entries.
 IndexView object_offsets(const ContactList& walls, int nobj);

@@ -17,55 +17,122 @@ struct MaxOverlap {
   KOKKOS_INLINE_FUNCTION void init(value_type& a) const { a.ratio = 0; a.contact = -1; }
 };
 
-/// One thread per particle: evaluates the contacts it owns, sums its own side in key order.
+/// The parameters of W material pairs as lanes: pair(k) gives lane k's.
+template <class T, class Pair>
+KOKKOS_INLINE_FUNCTION ContactParamsT<T> params_of_lanes(const Pair& pair) {
+  static_assert(sizeof(ContactParams) == 9 * sizeof(Real), "a new ContactParams field must be copied here");
+  const auto field = [&](Real ContactParams::*m) { return from_lanes<T>([&](int k) { return pair(k).*m; }); };
+  ContactParamsT<T> P;
+  P.emod = field(&ContactParams::emod);
+  P.kratio = field(&ContactParams::kratio);
+  P.mu_s = field(&ContactParams::mu_s);
+  P.mu_r = field(&ContactParams::mu_r);
+  P.beta_n = field(&ContactParams::beta_n);
+  P.hertz_overlap = field(&ContactParams::hertz_overlap);
+  P.roughness = field(&ContactParams::roughness);
+  P.wear = field(&ContactParams::wear);
+  P.wear_slip = field(&ContactParams::wear_slip);
+  return P;
+}
+
+/// The 3-vectors f(0) .. f(W-1) as a vector of lanes.
+template <class T, class F>
+KOKKOS_INLINE_FUNCTION Vec3T<T> vec_of_lanes(const F& f) {
+  Vec3 a[kContactLanes];
+  TRIAXDEM_UNROLL_LANES
+  for (int k = 0; k < kContactLanes; ++k) a[k] = f(k);
+  return Vec3T<T>(from_lanes<T>([&](int k) { return a[k].x; }), from_lanes<T>([&](int k) { return a[k].y; }),
+                  from_lanes<T>([&](int k) { return a[k].z; }));
+}
+
+template <class T>
+KOKKOS_INLINE_FUNCTION Vec3 lane(const Vec3T<T>& a, int k) { return Vec3(lane(a.x, k), lane(a.y, k), lane(a.z, k)); }
+
+/// One work item per kContactLanes consecutive ball-ball contacts, evaluated side by side as lanes of T. Each
+/// lane's arithmetic is that of a single contact, so the results do not depend on which lane a contact falls in.
 struct BallForce : MaxOverlap {
+  using T = ContactPack;
+  static constexpr int W = kContactLanes;
   ConstVec3View x, v, w;
-  Vec3View f, m;
   ConstScalarView radius, mass;
   ConstIndexView material;
   ContactList c;
-  Index2View own;
   ParamTableView params;
   Domain dom;
   MinImage image;
   Real dt;
 
-  KOKKOS_INLINE_FUNCTION void operator()(const int i, value_type& worst) const {
-    const Vec3 xi = load(x, i), vi = load(v, i), wi = load(w, i);
-    const Real ri = radius(i);
-    Vec3 fi, mi;
-    for (int s = own(i, 0); s < own(i, 1); ++s) {
-      const int j = c.j(s);
-      const Vec3 d = image(load(x, j) - xi);
-      const Real dist = norm(d);
-      const Real rj = radius(j);
-      const Real overlap = ri + rj - dist;
-      if (overlap <= 0 || dist == Real(0)) { open_contact(c, s); continue; }
-      ContactKinematics k;
-      k.n = (Real(1) / dist) * d;
-      k.overlap = overlap;
-      k.r1 = ri; k.r2 = rj;
-      k.m1 = mass(i);
-      k.m2 = mass(j);
-      // Branch vectors from the centres to the contact point: r1 = a n, r2 = -b n (both along n),
-      // which folds the two spin terms of the relative velocity into one cross product.
-      const Real a = ri - Real(0.5) * overlap, b = rj - Real(0.5) * overlap;
-      const Vec3 wj = load(w, j);
-      k.vrel = load(v, j) - vi - cross(a * wi + b * wj, k.n) + dom.affine_velocity(d);
-      k.dtheta = dt * (wj - wi);
-      k.dt = dt;
-      const ContactParams& prm = params(material(i), material(j));
-      k.kn = RRLinear::stiffness(prm, ri, rj);
-      const ContactOutput out = apply_law(c, s, prm, k);
-      const Vec3 nxf = cross(k.n, out.force);
-      store(c.mt, s, b * nxf - out.moment);
-      fi += out.force;
-      mi += a * nxf + out.moment;
-      const value_type mine{overlap / kc::min(ri, rj), s};
+  KOKKOS_INLINE_FUNCTION void operator()(const int item, value_type& worst) const {
+    const int s0 = item * W;
+    const int lanes = c.n - s0 < W ? c.n - s0 : W;
+    // Lanes past the end repeat the last contact; their results are not stored.
+    int cs[W], ci[W], cj[W];
+    const ContactParams* pair[W];
+    bool one_pair = true;
+    TRIAXDEM_UNROLL_LANES
+    for (int k = 0; k < W; ++k) {
+      cs[k] = s0 + (k < lanes ? k : lanes - 1);
+      ci[k] = c.i(cs[k]);
+      cj[k] = c.j(cs[k]);
+      pair[k] = &params(material(ci[k]), material(cj[k]));
+      one_pair = one_pair && pair[k] == pair[0];
+    }
+    const Vec3T<T> d = vec_of_lanes<T>([&](int k) { return image(load(x, cj[k]) - load(x, ci[k])); });
+    const Vec3T<T> vi = vec_of_lanes<T>([&](int k) { return load(v, ci[k]); });
+    const Vec3T<T> vj = vec_of_lanes<T>([&](int k) { return load(v, cj[k]); });
+    const Vec3T<T> wi = vec_of_lanes<T>([&](int k) { return load(w, ci[k]); });
+    const Vec3T<T> wj = vec_of_lanes<T>([&](int k) { return load(w, cj[k]); });
+    const T ri = from_lanes<T>([&](int k) { return radius(ci[k]); });
+    const T rj = from_lanes<T>([&](int k) { return radius(cj[k]); });
+    const ContactParamsT<T> prm = one_pair ? params_of_lanes<T>([&](int) -> const ContactParams& { return *pair[0]; })
+                                           : params_of_lanes<T>([&](int k) -> const ContactParams& { return *pair[k]; });
+    const T dist = norm(d);
+    const T overlap = ri + rj - dist;
+    const auto touching = !((overlap <= T(0)) | (dist == T(0)));
+    if (!any(touching)) {
+      for (int k = 0; k < lanes; ++k) open_contact(c, s0 + k);
+      return;
+    }
+    ContactKinematicsT<T> kin;
+    kin.n = (T(1) / dist) * d;
+    kin.overlap = overlap;
+    kin.r1 = ri; kin.r2 = rj;
+    kin.m1 = from_lanes<T>([&](int k) { return mass(ci[k]); });
+    kin.m2 = from_lanes<T>([&](int k) { return mass(cj[k]); });
+    // Branch vectors from the centres to the contact point: r1 = a n, r2 = -b n (both along n),
+    // which folds the two spin terms of the relative velocity into one cross product.
+    const T a = ri - Real(0.5) * overlap, b = rj - Real(0.5) * overlap;
+    kin.vrel = vj - vi - cross(a * wi + b * wj, kin.n) + dom.affine_velocity(d);
+    kin.dtheta = dt * (wj - wi);
+    kin.dt = dt;
+    kin.kn = RRLinear::stiffness(prm, ri, rj);
+    ContactHistoryT<T> h;  // flags start clear: the law sets or clears every ContactFlag bit of a touching contact
+    h.fs = vec_of_lanes<T>([&](int k) { return load(c.fs, cs[k]); });
+    h.mr = vec_of_lanes<T>([&](int k) { return load(c.mr, cs[k]); });
+    h.slip = from_lanes<T>([&](int k) { return c.slip(cs[k]); });
+    const ContactOutputT<T> out = RRLinear::eval(prm, kin, h);
+    const Vec3T<T> nxf = cross(kin.n, out.force);
+    const Vec3T<T> mt = b * nxf - out.moment, mo = a * nxf + out.moment;
+    const T ratio = overlap / kc::min(ri, rj);
+    TRIAXDEM_UNROLL_LANES
+    for (int k = 0; k < W; ++k) {
+      if (k == lanes) break;
+      const int s = s0 + k;
+      if (!lane(touching, k)) {
+        open_contact(c, s);
+        continue;
+      }
+      store(c.fs, s, lane(h.fs, k));
+      store(c.mr, s, lane(h.mr, k));
+      c.flags(s) = lane(h.flags, k);
+      c.slip(s) = lane(h.slip, k);
+      store(c.fc, s, lane(out.force, k));
+      c.fn(s) = lane(out.fn, k);
+      store(c.mo, s, lane(mo, k));
+      store(c.mt, s, lane(mt, k));
+      const value_type mine{lane(ratio, k), s};
       join(worst, mine);
     }
-    store(f, i, fi);
-    store(m, i, mi);
   }
 };
 
@@ -158,14 +225,14 @@ void bind_particles(Kernel& k, const Particles& p) {
 
 }  // namespace
 
-OverlapStat compute_ball_forces(Particles& p, ContactList& c, const Index2View& own, const ParamTableView& params,
-                                const Domain& dom, Real dt) {
+OverlapStat compute_ball_forces(const Particles& p, ContactList& c, const ParamTableView& params, const Domain& dom,
+                                Real dt) {
   BallForce k;
   bind_particles(k, p);
-  k.f = p.f; k.m = p.m;
-  k.c = c; k.own = own; k.params = params; k.dom = dom; k.image = MinImage(dom); k.dt = dt;
+  k.c = c; k.params = params; k.dom = dom; k.image = MinImage(dom); k.dt = dt;
   OverlapStat worst;
-  Kokkos::parallel_reduce("dem::force::balls", RangePolicy(0, p.n), k, worst);
+  const int items = (c.n + BallForce::W - 1) / BallForce::W;
+  Kokkos::parallel_reduce("dem::force::balls", RangePolicy(0, items), k, worst);
   return worst;
 }
 

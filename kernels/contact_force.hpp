@@ -14,10 +14,10 @@ struct OverlapStat {
   int contact = -1;
 };
 
-/// Ball-ball forces with law RRLinear, evaluated by each contact's owner (accumulate.hpp): writes the
-/// owner's own side into p.f and p.m and each contact's reaction data. Returns the largest overlap ratio.
-OverlapStat compute_ball_forces(Particles& p, ContactList& c, const Index2View& own, const ParamTableView& params,
-                                const Domain& dom, Real dt);
+/// Ball-ball forces with law RRLinear, kContactLanes contacts per work item (simd.hpp): writes each contact's
+/// force and moments on both sides (fc, mo, mt) for the gather (accumulate.hpp). Returns the largest overlap ratio.
+OverlapStat compute_ball_forces(const Particles& p, ContactList& c, const ParamTableView& params, const Domain& dom,
+                                Real dt);
 
 /// Ball-wall forces (analytic walls and facets). A ball touching several facets at a shared edge or
 /// vertex gets one contact: an edge/vertex hit yields to a face hit, or an equal hit of a lower facet
@@ -50,6 +50,7 @@ KOKKOS_INLINE_FUNCTION void open_contact(const ContactList& c, int s) {
   c.flags(s) = 0;
   c.slip(s) = 0;
   store(c.fc, s, Vec3());
+  store(c.mo, s, Vec3());
   store(c.mt, s, Vec3());
   c.fn(s) = 0;
 }

@@ -33,22 +33,31 @@
 
 namespace dem {
 
-/// Parameters of one material pair. Units: Pa, -, -, -, -.
-struct ContactParams {
-  Real emod = 1e8;     ///< effective modulus E* of the deformability method (Pa)
-  Real kratio = 1.5;   ///< kappa* = kn / ks
-  Real mu_s = 0.5;     ///< sliding friction coefficient
-  Real mu_r = 0.0;     ///< rolling friction coefficient
-  Real beta_n = 0.0;   ///< normal viscous damping ratio (PFC dp_nratio); 0 = off, force never tensile
+/// Makes a parameter non-deduced, so that a Real or an int argument converts to the law's T.
+template <class T>
+struct Same {
+  using type = T;
+};
+template <class T>
+using Arg = typename Same<T>::type;
+
+/// Parameters of one material pair. Units: Pa, -, -, -, -. T is Real, or a pack of W pairs' values (simd.hpp).
+template <class T>
+struct ContactParamsT {
+  T emod = 1e8;     ///< effective modulus E* of the deformability method (Pa)
+  T kratio = 1.5;   ///< kappa* = kn / ks
+  T mu_s = 0.5;     ///< sliding friction coefficient
+  T mu_r = 0.0;     ///< rolling friction coefficient
+  T beta_n = 0.0;   ///< normal viscous damping ratio (PFC dp_nratio); 0 = off, force never tensile
   // Extensions (see the top of this file), 0 = off.
-  Real hertz_overlap = 0.0;  ///< Hertz-Mindlin: overlap / r at which the secant stiffness equals kn
-  Real roughness = 0.0;      ///< rough-surface compliance: combined rms roughness / r
-  Real wear = 0.0;           ///< slip weakening: fraction of mu_s lost after long sliding
-  Real wear_slip = 0.5;      ///< slip weakening: sliding distance / r over which friction decays by 1/e
+  T hertz_overlap = 0.0;  ///< Hertz-Mindlin: overlap / r at which the secant stiffness equals kn
+  T roughness = 0.0;      ///< rough-surface compliance: combined rms roughness / r
+  T wear = 0.0;           ///< slip weakening: fraction of mu_s lost after long sliding
+  T wear_slip = 0.5;      ///< slip weakening: sliding distance / r over which friction decays by 1/e
 
   /// The same pair without the extensions (specimen preparation, which must not depend on them).
-  ContactParams base() const {
-    ContactParams b = *this;
+  ContactParamsT base() const {
+    ContactParamsT b = *this;
     b.hertz_overlap = b.roughness = b.wear = 0;
     return b;
   }
@@ -57,55 +66,68 @@ struct ContactParams {
 /// Geometry and kinematics of one contact, seen from particle 1 ("i"); body 2 is a particle or a wall.
 /// n points from 1 to 2; vrel is the velocity of 2 relative to 1 at the contact point; dtheta the
 /// relative rotation increment (w2 - w1) dt. R2 = 0 marks a wall.
-struct ContactKinematics {
-  Vec3 n;
-  Real overlap;   ///< m, > 0 when touching
-  Real kn;        ///< N/m, normal stiffness of this pair (Normal::stiffness, computed once per contact)
-  Real r1, r2;    ///< m
-  Real m1, m2;    ///< kg, masses (m2 = 0 at walls), for the dashpot's reduced mass
-  Vec3 vrel;      ///< m/s
-  Vec3 dtheta;    ///< rad
-  Real dt;        ///< s
+template <class T>
+struct ContactKinematicsT {
+  Vec3T<T> n;
+  T overlap;   ///< m, > 0 when touching
+  T kn;        ///< N/m, normal stiffness of this pair (Normal::stiffness, computed once per contact)
+  T r1, r2;    ///< m
+  T m1, m2;    ///< kg, masses (m2 = 0 at walls), for the dashpot's reduced mass
+  Vec3T<T> vrel;      ///< m/s
+  Vec3T<T> dtheta;    ///< rad
+  Real dt;            ///< s
 };
+using ContactKinematics = ContactKinematicsT<Real>;
 
 /// History carried by a contact between steps (contact-plane vectors stored in global coordinates).
-struct ContactHistory {
-  Vec3 fs;               ///< shear force on particle 1 (N)
-  Vec3 mr;               ///< rolling moment on particle 1 (N m)
-  std::uint8_t flags = 0;
-  Real slip = 0;         ///< sliding distance accumulated while touching (m), for slip-weakening friction
+template <class T>
+struct ContactHistoryT {
+  Vec3T<T> fs;                          ///< shear force on particle 1 (N)
+  Vec3T<T> mr;                          ///< rolling moment on particle 1 (N m)
+  typename LaneFlags<T>::type flags{};  ///< ContactFlag bits
+  T slip = 0;                           ///< sliding distance accumulated while touching (m), for slip-weakening friction
 };
+using ContactHistory = ContactHistoryT<Real>;
 
 /// What a law returns for particle 1: total force and the extra (non-lever) moment.
-struct ContactOutput {
-  Vec3 force;    ///< N, on particle 1
-  Vec3 moment;   ///< N m, on particle 1, excluding the lever arm of force
-  Real fn = 0;   ///< N, elastic normal force (dashpot excluded), >= 0
+template <class T>
+struct ContactOutputT {
+  Vec3T<T> force;    ///< N, on particle 1
+  Vec3T<T> moment;   ///< N m, on particle 1, excluding the lever arm of force
+  T fn = 0;          ///< N, elastic normal force (dashpot excluded), >= 0
 };
+using ContactOutput = ContactOutputT<Real>;
 
-/// Scales a down to magnitude `cap` if it is longer; true if it was. Compares squares, so the common
-/// elastic case costs no square root.
-KOKKOS_INLINE_FUNCTION bool cap_to(Vec3& a, Real cap) {
-  const Real m2 = norm2(a);
-  if (m2 <= cap * cap) return false;
-  a = cap > 0 ? (cap / kc::sqrt(m2)) * a : Vec3();
-  return true;
+/// Scales a down to magnitude `cap` if it is longer (to zero if cap <= 0); returns where it was. Compares squares,
+/// so an elastic contact's value never passes through a square root.
+template <class T>
+KOKKOS_INLINE_FUNCTION auto cap_to(Vec3T<T>& a, const T& cap) {
+  const T m2 = norm2(a);
+  const auto capped = m2 > cap * cap;
+  if (any(capped)) a = select(capped, select(cap > T(0), (cap / kc::sqrt(m2)) * a, Vec3T<T>()), a);
+  return capped;
 }
 
 /// Normal force and its tangent stiffness dFn/doverlap (N, N/m); the shear and rolling springs scale with it.
-struct NormalResponse {
-  Real fn;
-  Real k;
+template <class T>
+struct NormalResponseT {
+  T fn;
+  T k;
 };
+using NormalResponse = NormalResponseT<Real>;
 
 /// The radius r of the deformability method: the smaller ball's, or the ball's at a wall.
-KOKKOS_INLINE_FUNCTION Real contact_radius(Real r1, Real r2) { return r2 > 0 ? kc::min(r1, r2) : r1; }
+template <class T>
+KOKKOS_INLINE_FUNCTION T contact_radius(const T& r1, const Arg<T>& r2) {
+  return select(r2 > T(0), kc::min(r1, r2), r1);
+}
 
 /// Elastic normal spring: linear with the deformability method's kn, optionally Hertzian and rough.
 struct NormalElastic {
-  KOKKOS_INLINE_FUNCTION static Real stiffness(const ContactParams& p, Real r1, Real r2) {
-    const Real r = contact_radius(r1, r2);
-    const Real L = r2 > 0 ? r1 + r2 : r1;
+  template <class T>
+  KOKKOS_INLINE_FUNCTION static T stiffness(const ContactParamsT<T>& p, const Arg<T>& r1, const Arg<T>& r2) {
+    const T r = contact_radius(r1, r2);
+    const T L = select(r2 > T(0), r1 + r2, r1);
     return Real(M_PI) * r * r * p.emod / L;
   }
   /// Largest tangent stiffness up to an overlap of overlap_max (m), for the critical time step.
@@ -116,51 +138,57 @@ struct NormalElastic {
     return kc::max(kn, Real(1.5) * kn * kc::sqrt(overlap_max / dref));
   }
   /// Elastic normal force (>= 0) and tangent stiffness of a touching contact (k.overlap > 0, k.kn set).
-  KOKKOS_INLINE_FUNCTION static NormalResponse response(const ContactParams& p, const ContactKinematics& k) {
-    if (p.hertz_overlap == Real(0) && p.roughness == Real(0)) return {k.kn * k.overlap, k.kn};
-    const Real r = contact_radius(k.r1, k.r2);
-    Real d = k.overlap, dd = 1;  // bulk overlap and d(bulk overlap)/d(overlap)
-    if (p.roughness > Real(0)) {
-      const Real c = 2 * p.roughness * r, s = k.overlap + c;
-      d = k.overlap * k.overlap / s;
-      dd = k.overlap * (k.overlap + 2 * c) / (s * s);
+  template <class T>
+  KOKKOS_INLINE_FUNCTION static NormalResponseT<T> response(const ContactParamsT<T>& p, const ContactKinematicsT<T>& k) {
+    const auto rough = p.roughness > T(0), hertz = p.hertz_overlap > T(0);
+    if (!any(rough | hertz)) return {k.kn * k.overlap, k.kn};
+    const T r = contact_radius(k.r1, k.r2);
+    T d = k.overlap, dd = 1;  // bulk overlap and d(bulk overlap)/d(overlap)
+    if (any(rough)) {
+      const T c = 2 * p.roughness * r, s = k.overlap + c;
+      d = select(rough, k.overlap * k.overlap / s, d);
+      dd = select(rough, k.overlap * (k.overlap + 2 * c) / (s * s), dd);
     }
-    if (p.hertz_overlap > Real(0)) {
-      const Real root = kc::sqrt(d / (p.hertz_overlap * r));
-      return {k.kn * d * root, Real(1.5) * k.kn * root * dd};
+    if (any(hertz)) {
+      const T root = kc::sqrt(d / (p.hertz_overlap * r));
+      return {select(hertz, k.kn * d * root, k.kn * d), select(hertz, Real(1.5) * k.kn * root * dd, k.kn * dd)};
     }
     return {k.kn * d, k.kn * dd};
   }
   /// The dashpot's addition (may make the sum tensile; clamped by the caller), from the tangent stiffness.
-  KOKKOS_INLINE_FUNCTION static Real dashpot(const ContactParams& p, const ContactKinematics& k, Real kt) {
-    if (p.beta_n == Real(0)) return 0;
-    const Real mc = k.m2 > 0 ? k.m1 * k.m2 / (k.m1 + k.m2) : k.m1;
-    return Real(2) * p.beta_n * kc::sqrt(mc * kt) * dot(k.vrel, k.n);  // < 0 when approaching
+  template <class T>
+  KOKKOS_INLINE_FUNCTION static T dashpot(const ContactParamsT<T>& p, const ContactKinematicsT<T>& k, const T& kt) {
+    const auto on = p.beta_n != T(0);
+    if (!any(on)) return 0;
+    const T mc = select(k.m2 > T(0), k.m1 * k.m2 / (k.m1 + k.m2), k.m1);
+    return select(on, Real(2) * p.beta_n * kc::sqrt(mc * kt) * dot(k.vrel, k.n), T(0));  // < 0 when approaching
   }
 };
 
 /// Incremental shear spring (ks = kt / kappa*) with a Coulomb cap on the elastic normal force; the friction
 /// coefficient weakens with the contact's sliding distance when wear > 0.
 struct TangentialCoulomb {
-  KOKKOS_INLINE_FUNCTION static Real friction(const ContactParams& p, Real r, Real slip) {
-    if (p.wear == Real(0)) return p.mu_s;
-    return p.mu_s * (1 - p.wear * (1 - kc::exp(-slip / (p.wear_slip * r))));
+  template <class T>
+  KOKKOS_INLINE_FUNCTION static T friction(const ContactParamsT<T>& p, const Arg<T>& r, const Arg<T>& slip) {
+    const auto worn = p.wear != T(0);
+    if (!any(worn)) return p.mu_s;
+    return select(worn, p.mu_s * (1 - p.wear * (1 - kc::exp(-slip / (p.wear_slip * r)))), p.mu_s);
   }
-  KOKKOS_INLINE_FUNCTION static Vec3 update(const ContactParams& p, const ContactKinematics& k,
-                                             const NormalResponse& nr, ContactHistory& h) {
-    const Real ks = nr.k / p.kratio;
-    Vec3 fs = rotate_into_plane(h.fs, k.n) + ks * k.dt * tangential(k.vrel, k.n);
-    h.flags &= ~kSliding;
-    if (p.wear == Real(0)) {
-      if (cap_to(fs, p.mu_s * nr.fn)) h.flags |= kSliding;
+  template <class T>
+  KOKKOS_INLINE_FUNCTION static Vec3T<T> update(const ContactParamsT<T>& p, const ContactKinematicsT<T>& k,
+                                                const NormalResponseT<T>& nr, ContactHistoryT<T>& h) {
+    const T ks = nr.k / p.kratio;
+    Vec3T<T> fs = rotate_into_plane(h.fs, k.n) + ks * k.dt * tangential(k.vrel, k.n);
+    const auto worn = p.wear != T(0);
+    if (!any(worn)) {
+      set_flag(h.flags, cap_to(fs, p.mu_s * nr.fn), kSliding);
     } else {
       // The slip of this step is the trial force beyond the cap over the spring stiffness.
-      const Real trial = norm(fs);
-      const Real cap = friction(p, contact_radius(k.r1, k.r2), h.slip) * nr.fn;
-      if (cap_to(fs, cap)) {
-        h.flags |= kSliding;
-        if (ks > Real(0)) h.slip += (trial - cap) / ks;
-      }
+      const T trial = norm(fs);
+      const T cap = friction(p, contact_radius(k.r1, k.r2), h.slip) * nr.fn;
+      const auto capped = cap_to(fs, cap);
+      set_flag(h.flags, capped, kSliding);
+      h.slip = select(worn & capped & (ks > T(0)), h.slip + (trial - cap) / ks, h.slip);
     }
     h.fs = fs;
     return fs;
@@ -170,14 +198,17 @@ struct TangentialCoulomb {
 /// Rolling resistance linear (Iwashita and Oda): bend rotation only, kr = ks Rbar^2 (ks from the tangent
 /// stiffness), cap mu_r Rbar Fn.
 struct RollingLinear {
-  KOKKOS_INLINE_FUNCTION static Real rbar(Real r1, Real r2) { return r2 > 0 ? r1 * r2 / (r1 + r2) : r1; }
-  KOKKOS_INLINE_FUNCTION static Vec3 update(const ContactParams& p, const ContactKinematics& k,
-                                             const NormalResponse& nr, ContactHistory& h) {
-    const Real rb = rbar(k.r1, k.r2);
-    const Real kr = nr.k / p.kratio * rb * rb;
-    Vec3 mr = rotate_into_plane(h.mr, k.n) + kr * tangential(k.dtheta, k.n);
-    h.flags &= ~kRolling;
-    if (cap_to(mr, p.mu_r * rb * nr.fn)) h.flags |= kRolling;
+  template <class T>
+  KOKKOS_INLINE_FUNCTION static T rbar(const T& r1, const Arg<T>& r2) {
+    return select(r2 > T(0), r1 * r2 / (r1 + r2), r1);
+  }
+  template <class T>
+  KOKKOS_INLINE_FUNCTION static Vec3T<T> update(const ContactParamsT<T>& p, const ContactKinematicsT<T>& k,
+                                                const NormalResponseT<T>& nr, ContactHistoryT<T>& h) {
+    const T rb = rbar(k.r1, k.r2);
+    const T kr = nr.k / p.kratio * rb * rb;
+    Vec3T<T> mr = rotate_into_plane(h.mr, k.n) + kr * tangential(k.dtheta, k.n);
+    set_flag(h.flags, cap_to(mr, p.mu_r * rb * nr.fn), kRolling);
     h.mr = mr;
     return mr;
   }
@@ -186,20 +217,22 @@ struct RollingLinear {
 template <class Normal, class Tangential, class Rolling>
 struct ContactLaw {
   /// Normal stiffness scale kn of a pair, to be stored in ContactKinematics::kn before eval.
-  KOKKOS_INLINE_FUNCTION static Real stiffness(const ContactParams& p, Real r1, Real r2) {
+  template <class T>
+  KOKKOS_INLINE_FUNCTION static T stiffness(const ContactParamsT<T>& p, const Arg<T>& r1, const Arg<T>& r2) {
     return Normal::stiffness(p, r1, r2);
   }
   /// Evaluates a touching contact (k.overlap > 0, k.kn set) and updates its history.
-  KOKKOS_FORCEINLINE_FUNCTION static ContactOutput eval(const ContactParams& p, const ContactKinematics& k,
-                                                   ContactHistory& h) {
-    ContactOutput out;
-    const NormalResponse nr = Normal::response(p, k);
-    const Real fn_total = kc::max(nr.fn - Normal::dashpot(p, k, nr.k), Real(0));  // no tension
-    const Vec3 fs = Tangential::update(p, k, nr, h);
+  template <class T>
+  KOKKOS_FORCEINLINE_FUNCTION static ContactOutputT<T> eval(const ContactParamsT<T>& p, const ContactKinematicsT<T>& k,
+                                                           ContactHistoryT<T>& h) {
+    ContactOutputT<T> out;
+    const NormalResponseT<T> nr = Normal::response(p, k);
+    const T fn_total = kc::max(nr.fn - Normal::dashpot(p, k, nr.k), T(0));  // no tension
+    const Vec3T<T> fs = Tangential::update(p, k, nr, h);
     out.force = fs - fn_total * k.n;
     out.moment = Rolling::update(p, k, nr, h);
     out.fn = nr.fn;
-    h.flags |= kTouching;
+    set_flag(h.flags, true, kTouching);
     return out;
   }
 };

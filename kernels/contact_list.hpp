@@ -38,6 +38,7 @@ struct ContactList {
   ScalarView slip;        ///< sliding distance accumulated while touching (m)
   // results of the current step
   Vec3View fc;            ///< total contact force on particle 1 (N)
+  Vec3View mo;            ///< moment on particle 1 (N m), ball-ball: the owner's side, summed in its gather
   Vec3View mt;            ///< moment on the gathering side (N m): particle 2 (ball-ball), the ball (ball-wall)
   ScalarView fn;          ///< linear normal force (N), 0 when not touching
   int n = 0;

@@ -18,8 +18,9 @@ struct Domain {
   KOKKOS_INLINE_FUNCTION Vec3 min_image(const Vec3& d) const;
 
   /// Velocity of the affine field at separation d (m/s).
-  KOKKOS_INLINE_FUNCTION Vec3 affine_velocity(const Vec3& d) const {
-    return Vec3(strain_rate[0] * d.x, strain_rate[1] * d.y, strain_rate[2] * d.z);
+  template <class T>
+  KOKKOS_INLINE_FUNCTION Vec3T<T> affine_velocity(const Vec3T<T>& d) const {
+    return Vec3T<T>(strain_rate[0] * d.x, strain_rate[1] * d.y, strain_rate[2] * d.z);
   }
   KOKKOS_INLINE_FUNCTION Real volume() const { return length(0) * length(1) * length(2); }
 

@@ -26,7 +26,9 @@ using FlagView = Kokkos::View<std::uint8_t*, MemSpace>;             ///< per-con
 using Index2View = Kokkos::View<int* [2], Layout, MemSpace>;         ///< pair of local indices
 using Index3View = Kokkos::View<int* [3], Layout, MemSpace>;         ///< facet vertex indices
 
-struct ContactParams;
+template <class T>
+struct ContactParamsT;
+using ContactParams = ContactParamsT<Real>;
 /// Contact parameters per pair of material indices (contact_law.hpp).
 using ParamTableView = Kokkos::View<ContactParams**, MemSpace>;
 

@@ -1,6 +1,7 @@
 #pragma once
 /// Small device-callable 3-vector and the math shim that compiles on Kokkos 3.4 and 4.x
 /// (Kokkos::sqrt/min/max appeared in 3.7; 4.0 dropped Kokkos::Experimental math).
+#include "simd.hpp"
 #include "types.hpp"
 
 namespace dem {
@@ -26,26 +27,35 @@ KOKKOS_INLINE_FUNCTION constexpr const T& max(const T& a, const T& b) { return a
 #endif
 }  // namespace kc
 
-struct Vec3 {
-  Real x = 0, y = 0, z = 0;
-  KOKKOS_INLINE_FUNCTION Vec3() = default;
-  KOKKOS_INLINE_FUNCTION Vec3(Real a, Real b, Real c) : x(a), y(b), z(c) {}
-  KOKKOS_INLINE_FUNCTION Real operator[](int d) const { return d == 0 ? x : (d == 1 ? y : z); }
-  KOKKOS_INLINE_FUNCTION Vec3& operator+=(const Vec3& o) { x += o.x; y += o.y; z += o.z; return *this; }
-  KOKKOS_INLINE_FUNCTION Vec3& operator-=(const Vec3& o) { x -= o.x; y -= o.y; z -= o.z; return *this; }
-  KOKKOS_INLINE_FUNCTION Vec3& operator*=(Real s) { x *= s; y *= s; z *= s; return *this; }
+/// A 3-vector of T: Real for particles, walls and host code, a Pack (simd.hpp) where W contacts are evaluated at
+/// once. The operators are hidden friends, so a Real or an int converts to T as it would for a plain function.
+template <class T>
+struct Vec3T {
+  T x = 0, y = 0, z = 0;
+  KOKKOS_INLINE_FUNCTION Vec3T() = default;
+  KOKKOS_INLINE_FUNCTION Vec3T(const T& a, const T& b, const T& c) : x(a), y(b), z(c) {}
+  KOKKOS_INLINE_FUNCTION T operator[](int d) const { return d == 0 ? x : (d == 1 ? y : z); }
+  KOKKOS_INLINE_FUNCTION Vec3T& operator+=(const Vec3T& o) { x += o.x; y += o.y; z += o.z; return *this; }
+  KOKKOS_INLINE_FUNCTION Vec3T& operator-=(const Vec3T& o) { x -= o.x; y -= o.y; z -= o.z; return *this; }
+  KOKKOS_INLINE_FUNCTION Vec3T& operator*=(const T& s) { x *= s; y *= s; z *= s; return *this; }
+  friend KOKKOS_INLINE_FUNCTION Vec3T operator+(Vec3T a, const Vec3T& b) { return a += b; }
+  friend KOKKOS_INLINE_FUNCTION Vec3T operator-(Vec3T a, const Vec3T& b) { return a -= b; }
+  friend KOKKOS_INLINE_FUNCTION Vec3T operator-(const Vec3T& a) { return Vec3T(-a.x, -a.y, -a.z); }
+  friend KOKKOS_INLINE_FUNCTION Vec3T operator*(const T& s, Vec3T a) { return a *= s; }
+  friend KOKKOS_INLINE_FUNCTION Vec3T operator*(Vec3T a, const T& s) { return a *= s; }
 };
-KOKKOS_INLINE_FUNCTION Vec3 operator+(Vec3 a, const Vec3& b) { return a += b; }
-KOKKOS_INLINE_FUNCTION Vec3 operator-(Vec3 a, const Vec3& b) { return a -= b; }
-KOKKOS_INLINE_FUNCTION Vec3 operator-(const Vec3& a) { return Vec3(-a.x, -a.y, -a.z); }
-KOKKOS_INLINE_FUNCTION Vec3 operator*(Real s, Vec3 a) { return a *= s; }
-KOKKOS_INLINE_FUNCTION Vec3 operator*(Vec3 a, Real s) { return a *= s; }
-KOKKOS_INLINE_FUNCTION Real dot(const Vec3& a, const Vec3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-KOKKOS_INLINE_FUNCTION Vec3 cross(const Vec3& a, const Vec3& b) {
-  return Vec3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+using Vec3 = Vec3T<Real>;
+
+template <class T>
+KOKKOS_INLINE_FUNCTION T dot(const Vec3T<T>& a, const Vec3T<T>& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+template <class T>
+KOKKOS_INLINE_FUNCTION Vec3T<T> cross(const Vec3T<T>& a, const Vec3T<T>& b) {
+  return Vec3T<T>(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
 }
-KOKKOS_INLINE_FUNCTION Real norm2(const Vec3& a) { return dot(a, a); }
-KOKKOS_INLINE_FUNCTION Real norm(const Vec3& a) { return kc::sqrt(dot(a, a)); }
+template <class T>
+KOKKOS_INLINE_FUNCTION T norm2(const Vec3T<T>& a) { return dot(a, a); }
+template <class T>
+KOKKOS_INLINE_FUNCTION T norm(const Vec3T<T>& a) { return kc::sqrt(dot(a, a)); }
 
 /// Read/write row i of a 3-vector View.
 template <class V>
@@ -53,18 +63,27 @@ KOKKOS_INLINE_FUNCTION Vec3 load(const V& v, int i) { return Vec3(v(i, 0), v(i, 
 template <class V>
 KOKKOS_INLINE_FUNCTION void store(const V& v, int i, const Vec3& a) { v(i, 0) = a.x; v(i, 1) = a.y; v(i, 2) = a.z; }
 
+/// Lane-wise choice for masks of T: a plain conditional for Real (simd.hpp overloads it for packs).
+KOKKOS_INLINE_FUNCTION Real select(bool m, Real a, Real b) { return m ? a : b; }
+KOKKOS_INLINE_FUNCTION bool any(bool m) { return m; }
+template <class M, class T>
+KOKKOS_INLINE_FUNCTION Vec3T<T> select(const M& m, const Vec3T<T>& a, const Vec3T<T>& b) {
+  return Vec3T<T>(select(m, a.x, b.x), select(m, a.y, b.y), select(m, a.z, b.z));
+}
+
 /// The tangential part of a relative to the unit normal n.
-KOKKOS_INLINE_FUNCTION Vec3 tangential(const Vec3& a, const Vec3& n) { return a - dot(a, n) * n; }
+template <class T>
+KOKKOS_INLINE_FUNCTION Vec3T<T> tangential(const Vec3T<T>& a, const Vec3T<T>& n) { return a - dot(a, n) * n; }
 
 /// Carries a stored tangential vector (shear force, rolling moment) into the current contact plane,
-/// keeping its magnitude (the contact frame turned, the spring did not relax).
-KOKKOS_INLINE_FUNCTION Vec3 rotate_into_plane(const Vec3& s, const Vec3& n) {
-  const Real m2 = norm2(s);
-  if (m2 == Real(0)) return s;
-  Vec3 t = tangential(s, n);
-  const Real t2 = norm2(t);
-  if (t2 == Real(0)) return Vec3();
-  return t * kc::sqrt(m2 / t2);
+/// keeping its magnitude (the contact frame turned, the spring did not relax). A zero vector stays zero, and so
+/// does one along n. Written with select, not branches, so that W lanes take it together.
+template <class T>
+KOKKOS_INLINE_FUNCTION Vec3T<T> rotate_into_plane(const Vec3T<T>& s, const Vec3T<T>& n) {
+  const T m2 = norm2(s);
+  const Vec3T<T> t = tangential(s, n);
+  const T t2 = norm2(t);
+  return select(m2 == T(0), s, select(t2 == T(0), Vec3T<T>(), t * kc::sqrt(m2 / t2)));
 }
 
 }  // namespace dem

@@ -1,0 +1,205 @@
+/// The ball-ball force kernel evaluates kContactLanes contacts side by side (kernels/simd.hpp). These tests hold it
+/// to what makes that safe: a lane gives the bits of the scalar law (the build fuses no multiply-add, so both round
+/// every operation alike), whatever its neighbours in the pack are doing, and the kernel's result for a contact does
+/// not depend on which lane or pack it falls in. Comparisons are exact: any difference is a lane mixed up or a
+/// masked branch that computes something else, not rounding.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "host/builder.hpp"
+#include "kernels/contact_force.hpp"
+#include "test_util.hpp"
+
+using namespace dem;
+
+namespace {
+
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+bool same_bits(const Vec3& a, const Vec3& b) { return same_bits(a.x, b.x) && same_bits(a.y, b.y) && same_bits(a.z, b.z); }
+
+struct LawCase {
+  ContactParams p;
+  ContactKinematics k;
+  ContactHistory h;
+};
+
+/// A random touching contact; every fourth uses one extension or the dashpot, every seventh is a wall, every
+/// third starts with no history and some have history along n (it must vanish) or loads past the caps.
+LawCase random_case(std::mt19937_64& rng, int t) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  LawCase c;
+  c.p = test::law(1e8, 1.5, 0.3, 0.02);
+  switch (t % 5) {
+    case 1: c.p.wear = 0.6; break;
+    case 2: c.p.hertz_overlap = 3e-3; break;
+    case 3: c.p.roughness = 1e-2; break;
+    case 4: c.p.beta_n = 0.2; break;
+    default: break;
+  }
+  Vec3 n(u(rng), u(rng), u(rng));
+  c.k.n = (1 / norm(n)) * n;
+  c.k.overlap = 1e-6 * (1.01 + u(rng));
+  c.k.r1 = 1e-3 * (1 + 0.2 * u(rng));
+  c.k.r2 = t % 7 == 0 ? 0 : 1e-3 * (1 + 0.2 * u(rng));
+  c.k.m1 = 1e-5;
+  c.k.m2 = c.k.r2 > 0 ? 1.2e-5 : 0;
+  c.k.kn = RRLinear::stiffness(c.p, c.k.r1, c.k.r2);
+  c.k.vrel = Vec3(u(rng), u(rng), u(rng));
+  c.k.dtheta = 1e-3 * Vec3(u(rng), u(rng), u(rng));
+  c.k.dt = 1e-7;
+  const double scale = t % 3 == 0 ? 0 : (t % 3 == 1 ? 1e-4 : 1e-1);  // none, elastic, past the caps
+  c.h.fs = scale * Vec3(u(rng), u(rng), u(rng));
+  c.h.mr = 1e-3 * scale * Vec3(u(rng), u(rng), u(rng));
+  if (t % 11 == 0) c.h.fs = scale * c.k.n;
+  c.h.slip = 1e-5 * (1 + u(rng));
+  return c;
+}
+
+#ifdef TRIAXDEM_HOST_PACKS
+TEST(SimdLanes, EachLaneGivesTheScalarLawsBits) {
+  std::mt19937_64 rng(2026);
+  using T = ContactPack;
+  for (int t0 = 0; t0 < 40000; t0 += kContactLanes) {
+    LawCase c[kContactLanes];
+    for (int k = 0; k < kContactLanes; ++k) c[k] = random_case(rng, t0 + k);
+    const auto lanes = [&](auto get) { return from_lanes<T>([&](int k) { return get(c[k]); }); };
+    const auto vlanes = [&](auto get) {
+      return Vec3T<T>(lanes([&](const LawCase& q) { return get(q).x; }), lanes([&](const LawCase& q) { return get(q).y; }),
+                      lanes([&](const LawCase& q) { return get(q).z; }));
+    };
+    ContactParamsT<T> P;
+    P.emod = lanes([](const LawCase& q) { return q.p.emod; });
+    P.kratio = lanes([](const LawCase& q) { return q.p.kratio; });
+    P.mu_s = lanes([](const LawCase& q) { return q.p.mu_s; });
+    P.mu_r = lanes([](const LawCase& q) { return q.p.mu_r; });
+    P.beta_n = lanes([](const LawCase& q) { return q.p.beta_n; });
+    P.hertz_overlap = lanes([](const LawCase& q) { return q.p.hertz_overlap; });
+    P.roughness = lanes([](const LawCase& q) { return q.p.roughness; });
+    P.wear = lanes([](const LawCase& q) { return q.p.wear; });
+    P.wear_slip = lanes([](const LawCase& q) { return q.p.wear_slip; });
+    ContactKinematicsT<T> K;
+    K.n = vlanes([](const LawCase& q) { return q.k.n; });
+    K.overlap = lanes([](const LawCase& q) { return q.k.overlap; });
+    K.kn = lanes([](const LawCase& q) { return q.k.kn; });
+    K.r1 = lanes([](const LawCase& q) { return q.k.r1; });
+    K.r2 = lanes([](const LawCase& q) { return q.k.r2; });
+    K.m1 = lanes([](const LawCase& q) { return q.k.m1; });
+    K.m2 = lanes([](const LawCase& q) { return q.k.m2; });
+    K.vrel = vlanes([](const LawCase& q) { return q.k.vrel; });
+    K.dtheta = vlanes([](const LawCase& q) { return q.k.dtheta; });
+    K.dt = c[0].k.dt;
+    ContactHistoryT<T> H;
+    H.fs = vlanes([](const LawCase& q) { return q.h.fs; });
+    H.mr = vlanes([](const LawCase& q) { return q.h.mr; });
+    H.slip = lanes([](const LawCase& q) { return q.h.slip; });
+    const ContactOutputT<T> out = RRLinear::eval(P, K, H);
+    for (int k = 0; k < kContactLanes; ++k) {
+      ContactHistory h = c[k].h;
+      const ContactOutput ref = RRLinear::eval(c[k].p, c[k].k, h);
+      const auto at = [&](const Vec3T<T>& a) { return Vec3(lane(a.x, k), lane(a.y, k), lane(a.z, k)); };
+      ASSERT_TRUE(same_bits(at(out.force), ref.force)) << "contact " << t0 + k;
+      ASSERT_TRUE(same_bits(at(out.moment), ref.moment)) << "contact " << t0 + k;
+      ASSERT_TRUE(same_bits(lane(out.fn, k), ref.fn)) << "contact " << t0 + k;
+      ASSERT_TRUE(same_bits(at(H.fs), h.fs)) << "contact " << t0 + k;
+      ASSERT_TRUE(same_bits(at(H.mr), h.mr)) << "contact " << t0 + k;
+      ASSERT_TRUE(same_bits(lane(H.slip, k), h.slip)) << "contact " << t0 + k;
+      ASSERT_EQ(lane(H.flags, k), h.flags) << "contact " << t0 + k;
+    }
+  }
+}
+#endif
+
+/// Results of the kernel for every contact of a list, by key.
+struct KernelResult {
+  std::vector<Vec3> fs, mr, fc, mo, mt;
+  std::vector<double> fn, slip;
+  std::vector<int> flags;
+};
+
+KernelResult run_kernel(const Particles& p, const std::vector<std::uint64_t>& keys, const ParamTableView& table) {
+  ContactList c(static_cast<int>(keys.size()));
+  auto hk = Kokkos::create_mirror_view(c.key);
+  auto hi = Kokkos::create_mirror_view(c.i), hj = Kokkos::create_mirror_view(c.j);
+  auto hfs = Kokkos::create_mirror_view(c.fs);
+  for (std::size_t s = 0; s < keys.size(); ++s) {
+    hk(s) = keys[s];
+    hi(s) = static_cast<int>(key_hi(keys[s]));  // gids are local indices here
+    hj(s) = static_cast<int>(key_lo(keys[s]));
+    hfs(s, 0) = 1e-4 * static_cast<double>(keys[s] % 7);  // some history, the same for a key in any order
+  }
+  Kokkos::deep_copy(c.key, hk);
+  Kokkos::deep_copy(c.i, hi);
+  Kokkos::deep_copy(c.j, hj);
+  Kokkos::deep_copy(c.fs, hfs);
+  compute_ball_forces(p, c, table, Domain(), 1e-7);
+  const auto v3 = [&](const Vec3View& v) {
+    auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), v);
+    std::vector<Vec3> out(keys.size());
+    for (std::size_t s = 0; s < keys.size(); ++s) out[s] = load(h, static_cast<int>(s));
+    return out;
+  };
+  KernelResult r{v3(c.fs), v3(c.mr), v3(c.fc), v3(c.mo), v3(c.mt), {}, {}, {}};
+  auto fn = Kokkos::create_mirror_view_and_copy(HostSpace(), c.fn);
+  auto slip = Kokkos::create_mirror_view_and_copy(HostSpace(), c.slip);
+  auto fl = Kokkos::create_mirror_view_and_copy(HostSpace(), c.flags);
+  for (std::size_t s = 0; s < keys.size(); ++s) {
+    r.fn.push_back(fn(s));
+    r.slip.push_back(slip(s));
+    r.flags.push_back(fl(s));
+  }
+  return r;
+}
+
+// The same contacts, listed with one, two and three extra pairs in front (each contact moves to another lane and
+// meets other pack-mates, some of which do not touch), give the same bits in the kernel.
+TEST(SimdLanes, KernelResultDoesNotDependOnLaneOrPackMates) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const double R = 1e-3;
+  std::vector<BallSpec> b(60);
+  for (std::size_t i = 0; i < b.size(); ++i) {  // a loose cloud: some pairs overlap, most do not
+    b[i].x = 4 * R * Vec3(u(rng), u(rng), u(rng));
+    b[i].v = 0.1 * Vec3(u(rng), u(rng), u(rng));
+    b[i].w = 50 * Vec3(u(rng), u(rng), u(rng));
+    b[i].radius = R * (1 + 0.3 * u(rng));
+    b[i].material = static_cast<int>(i % 2);
+  }
+  const Particles p = make_particles(b);
+  ParamTableView table("table", 2, 2);
+  auto ht = Kokkos::create_mirror_view(table);
+  ht(0, 0) = ht(1, 1) = test::law(1e8, 1.5, 0.3, 0.02);
+  ht(0, 1) = ht(1, 0) = test::law(1e8, 1.5, 0.3, 0.02);
+  ht(0, 1).wear = ht(1, 0).wear = 0.5;  // a second pair in some packs: lanes with other parameters
+  Kokkos::deep_copy(table, ht);
+  std::vector<std::uint64_t> keys;
+  int touching = 0;
+  for (std::uint32_t i = 0; i < b.size(); ++i)
+    for (std::uint32_t j = i + 1; j < b.size(); ++j) {
+      const double gap = norm(b[j].x - b[i].x) - b[i].radius - b[j].radius;
+      if (gap < 0.5 * R) keys.push_back(pair_key(i, j));
+      touching += gap < 0 ? 1 : 0;
+    }
+  ASSERT_GT(touching, 10) << "test set-up: the cloud must hold touching pairs";
+  ASSERT_LT(touching, static_cast<int>(keys.size())) << "test set-up: and candidates that do not touch";
+  const KernelResult ref = run_kernel(p, keys, table);
+
+  for (int shift = 1; shift < 4; ++shift) {
+    std::vector<std::uint64_t> shifted(keys.begin() + shift, keys.end());
+    shifted.insert(shifted.end(), keys.begin(), keys.begin() + shift);  // the first ones last: another lane
+    const KernelResult r = run_kernel(p, shifted, table);
+
+    for (std::size_t s = 0; s < keys.size(); ++s) {
+      const std::size_t q = (s + keys.size() - shift) % keys.size();  // where keys[s] went
+      ASSERT_TRUE(same_bits(r.fc[q], ref.fc[s]) && same_bits(r.mo[q], ref.mo[s]) && same_bits(r.mt[q], ref.mt[s]))
+          << "contact " << s << ", shift " << shift;
+      ASSERT_TRUE(same_bits(r.fs[q], ref.fs[s]) && same_bits(r.mr[q], ref.mr[s])) << "contact " << s;
+      ASSERT_TRUE(same_bits(r.fn[q], ref.fn[s]) && same_bits(r.slip[q], ref.slip[s])) << "contact " << s;
+      ASSERT_EQ(r.flags[q], ref.flags[s]) << "contact " << s;
+    }
+  }
+}
+
+}  // namespace
