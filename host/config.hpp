@@ -156,10 +156,10 @@ struct Config {
 /// `path`, the key and the allowed range when dt_s is above the critical step.
 Real time_step(const SolverConfig& solver, Real critical, const std::string& path);
 
-/// Memory a run of `balls` balls needs at its peak (bytes): 571 bytes per ball measured in steady state
+/// Memory a run of `balls` balls needs at its peak (bytes): 667 bytes per ball in steady state
 /// (perf/bench_engine: particle arrays and contact lists at 6-7 contacts per ball), doubled for the rebuild,
-/// when the old and the new contact lists live side by side.
-constexpr double kBytesPerBall = 2 * 571;
+/// when the old and the new contact lists live side by side (perf/scaling.sh measured 1,259 at 10^6 balls).
+constexpr double kBytesPerBall = 2 * 667;
 double run_memory_bytes(long balls);
 
 /// Reads and validates a config file. Throws ConfigError.

@@ -45,9 +45,6 @@ KOKKOS_INLINE_FUNCTION Vec3T<T> vec_of_lanes(const F& f) {
                   from_lanes<T>([&](int k) { return a[k].z; }));
 }
 
-template <class T>
-KOKKOS_INLINE_FUNCTION Vec3 lane(const Vec3T<T>& a, int k) { return Vec3(lane(a.x, k), lane(a.y, k), lane(a.z, k)); }
-
 /// One work item per kContactLanes consecutive ball-ball contacts, evaluated side by side as lanes of T. Each
 /// lane's arithmetic is that of a single contact, so the results do not depend on which lane a contact falls in.
 struct BallForce : MaxOverlap {

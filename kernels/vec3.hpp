@@ -32,7 +32,7 @@ KOKKOS_INLINE_FUNCTION constexpr const T& max(const T& a, const T& b) { return a
 template <class T>
 struct Vec3T {
   T x = 0, y = 0, z = 0;
-  KOKKOS_INLINE_FUNCTION Vec3T() = default;
+  Vec3T() = default;
   KOKKOS_INLINE_FUNCTION Vec3T(const T& a, const T& b, const T& c) : x(a), y(b), z(c) {}
   KOKKOS_INLINE_FUNCTION T operator[](int d) const { return d == 0 ? x : (d == 1 ? y : z); }
   KOKKOS_INLINE_FUNCTION Vec3T& operator+=(const Vec3T& o) { x += o.x; y += o.y; z += o.z; return *this; }
@@ -70,6 +70,10 @@ template <class M, class T>
 KOKKOS_INLINE_FUNCTION Vec3T<T> select(const M& m, const Vec3T<T>& a, const Vec3T<T>& b) {
   return Vec3T<T>(select(m, a.x, b.x), select(m, a.y, b.y), select(m, a.z, b.z));
 }
+
+/// Lane k of a vector of packs (simd.hpp).
+template <class T>
+KOKKOS_INLINE_FUNCTION Vec3 lane(const Vec3T<T>& a, int k) { return Vec3(lane(a.x, k), lane(a.y, k), lane(a.z, k)); }
 
 /// The tangential part of a relative to the unit normal n.
 template <class T>

@@ -37,8 +37,8 @@ std::size_t bytes_per_particle(dem::Simulation& sim) {
                                    2 * sizeof(int) + 2 * sizeof(int) + 2 * sizeof(int);
   const auto& b = sim.ball_contacts();
   const auto& w = sim.wall_contacts();
-  // key, i, j, fs, mr, flags, fc, mt, fn, adjacency entry (+ owner ranges, per particle below)
-  const std::size_t per_contact = 8 + 4 + 4 + 4 * 3 * 8 + 1 + 8 + 4;
+  // key, i, j, fs, mr, fc, mo, mt, flags, slip, fn, adjacency entry (+ owner ranges, per particle above)
+  const std::size_t per_contact = 8 + 4 + 4 + 5 * 3 * 8 + 1 + 8 + 8 + 4;
   return per_particle + (b.n + w.n) * per_contact / p.n;
 }
 

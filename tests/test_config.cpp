@@ -100,7 +100,7 @@ TEST(Config, TimeStepRuleNamesKeyAndRange) {
 }
 
 // A run that cannot fit in memory is refused when the config is read, before any allocation: 2e9 balls
-// need 2.3 TB at 1,142 bytes each, more than any machine this runs on has available.
+// need 2.7 TB at 1,334 bytes each, more than any machine this runs on has available.
 TEST(Config, RunThatCannotFitInMemoryRefused) {
   std::string e = error_of("[particles]\ncount = 2000000000\n");
   EXPECT_NE(e.find("[particles] count: 2000000000 balls need about"), std::string::npos) << e;
