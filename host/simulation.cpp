@@ -17,6 +17,43 @@ double seconds_since(Kokkos::Timer& t) {
   t.reset();
   return s;
 }
+// The kernels of this file are free functions: nvcc allows no device lambda in a constructor or a private member.
+
+/// Largest radius of the balls (m).
+Real max_radius(const Particles& p) {
+  auto r = p.radius;
+  Real rmax = 0;
+  Kokkos::parallel_reduce("dem::sim::rmax", RangePolicy(0, p.n),
+      KOKKOS_LAMBDA(const int i, Real& acc) { acc = r(i) > acc ? r(i) : acc; }, Kokkos::Max<Real>(rmax));
+  return rmax;
+}
+
+/// The periodic cell's affine step: positions, and the positions of the last rebuild, stretched by s about lo.
+void stretch_about(const Particles& p, const Real (&lo)[3], const Real (&s)[3]) {
+  auto x = p.x, xr = p.x_ref;
+  const Real l0 = lo[0], l1 = lo[1], l2 = lo[2], s0 = s[0], s1 = s[1], s2 = s[2];
+  Kokkos::parallel_for("dem::sim::affine", RangePolicy(0, p.n), KOKKOS_LAMBDA(const int i) {
+    const Real l[3] = {l0, l1, l2}, f[3] = {s0, s1, s2};
+    for (int d = 0; d < 3; ++d) {
+      x(i, d) = l[d] + (x(i, d) - l[d]) * f[d];
+      xr(i, d) = l[d] + (xr(i, d) - l[d]) * f[d];
+    }
+  });
+}
+
+/// Moves the facet mesh's nodes by dt node_v; returns the largest node speed (m/s).
+Real move_nodes(const FacetMesh& mesh, Real dt) {
+  auto nx = mesh.node_x, nv = mesh.node_v;
+  Real nmax = 0;
+  Kokkos::parallel_reduce("dem::sim::move_mesh", RangePolicy(0, mesh.nnode),
+      KOKKOS_LAMBDA(const int k, Real& acc) {
+        const Vec3 v = load(nv, k);
+        store(nx, k, load(nx, k) + dt * v);
+        acc = norm(v) > acc ? norm(v) : acc;
+      }, Kokkos::Max<Real>(nmax));
+  return nmax;
+}
+
 }  // namespace
 
 Simulation::Simulation(Particles particles, WallSet walls, FacetMesh mesh, const std::vector<ContactParams>& table,
@@ -29,9 +66,7 @@ Simulation::Simulation(Particles particles, WallSet walls, FacetMesh mesh, const
   if (walls_.n == 0) walls_ = WallSet(0);
   hwall_point_ = Kokkos::create_mirror_view_and_copy(HostSpace(), walls_.point);
   hwall_vel_ = Kokkos::create_mirror_view_and_copy(HostSpace(), walls_.velocity);
-  auto r = p_.radius;
-  Kokkos::parallel_reduce("dem::sim::rmax", RangePolicy(0, p_.n),
-      KOKKOS_LAMBDA(const int i, Real& acc) { acc = r(i) > acc ? r(i) : acc; }, Kokkos::Max<Real>(rmax_));
+  rmax_ = max_radius(p_);
   if (prm_.skin <= 0) throw std::invalid_argument("Verlet skin must be > 0");
 }
 
@@ -149,29 +184,13 @@ void Simulation::move_boundaries() {
     Domain& dom = prm_.domain;
     const Real s[3] = {1 + rate[0] * dt, 1 + rate[1] * dt, 1 + rate[2] * dt};
     const Real lo[3] = {dom.lo[0], dom.lo[1], dom.lo[2]};
-    auto x = p_.x, xr = p_.x_ref;
-    Kokkos::parallel_for("dem::sim::affine", RangePolicy(0, p_.n), KOKKOS_LAMBDA(const int i) {
-      for (int d = 0; d < 3; ++d) {
-        x(i, d) = lo[d] + (x(i, d) - lo[d]) * s[d];
-        xr(i, d) = lo[d] + (xr(i, d) - lo[d]) * s[d];
-      }
-    });
+    stretch_about(p_, lo, s);
     for (int d = 0; d < 3; ++d) dom.hi[d] = lo[d] + (dom.hi[d] - lo[d]) * s[d];
     // Neighbours within the cut-off drift apart (or together) by at most |rate| dt times the cut-off.
     const Real rate_max = std::max({std::fabs(rate[0]), std::fabs(rate[1]), std::fabs(rate[2])});
     vmax = std::max(vmax, rate_max * (2 * rmax_ + prm_.skin));
   }
-  if (mesh_.ntri > 0) {
-    auto nx = mesh_.node_x, nv = mesh_.node_v;
-    Real nmax = 0;
-    Kokkos::parallel_reduce("dem::sim::move_mesh", RangePolicy(0, mesh_.nnode),
-        KOKKOS_LAMBDA(const int k, Real& acc) {
-          const Vec3 v = load(nv, k);
-          store(nx, k, load(nx, k) + dt * v);
-          acc = norm(v) > acc ? norm(v) : acc;
-        }, Kokkos::Max<Real>(nmax));
-    vmax = std::max(vmax, nmax);
-  }
+  if (mesh_.ntri > 0) vmax = std::max(vmax, move_nodes(mesh_, dt));
   wall_disp_ += vmax * dt;
 }
 

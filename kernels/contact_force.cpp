@@ -17,34 +17,6 @@ struct MaxOverlap {
   KOKKOS_INLINE_FUNCTION void init(value_type& a) const { a.ratio = 0; a.contact = -1; }
 };
 
-/// The parameters of W material pairs as lanes: pair(k) gives lane k's.
-template <class T, class Pair>
-KOKKOS_INLINE_FUNCTION ContactParamsT<T> params_of_lanes(const Pair& pair) {
-  static_assert(sizeof(ContactParams) == 9 * sizeof(Real), "a new ContactParams field must be copied here");
-  const auto field = [&](Real ContactParams::*m) { return from_lanes<T>([&](int k) { return pair(k).*m; }); };
-  ContactParamsT<T> P;
-  P.emod = field(&ContactParams::emod);
-  P.kratio = field(&ContactParams::kratio);
-  P.mu_s = field(&ContactParams::mu_s);
-  P.mu_r = field(&ContactParams::mu_r);
-  P.beta_n = field(&ContactParams::beta_n);
-  P.hertz_overlap = field(&ContactParams::hertz_overlap);
-  P.roughness = field(&ContactParams::roughness);
-  P.wear = field(&ContactParams::wear);
-  P.wear_slip = field(&ContactParams::wear_slip);
-  return P;
-}
-
-/// The 3-vectors f(0) .. f(W-1) as a vector of lanes.
-template <class T, class F>
-KOKKOS_INLINE_FUNCTION Vec3T<T> vec_of_lanes(const F& f) {
-  Vec3 a[kContactLanes];
-  TRIAXDEM_UNROLL_LANES
-  for (int k = 0; k < kContactLanes; ++k) a[k] = f(k);
-  return Vec3T<T>(from_lanes<T>([&](int k) { return a[k].x; }), from_lanes<T>([&](int k) { return a[k].y; }),
-                  from_lanes<T>([&](int k) { return a[k].z; }));
-}
-
 /// One work item per kContactLanes consecutive ball-ball contacts, evaluated side by side as lanes of T. Each
 /// lane's arithmetic is that of a single contact, so the results do not depend on which lane a contact falls in.
 struct BallForce : MaxOverlap {

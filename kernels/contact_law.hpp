@@ -63,6 +63,24 @@ struct ContactParamsT {
   }
 };
 
+/// The parameters of W material pairs as lanes: pair(k) gives lane k's.
+template <class T, class Pair>
+KOKKOS_INLINE_FUNCTION ContactParamsT<T> params_of_lanes(const Pair& pair) {
+  static_assert(sizeof(ContactParams) == 9 * sizeof(Real), "a new ContactParams field must be copied here");
+  const auto field = [&](Real ContactParams::*m) { return from_lanes<T>([&](int k) { return pair(k).*m; }); };
+  ContactParamsT<T> P;
+  P.emod = field(&ContactParams::emod);
+  P.kratio = field(&ContactParams::kratio);
+  P.mu_s = field(&ContactParams::mu_s);
+  P.mu_r = field(&ContactParams::mu_r);
+  P.beta_n = field(&ContactParams::beta_n);
+  P.hertz_overlap = field(&ContactParams::hertz_overlap);
+  P.roughness = field(&ContactParams::roughness);
+  P.wear = field(&ContactParams::wear);
+  P.wear_slip = field(&ContactParams::wear_slip);
+  return P;
+}
+
 /// Geometry and kinematics of one contact, seen from particle 1 ("i"); body 2 is a particle or a wall.
 /// n points from 1 to 2; vrel is the velocity of 2 relative to 1 at the contact point; dtheta the
 /// relative rotation increment (w2 - w1) dt. R2 = 0 marks a wall.

@@ -71,6 +71,16 @@ KOKKOS_INLINE_FUNCTION Vec3T<T> select(const M& m, const Vec3T<T>& a, const Vec3
   return Vec3T<T>(select(m, a.x, b.x), select(m, a.y, b.y), select(m, a.z, b.z));
 }
 
+/// The 3-vectors f(0) .. f(W-1) as a vector of lanes.
+template <class T, class F>
+KOKKOS_INLINE_FUNCTION Vec3T<T> vec_of_lanes(const F& f) {
+  Vec3 a[kContactLanes];
+  TRIAXDEM_UNROLL_LANES
+  for (int k = 0; k < kContactLanes; ++k) a[k] = f(k);
+  return Vec3T<T>(from_lanes<T>([&](int k) { return a[k].x; }), from_lanes<T>([&](int k) { return a[k].y; }),
+                  from_lanes<T>([&](int k) { return a[k].z; }));
+}
+
 /// Lane k of a vector of packs (simd.hpp).
 template <class T>
 KOKKOS_INLINE_FUNCTION Vec3 lane(const Vec3T<T>& a, int k) { return Vec3(lane(a.x, k), lane(a.y, k), lane(a.z, k)); }

@@ -66,20 +66,8 @@ TEST(SimdLanes, EachLaneGivesTheScalarLawsBits) {
     LawCase c[kContactLanes];
     for (int k = 0; k < kContactLanes; ++k) c[k] = random_case(rng, t0 + k);
     const auto lanes = [&](auto get) { return from_lanes<T>([&](int k) { return get(c[k]); }); };
-    const auto vlanes = [&](auto get) {
-      return Vec3T<T>(lanes([&](const LawCase& q) { return get(q).x; }), lanes([&](const LawCase& q) { return get(q).y; }),
-                      lanes([&](const LawCase& q) { return get(q).z; }));
-    };
-    ContactParamsT<T> P;
-    P.emod = lanes([](const LawCase& q) { return q.p.emod; });
-    P.kratio = lanes([](const LawCase& q) { return q.p.kratio; });
-    P.mu_s = lanes([](const LawCase& q) { return q.p.mu_s; });
-    P.mu_r = lanes([](const LawCase& q) { return q.p.mu_r; });
-    P.beta_n = lanes([](const LawCase& q) { return q.p.beta_n; });
-    P.hertz_overlap = lanes([](const LawCase& q) { return q.p.hertz_overlap; });
-    P.roughness = lanes([](const LawCase& q) { return q.p.roughness; });
-    P.wear = lanes([](const LawCase& q) { return q.p.wear; });
-    P.wear_slip = lanes([](const LawCase& q) { return q.p.wear_slip; });
+    const auto vlanes = [&](auto get) { return vec_of_lanes<T>([&](int k) { return get(c[k]); }); };
+    const ContactParamsT<T> P = params_of_lanes<T>([&](int k) -> const ContactParams& { return c[k].p; });
     ContactKinematicsT<T> K;
     K.n = vlanes([](const LawCase& q) { return q.k.n; });
     K.overlap = lanes([](const LawCase& q) { return q.k.overlap; });
@@ -99,7 +87,7 @@ TEST(SimdLanes, EachLaneGivesTheScalarLawsBits) {
     for (int k = 0; k < kContactLanes; ++k) {
       ContactHistory h = c[k].h;
       const ContactOutput ref = RRLinear::eval(c[k].p, c[k].k, h);
-      const auto at = [&](const Vec3T<T>& a) { return Vec3(lane(a.x, k), lane(a.y, k), lane(a.z, k)); };
+      const auto at = [&](const Vec3T<T>& a) { return lane(a, k); };
       ASSERT_TRUE(same_bits(at(out.force), ref.force)) << "contact " << t0 + k;
       ASSERT_TRUE(same_bits(at(out.moment), ref.moment)) << "contact " << t0 + k;
       ASSERT_TRUE(same_bits(lane(out.fn, k), ref.fn)) << "contact " << t0 + k;
