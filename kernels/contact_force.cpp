@@ -78,7 +78,9 @@ struct BallForce : MaxOverlap {
     ContactHistoryT<T> h;  // flags start clear: the law sets or clears every ContactFlag bit of a touching contact
     h.fs = vec_of_lanes<T>([&](int k) { return load(c.fs, cs[k]); });
     h.mr = vec_of_lanes<T>([&](int k) { return load(c.mr, cs[k]); });
-    h.slip = from_lanes<T>([&](int k) { return c.slip(cs[k]); });
+    // Only slip weakening reads or changes the sliding distance: without it in the pack, it stays as stored.
+    const bool worn = any(prm.wear != T(0));
+    if (worn) h.slip = from_lanes<T>([&](int k) { return c.slip(cs[k]); });
     const ContactOutputT<T> out = RRLinear::eval(prm, kin, h);
     const Vec3T<T> nxf = cross(kin.n, out.force);
     const Vec3T<T> mt = b * nxf - out.moment, mo = a * nxf + out.moment;
@@ -94,7 +96,7 @@ struct BallForce : MaxOverlap {
       store(c.fs, s, lane(h.fs, k));
       store(c.mr, s, lane(h.mr, k));
       c.flags(s) = lane(h.flags, k);
-      c.slip(s) = lane(h.slip, k);
+      if (worn) c.slip(s) = lane(h.slip, k);
       store(c.fc, s, lane(out.force, k));
       c.fn(s) = lane(out.fn, k);
       store(c.mo, s, lane(mo, k));
