@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "kernels/contact_law.hpp"
+#include "kernels/contact_params.hpp"
 
 namespace dem {
 

@@ -29,6 +29,7 @@
 ///     with s the sliding distance accumulated by the contact (reset when it opens): asperities worn by
 ///     sliding, a lower residual strength after the peak. The default s_c is half a radius: much shorter,
 ///     the contacts wear before the peak and the effect is a lower mu_s (diagnose cannot tell them apart).
+#include "contact_params.hpp"
 #include "vec3.hpp"
 
 namespace dem {
@@ -40,28 +41,6 @@ struct Same {
 };
 template <class T>
 using Arg = typename Same<T>::type;
-
-/// Parameters of one material pair. Units: Pa, -, -, -, -. T is Real, or a pack of W pairs' values (simd.hpp).
-template <class T>
-struct ContactParamsT {
-  T emod = 1e8;     ///< effective modulus E* of the deformability method (Pa)
-  T kratio = 1.5;   ///< kappa* = kn / ks
-  T mu_s = 0.5;     ///< sliding friction coefficient
-  T mu_r = 0.0;     ///< rolling friction coefficient
-  T beta_n = 0.0;   ///< normal viscous damping ratio (PFC dp_nratio); 0 = off, force never tensile
-  // Extensions (see the top of this file), 0 = off.
-  T hertz_overlap = 0.0;  ///< Hertz-Mindlin: overlap / r at which the secant stiffness equals kn
-  T roughness = 0.0;      ///< rough-surface compliance: combined rms roughness / r
-  T wear = 0.0;           ///< slip weakening: fraction of mu_s lost after long sliding
-  T wear_slip = 0.5;      ///< slip weakening: sliding distance / r over which friction decays by 1/e
-
-  /// The same pair without the extensions (specimen preparation, which must not depend on them).
-  ContactParamsT base() const {
-    ContactParamsT b = *this;
-    b.hertz_overlap = b.roughness = b.wear = 0;
-    return b;
-  }
-};
 
 /// The parameters of W material pairs as lanes: pair(k) gives lane k's.
 template <class T, class Pair>

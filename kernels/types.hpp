@@ -4,9 +4,10 @@
 #include <Kokkos_Core.hpp>
 #include <cstdint>
 
+#include "contact_params.hpp"
+
 namespace dem {
 
-using Real = double;                                   ///< SI units everywhere inside the engine
 using ExecSpace = Kokkos::DefaultExecutionSpace;
 using MemSpace = ExecSpace::memory_space;
 using HostSpace = Kokkos::HostSpace;
@@ -26,9 +27,6 @@ using FlagView = Kokkos::View<std::uint8_t*, MemSpace>;             ///< per-con
 using Index2View = Kokkos::View<int* [2], Layout, MemSpace>;         ///< pair of local indices
 using Index3View = Kokkos::View<int* [3], Layout, MemSpace>;         ///< facet vertex indices
 
-template <class T>
-struct ContactParamsT;
-using ContactParams = ContactParamsT<Real>;
 /// Contact parameters per pair of material indices (contact_law.hpp).
 using ParamTableView = Kokkos::View<ContactParams**, MemSpace>;
 

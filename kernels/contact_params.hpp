@@ -1,0 +1,31 @@
+#pragma once
+/// The parameters of a material pair's contact law (contact_law.hpp). Free of Kokkos, so that the config reader,
+/// which a CUDA build compiles with the host compiler (CMakeLists.txt), can fill them.
+#include "real.hpp"
+
+namespace dem {
+
+/// Parameters of one material pair. Units: Pa, -, -, -, -. T is Real, or a pack of W pairs' values (simd.hpp).
+template <class T>
+struct ContactParamsT {
+  T emod = 1e8;     ///< effective modulus E* of the deformability method (Pa)
+  T kratio = 1.5;   ///< kappa* = kn / ks
+  T mu_s = 0.5;     ///< sliding friction coefficient
+  T mu_r = 0.0;     ///< rolling friction coefficient
+  T beta_n = 0.0;   ///< normal viscous damping ratio (PFC dp_nratio); 0 = off, force never tensile
+  // Extensions (see the top of contact_law.hpp), 0 = off.
+  T hertz_overlap = 0.0;  ///< Hertz-Mindlin: overlap / r at which the secant stiffness equals kn
+  T roughness = 0.0;      ///< rough-surface compliance: combined rms roughness / r
+  T wear = 0.0;           ///< slip weakening: fraction of mu_s lost after long sliding
+  T wear_slip = 0.5;      ///< slip weakening: sliding distance / r over which friction decays by 1/e
+
+  /// The same pair without the extensions (specimen preparation, which must not depend on them).
+  ContactParamsT base() const {
+    ContactParamsT b = *this;
+    b.hertz_overlap = b.roughness = b.wear = 0;
+    return b;
+  }
+};
+using ContactParams = ContactParamsT<Real>;
+
+}  // namespace dem
