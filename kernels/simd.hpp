@@ -3,7 +3,7 @@
 /// dependent chain (two square roots and several divisions in a row), too long for the out-of-order window to
 /// overlap two of them; W lanes of a vector register run W chains side by side, and a vector division or square
 /// root costs about what a scalar one does. Every lane does the IEEE operations of the scalar code, so a lane's
-/// result is bit for bit the Real one (tests/test_contact_law.cpp checks it).
+/// result is bit for bit the Real one, given that the build fuses no multiply-add (tests/test_simd_lanes.cpp checks it).
 ///
 /// GPUs take one contact per thread (kContactLanes = 1): T is then Real and nothing here is used.
 #include "types.hpp"
@@ -130,11 +130,9 @@ KOKKOS_INLINE_FUNCTION T from_lanes(const F& f) {
 
 /// Lane k of a pack; a Real is its own lane 0.
 KOKKOS_INLINE_FUNCTION Real lane(Real a, int) { return a; }
-KOKKOS_INLINE_FUNCTION void set_lane(Real& a, int, Real s) { a = s; }
 KOKKOS_INLINE_FUNCTION bool lane(bool m, int) { return m; }
 #ifdef TRIAXDEM_HOST_PACKS
 inline Real lane(const Pack4& a, int k) { return a[k]; }
-inline void set_lane(Pack4& a, int k, Real s) { a.set(k, s); }
 inline bool lane(const Mask4& m, int k) { return m[k]; }
 inline std::uint8_t lane(const Flags4& f, int k) { return f[k]; }
 #endif
