@@ -17,6 +17,7 @@ double seconds_since(Kokkos::Timer& t) {
   t.reset();
   return s;
 }
+
 // The kernels of this file are free functions: nvcc allows no device lambda in a constructor or a private member.
 
 /// Largest radius of the balls (m).

@@ -93,12 +93,7 @@ struct BallForce : MaxOverlap {
         open_contact(c, s);
         continue;
       }
-      store(c.fs, s, lane(h.fs, k));
-      store(c.mr, s, lane(h.mr, k));
-      c.flags(s) = lane(h.flags, k);
-      if (worn) c.slip(s) = lane(h.slip, k);
-      store(c.fc, s, lane(out.force, k));
-      c.fn(s) = lane(out.fn, k);
+      store_law(c, s, h, out, k, worn);
       store(c.mo, s, lane(mo, k));
       store(c.mt, s, lane(mt, k));
       const value_type mine{lane(ratio, k), s};

@@ -25,18 +25,26 @@ OverlapStat compute_ball_forces(const Particles& p, ContactList& c, const ParamT
 OverlapStat compute_wall_forces(const Particles& p, ContactList& c, const Adjacency& adj, const WallSet& walls,
                                 const FacetMesh& mesh, const ParamTableView& params, Real dt);
 
-/// Applies the law to kinematics k of contact slot `s`, stores history, force on particle 1 and the
-/// elastic normal force (shared by both kernels), and returns the law's output.
+/// Stores lane k of a touching contact's updated history and of the law's output (force on particle 1, elastic
+/// normal force) in slot s; both kernels. The sliding distance only where `slip` holds: only slip weakening
+/// changes it.
+template <class T>
+KOKKOS_INLINE_FUNCTION void store_law(const ContactList& c, int s, const ContactHistoryT<T>& h,
+                                      const ContactOutputT<T>& out, int k, bool slip) {
+  store(c.fs, s, lane(h.fs, k));
+  store(c.mr, s, lane(h.mr, k));
+  c.flags(s) = lane(h.flags, k);
+  if (slip) c.slip(s) = lane(h.slip, k);
+  store(c.fc, s, lane(out.force, k));
+  c.fn(s) = lane(out.fn, k);
+}
+
+/// Applies the law to kinematics k of contact slot `s`, stores its history and output, and returns the output.
 KOKKOS_FORCEINLINE_FUNCTION ContactOutput apply_law(const ContactList& c, int s, const ContactParams& prm,
                                                const ContactKinematics& k) {
   ContactHistory h{load(c.fs, s), load(c.mr, s), c.flags(s), c.slip(s)};
   const ContactOutput out = RRLinear::eval(prm, k, h);
-  store(c.fs, s, h.fs);
-  store(c.mr, s, h.mr);
-  c.flags(s) = h.flags;
-  c.slip(s) = h.slip;
-  store(c.fc, s, out.force);
-  c.fn(s) = out.fn;
+  store_law(c, s, h, out, 0, true);
   return out;
 }
 
