@@ -46,7 +46,8 @@ struct BallForce : MaxOverlap {
       pair[k] = &params(material(ci[k]), material(cj[k]));
       one_pair = one_pair && pair[k] == pair[0];
     }
-    const Vec3T<T> d = vec_of_lanes<T>([&](int k) { return image(load(x, cj[k]) - load(x, ci[k])); });
+    const Vec3T<T> d = image(vec_of_lanes<T>([&](int k) { return load(x, cj[k]); }) -
+                             vec_of_lanes<T>([&](int k) { return load(x, ci[k]); }));
     const Vec3T<T> vi = vec_of_lanes<T>([&](int k) { return load(v, ci[k]); });
     const Vec3T<T> vj = vec_of_lanes<T>([&](int k) { return load(v, cj[k]); });
     const Vec3T<T> wi = vec_of_lanes<T>([&](int k) { return load(w, ci[k]); });
@@ -76,27 +77,42 @@ struct BallForce : MaxOverlap {
     kin.dt = dt;
     kin.kn = RRLinear::stiffness(prm, ri, rj);
     ContactHistoryT<T> h;  // flags start clear: the law sets or clears every ContactFlag bit of a touching contact
-    h.fs = vec_of_lanes<T>([&](int k) { return load(c.fs, cs[k]); });
-    h.mr = vec_of_lanes<T>([&](int k) { return load(c.mr, cs[k]); });
+    const bool full = lanes == W;
+    h.fs = full ? load_rows<T>(c.fs, s0) : vec_of_lanes<T>([&](int k) { return load(c.fs, cs[k]); });
+    h.mr = full ? load_rows<T>(c.mr, s0) : vec_of_lanes<T>([&](int k) { return load(c.mr, cs[k]); });
     // Only slip weakening reads or changes the sliding distance: without it in the pack, it stays as stored.
     const bool worn = any(prm.wear != T(0));
     if (worn) h.slip = from_lanes<T>([&](int k) { return c.slip(cs[k]); });
     const ContactOutputT<T> out = RRLinear::eval(prm, kin, h);
     const Vec3T<T> nxf = cross(kin.n, out.force);
     const Vec3T<T> mt = b * nxf - out.moment, mo = a * nxf + out.moment;
-    const T ratio = overlap / kc::min(ri, rj);
+    if (full && all(touching)) {
+      const PackRows at{s0};
+      store_law(c, at, h, out, worn);
+      put(c.mo, at, mo);
+      put(c.mt, at, mt);
+    } else {
+      TRIAXDEM_UNROLL_LANES
+      for (int k = 0; k < W; ++k) {
+        if (k == lanes) break;
+        const LaneRow at{s0 + k, k};
+        if (!lane(touching, k)) {
+          open_contact(c, at.s);
+          continue;
+        }
+        store_law(c, at, h, out, worn);
+        put(c.mo, at, mo);
+        put(c.mt, at, mt);
+      }
+    }
+    // A pack whose largest ratio is below the worst so far cannot change it (ties go to the later contact).
+    const T ratio = select(touching, overlap / kc::min(ri, rj), T(0));
+    if (max_lane(ratio) < worst.ratio) return;
     TRIAXDEM_UNROLL_LANES
     for (int k = 0; k < W; ++k) {
       if (k == lanes) break;
-      const int s = s0 + k;
-      if (!lane(touching, k)) {
-        open_contact(c, s);
-        continue;
-      }
-      store_law(c, s, h, out, k, worn);
-      store(c.mo, s, lane(mo, k));
-      store(c.mt, s, lane(mt, k));
-      const value_type mine{lane(ratio, k), s};
+      if (!lane(touching, k)) continue;
+      const value_type mine{lane(ratio, k), s0 + k};
       join(worst, mine);
     }
   }

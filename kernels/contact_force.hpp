@@ -25,18 +25,37 @@ OverlapStat compute_ball_forces(const Particles& p, ContactList& c, const ParamT
 OverlapStat compute_wall_forces(const Particles& p, ContactList& c, const Adjacency& adj, const WallSet& walls,
                                 const FacetMesh& mesh, const ParamTableView& params, Real dt);
 
-/// Stores lane k of a touching contact's updated history and of the law's output (force on particle 1, elastic
-/// normal force) in slot s; both kernels. The sliding distance only where `slip` holds: only slip weakening
-/// changes it.
-template <class T>
-KOKKOS_INLINE_FUNCTION void store_law(const ContactList& c, int s, const ContactHistoryT<T>& h,
-                                      const ContactOutputT<T>& out, int k, bool slip) {
-  store(c.fs, s, lane(h.fs, k));
-  store(c.mr, s, lane(h.mr, k));
-  c.flags(s) = lane(h.flags, k);
-  if (slip) c.slip(s) = lane(h.slip, k);
-  store(c.fc, s, lane(out.force, k));
-  c.fn(s) = lane(out.fn, k);
+/// Where a contact's results go: lane k of a pack into row s (LaneRow), or every lane of a full pack into rows
+/// s0 .. s0 + W - 1 (PackRows, load_rows/store_rows in vec3.hpp). One store_law serves both.
+struct LaneRow {
+  int s, k;
+};
+struct PackRows {
+  int s0;
+};
+template <class V, class T>
+KOKKOS_INLINE_FUNCTION void put(const V& v, LaneRow at, const Vec3T<T>& a) { store(v, at.s, lane(a, at.k)); }
+template <class V, class T>
+KOKKOS_INLINE_FUNCTION void put(const V& v, PackRows at, const Vec3T<T>& a) { store_rows(v, at.s0, a); }
+template <class V, class T>
+KOKKOS_INLINE_FUNCTION void put_scalar(const V& v, LaneRow at, const T& a) { v(at.s) = lane(a, at.k); }
+template <class V, class T>
+KOKKOS_INLINE_FUNCTION void put_scalar(const V& v, PackRows at, const T& a) {
+  TRIAXDEM_UNROLL_LANES
+  for (int k = 0; k < kContactLanes; ++k) v(at.s0 + k) = lane(a, k);
+}
+
+/// Stores a touching contact's updated history and the law's output (force on particle 1, elastic normal force)
+/// at `at`; both kernels. The sliding distance only where `slip` holds: only slip weakening changes it.
+template <class T, class At>
+KOKKOS_INLINE_FUNCTION void store_law(const ContactList& c, At at, const ContactHistoryT<T>& h,
+                                      const ContactOutputT<T>& out, bool slip) {
+  put(c.fs, at, h.fs);
+  put(c.mr, at, h.mr);
+  put_scalar(c.flags, at, h.flags);
+  if (slip) put_scalar(c.slip, at, h.slip);
+  put(c.fc, at, out.force);
+  put_scalar(c.fn, at, out.fn);
 }
 
 /// Applies the law to kinematics k of contact slot `s`, stores its history and output, and returns the output.
@@ -44,7 +63,7 @@ KOKKOS_FORCEINLINE_FUNCTION ContactOutput apply_law(const ContactList& c, int s,
                                                const ContactKinematics& k) {
   ContactHistory h{load(c.fs, s), load(c.mr, s), c.flags(s), c.slip(s)};
   const ContactOutput out = RRLinear::eval(prm, k, h);
-  store_law(c, s, h, out, 0, true);
+  store_law(c, LaneRow{s, 0}, h, out, true);
   return out;
 }
 

@@ -52,14 +52,17 @@ struct MinImage {
       half[k] = Real(0.5) * len[k];
     }
   }
-  KOKKOS_INLINE_FUNCTION Vec3 operator()(const Vec3& d) const {
-    Real c[3] = {d.x, d.y, d.z};
-    for (int k = 0; k < 3; ++k) {
-      if (len[k] == Real(0)) continue;
-      if (c[k] > half[k]) c[k] -= len[k];
-      else if (c[k] < -half[k]) c[k] += len[k];
-    }
-    return Vec3(c[0], c[1], c[2]);
+  /// Lane-wise on packs: the shift of each lane is the one its scalar would get.
+  template <class T>
+  KOKKOS_INLINE_FUNCTION Vec3T<T> operator()(const Vec3T<T>& d) const {
+    return Vec3T<T>(shift(d.x, 0), shift(d.y, 1), shift(d.z, 2));
+  }
+
+ private:
+  template <class T>
+  KOKKOS_INLINE_FUNCTION T shift(const T& c, int k) const {
+    if (len[k] == Real(0)) return c;
+    return select(c > T(half[k]), c - len[k], select(c < T(-half[k]), c + len[k], c));
   }
 };
 

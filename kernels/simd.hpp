@@ -32,7 +32,22 @@ struct Mask4 {
   friend Mask4 operator!(const Mask4& a) { return {~a.m}; }
   bool operator[](int k) const { return m[k] != 0; }
 };
-inline bool any(const Mask4& a) { return (a.m[0] | a.m[1] | a.m[2] | a.m[3]) != 0; }
+/// Whether any (all) lanes hold: one vptest where AVX is there (or-ing four extracted lanes cost about 45
+/// instructions per pack of the force kernel, callgrind).
+inline bool any(const Mask4& a) {
+#if defined(__AVX__)
+  return !_mm256_testz_si256(__m256i(a.m), __m256i(a.m));
+#else
+  return (a.m[0] | a.m[1] | a.m[2] | a.m[3]) != 0;
+#endif
+}
+inline bool all(const Mask4& a) {
+#if defined(__AVX__)
+  return _mm256_testc_si256(__m256i(a.m), _mm256_set1_epi64x(-1));
+#else
+  return (a.m[0] & a.m[1] & a.m[2] & a.m[3]) != 0;
+#endif
+}
 
 struct Pack4 {
   typedef double V __attribute__((vector_size(32)));
@@ -77,6 +92,12 @@ inline Pack4 exp(const Pack4& a) {
 inline Pack4 min(const Pack4& a, const Pack4& b) { return select(b < a, b, a); }
 inline Pack4 max(const Pack4& a, const Pack4& b) { return select(a < b, b, a); }
 }  // namespace kc
+
+/// The largest lane (no NaN lanes).
+inline Real max_lane(const Pack4& a) {
+  const Real l = a[0] < a[1] ? a[1] : a[0], h = a[2] < a[3] ? a[3] : a[2];
+  return l < h ? h : l;
+}
 
 using ContactPack = Pack4;
 #else
@@ -137,5 +158,6 @@ inline bool lane(const Mask4& m, int k) { return m[k]; }
 inline std::uint8_t lane(const Flags4& f, int k) { return f[k]; }
 #endif
 KOKKOS_INLINE_FUNCTION std::uint8_t lane(std::uint8_t f, int) { return f; }
+KOKKOS_INLINE_FUNCTION Real max_lane(Real a) { return a; }
 
 }  // namespace dem

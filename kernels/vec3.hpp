@@ -66,6 +66,7 @@ KOKKOS_INLINE_FUNCTION void store(const V& v, int i, const Vec3& a) { v(i, 0) = 
 /// Lane-wise choice for masks of T: a plain conditional for Real (simd.hpp overloads it for packs).
 KOKKOS_INLINE_FUNCTION Real select(bool m, Real a, Real b) { return m ? a : b; }
 KOKKOS_INLINE_FUNCTION bool any(bool m) { return m; }
+KOKKOS_INLINE_FUNCTION bool all(bool m) { return m; }
 template <class M, class T>
 KOKKOS_INLINE_FUNCTION Vec3T<T> select(const M& m, const Vec3T<T>& a, const Vec3T<T>& b) {
   return Vec3T<T>(select(m, a.x, b.x), select(m, a.y, b.y), select(m, a.z, b.z));
@@ -84,6 +85,44 @@ KOKKOS_INLINE_FUNCTION Vec3T<T> vec_of_lanes(const F& f) {
 /// Lane k of a vector of packs (simd.hpp).
 template <class T>
 KOKKOS_INLINE_FUNCTION Vec3 lane(const Vec3T<T>& a, int k) { return Vec3(lane(a.x, k), lane(a.y, k), lane(a.z, k)); }
+
+/// Rows s0 .. s0 + W - 1 of a 3-vector View as the lanes of a vector, and back. On the host the rows of a
+/// LayoutRight View are 3W consecutive doubles: W = 4 rows are three vector loads or stores and a transpose in
+/// registers, where lane by lane they were 12 scalar loads or stores and the inserts or extracts between.
+template <class T, class V>
+KOKKOS_INLINE_FUNCTION Vec3T<T> load_rows(const V& v, int s0) {
+#ifdef TRIAXDEM_HOST_PACKS
+  if constexpr (std::is_same<T, Pack4>::value) {
+    static_assert(std::is_same<typename V::array_layout, Kokkos::LayoutRight>::value, "rows must be contiguous");
+    using P = Pack4::V;
+    using I = Mask4::V;
+    P r0, r1, r2;  // (x0 y0 z0 x1) (y1 z1 x2 y2) (z2 x3 y3 z3)
+    const Real* a = &v(s0, 0);
+    __builtin_memcpy(&r0, a, sizeof(P));
+    __builtin_memcpy(&r1, a + 4, sizeof(P));
+    __builtin_memcpy(&r2, a + 8, sizeof(P));
+    return Vec3T<T>(Pack4(__builtin_shuffle(__builtin_shuffle(r0, r1, I{0, 3, 6, 0}), r2, I{0, 1, 2, 5})),
+                    Pack4(__builtin_shuffle(__builtin_shuffle(r0, r1, I{1, 4, 7, 0}), r2, I{0, 1, 2, 6})),
+                    Pack4(__builtin_shuffle(__builtin_shuffle(r0, r1, I{2, 5, 0, 0}), r2, I{0, 1, 4, 7})));
+  } else
+#endif
+    return load(v, s0);
+}
+template <class T, class V>
+KOKKOS_INLINE_FUNCTION void store_rows(const V& v, int s0, const Vec3T<T>& a) {
+#ifdef TRIAXDEM_HOST_PACKS
+  if constexpr (std::is_same<T, Pack4>::value) {
+    static_assert(std::is_same<typename V::array_layout, Kokkos::LayoutRight>::value, "rows must be contiguous");
+    using I = Mask4::V;
+    const Pack4::V x = a.x.v, y = a.y.v, z = a.z.v;
+    const Pack4::V r[3] = {__builtin_shuffle(__builtin_shuffle(x, y, I{0, 4, 0, 1}), z, I{0, 1, 4, 3}),
+                           __builtin_shuffle(__builtin_shuffle(y, z, I{1, 5, 0, 2}), x, I{0, 1, 6, 3}),
+                           __builtin_shuffle(__builtin_shuffle(z, x, I{2, 7, 0, 3}), y, I{0, 1, 7, 3})};
+    __builtin_memcpy(&v(s0, 0), r, sizeof(r));
+  } else
+#endif
+    store(v, s0, a);
+}
 
 /// The tangential part of a relative to the unit normal n.
 template <class T>

@@ -5,6 +5,7 @@
 /// masked branch that computes something else, not rounding.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <random>
 #include <vector>
@@ -98,6 +99,49 @@ TEST(SimdLanes, EachLaneGivesTheScalarLawsBits) {
     }
   }
 }
+
+// Rows loaded as lanes are the rows (lane k = row s0 + k, each component in place), a store puts them back, and
+// the minimum image of a pack is that of each lane: across the half length, on it, and past it either way.
+TEST(SimdLanes, RowsAndMinimumImageMatchTheScalarPath) {
+  using T = ContactPack;
+  const int n = 3 * kContactLanes + 1;
+  Vec3View v("rows", n), back("back", n);
+  auto hv = Kokkos::create_mirror_view(v);
+  for (int s = 0; s < n; ++s)
+    for (int d = 0; d < 3; ++d) hv(s, d) = 10 * s + d;
+  Kokkos::deep_copy(v, hv);
+  auto hb = Kokkos::create_mirror_view(back);
+  for (int s0 = 0; s0 + kContactLanes <= n; s0 += kContactLanes) {
+    const Vec3T<T> a = load_rows<T>(hv, s0);
+    for (int k = 0; k < kContactLanes; ++k) ASSERT_TRUE(same_bits(lane(a, k), load(hv, s0 + k))) << "row " << s0 + k;
+    store_rows(hb, s0, a);
+  }
+  for (int s = 0; s < n - n % kContactLanes; ++s) ASSERT_TRUE(same_bits(load(hb, s), load(hv, s))) << "row " << s;
+
+  Domain dom;
+  dom.hi[0] = 2.0; dom.hi[1] = 3.0; dom.hi[2] = 1.0;
+  dom.periodic[0] = dom.periodic[1] = true;  // z open: never shifted
+  const MinImage image(dom);
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-2.5, 2.5);
+  const double edge[] = {1.0, -1.0, 1.5, -1.5, 0.0};  // exactly half a length: not shifted
+  for (int t = 0; t < 4000; ++t) {
+    Vec3 d[kContactLanes];
+    for (int k = 0; k < kContactLanes; ++k) {
+      d[k] = Vec3(u(rng), u(rng), u(rng));
+      if (t % 5 == 0) d[k].x = edge[(t / 5 + k) % 5];
+      if (t % 7 == 0) d[k].y = edge[(t / 7 + k) % 5];
+    }
+    const Vec3T<T> got = image(vec_of_lanes<T>([&](int k) { return d[k]; }));
+    for (int k = 0; k < kContactLanes; ++k) {
+      const Vec3 want = image(d[k]);
+      ASSERT_LE(std::abs(want.x), 1.0);  // the scalar path is the minimum image itself
+      ASSERT_LE(std::abs(want.y), 1.5);
+      ASSERT_TRUE(same_bits(want.z, d[k].z));
+      ASSERT_TRUE(same_bits(lane(got, k), want)) << "case " << t;
+    }
+  }
+}
 #endif
 
 /// Results of the kernel for every contact of a list, by key.
@@ -111,17 +155,23 @@ KernelResult run_kernel(const Particles& p, const std::vector<std::uint64_t>& ke
   ContactList c(static_cast<int>(keys.size()));
   auto hk = Kokkos::create_mirror_view(c.key);
   auto hi = Kokkos::create_mirror_view(c.i), hj = Kokkos::create_mirror_view(c.j);
-  auto hfs = Kokkos::create_mirror_view(c.fs);
+  auto hfs = Kokkos::create_mirror_view(c.fs), hmr = Kokkos::create_mirror_view(c.mr);
   for (std::size_t s = 0; s < keys.size(); ++s) {
     hk(s) = keys[s];
     hi(s) = static_cast<int>(key_hi(keys[s]));  // gids are local indices here
     hj(s) = static_cast<int>(key_lo(keys[s]));
-    hfs(s, 0) = 1e-4 * static_cast<double>(keys[s] % 7);  // some history, the same for a key in any order
+    // Some history, the same for a key in any order and different in each component, so that a row or a component
+    // loaded into another lane or slot changes the result.
+    for (int d = 0; d < 3; ++d) {
+      hfs(s, d) = 1e-4 * static_cast<double>((keys[s] + d) % 7);
+      hmr(s, d) = 1e-8 * static_cast<double>((keys[s] + 2 * d) % 5);
+    }
   }
   Kokkos::deep_copy(c.key, hk);
   Kokkos::deep_copy(c.i, hi);
   Kokkos::deep_copy(c.j, hj);
   Kokkos::deep_copy(c.fs, hfs);
+  Kokkos::deep_copy(c.mr, hmr);
   compute_ball_forces(p, c, table, Domain(), 1e-7);
   const auto v3 = [&](const Vec3View& v) {
     auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), v);
@@ -141,8 +191,19 @@ KernelResult run_kernel(const Particles& p, const std::vector<std::uint64_t>& ke
   return r;
 }
 
+/// Asserts that contact s of `ref` and contact q of `r` have the same bits everywhere.
+void expect_same_contact(const KernelResult& r, std::size_t q, const KernelResult& ref, std::size_t s, const char* run) {
+  ASSERT_TRUE(same_bits(r.fc[q], ref.fc[s]) && same_bits(r.mo[q], ref.mo[s]) && same_bits(r.mt[q], ref.mt[s]))
+      << run << ": contact " << s;
+  ASSERT_TRUE(same_bits(r.fs[q], ref.fs[s]) && same_bits(r.mr[q], ref.mr[s])) << run << ": contact " << s;
+  ASSERT_TRUE(same_bits(r.fn[q], ref.fn[s]) && same_bits(r.slip[q], ref.slip[s])) << run << ": contact " << s;
+  ASSERT_EQ(r.flags[q], ref.flags[s]) << run << ": contact " << s;
+}
+
 // The same contacts, listed with one, two and three extra pairs in front (each contact moves to another lane and
-// meets other pack-mates, some of which do not touch), give the same bits in the kernel.
+// meets other pack-mates, some of which do not touch), give the same bits in the kernel. So does the list of the
+// touching contacts alone: its packs are full and all touching, which the kernel stores as whole rows
+// (store_rows), where the mixed packs of the full list store lane by lane.
 TEST(SimdLanes, KernelResultDoesNotDependOnLaneOrPackMates) {
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(-1, 1);
@@ -162,32 +223,31 @@ TEST(SimdLanes, KernelResultDoesNotDependOnLaneOrPackMates) {
   ht(0, 1) = ht(1, 0) = test::law(1e8, 1.5, 0.3, 0.02);
   ht(0, 1).wear = ht(1, 0).wear = 0.5;  // a second pair in some packs: lanes with other parameters
   Kokkos::deep_copy(table, ht);
-  std::vector<std::uint64_t> keys;
-  int touching = 0;
+  std::vector<std::uint64_t> keys, touching;
+  std::vector<std::size_t> touching_at;  // position of each touching pair in keys
   for (std::uint32_t i = 0; i < b.size(); ++i)
     for (std::uint32_t j = i + 1; j < b.size(); ++j) {
       const double gap = norm(b[j].x - b[i].x) - b[i].radius - b[j].radius;
-      if (gap < 0.5 * R) keys.push_back(pair_key(i, j));
-      touching += gap < 0 ? 1 : 0;
+      if (gap >= 0.5 * R) continue;
+      if (gap < 0) {
+        touching.push_back(pair_key(i, j));
+        touching_at.push_back(keys.size());
+      }
+      keys.push_back(pair_key(i, j));
     }
-  ASSERT_GT(touching, 10) << "test set-up: the cloud must hold touching pairs";
-  ASSERT_LT(touching, static_cast<int>(keys.size())) << "test set-up: and candidates that do not touch";
+  ASSERT_GT(touching.size(), 10u) << "test set-up: the cloud must hold touching pairs";
+  ASSERT_LT(touching.size(), keys.size()) << "test set-up: and candidates that do not touch";
   const KernelResult ref = run_kernel(p, keys, table);
 
   for (int shift = 1; shift < 4; ++shift) {
     std::vector<std::uint64_t> shifted(keys.begin() + shift, keys.end());
     shifted.insert(shifted.end(), keys.begin(), keys.begin() + shift);  // the first ones last: another lane
     const KernelResult r = run_kernel(p, shifted, table);
-
-    for (std::size_t s = 0; s < keys.size(); ++s) {
-      const std::size_t q = (s + keys.size() - shift) % keys.size();  // where keys[s] went
-      ASSERT_TRUE(same_bits(r.fc[q], ref.fc[s]) && same_bits(r.mo[q], ref.mo[s]) && same_bits(r.mt[q], ref.mt[s]))
-          << "contact " << s << ", shift " << shift;
-      ASSERT_TRUE(same_bits(r.fs[q], ref.fs[s]) && same_bits(r.mr[q], ref.mr[s])) << "contact " << s;
-      ASSERT_TRUE(same_bits(r.fn[q], ref.fn[s]) && same_bits(r.slip[q], ref.slip[s])) << "contact " << s;
-      ASSERT_EQ(r.flags[q], ref.flags[s]) << "contact " << s;
-    }
+    for (std::size_t s = 0; s < keys.size(); ++s)
+      expect_same_contact(r, (s + keys.size() - shift) % keys.size(), ref, s, "shifted list");  // where keys[s] went
   }
+  const KernelResult r = run_kernel(p, touching, table);
+  for (std::size_t q = 0; q < touching.size(); ++q) expect_same_contact(r, q, ref, touching_at[q], "touching only");
 }
 
 }  // namespace
