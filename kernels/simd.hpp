@@ -93,7 +93,7 @@ inline Pack4 min(const Pack4& a, const Pack4& b) { return select(b < a, b, a); }
 inline Pack4 max(const Pack4& a, const Pack4& b) { return select(a < b, b, a); }
 }  // namespace kc
 
-/// The largest lane (no NaN lanes).
+/// The largest lane. With a NaN lane the result is some lane: good for a filter whose per-lane test ignores NaN.
 inline Real max_lane(const Pack4& a) {
   const Real l = a[0] < a[1] ? a[1] : a[0], h = a[2] < a[3] ? a[3] : a[2];
   return l < h ? h : l;
