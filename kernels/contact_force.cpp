@@ -86,23 +86,19 @@ struct BallForce : MaxOverlap {
     const ContactOutputT<T> out = RRLinear::eval(prm, kin, h);
     const Vec3T<T> nxf = cross(kin.n, out.force);
     const Vec3T<T> mt = b * nxf - out.moment, mo = a * nxf + out.moment;
-    if (full && all(touching)) {
-      const PackRows at{s0};
+    const auto store_results = [&](auto at) {
       store_law(c, at, h, out, worn);
       put(c.mo, at, mo);
       put(c.mt, at, mt);
+    };
+    if (full && all(touching)) {
+      store_results(PackRows{s0});
     } else {
       TRIAXDEM_UNROLL_LANES
       for (int k = 0; k < W; ++k) {
         if (k == lanes) break;
-        const LaneRow at{s0 + k, k};
-        if (!lane(touching, k)) {
-          open_contact(c, at.s);
-          continue;
-        }
-        store_law(c, at, h, out, worn);
-        put(c.mo, at, mo);
-        put(c.mt, at, mt);
+        if (lane(touching, k)) store_results(LaneRow{s0 + k, k});
+        else open_contact(c, s0 + k);
       }
     }
     // A pack whose largest ratio is below the worst so far cannot change it (ties go to the later contact).
