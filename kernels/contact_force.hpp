@@ -25,26 +25,6 @@ OverlapStat compute_ball_forces(const Particles& p, ContactList& c, const ParamT
 OverlapStat compute_wall_forces(const Particles& p, ContactList& c, const Adjacency& adj, const WallSet& walls,
                                 const FacetMesh& mesh, const ParamTableView& params, Real dt);
 
-/// Where a contact's results go: lane k of a pack into row s (LaneRow), or every lane of a full pack into rows
-/// s0 .. s0 + W - 1 (PackRows, load_rows/store_rows in vec3.hpp). One store_law serves both.
-struct LaneRow {
-  int s, k;
-};
-struct PackRows {
-  int s0;
-};
-template <class V, class T>
-KOKKOS_INLINE_FUNCTION void put(const V& v, LaneRow at, const Vec3T<T>& a) { store(v, at.s, lane(a, at.k)); }
-template <class V, class T>
-KOKKOS_INLINE_FUNCTION void put(const V& v, PackRows at, const Vec3T<T>& a) { store_rows(v, at.s0, a); }
-template <class V, class T>
-KOKKOS_INLINE_FUNCTION void put_scalar(const V& v, LaneRow at, const T& a) { v(at.s) = lane(a, at.k); }
-template <class V, class T>
-KOKKOS_INLINE_FUNCTION void put_scalar(const V& v, PackRows at, const T& a) {
-  TRIAXDEM_UNROLL_LANES
-  for (int k = 0; k < kContactLanes; ++k) v(at.s0 + k) = lane(a, k);
-}
-
 /// Stores a touching contact's updated history and the law's output (force on particle 1, elastic normal force)
 /// at `at`; both kernels. The sliding distance only where `slip` holds: only slip weakening changes it.
 template <class T, class At>

@@ -33,21 +33,105 @@ struct StepStats {
   int bad = -1;           ///< a particle with a non-finite position, or -1
 };
 
+/// Local damping of one component: -alpha |F| sign(v), lane by lane for a pack (sign(0) = sign(NaN) = 0).
+template <class T>
+KOKKOS_INLINE_FUNCTION T local_damping(const T& f, const T& v, Real alpha) {
+  const T s = select(v > T(0), T(1), select(v < T(0), T(-1), T(0)));
+  return T(-alpha) * kc::fabs(f) * s;
+}
+
+/// Each component of F plus its local damping against v.
+template <class T>
+KOKKOS_INLINE_FUNCTION Vec3T<T> damped(const Vec3T<T>& f, const Vec3T<T>& v, Real alpha) {
+  return Vec3T<T>(f.x + local_damping(f.x, v.x, alpha), f.y + local_damping(f.y, v.y, alpha),
+                  f.z + local_damping(f.z, v.z, alpha));
+}
+
+/// A Real 3-vector in every lane.
+template <class T>
+KOKKOS_INLINE_FUNCTION Vec3T<T> broadcast(const Vec3& a) { return Vec3T<T>(T(a.x), T(a.y), T(a.z)); }
+
+/// The velocity local damping is measured against (IntegrateParams::about_flow): v, or v less the mean flow at x.
+template <class T>
+KOKKOS_INLINE_FUNCTION Vec3T<T> damped_velocity(const IntegrateParams& prm, const Vec3T<T>& v, const Vec3T<T>& x) {
+  if (!prm.about_flow) return v;
+  const Vec3T<T> d = x - broadcast<T>(prm.flow_origin);
+  return v - Vec3T<T>(prm.flow_rate.x * d.x, prm.flow_rate.y * d.y, prm.flow_rate.z * d.z);
+}
+
+/// The step of W particles at once, as the lanes of a pack (kContactLanes; one on a GPU): each one's gather, then
+/// the leapfrog update. Every lane does the IEEE operations of one particle, so the lanes change no bit.
+struct Leapfrog {
+  /// A particle's values: {|F + m g|, kinetic energy, non-finite flag | displacement^2 since rebuild,
+  /// (move this step / radius)^2}; the first kSums are summed, the last kMaxima maximised (reduce_block).
+  static constexpr int kSums = 3, kMaxima = 2, kValues = kSums + kMaxima;
+  static constexpr int W = kContactLanes;
+  Vec3View x, v, w, f, m;
+  ConstVec3View x_ref;
+  ConstScalarView mass, inertia, radius;
+  Gather gather;
+  IntegrateParams prm;
+
+  /// Particles i0 .. i0 + count - 1 (count <= W); vals[k] gets particle i0 + k's values.
+  KOKKOS_INLINE_FUNCTION void operator()(const int i0, const int count, Real (*vals)[kValues]) const {
+    using T = ContactPack;
+    // Lanes past count repeat the last particle; their results are not stored.
+    int id[W];
+    Vec3 fk[W], mk[W];
+    TRIAXDEM_UNROLL_LANES
+    for (int k = 0; k < W; ++k) {
+      id[k] = i0 + (k < count ? k : count - 1);
+      gather(id[k], fk[k], mk[k]);
+    }
+    const bool full = count == W;
+    const auto rows = [&](const auto& view) {
+      return full ? load_rows<T>(view, i0) : vec_of_lanes<T>([&](int k) { return load(view, id[k]); });
+    };
+    const T mi = from_lanes<T>([&](int k) { return mass(id[k]); });
+    const T ii = from_lanes<T>([&](int k) { return inertia(id[k]); });
+    const T ri = from_lanes<T>([&](int k) { return radius(id[k]); });
+    const Vec3T<T> fc = vec_of_lanes<T>([&](int k) { return fk[k]; });
+    const Vec3T<T> moment = vec_of_lanes<T>([&](int k) { return mk[k]; });
+    const Vec3T<T> force = fc + mi * broadcast<T>(prm.gravity);
+    const Vec3T<T> x0 = rows(x);
+    Vec3T<T> vi = rows(v), wi = rows(w);
+    const T a = prm.dt / (mi * prm.mass_scale), b = prm.dt / (ii * prm.mass_scale);
+    vi = vi + a * damped(force, damped_velocity(prm, vi, x0), prm.alpha);
+    wi = wi + b * damped(moment, wi, prm.alpha);
+    const Vec3T<T> xi = x0 + T(prm.dt) * vi;
+    const auto put_all = [&](auto at) {
+      put(f, at, fc);
+      put(m, at, moment);
+      put(v, at, vi);
+      put(w, at, wi);
+      put(x, at, xi);
+    };
+    if (full) {
+      put_all(PackRows{i0});
+    } else {
+      TRIAXDEM_UNROLL_LANES
+      for (int k = 0; k < W; ++k)
+        if (k < count) put_all(LaneRow{id[k], k});
+    }
+    const T unbalanced = prm.measure ? norm(force) : T(0);
+    const T kinetic = prm.measure ? T(Real(0.5)) * (mi * norm2(vi) + ii * norm2(wi)) : T(0);
+    const T disp2 = norm2(xi - rows(x_ref));
+    const T move2 = norm2(vi) * T(prm.dt * prm.dt) / (ri * ri);
+    TRIAXDEM_UNROLL_LANES
+    for (int k = 0; k < W; ++k) {
+      if (k == count) break;
+      const Vec3 xk = lane(xi, k);
+      vals[k][0] = lane(unbalanced, k);
+      vals[k][1] = lane(kinetic, k);
+      vals[k][2] = (kc::isfinite(xk.x) && kc::isfinite(xk.y) && kc::isfinite(xk.z)) ? Real(0) : Real(1);
+      vals[k][3] = lane(disp2, k);
+      vals[k][4] = lane(move2, k);
+    }
+  }
+};
+
 /// Completes each particle's force and moment (gather), stores them in p.f, p.m, and advances all
 /// particles one step. Returns the step's sums (deterministic: fixed-order reduction).
 StepStats integrate(Particles& p, const IntegrateParams& prm, const Gather& gather);
-
-/// Local damping of one component: -alpha |F| sign(v).
-KOKKOS_INLINE_FUNCTION Real local_damping(Real f, Real v, Real alpha) {
-  const Real s = v > 0 ? Real(1) : (v < 0 ? Real(-1) : Real(0));
-  return -alpha * kc::fabs(f) * s;
-}
-
-/// The velocity local damping is measured against (IntegrateParams::about_flow): v, or v less the mean flow at x.
-KOKKOS_INLINE_FUNCTION Vec3 damped_velocity(const IntegrateParams& prm, const Vec3& v, const Vec3& x) {
-  if (!prm.about_flow) return v;
-  const Vec3 d = x - prm.flow_origin;
-  return v - Vec3(prm.flow_rate.x * d.x, prm.flow_rate.y * d.y, prm.flow_rate.z * d.z);
-}
 
 }  // namespace dem

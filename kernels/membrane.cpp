@@ -3,7 +3,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "integrate.hpp"  // local_damping: the same damping law as the balls
+#include "integrate.hpp"  // damped: the same damping law as the balls
 #include "reduce.hpp"
 
 // Elasticity choice: total Lagrangian CST with the Green-Lagrange strain and a St. Venant-Kirchhoff
@@ -92,7 +92,7 @@ struct ReferenceGeometry {
   }
 };
 
-struct Leapfrog {
+struct NodeLeapfrog {
   Vec3View x, v;
   ConstVec3View f;
   ConstScalarView mass;
@@ -106,8 +106,7 @@ struct Leapfrog {
     if (!fixed(n)) {
       const Vec3 F = load(f, n) + mn * prm.gravity;
       const Real a = prm.dt / (mn * prm.mass_scale);
-      vn = vn + a * Vec3(F.x + local_damping(F.x, vn.x, prm.alpha), F.y + local_damping(F.y, vn.y, prm.alpha),
-                         F.z + local_damping(F.z, vn.z, prm.alpha));
+      vn = vn + a * damped(F, vn, prm.alpha);
       store(v, n, vn);
       vals[0] = norm(F);
     }
@@ -292,7 +291,7 @@ MembraneStepStats membrane_integrate(Membrane& m, const Vec3View& force, const M
   if (static_cast<int>(force.extent(0)) != m.nnode)
     throw std::invalid_argument("membrane_integrate: force has " + std::to_string(force.extent(0)) +
                                 " rows, the membrane " + std::to_string(m.nnode) + " nodes");
-  const Leapfrog lf{m.mesh.node_x, m.mesh.node_v, force, m.node_mass, m.fixed, prm};
+  const NodeLeapfrog lf{m.mesh.node_x, m.mesh.node_v, force, m.node_mass, m.fixed, prm};
   Real sums[4];
   // Functors go in through a lambda, as in integrate.cpp: the reduction template then launches its
   // kernel on an extended-lambda closure type, which CUDA accepts in any translation unit.

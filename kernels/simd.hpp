@@ -88,6 +88,11 @@ inline Pack4 exp(const Pack4& a) {
   for (int k = 0; k < 4; ++k) r.set(k, std::exp(a[k]));
   return r;
 }
+/// |a| by clearing the sign bit, as fabs does (-0 gives +0).
+inline Pack4 fabs(const Pack4& a) {
+  const Mask4::V magnitude = Mask4::V{} + 0x7fffffffffffffffLL;
+  return Pack4(Pack4::V(Mask4::V(a.v) & magnitude));
+}
 /// The scalar shims' operand order (b < a ? b : a), so that equal operands pick the same one.
 inline Pack4 min(const Pack4& a, const Pack4& b) { return select(b < a, b, a); }
 inline Pack4 max(const Pack4& a, const Pack4& b) { return select(a < b, b, a); }

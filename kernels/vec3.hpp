@@ -124,6 +124,26 @@ KOKKOS_INLINE_FUNCTION void store_rows(const V& v, int s0, const Vec3T<T>& a) {
     store(v, s0, a);
 }
 
+/// Where a pack's results go: lane k into row s (LaneRow), or every lane of a full pack into rows s0 .. s0 + W - 1
+/// (PackRows, store_rows). One store function serves both (store_law in contact_force.hpp, the leapfrog).
+struct LaneRow {
+  int s, k;
+};
+struct PackRows {
+  int s0;
+};
+template <class V, class T>
+KOKKOS_INLINE_FUNCTION void put(const V& v, LaneRow at, const Vec3T<T>& a) { store(v, at.s, lane(a, at.k)); }
+template <class V, class T>
+KOKKOS_INLINE_FUNCTION void put(const V& v, PackRows at, const Vec3T<T>& a) { store_rows(v, at.s0, a); }
+template <class V, class T>
+KOKKOS_INLINE_FUNCTION void put_scalar(const V& v, LaneRow at, const T& a) { v(at.s) = lane(a, at.k); }
+template <class V, class T>
+KOKKOS_INLINE_FUNCTION void put_scalar(const V& v, PackRows at, const T& a) {
+  TRIAXDEM_UNROLL_LANES
+  for (int k = 0; k < kContactLanes; ++k) v(at.s0 + k) = lane(a, k);
+}
+
 /// The tangential part of a relative to the unit normal n.
 template <class T>
 KOKKOS_INLINE_FUNCTION Vec3T<T> tangential(const Vec3T<T>& a, const Vec3T<T>& n) { return a - dot(a, n) * n; }

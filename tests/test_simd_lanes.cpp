@@ -12,6 +12,7 @@
 
 #include "host/builder.hpp"
 #include "kernels/contact_force.hpp"
+#include "kernels/integrate.hpp"
 #include "test_util.hpp"
 
 using namespace dem;
@@ -248,6 +249,111 @@ TEST(SimdLanes, KernelResultDoesNotDependOnLaneOrPackMates) {
   }
   const KernelResult r = run_kernel(p, touching, table);
   for (std::size_t q = 0; q < touching.size(); ++q) expect_same_contact(r, q, ref, touching_at[q], "touching only");
+}
+
+/// The leapfrog of one particle as the scalar code spells it (kernels/integrate.hpp before the lanes), for the
+/// reference of the test below. The forces are summed as the gather sums them: the owner's side of its contacts in
+/// key order, then the reactions of the others in contact order.
+struct ScalarStep {
+  Vec3 f, m, v, w, x;
+  double vals[5];
+};
+double scalar_damping(double f, double v, double alpha) {
+  const double s = v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0);
+  return -alpha * std::fabs(f) * s;
+}
+
+// Particles advanced 4 (W) at a time, the last group partial, give each particle the bits of the scalar update:
+// gather, gravity, local damping about a flow (zero velocity components included: sign 0), density scaling, and
+// the step's values, summed in particle order.
+TEST(SimdLanes, LeapfrogLanesGiveTheScalarUpdatesBits) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const int n = 4 * kContactLanes + 3;
+  std::vector<BallSpec> b(n);
+  for (int i = 0; i < n; ++i) {
+    b[i].x = 1e-2 * Vec3(u(rng), u(rng), u(rng));
+    b[i].v = 0.1 * Vec3(i % 5 == 0 ? 0.0 : u(rng), u(rng), i % 3 == 0 ? 0.0 : u(rng));
+    b[i].w = 50 * Vec3(u(rng), i % 4 == 0 ? 0.0 : u(rng), u(rng));
+    b[i].radius = 1e-3 * (1 + 0.3 * u(rng));
+  }
+  Particles p = make_particles(b);
+  // Hand-made contact results on pairs (i, i + 1) and (i, i + 3): their sums are the particles' forces.
+  std::vector<std::pair<int, int>> pairs;
+  for (int i = 0; i < n; ++i)
+    for (int d : {1, 3})
+      if (i + d < n) pairs.emplace_back(i, i + d);
+  ContactList c(static_cast<int>(pairs.size()));
+  auto hk = Kokkos::create_mirror_view(c.key);
+  auto hi = Kokkos::create_mirror_view(c.i), hj = Kokkos::create_mirror_view(c.j);
+  auto hfc = Kokkos::create_mirror_view(c.fc), hmo = Kokkos::create_mirror_view(c.mo), hmt = Kokkos::create_mirror_view(c.mt);
+  for (std::size_t s = 0; s < pairs.size(); ++s) {
+    hk(s) = pair_key(pairs[s].first, pairs[s].second);
+    hi(s) = pairs[s].first;
+    hj(s) = pairs[s].second;
+    store(hfc, static_cast<int>(s), 1e-2 * Vec3(u(rng), u(rng), u(rng)));
+    store(hmo, static_cast<int>(s), 1e-6 * Vec3(u(rng), u(rng), u(rng)));
+    store(hmt, static_cast<int>(s), 1e-6 * Vec3(u(rng), u(rng), u(rng)));
+  }
+  Kokkos::deep_copy(c.key, hk);
+  Kokkos::deep_copy(c.i, hi);
+  Kokkos::deep_copy(c.j, hj);
+  Kokkos::deep_copy(c.fc, hfc);
+  Kokkos::deep_copy(c.mo, hmo);
+  Kokkos::deep_copy(c.mt, hmt);
+  const ContactList walls(0);
+  const Gather g = make_gather(c, owner_ranges(p, c), build_adjacency(n, c, c.j), walls,
+                               build_adjacency(n, walls, walls.i));
+  IntegrateParams prm;
+  prm.gravity = Vec3(0.3, -0.2, -9.81);
+  prm.alpha = 0.7;
+  prm.mass_scale = 3;
+  prm.dt = 1e-5;
+  prm.about_flow = true;
+  prm.flow_rate = Vec3(0.1, 0.1, -0.2);
+  prm.flow_origin = Vec3(0, 0, -1e-2);
+  auto h = [](const auto& v) { return Kokkos::create_mirror_view_and_copy(HostSpace(), v); };
+  auto x0 = h(p.x), v0 = h(p.v), w0 = h(p.w), xr = h(p.x_ref);
+  auto mass = h(p.mass), inertia = h(p.inertia), radius = h(p.radius);
+  std::vector<ScalarStep> want(n);
+  double sums[5] = {0, 0, 0, 0, 0};
+  for (int i = 0; i < n; ++i) {
+    ScalarStep& r = want[i];
+    for (std::size_t s = 0; s < pairs.size(); ++s)
+      if (pairs[s].first == i) { r.f += load(hfc, static_cast<int>(s)); r.m += load(hmo, static_cast<int>(s)); }
+    for (std::size_t s = 0; s < pairs.size(); ++s)
+      if (pairs[s].second == i) { r.f -= load(hfc, static_cast<int>(s)); r.m += load(hmt, static_cast<int>(s)); }
+    const double mi = mass(i), ii = inertia(i);
+    const Vec3 force = r.f + mi * prm.gravity, x = load(x0, i);
+    const Vec3 d = x - prm.flow_origin;
+    const Vec3 vd = load(v0, i) - Vec3(prm.flow_rate.x * d.x, prm.flow_rate.y * d.y, prm.flow_rate.z * d.z);
+    const double a = prm.dt / (mi * prm.mass_scale), bb = prm.dt / (ii * prm.mass_scale);
+    const Vec3 w = load(w0, i);
+    r.v = load(v0, i) + a * Vec3(force.x + scalar_damping(force.x, vd.x, prm.alpha),
+                                 force.y + scalar_damping(force.y, vd.y, prm.alpha),
+                                 force.z + scalar_damping(force.z, vd.z, prm.alpha));
+    r.w = w + bb * Vec3(r.m.x + scalar_damping(r.m.x, w.x, prm.alpha), r.m.y + scalar_damping(r.m.y, w.y, prm.alpha),
+                        r.m.z + scalar_damping(r.m.z, w.z, prm.alpha));
+    r.x = x + prm.dt * r.v;
+    const double vals[5] = {std::sqrt(dot(force, force)), 0.5 * (mi * dot(r.v, r.v) + ii * dot(r.w, r.w)), 0,
+                            dot(r.x - load(xr, i), r.x - load(xr, i)),
+                            dot(r.v, r.v) * (prm.dt * prm.dt) / (radius(i) * radius(i))};
+    for (int q = 0; q < 3; ++q) sums[q] += vals[q];
+    for (int q = 3; q < 5; ++q) sums[q] = std::max(sums[q], vals[q]);
+  }
+  const StepStats st = integrate(p, prm, g);
+  auto x1 = h(p.x), v1 = h(p.v), w1 = h(p.w), f1 = h(p.f), m1 = h(p.m);
+  for (int i = 0; i < n; ++i) {
+    ASSERT_TRUE(same_bits(load(f1, i), want[i].f) && same_bits(load(m1, i), want[i].m)) << "gather, particle " << i;
+    ASSERT_TRUE(same_bits(load(v1, i), want[i].v)) << "velocity, particle " << i;
+    ASSERT_TRUE(same_bits(load(w1, i), want[i].w)) << "spin, particle " << i;
+    ASSERT_TRUE(same_bits(load(x1, i), want[i].x)) << "position, particle " << i;
+  }
+  EXPECT_TRUE(same_bits(st.unbalanced, sums[0]));
+  EXPECT_TRUE(same_bits(st.kinetic, sums[1]));
+  EXPECT_TRUE(same_bits(st.max_disp2, sums[3]));
+  EXPECT_TRUE(same_bits(st.max_move2, sums[4]));
+  EXPECT_EQ(st.bad, -1);
 }
 
 }  // namespace
