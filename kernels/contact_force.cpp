@@ -78,8 +78,8 @@ struct BallForce : MaxOverlap {
     kin.kn = RRLinear::stiffness(prm, ri, rj);
     ContactHistoryT<T> h;  // flags start clear: the law sets or clears every ContactFlag bit of a touching contact
     const bool full = lanes == W;
-    h.fs = full ? load_rows<T>(c.fs, s0) : vec_of_lanes<T>([&](int k) { return load(c.fs, cs[k]); });
-    h.mr = full ? load_rows<T>(c.mr, s0) : vec_of_lanes<T>([&](int k) { return load(c.mr, cs[k]); });
+    h.fs = load_lanes<T>(c.fs, s0, cs, full);
+    h.mr = load_lanes<T>(c.mr, s0, cs, full);
     // Only slip weakening reads or changes the sliding distance: without it in the pack, it stays as stored.
     const bool worn = any(prm.wear != T(0));
     if (worn) h.slip = from_lanes<T>([&](int k) { return c.slip(cs[k]); });

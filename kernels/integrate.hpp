@@ -47,10 +47,6 @@ KOKKOS_INLINE_FUNCTION Vec3T<T> damped(const Vec3T<T>& f, const Vec3T<T>& v, Rea
                   f.z + local_damping(f.z, v.z, alpha));
 }
 
-/// A Real 3-vector in every lane.
-template <class T>
-KOKKOS_INLINE_FUNCTION Vec3T<T> broadcast(const Vec3& a) { return Vec3T<T>(T(a.x), T(a.y), T(a.z)); }
-
 /// The velocity local damping is measured against (IntegrateParams::about_flow): v, or v less the mean flow at x.
 template <class T>
 KOKKOS_INLINE_FUNCTION Vec3T<T> damped_velocity(const IntegrateParams& prm, const Vec3T<T>& v, const Vec3T<T>& x) {
@@ -84,17 +80,14 @@ struct Leapfrog {
       gather(id[k], fk[k], mk[k]);
     }
     const bool full = count == W;
-    const auto rows = [&](const auto& view) {
-      return full ? load_rows<T>(view, i0) : vec_of_lanes<T>([&](int k) { return load(view, id[k]); });
-    };
     const T mi = from_lanes<T>([&](int k) { return mass(id[k]); });
     const T ii = from_lanes<T>([&](int k) { return inertia(id[k]); });
     const T ri = from_lanes<T>([&](int k) { return radius(id[k]); });
     const Vec3T<T> fc = vec_of_lanes<T>([&](int k) { return fk[k]; });
     const Vec3T<T> moment = vec_of_lanes<T>([&](int k) { return mk[k]; });
     const Vec3T<T> force = fc + mi * broadcast<T>(prm.gravity);
-    const Vec3T<T> x0 = rows(x);
-    Vec3T<T> vi = rows(v), wi = rows(w);
+    const Vec3T<T> x0 = load_lanes<T>(x, i0, id, full);
+    Vec3T<T> vi = load_lanes<T>(v, i0, id, full), wi = load_lanes<T>(w, i0, id, full);
     const T a = prm.dt / (mi * prm.mass_scale), b = prm.dt / (ii * prm.mass_scale);
     vi = vi + a * damped(force, damped_velocity(prm, vi, x0), prm.alpha);
     wi = wi + b * damped(moment, wi, prm.alpha);
@@ -115,7 +108,7 @@ struct Leapfrog {
     }
     const T unbalanced = prm.measure ? norm(force) : T(0);
     const T kinetic = prm.measure ? T(Real(0.5)) * (mi * norm2(vi) + ii * norm2(wi)) : T(0);
-    const T disp2 = norm2(xi - rows(x_ref));
+    const T disp2 = norm2(xi - load_lanes<T>(x_ref, i0, id, full));
     const T move2 = norm2(vi) * T(prm.dt * prm.dt) / (ri * ri);
     TRIAXDEM_UNROLL_LANES
     for (int k = 0; k < W; ++k) {

@@ -293,7 +293,7 @@ MembraneStepStats membrane_integrate(Membrane& m, const Vec3View& force, const M
                                 " rows, the membrane " + std::to_string(m.nnode) + " nodes");
   const NodeLeapfrog lf{m.mesh.node_x, m.mesh.node_v, force, m.node_mass, m.fixed, prm};
   Real sums[4];
-  // Functors go in through a lambda, as in integrate.cpp: the reduction template then launches its
+  // Functors go in through a lambda: the reduction template then launches its
   // kernel on an extended-lambda closure type, which CUDA accepts in any translation unit.
   deterministic_reduce<3, 1>("dem::membrane::leapfrog", m.nnode, KOKKOS_LAMBDA(const int n, Real* v) { lf(n, v); },
                              sums);

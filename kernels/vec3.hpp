@@ -108,6 +108,10 @@ KOKKOS_INLINE_FUNCTION Vec3T<T> vec_of_lanes(const F& f) {
                   from_lanes<T>([&](int k) { return a[k].z; }));
 }
 
+/// A Real 3-vector in every lane.
+template <class T>
+KOKKOS_INLINE_FUNCTION Vec3T<T> broadcast(const Vec3& a) { return Vec3T<T>(T(a.x), T(a.y), T(a.z)); }
+
 /// Lane k of a vector of packs (simd.hpp).
 template <class T>
 KOKKOS_INLINE_FUNCTION Vec3 lane(const Vec3T<T>& a, int k) { return Vec3(lane(a.x, k), lane(a.y, k), lane(a.z, k)); }
@@ -148,6 +152,13 @@ KOKKOS_INLINE_FUNCTION void store_rows(const V& v, int s0, const Vec3T<T>& a) {
   } else
 #endif
     store(v, s0, a);
+}
+
+/// Rows ids[0 .. W) of a 3-vector View as the lanes of a vector: whole rows (load_rows) when the pack is full, its
+/// rows then being s0 .. s0 + W - 1, else row by row. The load side of put() below.
+template <class T, class V>
+KOKKOS_INLINE_FUNCTION Vec3T<T> load_lanes(const V& v, int s0, const int* ids, bool full) {
+  return full ? load_rows<T>(v, s0) : vec_of_lanes<T>([&](int k) { return load(v, ids[k]); });
 }
 
 /// Where a pack's results go: lane k into row s (LaneRow), or every lane of a full pack into rows s0 .. s0 + W - 1
