@@ -11,9 +11,18 @@
 ///   summary:  q_peak_<stress unit>, and optionally eps_a_peak_<u>, q_end_<stress unit>, max_dilatancy,
 ///             e_ini_<stress unit> (initial stiffness dq/deps_a over the first 0.2% of axial strain),
 ///             q_1pct_<stress unit>, q_3pct_<stress unit> (q at 1% and 3% axial strain)
+///   optional, either kind:
+///     <quantity>_sd_<unit>   the standard deviation of a column (q_sd_kPa, eps_v_sd_pct, q_peak_sd_kPa,
+///                            max_dilatancy_sd): on every row of a test or on none, > 0
+///     void_ratio or porosity the specimen's state after consolidation (one value per test, repeated on its
+///                            rows), with optional void_ratio_sd / porosity_sd
+///     test                   a label that tells replicates apart: tests of one material and sigma3 with
+///                            different labels are replicates (the scatter between them is measured noise)
 /// A file is a curve file when it has an eps_a column, a summary file when it has q_peak. Within a curve
-/// the axial strain must increase; a material and pressure appear once in a summary file.
+/// the axial strain must increase; a material, pressure and test label appear once in a summary file.
+/// Implausible values are refused: |q| above kMaxStressRatio sigma3, a strain beyond kMaxStrain.
 #include <functional>
+#include <limits>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -37,13 +46,28 @@ struct MeasuredTest {
   Real q_peak = 0, eps_a_peak = 0, q_end = 0, max_dilatancy = 0;  ///< Pa, -, Pa, -
   Real e_ini = 0;                           ///< Pa, initial stiffness dq/deps_a (first kInitialWindow of strain)
   Real q_1pct = 0, q_3pct = 0;              ///< Pa, q at kEarlyStrain and kMidStrain (NaN: the curve ends before)
+  std::string replicate;                    ///< the file's `test` label ("" without one)
+  std::vector<Real> q_sd, eps_v_sd;         ///< Pa, fractions: each row's standard deviation (empty: not given)
+  std::map<std::string, Real> summary_sd;   ///< summary files: standard deviation by quantity (q_peak, ...), SI
+  Real void_ratio = std::numeric_limits<Real>::quiet_NaN();     ///< after consolidation (NaN: not given)
+  Real void_ratio_sd = std::numeric_limits<Real>::quiet_NaN();  ///< its standard deviation (NaN: not given)
 };
 
 struct MeasuredData {
   std::string path;
   bool curves = false;                      ///< curve file (else summary)
   std::vector<MeasuredTest> tests;          ///< in file order of first appearance
+  std::vector<std::string> notes;           ///< what the reader accepted but a user should know (near-equal pressures)
 };
+
+/// Limits of plausible data: |q| <= kMaxStressRatio sigma3, |strain| <= kMaxStrain (fractions).
+constexpr Real kMaxStressRatio = 100, kMaxStrain = 1.0;
+/// Tests of one material whose sigma3 differ by less than this fraction are replicates of one pressure.
+constexpr Real kReplicateTolerance = 0.02;
+
+/// Groups of replicate tests (indices into tests): the same material, sigma3 within kReplicateTolerance; every
+/// test is in exactly one group, groups in order of their first test.
+std::vector<std::vector<std::size_t>> replicate_groups(const std::vector<MeasuredTest>& tests);
 
 /// Reads and validates a measured-data file: CSV, or HDF5 (.h5, .hdf5) with the same columns: one group per
 /// material holding a 2-D dataset `table` (rows x columns, numbers) whose string attribute `columns` names
