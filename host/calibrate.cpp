@@ -10,74 +10,6 @@
 
 namespace dem {
 
-const char* quantity_name(int q) {
-  static const char* names[kQuantities] = {"E_ini", "q_1pct", "q_3pct", "q_peak", "eps_a_peak", "q_end",
-                                           "max_dilatancy"};
-  return names[q];
-}
-
-std::array<Real, kQuantities> quantities(const MeasuredTest& t) {
-  return {t.e_ini, t.q_1pct, t.q_3pct, t.q_peak, t.eps_a_peak, t.q_end, t.max_dilatancy};
-}
-
-Real NoiseModel::sigma(int q, Real measured) const { return std::max(rel[q] * std::fabs(measured), abs[q]); }
-
-bool NoiseModel::is_stress(int q) { return q != kStrainAtPeak && q != kDilatancy; }
-
-std::array<Real, kQuantities> test_residuals(const MeasuredTest& measured, const MeasuredTest& simulated,
-                                             const NoiseModel& noise) {
-  const auto m = quantities(measured), s = quantities(simulated);
-  std::array<Real, kQuantities> r;
-  r.fill(std::numeric_limits<Real>::quiet_NaN());
-  std::vector<int> idx;  // quantities measured and simulated: the whitened block
-  for (int q = 0; q < kQuantities; ++q) {
-    if (!std::isfinite(m[q])) continue;
-    if (std::isfinite(s[q]))
-      idx.push_back(q);
-    else
-      r[q] = kMissingResidual;
-  }
-  const int n = static_cast<int>(idx.size());
-  Eigen::MatrixXd cov(n, n);
-  Eigen::VectorXd diff(n), shared(n);
-  for (int i = 0; i < n; ++i) {
-    const int q = idx[i];
-    shared(i) = NoiseModel::is_stress(q) ? noise.specimen * m[q] : 0.0;
-    diff(i) = s[q] - m[q];
-  }
-  cov = shared * shared.transpose();
-  for (int i = 0; i < n; ++i) {
-    const Real total = noise.sigma(idx[i], m[idx[i]]);
-    // The shared part cannot exceed the whole scatter; the floor keeps C positive definite when it nearly does.
-    cov(i, i) = std::max(total * total, cov(i, i) + 0.01 * total * total);
-  }
-  const Eigen::LLT<Eigen::MatrixXd> llt(cov);
-  if (llt.info() != Eigen::Success) throw std::logic_error("test_residuals: noise covariance not positive definite");
-  const Eigen::VectorXd w = llt.matrixL().solve(diff);
-  for (int i = 0; i < n; ++i) r[idx[i]] = w(i);
-  return r;
-}
-
-std::vector<Real> residuals(const std::vector<MeasuredTest>& measured, const std::vector<MeasuredTest>& simulated,
-                            const NoiseModel& noise, const std::vector<bool>& use) {
-  std::vector<Real> r;
-  for (std::size_t k = 0; k < measured.size(); ++k) {
-    if (!use.empty() && !use[k]) continue;
-    for (Real v : test_residuals(measured[k], simulated[k], noise))
-      if (!std::isnan(v)) r.push_back(v);
-  }
-  return r;
-}
-
-int data_count(const std::vector<MeasuredTest>& measured, const std::vector<bool>& use) {
-  int n = 0;
-  for (std::size_t k = 0; k < measured.size(); ++k) {
-    if (!use.empty() && !use[k]) continue;
-    for (Real v : quantities(measured[k])) n += std::isfinite(v) ? 1 : 0;
-  }
-  return n;
-}
-
 // ---------------------------------------------------------------------------------------------------
 // Free parameters
 
@@ -116,13 +48,6 @@ const ParamSpec& spec(const std::string& name) {
 }  // namespace
 
 FreeParam free_param(const std::string& name) { return spec(name).range; }
-
-Model model_of(const Config& cfg) {
-  Model m;
-  m.law = cfg.ball;
-  m.membrane = cfg.periodic.triax.membrane_stiffness;
-  return m;
-}
 
 FreeParam free_param(const std::string& name, const Model& base) {
   FreeParam f = free_param(name);
@@ -265,16 +190,18 @@ bool recentre(FreeParam& f, Real v) {
   return true;
 }
 
-CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,
-                            const std::vector<MeasuredTest>& measured, const NoiseModel& noise, int rounds,
-                            const CalibrationProgress& progress, int widen) {
+namespace {
+
+CalibrationResult search(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,
+                         const std::vector<MeasuredTest>& measured, const Misfit& misfit, int rounds,
+                         const CalibrationProgress& progress, int widen) {
   const int d = static_cast<int>(free.size());
   CalibrationResult res;
   res.free = free;
-  res.data = data_count(measured);
+  res.data = misfit.data();
   long design_points = 1;
   for (int k = 0; k < d; ++k) design_points *= 3;
-  const long planned = (design_points + rounds) * static_cast<long>(measured.size());
+  const long planned = (design_points + rounds) * static_cast<long>(measured.size()) * lab.members();
   auto model_at = [&](const std::vector<Real>& u) {
     Model m = base;
     for (int k = 0; k < d; ++k) set_param(m, free[k].name, free[k].value(u[k]));
@@ -283,8 +210,9 @@ CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vect
   auto evaluate = [&](const std::vector<Real>& u) {
     Evaluation e;
     e.u = u;
-    e.sim = lab.run_all(model_at(u), measured);
-    e.r = residuals(measured, e.sim, noise);
+    const Ensemble ens = lab.run_ensemble(model_at(u), measured);
+    for (const auto& members : ens) e.sim.push_back(mean_curve(members));
+    e.r = misfit.residuals(ens);
     e.chi2 = chi2_of(e.r);
     res.design.push_back(e);
     if (res.design.size() == 1 || e.chi2 < res.best.chi2) res.best = e;
@@ -330,7 +258,7 @@ CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vect
     notes.push_back(line);
   }
   if (notes.empty()) return res;
-  CalibrationResult again = calibrate(lab, base, moved, measured, noise, rounds, progress, widen - 1);
+  CalibrationResult again = search(lab, base, moved, measured, misfit, rounds, progress, widen - 1);
   if (again.best.chi2 >= res.best.chi2) {
     notes.push_back("the wider search found no better point");
     for (int k = 0; k < d; ++k)
@@ -339,6 +267,102 @@ CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vect
   CalibrationResult& out = again.best.chi2 < res.best.chi2 ? again : res;
   out.widened.insert(out.widened.begin(), notes.begin(), notes.end());
   return out;
+}
+
+/// The 95% quantile of chi2 with d degrees of freedom (d = 1..4; beyond, Wilson-Hilferty).
+Real chi2_95(int d) {
+  static const Real q[] = {3.841, 5.991, 7.815, 9.488};
+  if (d >= 1 && d <= 4) return q[d - 1];
+  const Real a = 2.0 / (9 * d);
+  return d * std::pow(1 - a + 1.645 * std::sqrt(a), 3);
+}
+
+void add_uncertainty(CalibrationResult& r) {
+  const int d = static_cast<int>(r.free.size());
+  if (d == 0 || r.design.size() < 2) return;
+  r.surfaces = response_surfaces(r.design, r.best.u);
+  r.offset.clear();
+  for (std::size_t i = 0; i < r.surfaces.size(); ++i) r.offset.push_back(r.best.r[i] - r.surfaces[i](r.best.u));
+  r.scale = std::max(Real(1), r.best.chi2 / std::max(1, r.data - d));
+  // Profile intervals: each parameter on a grid of its unit range, the surrogate minimised over the others.
+  const Real best = r.surrogate_chi2(r.best.u), rise = 3.841 * r.scale;
+  r.interval.clear();
+  for (int j = 0; j < d; ++j) {
+    constexpr int kGrid = 201;
+    std::vector<Real> profile(kGrid);
+    for (int g = 0; g < kGrid; ++g) {
+      const Real t = static_cast<Real>(g) / (kGrid - 1);
+      const std::vector<Real> rest = minimise_unit_box([&](const std::vector<Real>& x) {
+        std::vector<Real> u(x);
+        u.insert(u.begin() + j, t);
+        return r.surrogate_chi2(u);
+      }, d - 1, 11);
+      std::vector<Real> u(rest);
+      u.insert(u.begin() + j, t);
+      profile[g] = r.surrogate_chi2(u);
+    }
+    int at = static_cast<int>(std::lround(r.best.u[j] * (kGrid - 1)));
+    int lo = at, hi = at;
+    while (lo > 0 && profile[lo - 1] - best <= rise) --lo;
+    while (hi < kGrid - 1 && profile[hi + 1] - best <= rise) ++hi;
+    r.interval.emplace_back(r.free[j].value(static_cast<Real>(lo) / (kGrid - 1)),
+                            r.free[j].value(static_cast<Real>(hi) / (kGrid - 1)));
+  }
+  // Correlation: J = d residuals / du at the best point (central differences of the surfaces).
+  Eigen::MatrixXd J(static_cast<int>(r.surfaces.size()), d);
+  for (int j = 0; j < d; ++j) {
+    std::vector<Real> up = r.best.u, dn = r.best.u;
+    up[j] += 1e-3, dn[j] -= 1e-3;
+    for (std::size_t i = 0; i < r.surfaces.size(); ++i)
+      J(static_cast<int>(i), j) = (r.surfaces[i](up) - r.surfaces[i](dn)) / 2e-3;
+  }
+  const Eigen::MatrixXd cov = (J.transpose() * J).completeOrthogonalDecomposition().pseudoInverse();
+  r.correlation.assign(d, std::vector<Real>(d, 0));
+  for (int a = 0; a < d; ++a)
+    for (int b = 0; b < d; ++b) {
+      const Real den = std::sqrt(cov(a, a) * cov(b, b));
+      r.correlation[a][b] = den > 0 ? cov(a, b) / den : (a == b ? 1 : 0);
+    }
+}
+
+}  // namespace
+
+Real CalibrationResult::surrogate_chi2(const std::vector<Real>& u) const {
+  Real c = 0;
+  for (std::size_t i = 0; i < surfaces.size(); ++i) {
+    const Real v = surfaces[i](u) + offset[i];
+    c += v * v;
+  }
+  return c;
+}
+
+bool CalibrationResult::inside_region(const std::vector<Real>& values) const {
+  std::vector<Real> u;
+  for (std::size_t k = 0; k < free.size(); ++k) {
+    if (values[k] < free[k].lo || values[k] > free[k].hi) return false;
+    u.push_back(free[k].unit(values[k]));
+  }
+  return surrogate_chi2(u) - surrogate_chi2(best.u) <= chi2_95(static_cast<int>(free.size())) * scale;
+}
+
+std::vector<std::string> CalibrationResult::inseparable() const {
+  std::vector<std::string> out;
+  for (std::size_t a = 0; a < correlation.size(); ++a)
+    for (std::size_t b = a + 1; b < correlation.size(); ++b)
+      if (std::fabs(correlation[a][b]) > 0.9) {
+        char c[32];
+        std::snprintf(c, sizeof c, " (%+.2f)", correlation[a][b]);
+        out.push_back(free[a].name + " and " + free[b].name + c);
+      }
+  return out;
+}
+
+CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,
+                            const std::vector<MeasuredTest>& measured, const Misfit& misfit, int rounds,
+                            const CalibrationProgress& progress, int widen) {
+  CalibrationResult r = search(lab, base, free, measured, misfit, rounds, progress, widen);
+  add_uncertainty(r);
+  return r;
 }
 
 }  // namespace dem

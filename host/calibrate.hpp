@@ -34,59 +34,10 @@
 #include "config.hpp"
 #include "host/builder.hpp"
 #include "measured.hpp"
+#include "misfit.hpp"
+#include "periodic_lab.hpp"
 
 namespace dem {
-
-enum Quantity : int { kInitialStiffness = 0, kEarly, kMid, kPeak, kStrainAtPeak, kResidual, kDilatancy, kQuantities };
-
-/// Name of a quantity in tables ("E_ini", "q_peak", ...).
-const char* quantity_name(int q);
-
-/// The quantities of a test (NaN where absent).
-std::array<Real, kQuantities> quantities(const MeasuredTest& t);
-
-/// Noise of each quantity: s_q = max(rel_q |measured|, abs_q), its whole scatter. Part of it is shared by the
-/// stress quantities of one test (E_ini, q at 1% and 3%, q_peak, q_end): a specimen that is a little denser
-/// or stiffer than the next raises all its stresses together, by a factor of standard deviation `specimen`.
-/// The residuals of a test are therefore correlated, with covariance
-///   C = diag(s_q^2 - (specimen m_q)^2) + specimen^2 m m^T,   m_q = measured stress quantity (0 for the others),
-/// and treating them as independent lets one lucky specimen look like a systematic effect.
-struct NoiseModel {
-  std::array<Real, kQuantities> rel{0.10, 0.06, 0.06, 0.04, 0.0, 0.05, 0.20};
-  std::array<Real, kQuantities> abs{0.0, 0.0, 0.0, 0.0, 0.02, 0.0, 0.05};
-  Real specimen = 0.02;                     ///< shared relative scatter of a test's stresses (<= every stress rel_q)
-  Real sigma(int q, Real measured) const;
-  static bool is_stress(int q);             ///< scaled by the specimen factor
-};
-
-/// Residual of a datum the simulation could not produce (no peak, a blow-up): ten standard deviations.
-constexpr Real kMissingResidual = 10;
-
-/// Whitened residuals of one test, one per quantity (NaN where the measured test lacks it): r = L^-1 (s - m)
-/// with C = L L^T over the quantities present (NoiseModel), so that sum r^2 = (s - m)^T C^-1 (s - m). L is
-/// lower triangular in quantity order: r_q is what datum q says beyond the quantities before it (E_ini
-/// first), the shared specimen factor counted once. A quantity the simulation could not produce counts
-/// kMissingResidual and leaves the others' covariance.
-std::array<Real, kQuantities> test_residuals(const MeasuredTest& measured, const MeasuredTest& simulated,
-                                             const NoiseModel& noise);
-
-/// The whitened residuals of every present quantity, test by test (tests matched by index), concatenated;
-/// `use[k]` false leaves test k out.
-std::vector<Real> residuals(const std::vector<MeasuredTest>& measured, const std::vector<MeasuredTest>& simulated,
-                            const NoiseModel& noise, const std::vector<bool>& use = {});
-
-/// Number of data (present quantities) in the tests used.
-int data_count(const std::vector<MeasuredTest>& measured, const std::vector<bool>& use = {});
-
-
-/// A model to simulate: contact law (with extensions) and the membrane extension (Pa, E_m t / R0).
-struct Model {
-  ContactParams law;
-  Real membrane = 0;
-};
-
-/// The model of a config: its ball law and the periodic cell's membrane.
-Model model_of(const Config& cfg);
 
 /// A parameter that calibration may vary: its config key, its range, log or linear search.
 struct FreeParam {
@@ -108,42 +59,22 @@ FreeParam free_param(const std::string& name, const Model& base);
 void set_param(Model& m, const std::string& name, Real v);
 Real get_param(const Model& m, const std::string& name);
 
-/// The simulator: periodic-cell triaxial runs on one specimen prepared from the base config.
-class PeriodicLab {
+/// A quadratic response surface in unit coordinates: value(u) = c . basis(u), fitted by weighted least squares.
+class QuadraticSurface {
  public:
-  PeriodicLab(const Config& base, bool verbose);
-  /// A simulated test as measured data (curves, summarised), at confining pressure sigma3 (Pa).
-  MeasuredTest run(const Model& m, Real sigma3, const std::string& material = "sim");
-  /// All tests of `like` (same materials and pressures), in order; up to jobs() at once.
-  std::vector<MeasuredTest> run_all(const Model& m, const std::vector<MeasuredTest>& like);
-  /// Runs at once: each in a child process (fork) with the same specimen; the results are the same as one at a
-  /// time, bit for bit. Only where that is safe: a host backend on one thread (OMP_NUM_THREADS=1); otherwise
-  /// the runs go one at a time with all threads. Returns the value in effect.
-  int set_jobs(int jobs);
-  int jobs() const { return jobs_; }
-  const Config& config() const { return cfg_; }
-  long runs() const { return runs_; }
-  double seconds() const { return seconds_; }
-  std::size_t balls() const { return balls_.size(); }
+  QuadraticSurface() = default;
+  QuadraticSurface(const std::vector<std::vector<Real>>& u, const std::vector<Real>& y, const std::vector<Real>& w);
+  Real operator()(const std::vector<Real>& u) const;
+  static std::vector<Real> basis(const std::vector<Real>& u);
 
  private:
-  Config cfg_;
-  std::vector<BallSpec> balls_;
-  std::array<Real, 3> cell_{};
-  long runs_ = 0;
-  double seconds_ = 0;
-  int jobs_ = 1;
+  std::vector<Real> c_;
 };
-
-/// Before Kokkos starts, in a program that will run `jobs` > 1 simulator runs at once: sets OpenMP to one
-/// thread (its runtime read OMP_NUM_THREADS when it was loaded, before main, so through its API), as
-/// PeriodicLab::set_jobs requires.
-void prepare_parallel_runs(int jobs);
 
 /// One evaluated point of a search.
 struct Evaluation {
   std::vector<Real> u;                ///< unit coordinates of the free parameters
-  std::vector<MeasuredTest> sim;      ///< simulated tests
+  std::vector<MeasuredTest> sim;      ///< simulated tests: the mean curves of the ensemble (mean_curve)
   std::vector<Real> r;                ///< normalised residuals (all tests)
   Real chi2 = 0;
 };
@@ -164,6 +95,24 @@ struct CalibrationResult {
   /// Parameters searched beyond the edge their best value lies on, without a better point there: the
   /// optimum is at the edge within the scatter of the runs, and at_edge() does not flag them.
   std::vector<std::string> searched_beyond;
+
+  /// Uncertainty, from the response surfaces of the residuals around the best run (the surrogate chi2, shifted
+  /// to agree with that run): each parameter's 95% profile interval (where the chi2 minimised over the others
+  /// rises by 3.84 x scale), the correlation of the free parameters (Gauss-Newton, (J^T J)^-1), and the joint
+  /// 95% region (a rise of the chi2 quantile with d degrees of freedom). scale = chi2 / (n - d) where that
+  /// exceeds 1: a misfit beyond the noise widens the region by its root, as the noise was understated.
+  std::vector<std::pair<Real, Real>> interval;     ///< SI, per free parameter
+  std::vector<std::vector<Real>> correlation;      ///< d x d
+  Real scale = 1;
+  /// The surrogate chi2 at unit coordinates u.
+  Real surrogate_chi2(const std::vector<Real>& u) const;
+  /// Whether parameter values (SI, in free order) lie inside the joint 95% region.
+  bool inside_region(const std::vector<Real>& values) const;
+  /// Pairs of parameters whose correlation is beyond +-0.9, in words ("mu_s and mu_r (-0.95)"): these data
+  /// cannot separate them.
+  std::vector<std::string> inseparable() const;
+  std::vector<QuadraticSurface> surfaces;          ///< the residuals' surfaces around the best run
+  std::vector<Real> offset;                        ///< best-run residual minus surface value there
 };
 
 /// Moves f's range to centre on v, keeping its width (its ratio when logarithmic), inside the registry's range
@@ -175,20 +124,8 @@ using CalibrationProgress = std::function<void(long, long, Real)>;
 
 /// Calibrates `free` on `measured` (one material, any number of pressures) from `base`; see the top of the file.
 CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,
-                            const std::vector<MeasuredTest>& measured, const NoiseModel& noise, int rounds = 4,
+                            const std::vector<MeasuredTest>& measured, const Misfit& misfit, int rounds = 4,
                             const CalibrationProgress& progress = {}, int widen = 2);
-
-/// A quadratic response surface in unit coordinates: value(u) = c . basis(u), fitted by weighted least squares.
-class QuadraticSurface {
- public:
-  QuadraticSurface() = default;
-  QuadraticSurface(const std::vector<std::vector<Real>>& u, const std::vector<Real>& y, const std::vector<Real>& w);
-  Real operator()(const std::vector<Real>& u) const;
-  static std::vector<Real> basis(const std::vector<Real>& u);
-
- private:
-  std::vector<Real> c_;
-};
 
 /// One response surface per residual of the evaluations, weighted towards `centre` (unit coordinates).
 std::vector<QuadraticSurface> response_surfaces(const std::vector<Evaluation>& pts, const std::vector<Real>& centre);

@@ -113,6 +113,22 @@ struct Session {
                                 : load_reference(o.reference, [](const std::string& n) { free_param(n); })),
         free(free_params(base, o.free)), lab(base, true), folder(new_dated_folder(o.output, kind)) {
     lab.set_jobs(o.jobs);
+    noise.mode = o.noise;
+  }
+  NoiseOptions noise;
+  /// The misfit of a material's tests: the ensemble run at the base model, its scatter beside the data's noise.
+  Misfit misfit_of(const Config& base, const std::string& material, const std::vector<MeasuredTest>& tests) {
+    std::printf("%s: %s: measuring the simulator's scatter: %d specimens of %zu balls at the base model\n",
+                folder.c_str(), material.c_str(), lab.members(), lab.balls());
+    Misfit m = measure_misfit(lab, model_of(base), tests, noise);
+    for (const std::string& n : m.notes()) std::printf("  noise: %s\n", n.c_str());
+    const Real ratio = m.ensemble_ratio();
+    std::printf("  the simulator's standard error is %.2f of the data's noise (median; %d specimens)%s\n", ratio,
+                lab.members(), ratio > 0.5 ? "" : ": below 1/2, enough");
+    if (ratio > 0.5)
+      std::printf("  WARNING: above 1/2: [calibrate] ensemble = %ld would bring it to 1/2; the misfit counts it\n",
+                  std::lround(std::ceil(lab.members() * 4 * ratio * ratio)));
+    return m;
   }
   /// The reference value of a parameter for a material, in the key's unit; NaN when there is none.
   Real reference(const std::string& material, const std::string& name) const {
@@ -142,16 +158,68 @@ const ExtensionFit* top_fit(const Diagnosis& dg) {
   return top;
 }
 
-/// Residual in noise units, NaN when the simulation has no value.
-Real residual(int q, Real measured, Real simulated) {
-  return std::isfinite(simulated) ? (simulated - measured) / NoiseModel().sigma(q, measured) : NAN;
+/// The calibrated values with their 95% intervals and correlations, in lines prefixed "<job>: <material>: ".
+std::string uncertainty_text(const CalibrationResult& r, const std::string& material, const std::string& job) {
+  std::ostringstream o;
+  const std::string at = job + ": " + material + ": ";
+  for (std::size_t k = 0; k < r.free.size() && k < r.interval.size(); ++k)
+    o << at << r.free[k].name << " = " << fmt("%.4g", r.free[k].shown * r.values[k]) << ", 95% interval ["
+      << fmt("%.4g", r.free[k].shown * r.interval[k].first) << ", " << fmt("%.4g", r.free[k].shown * r.interval[k].second)
+      << "]\n";
+  for (std::size_t a = 0; a < r.correlation.size(); ++a)
+    for (std::size_t b = a + 1; b < r.correlation.size(); ++b)
+      o << at << "correlation of " << r.free[a].name << " and " << r.free[b].name << ": "
+        << fmt("%+.2f", r.correlation[a][b]) << "\n";
+  for (const std::string& p : r.inseparable())
+    o << at << "these data cannot separate " << p << ": they trade against each other (in strength, for friction)\n";
+  if (r.scale > 1)
+    o << at << "the misfit exceeds the noise (chi2 / dof " << fmt("%.2f", r.scale)
+      << "): the intervals are widened by its square root\n";
+  o << at << r.design.size() << " parameter points run to find the optimum\n";
+  return o.str();
+}
+
+/// A feature's value and unit in the tables: q in kPa, eps_v in %, summary quantities in_table_unit.
+std::pair<double, const char*> feature_unit(const Feature& f, Real v) {
+  if (f.strain == 0) return in_table_unit(f.quantity, v);
+  return f.quantity == 0 ? std::make_pair(1e-3 * v, "kPa") : std::make_pair(100 * v, "pct");
+}
+
+/// The noise used, per test and quantity: the median over the test's features of each part.
+std::string noise_table(const Misfit& mf, const std::vector<MeasuredTest>& tests) {
+  std::ostringstream md;
+  md << "Noise (" << mf.source() << "; median standard deviation over each test's data; the simulator's is that of "
+     << "the mean of " << mf.members() << " specimens; correlation length along strain "
+     << fmt("%.2f", mf.correlation_length()) << " in ln strain):\n\n| sigma3 kPa | quantity | data | measured specimen | "
+        "simulator mean |\n|---|---|---|---|---|\n";
+  for (std::size_t k = 0; k < mf.tests(); ++k) {
+    std::map<std::string, std::vector<std::array<Real, 3>>> by;
+    for (const Feature& f : mf.features(k)) {
+      const std::string q = f.strain > 0 ? (f.quantity == 0 ? "q (kPa)" : "eps_v (%)") : f.name;
+      const Real u = feature_unit(f, 1).first;
+      by[q].push_back({u * f.data_sd, u * f.specimen_sd, u * f.ensemble_sd / std::sqrt(Real(mf.members()))});
+    }
+    for (auto& [q, v] : by) {
+      md << "| " << fmt("%g", 1e-3 * tests[k].sigma3) << " | " << q;
+      for (int c = 0; c < 3; ++c) {
+        std::vector<Real> x;
+        for (const auto& a : v) x.push_back(a[c]);
+        std::nth_element(x.begin(), x.begin() + x.size() / 2, x.end());
+        md << " | " << fmt("%.3g", x[x.size() / 2]);
+      }
+      md << " |\n";
+    }
+  }
+  md << "\n";
+  for (const std::string& n : mf.notes()) md << "- " << n << "\n";
+  return md.str() + "\n";
 }
 
 /// The gain in markdown: chi2 of the base and the extended model by pressure, by strain range and by quantity,
-/// then every datum. Strain ranges: small (E_ini, q at 1%), hardening (q at 3%, the peak and its strain),
-/// large (q at the end, dilatancy).
-std::string gain_tables(const std::vector<MeasuredTest>& tests, const std::vector<MeasuredTest>& base,
-                        const std::vector<MeasuredTest>& ext, const std::string& name) {
+/// then every datum. Strain ranges: small (up to 0.2%), hardening (to 3%), large (beyond); summary data: E_ini
+/// and q at 1% small, q at 3%, the peak and its strain hardening, q_end and dilatancy large.
+std::string gain_tables(const Misfit& mf, const std::vector<MeasuredTest>& tests, const Evaluation& base,
+                        const Evaluation& ext, const std::string& name) {
   static const char* range_of[kQuantities] = {"small strain", "small strain", "hardening", "hardening",
                                               "hardening", "large strain", "large strain"};
   using Groups = std::vector<std::pair<std::string, std::pair<Real, Real>>>;  // in the order first met
@@ -162,37 +230,45 @@ std::string gain_tables(const std::vector<MeasuredTest>& tests, const std::vecto
     return g.emplace_back(key, std::pair<Real, Real>{0, 0}).second;
   };
   std::ostringstream rows;
-  for (std::size_t k = 0; k < tests.size(); ++k) {
-    const auto m = quantities(tests[k]), b = quantities(base[k]), e = quantities(ext[k]);
-    const auto wb = test_residuals(tests[k], base[k], NoiseModel()), we = test_residuals(tests[k], ext[k], NoiseModel());
+  std::size_t first = 0;
+  for (std::size_t k = 0; k < mf.tests(); ++k) {
+    const std::vector<Real> b = mf.mean_values(k, {base.sim[k]}), e = mf.mean_values(k, {ext.sim[k]});
     const std::string p = fmt("%g kPa", 1e-3 * tests[k].sigma3);
-    for (int q = 0; q < kQuantities; ++q) {
-      if (!std::isfinite(m[q])) continue;
-      const Real rb = residual(q, m[q], b[q]), re = residual(q, m[q], e[q]);
-      const Real cb = wb[q] * wb[q], ce = we[q] * we[q];
+    for (std::size_t i = 0; i < mf.features(k).size(); ++i) {
+      const Feature& f = mf.features(k)[i];
+      const Real cb = base.r[first + i] * base.r[first + i], ce = ext.r[first + i] * ext.r[first + i];
+      const bool summary = f.strain == 0;
+      const std::string range = summary ? range_of[f.quantity]
+                                        : f.strain <= 0.002 ? "small strain" : f.strain <= 0.03 ? "hardening"
+                                                                                                 : "large strain";
+      const std::string quantity = summary ? f.name : f.quantity == 0 ? "q" : "eps_v";
       for (auto* t : {&by_pressure, &by_range, &by_quantity}) {
-        const std::string key = t == &by_pressure ? p : t == &by_range ? range_of[q] : quantity_name(q);
+        const std::string key = t == &by_pressure ? p : t == &by_range ? range : quantity;
         at(*t, key).first += cb;
         at(*t, key).second += ce;
       }
-      rows << "| " << fmt("%g", 1e-3 * tests[k].sigma3) << " | " << quantity_name(q) << " | "
-           << in_table_unit(q, m[q]).second << " | " << fmt("%.4g", in_table_unit(q, m[q]).first) << " | "
-           << fmt("%.4g", in_table_unit(q, b[q]).first) << " | " << fmt("%+.1f", rb) << " | "
-           << fmt("%.4g", in_table_unit(q, e[q]).first) << " | " << fmt("%+.1f", re) << " |\n";
+      const Real s = std::sqrt(f.data_sd * f.data_sd + f.specimen_sd * f.specimen_sd +
+                               f.ensemble_sd * f.ensemble_sd / mf.members());
+      const auto u = feature_unit(f, f.measured);
+      rows << "| " << fmt("%g", 1e-3 * tests[k].sigma3) << " | " << f.name << " | " << u.second << " | "
+           << fmt("%.4g", u.first) << " | " << fmt("%.4g", feature_unit(f, b[i]).first) << " | "
+           << fmt("%+.1f", (b[i] - f.measured) / s) << " | " << fmt("%.4g", feature_unit(f, e[i]).first) << " | "
+           << fmt("%+.1f", (e[i] - f.measured) / s) << " |\n";
     }
+    first += mf.features(k).size();
   }
   std::ostringstream md;
   md << "\nMisfit (chi2) of the base model and of the base + " << name
-     << " model, from the whitened residuals (a test's shared specimen factor counted once; each quantity "
-        "counts what it says beyond those before it, E_ini first), so that the groups add up to chi2:\n\n"
+     << " model, from the whitened residuals (each datum counts what it says beyond those before it in the "
+        "test, q before eps_v, small strain first), so that the groups add up to chi2:\n\n"
         "| by | group | base | + " << name
      << " |\n|---|---|---|---|\n";
   for (const auto& [what, table] : {std::make_pair("pressure", &by_pressure), std::make_pair("strain range", &by_range),
                                     std::make_pair("quantity", &by_quantity)})
     for (const auto& [key, c] : *table)
       md << "| " << what << " | " << key << " | " << fmt("%.1f", c.first) << " | " << fmt("%.1f", c.second) << " |\n";
-  md << "\nEvery datum (plain residual in noise units, (simulated - measured) / s):\n\n| sigma3 kPa | quantity | unit | "
-        "measured | base | residual | + " << name << " | residual |\n|---|---|---|---|---|---|---|---|\n"
+  md << "\nEvery datum (plain residual in units of its whole noise, (simulated - measured) / s):\n\n| sigma3 kPa | "
+        "datum | unit | measured | base | residual | + " << name << " | residual |\n|---|---|---|---|---|---|---|---|\n"
      << rows.str();
   return md.str();
 }
@@ -202,15 +278,17 @@ std::string gain_tables(const std::vector<MeasuredTest>& tests, const std::vecto
 int calibrate_job(const Config& base, const CalibrationOptions& o) {
   Session ss(base, o, "calibrate");
   std::ostringstream table;
-  table << "material,parameter,value,reference,chi2,data,runs\n";
+  table << "material,parameter,value,low95,high95,reference,chi2,data,runs\n";
   std::vector<MeasuredTest> all_meas, all_sim;
   for (const auto& [material, tests] : by_material(ss.data, o.material)) {
     std::printf("calibrate: %s, %zu tests, free %zu parameters, %zu balls in the periodic cell\n", material.c_str(),
                 tests.size(), ss.free.size(), ss.lab.balls());
-    const long planned = (std::lround(std::pow(3.0, ss.free.size())) + 4) * static_cast<long>(tests.size());
+    const long planned = (std::lround(std::pow(3.0, ss.free.size())) + 4) * static_cast<long>(tests.size()) *
+                         ss.lab.members();
     Progress progress("calibrate " + material, planned);
     const long runs0 = ss.lab.runs();
-    const CalibrationResult r = calibrate(ss.lab, model_of(base), ss.free, tests, NoiseModel(), 4,
+    const Misfit misfit = ss.misfit_of(base, material, tests);
+    const CalibrationResult r = calibrate(ss.lab, model_of(base), ss.free, tests, misfit, 4,
                                           [&](long done, long, Real chi2) {
                                             char extra[64];
                                             std::snprintf(extra, sizeof extra, "runs, best chi2 %.1f", chi2);
@@ -223,8 +301,10 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
       std::printf("calibrate: %s: %s = %.4g%s\n", material.c_str(), f.name.c_str(), f.shown * r.values[k],
                   std::isfinite(ref) ? fmt(" (reference %g)", ref).c_str() : "");
       table << material << "," << f.name << "," << fmt("%.6g", f.shown * r.values[k]) << ","
+            << fmt("%.6g", f.shown * r.interval[k].first) << "," << fmt("%.6g", f.shown * r.interval[k].second) << ","
             << (std::isfinite(ref) ? fmt("%g", ref) : "") << "," << fmt("%.3f", r.best.chi2) << "," << r.data << "," << ss.lab.runs() - runs0 << "\n";
     }
+    std::printf("%s", uncertainty_text(r, material, "calibrate").c_str());
     for (const std::string& note : r.widened) std::printf("calibrate: %s: %s\n", material.c_str(), note.c_str());
     for (const std::string& name : r.at_edge())
       std::printf("calibrate: %s: WARNING: %s is at the edge of its range: widen it (the optimum may lie "
@@ -246,12 +326,14 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
   Session ss(base, o, "diagnose");
   std::ostringstream md, csv;
   md << "# Diagnosis of " << o.data << "\n\n"
-     << "Simulator: periodic-cell triaxial, " << ss.lab.balls() << " balls, one specimen for every run. Free base "
-     << "parameters:";
+     << "Simulator: periodic-cell triaxial, an ensemble of " << ss.lab.members() << " specimens of " << ss.lab.balls()
+     << " balls (packing seeds from " << base.run.seed << "), each prepared once; every parameter point runs them all "
+        "and compares their mean. Free base parameters:";
   for (const FreeParam& f : ss.free) md << " " << f.name;
-  md << ". Misfit: chi2 over the initial stiffness, q at 1% and 3% strain, q_peak, eps_a at peak, q_end and "
-        "maximum dilatancy with "
-        "lab-like noise, a test's stresses sharing a specimen factor (host/calibrate.hpp).\n\n";
+  md << ". Misfit: chi2 over " << (ss.data.curves ? "q and eps_v at fixed axial strains (0.02% to 15%)"
+                                                  : "the summary quantities given")
+     << ", with the data's noise, the measured specimen's own scatter and the simulator's standard error "
+        "(host/misfit.hpp); noise: " << ss.noise.mode << ".\n\n";
   if (!ss.ref.values.empty())
     md << "Reference values: " << ss.ref.path << (ss.ref.comment.empty() ? "" : ": " + ss.ref.comment)
        << " The calibrated values belong to this simulator (its cell, density and boundary), the reference values to "
@@ -260,8 +342,10 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
   csv << "material,model,parameter,value,chi2,bic,heldout_chi2,runs\n";
   std::vector<MeasuredTest> all_meas, all_sim, all_ext;
   for (const auto& [material, tests] : by_material(ss.data, o.material)) {
-    const Diagnosis dg = diagnose(ss.lab, model_of(base), ss.free, tests, NoiseModel(), true);
+    const Misfit misfit = ss.misfit_of(base, material, tests);
+    const Diagnosis dg = diagnose(ss.lab, model_of(base), ss.free, tests, misfit, true);
     std::printf("diagnose: %s: verdict: %s\n  %s\n", material.c_str(), dg.verdict.c_str(), dg.explanation.c_str());
+    std::printf("%s", uncertainty_text(dg.base, material, "diagnose").c_str());
     std::string edge, widened;
     for (const std::string& note : dg.base.widened) {
       std::printf("diagnose: %s: %s\n", material.c_str(), note.c_str());
@@ -271,6 +355,7 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
     if (!edge.empty())
       std::printf("diagnose: %s: WARNING: %s at the edge of the search range\n", material.c_str(), edge.c_str());
     md << "## " << material << "\n\n**Verdict: " << dg.verdict << ".** " << dg.explanation << "\n\n"
+       << noise_table(misfit, tests)
        << (widened.empty() ? "" : "Search ranges: " + widened + ".\n\n")
        << (edge.empty() ? "" : "**Warning:** the base model's " + edge + " lies at the edge of its search range: the "
                                "optimum may lie outside, and part of the misfit may be the range's, not the model's.\n\n")
@@ -282,7 +367,7 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
           << "," << dg.base.design.size() * tests.size() << "\n";
     }
     md << "| " << fmt("%.1f", dg.base.best.chi2) << " | " << fmt("%.1f", dg.base_bic) << " | "
-       << fmt("%.1f", dg.base_heldout) << " | " << dg.base.design.size() * tests.size() << " |\n";
+       << fmt("%.1f", dg.base_heldout) << " | " << dg.base.design.size() * tests.size() * ss.lab.members() << " |\n";
     for (const ExtensionFit& f : dg.fits) {
       md << "| " << f.ext.name << " | ";
       for (std::size_t k = 0; k < ss.free.size(); ++k)
@@ -308,9 +393,18 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
            << (std::isfinite(ref) ? fmt("%g", ref) : std::string("-")) << " |\n";
       }
     }
+    md << "\nEach extension against the base model:\n\n";
+    for (const ExtensionFit& f : dg.fits) md << "- **" << f.ext.name << "**: " << f.reason << "\n";
+    for (const std::string& n : dg.notes) md << "- " << n << "\n";
+    md << "\nThe base model's calibrated values:\n\n```\n" << uncertainty_text(dg.base, material, "diagnose")
+       << "```\n";
+    if (std::all_of(tests.begin(), tests.end(), [](const MeasuredTest& t) { return std::isnan(t.void_ratio); }))
+      md << "\nThe data give no void ratio: the simulator's specimens have the density their preparation gives ("
+         << fmt("e = %.3f", ss.lab.prepared_void_ratio(0)) << " for the first), and the calibrated friction absorbs "
+            "any difference in density.\n";
     const ExtensionFit* top = top_fit(dg);
     if (top) {
-      md << gain_tables(tests, dg.base.best.sim, top->best.sim,
+      md << gain_tables(misfit, tests, dg.base.best, top->best,
                         top->ext.name + (dg.verdict == "none" ? " (candidate, not named)" : ""));
       all_ext.insert(all_ext.end(), top->best.sim.begin(), top->best.sim.end());
       std::printf("diagnose: %s: gain of %s: chi2 %.1f -> %.1f, held-out chi2 %.1f -> %.1f (diagnosis.md has it by "
@@ -343,7 +437,10 @@ int synth_job(const Config& base, const SynthOptions& o) {
     set_param(truth, e.param, v);
     comment += " (" + e.param + " = " + fmt("%.4g", free_param(e.param).shown * v) + ")";
   }
-  PeriodicLab lab(base, false);
+  const unsigned specimen = o.specimen_seed >= 0 ? static_cast<unsigned>(o.specimen_seed)
+                                                 : base.run.seed + kForeignSeedOffset;
+  comment += ", specimen seed " + std::to_string(specimen);
+  PeriodicLab lab(base, false, 1, specimen);
   const std::vector<MeasuredTest> tests = synthetic_tests(lab, truth, o.sigma3, o.material, o.seed);
   write_measured_curves(o.output, tests, comment);
   std::printf("synth: %s -> %s\n", comment.c_str(), o.output.c_str());

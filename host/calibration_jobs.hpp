@@ -15,6 +15,7 @@ struct CalibrationOptions {
   std::string material;                   ///< empty: every material of the file
   int jobs = 1;                           ///< simulator runs at once (PeriodicLab::set_jobs)
   std::string reference;                  ///< optional reference values (load_reference) to set beside the fit
+  std::string noise = "data";             ///< the data's noise (NoiseOptions::mode): data or lab
 };
 
 /// Calibrates each material of the data; writes calibrate_<date>/ under options.output. Returns 0.
@@ -28,6 +29,7 @@ struct SynthOptions {
   std::string extension = "none";         ///< hertz, roughness, wear, membrane or none
   Real strength = -1;                     ///< extension parameter; < 0: drawn from the seed within its range
   unsigned seed = 1;
+  long specimen_seed = -1;                ///< packing seed; < 0: the config's seed + kForeignSeedOffset
   std::vector<Real> sigma3{100e3, 200e3, 300e3};  ///< Pa
   std::string material = "synthetic";
 };

@@ -122,6 +122,9 @@ struct PeriodicTriaxialParams {
 /// [calibrate]: the parameters `triaxdem calibrate` and `diagnose` free (host/calibrate.hpp lists the names).
 struct CalibrateConfig {
   std::vector<std::string> free{"mu_s", "mu_r"};
+  /// Specimens of the simulator's ensemble (packing seeds [run] seed, seed + 1, ...): every parameter point runs
+  /// each of them and compares their mean (host/misfit.hpp).
+  long ensemble = 4;
 };
 
 /// The [periodic] table: the periodic-cell triaxial test (host/periodic_triaxial.hpp).

@@ -12,12 +12,13 @@
 /// 3. Held-out prediction: for each pressure, the surrogate is fitted to the other pressures, and a run with
 ///    those parameters predicts it; the held-out misfit is the sum of those chi2 (runs, not surrogate values). Information criterion: BIC = chi2 + k ln n (k free
 ///    parameters, n data; the noise is known, so chi2 is -2 log-likelihood up to a constant).
-/// 4. Verdict: the extension with the lowest BIC is named when it beats the base by at least 6 (strong
-///    evidence: the nested models' likelihood-ratio test) and lowers the held-out chi2 by at least 6 too (the
-///    same evidence on data the fit did not see); extensions within 2
-///    of its BIC cannot be told apart from these data and are named with it. Otherwise "none", and the report
-///    says whether the base model fits within the noise (chi2 below the 99% quantile of chi2 with n - k
-///    degrees of freedom) or misses the data in a way no extension explains.
+/// 4. Verdict: each extension is accepted when it beats the base BIC by at least 6 (strong evidence: the nested
+///    models' likelihood-ratio test) and lowers the held-out chi2 by at least 6 too (the same evidence on data
+///    the fit did not see). The accepted extension with the lowest BIC is named; accepted ones within 2 of its
+///    BIC cannot be told apart from these data and are named with it. Otherwise "none", and the report says
+///    whether the base model fits within the noise (chi2 below the 99% quantile of chi2 with n - k degrees of
+///    freedom) or misses the data in a way no extension explains. A run of an extension fit at strength 0 is
+///    a base run: when it beats the base calibration, it becomes the base fit.
 #include <string>
 #include <vector>
 
@@ -48,6 +49,8 @@ struct ExtensionFit {
   Evaluation best;            ///< best point run (its u has the base coordinates only)
   Real bic = 0, heldout = 0;  ///< BIC of the fit; held-out chi2 (runs)
   long runs = 0;
+  bool accepted = false;      ///< passes both tests of the verdict (BIC and held-out, each by kStrongEvidence)
+  std::string reason;         ///< why accepted or rejected, in words
 };
 
 struct Diagnosis {
@@ -57,6 +60,7 @@ struct Diagnosis {
   std::vector<ExtensionFit> fits;   ///< in the order of extensions()
   std::string verdict;              ///< name of the extension found, "none", or several joined by " or "
   std::string explanation;          ///< plain words
+  std::vector<std::string> notes;   ///< what the search did beyond the plan (a better base run found late)
 };
 
 /// The upper quantile of chi2 with nu degrees of freedom at standard normal score z (Wilson-Hilferty).
@@ -64,7 +68,7 @@ Real chi2_quantile(Real nu, Real z);
 
 /// Runs the diagnosis of `measured` (one material) from `base` with base parameters `free`.
 Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,
-                   const std::vector<MeasuredTest>& measured, const NoiseModel& noise, bool verbose);
+                   const std::vector<MeasuredTest>& measured, const Misfit& misfit, bool verbose);
 
 /// A hidden strength drawn from `seed`: log-uniform between the extension's lowest and highest level.
 Real draw_strength(const Extension& e, unsigned seed);

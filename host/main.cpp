@@ -90,6 +90,9 @@ int main(int argc, char** argv) {
     c->add_option("-o,--output", cal.output, "parent folder of the dated result folder (default out)");
     c->add_option("-j,--jobs", cal.jobs, "simulator runs at once, one thread each (default: one per core)")
         ->check(CLI::PositiveNumber);
+    c->add_option("--noise", cal.noise, "the data's noise: data (its standard-deviation columns, replicates, or its "
+                  "curves' own scatter) or lab (a lab's fixed scatter); default data")
+        ->check(CLI::IsMember({"data", "lab"}));
   };
   auto* calibrate = app.add_subcommand("calibrate", "fit the free parameters to measured triaxial data");
   add_calibration(calibrate);
@@ -103,6 +106,8 @@ int main(int argc, char** argv) {
   synth->add_option("--extension", syn.extension, "hertz, roughness, wear, membrane or none");
   synth->add_option("--strength", syn.strength, "the extension's parameter in its config unit (default: drawn from the seed)");
   synth->add_option("--seed", syn.seed, "noise and strength seed");
+  synth->add_option("--specimen-seed", syn.specimen_seed, "packing seed of the specimen (default: the config's [run] "
+                    "seed + 100000, a specimen no calibration ensemble of that config uses)");
   synth->add_option("--pressures", syn_kpa, "confining pressures, kPa (default 100 200 300)");
   synth->add_option("--material", syn.material, "material name in the file");
 

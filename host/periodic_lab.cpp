@@ -1,4 +1,4 @@
-#include "calibrate.hpp"
+#include "periodic_lab.hpp"
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -33,12 +33,32 @@ void mark_failed(MeasuredTest& t) {
 // ---------------------------------------------------------------------------------------------------
 // Simulator
 
-PeriodicLab::PeriodicLab(const Config& base, bool verbose) : cfg_(base) {
-  prepare_periodic_specimen(cfg_, balls_, cell_, verbose);
+Model model_of(const Config& cfg) {
+  Model m;
+  m.law = cfg.ball;
+  m.membrane = cfg.periodic.triax.membrane_stiffness;
+  return m;
 }
 
-MeasuredTest PeriodicLab::run(const Model& m, Real sigma3, const std::string& material) {
+PeriodicLab::PeriodicLab(const Config& base, bool verbose, int members, unsigned first_seed) : cfg_(base) {
+  for (int k = 0; k < std::max(members, 1); ++k) {
+    Config c = base;
+    c.run.seed = first_seed + static_cast<unsigned>(k);
+    Specimen s;
+    prepare_periodic_specimen(c, s.balls, s.cell, verbose && k == 0);
+    Real solid = 0;
+    for (const BallSpec& b : s.balls) solid += 4.0 / 3.0 * M_PI * b.radius * b.radius * b.radius;
+    s.void_ratio = s.cell[0] * s.cell[1] * s.cell[2] / solid - 1;
+    specimens_.push_back(std::move(s));
+  }
+}
+
+PeriodicLab::PeriodicLab(const Config& base, bool verbose)
+    : PeriodicLab(base, verbose, static_cast<int>(base.calibrate.ensemble), base.run.seed) {}
+
+MeasuredTest PeriodicLab::run(const Model& m, Real sigma3, const std::string& material, int member) {
   const auto t0 = std::chrono::steady_clock::now();
+  const Specimen& sp = specimens_.at(static_cast<std::size_t>(member));
   MeasuredTest t;
   PeriodicTriaxialParams p = cfg_.periodic.triax;
   p.sigma3 = sigma3;
@@ -46,8 +66,10 @@ MeasuredTest PeriodicLab::run(const Model& m, Real sigma3, const std::string& ma
   p.verbose = false;
   p.snapshot_strains.clear();
   try {
-    auto sim = make_periodic_simulation(balls_, cell_, m.law, cfg_.solver);
-    t = summarised(run_periodic_triaxial(*sim, p).series, sigma3);
+    auto sim = make_periodic_simulation(sp.balls, sp.cell, m.law, cfg_.solver);
+    const PeriodicTriaxialResult r = run_periodic_triaxial(*sim, p);
+    t = summarised(r.series, sigma3);
+    t.void_ratio = r.void_ratio0;
   } catch (const BlowUp&) {
     t.sigma3 = sigma3;
     mark_failed(t);
@@ -85,6 +107,7 @@ void send_curves(int fd, const MeasuredTest& t) {
   };
   const long n = std::isfinite(t.q_peak) ? static_cast<long>(t.q.size()) : -1;
   put(&n, sizeof n);
+  put(&t.void_ratio, sizeof t.void_ratio);
   for (const std::vector<Real>* v : {&t.eps_a, &t.q, &t.eps_v})
     if (n > 0) put(v->data(), sizeof(Real) * v->size());
 }
@@ -99,7 +122,7 @@ bool receive_curves(int fd, MeasuredTest& t) {
     return true;
   };
   long n = 0;
-  if (!get(&n, sizeof n)) return false;
+  if (!get(&n, sizeof n) || !get(&t.void_ratio, sizeof t.void_ratio)) return false;
   if (n < 0) {
     mark_failed(t);
     return true;
@@ -114,26 +137,28 @@ bool receive_curves(int fd, MeasuredTest& t) {
 
 }  // namespace
 
-std::vector<MeasuredTest> PeriodicLab::run_all(const Model& m, const std::vector<MeasuredTest>& like) {
-  std::vector<MeasuredTest> out;
-  if (jobs_ <= 1 || like.size() <= 1) {
-    for (const MeasuredTest& t : like) out.push_back(run(m, t.sigma3, t.material));
+Ensemble PeriodicLab::run_ensemble(const Model& m, const std::vector<MeasuredTest>& like) {
+  const std::size_t M = specimens_.size(), N = like.size() * M;  // run j: test j / M, member j % M
+  Ensemble out(like.size());
+  if (jobs_ <= 1 || N <= 1) {
+    for (std::size_t j = 0; j < N; ++j)
+      out[j / M].push_back(run(m, like[j / M].sigma3, like[j / M].material, static_cast<int>(j % M)));
     return out;
   }
   const auto t0 = std::chrono::steady_clock::now();
   std::cout.flush();
   std::fflush(nullptr);  // a child must not write the parent's buffered output again
-  for (std::size_t first = 0; first < like.size(); first += static_cast<std::size_t>(jobs_)) {
-    const std::size_t last = std::min(like.size(), first + static_cast<std::size_t>(jobs_));
+  for (std::size_t first = 0; first < N; first += static_cast<std::size_t>(jobs_)) {
+    const std::size_t last = std::min(N, first + static_cast<std::size_t>(jobs_));
     std::vector<std::pair<pid_t, int>> children;
-    for (std::size_t k = first; k < last; ++k) {
+    for (std::size_t j = first; j < last; ++j) {
       int fd[2];
       if (::pipe(fd) != 0) throw std::runtime_error("calibration: cannot create a pipe for a parallel run");
       const pid_t pid = ::fork();
       if (pid < 0) throw std::runtime_error("calibration: cannot start a parallel run (fork failed)");
       if (pid == 0) {
         ::close(fd[0]);
-        send_curves(fd[1], run(m, like[k].sigma3, like[k].material));
+        send_curves(fd[1], run(m, like[j / M].sigma3, like[j / M].material, static_cast<int>(j % M)));
         ::_exit(0);  // no atexit handlers, no Kokkos finalize: the parent owns those
       }
       ::close(fd[1]);
@@ -141,19 +166,20 @@ std::vector<MeasuredTest> PeriodicLab::run_all(const Model& m, const std::vector
     }
     bool ok = true;
     for (std::size_t c = 0; c < children.size(); ++c) {
+      const MeasuredTest& like_it = like[(first + c) / M];
       MeasuredTest t;
-      t.material = like[first + c].material;
-      t.sigma3 = like[first + c].sigma3;
+      t.material = like_it.material;
+      t.sigma3 = like_it.sigma3;
       ok = receive_curves(children[c].second, t) && ok;
       ::close(children[c].second);
       int status = 0;
       ::waitpid(children[c].first, &status, 0);
       ok = ok && WIFEXITED(status) && WEXITSTATUS(status) == 0;
-      out.push_back(t);
+      out[(first + c) / M].push_back(t);
     }
     if (!ok) throw std::runtime_error("calibration: a parallel run failed (set OMP_NUM_THREADS=1 and -j 1 to see it)");
   }
-  runs_ += static_cast<long>(like.size());
+  runs_ += static_cast<long>(N);
   seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }

@@ -61,14 +61,12 @@ TEST(Calibrate, ResidualsUseTheNoiseModel) {
   s.q_peak = 108e3;
   s.eps_a_peak = 0.03;
   const NoiseModel noise;
-  const std::vector<Real> r = residuals({m}, {s}, noise);
-  ASSERT_EQ(r.size(), 2u);
-  EXPECT_NEAR(r[0], 8e3 / (noise.rel[kPeak] * 100e3), 1e-12);
-  EXPECT_NEAR(r[1], -0.02 / noise.abs[kStrainAtPeak], 1e-12);
-  EXPECT_EQ(data_count({m}), 2);
+  const auto r = test_residuals(m, s, noise);
+  EXPECT_NEAR(r[kPeak], 8e3 / (noise.rel[kPeak] * 100e3), 1e-12);
+  EXPECT_NEAR(r[kStrainAtPeak], -0.02 / noise.abs[kStrainAtPeak], 1e-12);
+  EXPECT_TRUE(std::isnan(r[kInitialStiffness])) << "absent from the measured test";
   s.q_peak = std::nan("");
-  EXPECT_EQ(residuals({m}, {s}, noise)[0], 10.0);
-  EXPECT_TRUE(residuals({m}, {s}, noise, {false}).empty());
+  EXPECT_EQ(test_residuals(m, s, noise)[kPeak], kMissingResidual);
 }
 
 // The shared specimen factor. A simulated test that is the measured one scaled by (1 + d) on every stress
@@ -178,7 +176,7 @@ TEST(Calibrate, MeasuredCurvesRoundTrip) {
 }
 
 // Parallel runs (child processes) give the same tests as runs one at a time, bit for bit: each child runs the
-// same specimen and law as the parent would. A tiny cell (64 balls, 1% strain) keeps this to a few seconds.
+// same specimen and law as the parent would, for each member of a two-specimen ensemble. A tiny cell (64 balls, 1% strain) keeps this to a few seconds.
 // With 2 OpenMP threads set_jobs refuses (forking a multithreaded OpenMP process is unsafe) and both paths
 // are the in-process one.
 TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
@@ -201,24 +199,29 @@ TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
   cfg.periodic.triax.target_strain = 0.01;
   cfg.periodic.triax.target_inertial = 1e-3;
   cfg.periodic.triax.record_strain = 0.001;
-  PeriodicLab lab(cfg, false);
+  PeriodicLab lab(cfg, false, 2, 1);
   Model m;
   m.law = cfg.ball;
   std::vector<MeasuredTest> like(3);
   for (int k = 0; k < 3; ++k) like[k].sigma3 = 100e3 * (k + 1);
-  const std::vector<MeasuredTest> one = lab.run_all(m, like);
+  const Ensemble one = lab.run_ensemble(m, like);
   const int jobs = lab.set_jobs(2);
   EXPECT_EQ(jobs, std::getenv("OMP_NUM_THREADS") && std::string(std::getenv("OMP_NUM_THREADS")) == "1" ? 2 : 1);
-  const std::vector<MeasuredTest> par = lab.run_all(m, like);
+  const Ensemble par = lab.run_ensemble(m, like);
   ASSERT_EQ(par.size(), 3u);
   for (int k = 0; k < 3; ++k) {
-    EXPECT_EQ(par[k].sigma3, like[k].sigma3);
-    ASSERT_GT(one[k].q.size(), 5u);
-    EXPECT_EQ(par[k].q, one[k].q) << "sigma3 " << like[k].sigma3;
-    EXPECT_EQ(par[k].eps_v, one[k].eps_v);
-    EXPECT_EQ(par[k].q_peak, one[k].q_peak);
+    ASSERT_EQ(par[k].size(), 2u);
+    for (int j = 0; j < 2; ++j) {
+      EXPECT_EQ(par[k][j].sigma3, like[k].sigma3);
+      ASSERT_GT(one[k][j].q.size(), 5u);
+      EXPECT_EQ(par[k][j].q, one[k][j].q) << "sigma3 " << like[k].sigma3 << " member " << j;
+      EXPECT_EQ(par[k][j].eps_v, one[k][j].eps_v);
+      EXPECT_EQ(par[k][j].q_peak, one[k][j].q_peak);
+      EXPECT_EQ(par[k][j].void_ratio, one[k][j].void_ratio);
+    }
+    EXPECT_NE(one[k][0].q, one[k][1].q) << "the two members are different specimens";
   }
-  EXPECT_EQ(lab.runs(), 6);
+  EXPECT_EQ(lab.runs(), 12);
 }
 
 // A best point on the edge of the search range is flagged (the Table 6 fits of S-2 and S-3 ended on mu_s = 3 x

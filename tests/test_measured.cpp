@@ -205,3 +205,223 @@ TEST(Measured, Hdf5FormReadsLikeTheCsv) {
               std::string::npos) << e.what();
   }
 }
+
+// Standard deviations in their own units, each turned into SI: per row in a curve file, per quantity in a
+// summary file.
+TEST(Measured, StandardDeviationColumnsAreReadInSI) {
+  const MeasuredData c = load_measured(write("curve_sd.csv",
+                                             "material,sigma3_kPa,eps_a_pct,q_kPa,eps_v_pct,q_sd_MPa,eps_v_sd_frac\n"
+                                             "A,100,0,0,0,0.002,0.0001\nA,100,1,100,0.2,0.003,0.0002\n"
+                                             "A,100,2,150,0.1,0.004,0.0003\n"));
+  ASSERT_EQ(c.tests.size(), 1u);
+  EXPECT_EQ(c.tests[0].q_sd, (std::vector<Real>{2e3, 3e3, 4e3}));
+  EXPECT_EQ(c.tests[0].eps_v_sd, (std::vector<Real>{1e-4, 2e-4, 3e-4}));
+  EXPECT_TRUE(c.tests[0].summary_sd.empty());
+  const MeasuredData s = load_measured(write("summary_sd.csv",
+                                             "material,sigma3_kPa,q_peak_kPa,q_peak_sd_MPa,eps_a_peak_pct,eps_a_peak_sd_pct,"
+                                             "max_dilatancy,max_dilatancy_sd,e_ini_MPa,e_ini_sd_kPa\n"
+                                             "A,100,300,0.01,4,0.5,0.3,0.05,50,2000\n"));
+  const MeasuredTest& t = s.tests[0];
+  EXPECT_DOUBLE_EQ(t.summary_sd.at("q_peak"), 1e4);
+  EXPECT_DOUBLE_EQ(t.summary_sd.at("eps_a_peak"), 0.005);
+  EXPECT_DOUBLE_EQ(t.summary_sd.at("max_dilatancy"), 0.05);
+  EXPECT_DOUBLE_EQ(t.summary_sd.at("e_ini"), 2e6);
+  EXPECT_EQ(t.summary_sd.size(), 4u);
+  EXPECT_TRUE(t.q_sd.empty());
+}
+
+TEST(Measured, BadStandardDeviationsAreRefusedWithLineAndColumn) {
+  const std::string curve = "material,sigma3_kPa,eps_a_pct,q_kPa,q_sd_kPa\nA,100,0,0,1\n";
+  std::string e = error_of(curve + "A,100,1,50,0\n");
+  EXPECT_NE(e.find("bad.csv:3:q_sd_kPa: standard deviation must be > 0"), std::string::npos) << e;
+  e = error_of(curve + "A,100,1,50,-2\n");
+  EXPECT_NE(e.find("bad.csv:3:q_sd_kPa: standard deviation must be > 0"), std::string::npos) << e;
+  e = error_of(curve + "A,100,1,50,inf\n");
+  EXPECT_NE(e.find("bad.csv:3:q_sd_kPa: standard deviation must be > 0"), std::string::npos) << e;
+  e = error_of(curve + "A,100,1,50,\n");  // given on the first row of the test, not on the second
+  EXPECT_NE(e.find("bad.csv:3:q_sd_kPa: missing for part of a test: give it on every row or on none"), std::string::npos)
+      << e;
+  e = error_of(curve + "A,100,1,50,x\n");
+  EXPECT_NE(e.find("bad.csv:3:q_sd_kPa: 'x' is not a number"), std::string::npos) << e;
+  e = error_of("material,sigma3_kPa,eps_a_pct,q_kPa,q_peak_sd_kPa\nA,100,0,0,1\n");
+  EXPECT_NE(e.find("bad.csv:1:q_peak_sd_kPa: a curve file has no standard deviation of q_peak (allowed: "
+                   "q_sd_<unit>, eps_v_sd_<unit>, void_ratio_sd, porosity_sd)"),
+            std::string::npos) << e;
+  e = error_of("material,sigma3_kPa,eps_a_pct,q_kPa,eps_v_sd_pct\nA,100,0,0,1\n");
+  EXPECT_NE(e.find("bad.csv:1:eps_v_sd_pct: a standard deviation of eps_v, which the file does not give"),
+            std::string::npos) << e;
+  e = error_of("material,sigma3_kPa,q_peak_kPa,sigma3_sd_kPa\nA,100,300,1\n");
+  EXPECT_NE(e.find("bad.csv:1:sigma3_sd_kPa: a summary file has no standard deviation of sigma3 (allowed: "
+                   "q_peak_sd_<unit>, eps_a_peak_sd_<unit>, q_end_sd_<unit>, max_dilatancy_sd, e_ini_sd_<unit>"),
+            std::string::npos) << e;
+  e = error_of("material,sigma3_kPa,q_peak_kPa,q_end_sd_kPa\nA,100,300,1\n");
+  EXPECT_NE(e.find("bad.csv:1:q_end_sd_kPa: a standard deviation of q_end, which the file does not give"),
+            std::string::npos) << e;
+  e = error_of("material,sigma3_kPa,q_peak_kPa,q_peak_sd_kPa\nA,100,300,\n");
+  EXPECT_NE(e.find("bad.csv:2:q_peak_sd_kPa: missing for part of a test"), std::string::npos) << e;
+  e = error_of("material,sigma3_kPa,q_peak_kPa,q_peak_sd_psi\nA,100,300,1\n");
+  EXPECT_NE(e.find("bad.csv:1:q_peak_sd_psi: unit 'psi' does not parse for q_peak_sd (allowed: MPa, Pa, kPa)"),
+            std::string::npos) << e;
+  e = error_of("material,sigma3_kPa,q_peak_kPa,q_peak_sd_kPa,q_peak_sd_MPa\nA,100,300,1,1\n");
+  EXPECT_NE(e.find("bad.csv:1:q_peak_sd_MPa: column given twice"), std::string::npos) << e;
+}
+
+// The state after consolidation: one value per test, a porosity taken as a void ratio (e = n / (1 - n), its
+// standard deviation through de/dn = 1 / (1 - n)^2).
+TEST(Measured, VoidRatioOrPorosityIsOnePerTest) {
+  const MeasuredData c = load_measured(write("curve_e.csv",
+                                             "material,sigma3_kPa,eps_a_pct,q_kPa,void_ratio,void_ratio_sd\n"
+                                             "A,100,0,0,0.65,0.02\nA,100,1,100,0.65,0.02\nB,100,0,0,0.7,0.01\n"));
+  ASSERT_EQ(c.tests.size(), 2u);
+  EXPECT_DOUBLE_EQ(c.tests[0].void_ratio, 0.65);
+  EXPECT_DOUBLE_EQ(c.tests[0].void_ratio_sd, 0.02);
+  EXPECT_DOUBLE_EQ(c.tests[1].void_ratio, 0.7);
+  const MeasuredData s = load_measured(write("summary_n.csv",
+                                             "material,sigma3_kPa,q_peak_kPa,porosity,porosity_sd\n"
+                                             "A,100,300,0.4,0.012\nA,200,500,0.375,0.01\n"));
+  EXPECT_DOUBLE_EQ(s.tests[0].void_ratio, 0.4 / 0.6);
+  EXPECT_DOUBLE_EQ(s.tests[0].void_ratio_sd, 0.012 / (0.6 * 0.6));
+  EXPECT_DOUBLE_EQ(s.tests[1].void_ratio, 0.6);
+  const MeasuredData none = load_measured(write("summary_none.csv", "material,sigma3_kPa,q_peak_kPa\nA,100,300\n"));
+  EXPECT_TRUE(std::isnan(none.tests[0].void_ratio));
+  EXPECT_TRUE(std::isnan(none.tests[0].void_ratio_sd));
+}
+
+TEST(Measured, BadVoidRatiosAreRefusedWithLineAndColumn) {
+  std::string e = error_of("material,sigma3_kPa,q_peak_kPa,void_ratio,porosity\nA,100,300,0.6,0.4\n");
+  EXPECT_NE(e.find("bad.csv:1:porosity: give void_ratio or porosity, not both"), std::string::npos) << e;
+  e = error_of("material,sigma3_kPa,q_peak_kPa,void_ratio\nA,100,300,0\n");
+  EXPECT_NE(e.find("bad.csv:2:void_ratio: void ratio must be in (0, 5]"), std::string::npos) << e;
+  e = error_of("material,sigma3_kPa,q_peak_kPa,void_ratio\nA,100,300,5.5\n");
+  EXPECT_NE(e.find("bad.csv:2:void_ratio: void ratio must be in (0, 5]"), std::string::npos) << e;
+  e = error_of("material,sigma3_kPa,q_peak_kPa,porosity\nA,100,300,40\n");  // percent
+  EXPECT_NE(e.find("bad.csv:2:porosity: porosity must be in (0, 1)"), std::string::npos) << e;
+  e = error_of("material,sigma3_kPa,q_peak_kPa,porosity\nA,100,300,1\n");
+  EXPECT_NE(e.find("bad.csv:2:porosity: porosity must be in (0, 1)"), std::string::npos) << e;
+  const std::string curve = "material,sigma3_kPa,eps_a_pct,q_kPa,porosity,porosity_sd\nA,100,0,0,0.4,0.01\n";
+  e = error_of(curve + "A,100,1,50,0.41,0.01\n");
+  EXPECT_NE(e.find("bad.csv:3:porosity: '0.41' differs from the test's first row, "), std::string::npos) << e;
+  EXPECT_NE(e.find("bad.csv:2 (one value per test"), std::string::npos) << e;
+  e = error_of(curve + "A,100,1,50,0.4,0.02\n");
+  EXPECT_NE(e.find("bad.csv:3:porosity_sd: '0.02' differs from the test's first row, "), std::string::npos) << e;
+  e = error_of(curve + "A,100,1,50,0.4,0\n");
+  EXPECT_NE(e.find("bad.csv:3:porosity_sd: standard deviation must be > 0"), std::string::npos) << e;
+  e = error_of("material,sigma3_kPa,q_peak_kPa,porosity,void_ratio_sd\nA,100,300,0.4,0.01\n");
+  EXPECT_NE(e.find("bad.csv:1:void_ratio_sd: a standard deviation of void_ratio, which the file does not give"),
+            std::string::npos) << e;
+}
+
+// Tests are keyed by material, pressure and label: two labels at one pressure are two curves (each with its own
+// increasing strain), and a summary may give a pressure once per label.
+TEST(Measured, TestLabelsTellReplicatesApart) {
+  const MeasuredData c = load_measured(write("replicates.csv",
+                                             "material,sigma3_kPa,test,eps_a_pct,q_kPa\n"
+                                             "A,100,r1,0,0\nA,100,r1,1,100\nA,100,r2,0,0\nA,100,r2,1,110\n"
+                                             "A,100,r1,2,120\n"));
+  ASSERT_EQ(c.tests.size(), 2u);
+  EXPECT_EQ(c.tests[0].replicate, "r1");
+  EXPECT_EQ(c.tests[1].replicate, "r2");
+  EXPECT_EQ(c.tests[0].q, (std::vector<Real>{0, 100e3, 120e3}));
+  EXPECT_EQ(c.tests[1].q, (std::vector<Real>{0, 110e3}));
+  EXPECT_EQ(replicate_groups(c.tests), (std::vector<std::vector<std::size_t>>{{0, 1}}));
+  EXPECT_TRUE(c.notes.empty());  // the same pressure: nothing to tell
+  const MeasuredData s = load_measured(write("replicates_summary.csv", "material,sigma3_kPa,test,q_peak_kPa\n"
+                                                                        "A,100,1,300\nA,100,2,310\n"));
+  ASSERT_EQ(s.tests.size(), 2u);
+  EXPECT_EQ(s.tests[1].replicate, "2");
+  const MeasuredData u = load_measured(write("unlabelled.csv", "material,sigma3_kPa,q_peak_kPa\nA,100,300\n"));
+  EXPECT_TRUE(u.tests[0].replicate.empty());
+  std::string e = error_of("material,sigma3_kPa,test,q_peak_kPa\nA,100,1,300\nA,100,2,310\nA,100,1,320\n");
+  EXPECT_NE(e.find("bad.csv:4: material A at 100 kPa, test 1 given twice (first on "), std::string::npos) << e;
+  e = error_of("material,sigma3_kPa,test,eps_a_pct,q_kPa\nA,100,r1,0,0\nA,100,r2,0,0\nA,100,r1,0,10\n");
+  EXPECT_NE(e.find("bad.csv:4:eps_a_pct: axial strain must increase within a test (A at 100 kPa, test r1)"),
+            std::string::npos) << e;
+}
+
+// Implausible values are refused: a deviator beyond 100 sigma3 (q = -3e9 kPa was once accepted), a strain
+// beyond 100%, a negative initial stiffness; the limits themselves are accepted.
+TEST(Measured, ImplausibleValuesAreRefusedWithLineAndColumn) {
+  const std::string curve = "material,sigma3_kPa,eps_a_pct,q_kPa,eps_v_pct\nA,100,0,0,0\n";
+  std::string e = error_of(curve + "A,100,1,-3e9,0\n");
+  EXPECT_NE(e.find("bad.csv:3:q_kPa: -3e+09 kPa is implausible at sigma3 = 100 kPa (allowed: |q| <= 100 sigma3 = "
+                   "10000 kPa)"),
+            std::string::npos) << e;
+  e = error_of(curve + "A,100,150,50,0\n");
+  EXPECT_NE(e.find("bad.csv:3:eps_a_pct: 150% is implausible (allowed: |eps_a| <= 100%)"), std::string::npos) << e;
+  e = error_of(curve + "A,100,1,50,-101\n");
+  EXPECT_NE(e.find("bad.csv:3:eps_v_pct: -101% is implausible (allowed: |eps_v| <= 100%)"), std::string::npos) << e;
+  const MeasuredTest edge = load_measured(write("edge.csv", curve + "A,100,100,10000,-100\n")).tests[0];
+  EXPECT_DOUBLE_EQ(edge.q.back(), 100 * 100e3);
+  const std::string summary =
+      "material,sigma3_kPa,q_peak_kPa,eps_a_peak_pct,q_end_kPa,e_ini_MPa,q_1pct_kPa,q_3pct_kPa\n";
+  e = error_of(summary + "A,100,10001,5,200,50,100,150\n");
+  EXPECT_NE(e.find("bad.csv:2:q_peak_kPa: 10001 kPa is implausible at sigma3 = 100 kPa (allowed: |q_peak| <= "),
+            std::string::npos) << e;
+  e = error_of(summary + "A,100,300,101,200,50,100,150\n");
+  EXPECT_NE(e.find("bad.csv:2:eps_a_peak_pct: 101% is implausible (allowed: |eps_a_peak| <= 100%)"), std::string::npos)
+      << e;
+  e = error_of(summary + "A,100,300,5,-20000,50,100,150\n");
+  EXPECT_NE(e.find("bad.csv:2:q_end_kPa: -20000 kPa is implausible"), std::string::npos) << e;
+  e = error_of(summary + "A,100,300,5,200,-50,100,150\n");
+  EXPECT_NE(e.find("bad.csv:2:e_ini_MPa: initial stiffness must be >= 0"), std::string::npos) << e;
+  e = error_of(summary + "A,100,300,5,200,inf,100,150\n");
+  EXPECT_NE(e.find("bad.csv:2:e_ini_MPa: 'inf' is not a number"), std::string::npos) << e;
+  e = error_of(summary + "A,100,300,5,200,50,1e5,150\n");
+  EXPECT_NE(e.find("bad.csv:2:q_1pct_kPa: 100000 kPa is implausible"), std::string::npos) << e;
+  e = error_of(summary + "A,100,300,5,200,50,100,0.011e6\n");
+  EXPECT_NE(e.find("bad.csv:2:q_3pct_kPa: 11000 kPa is implausible"), std::string::npos) << e;
+}
+
+// Pressures within 2% of a group's first test are one pressure: grouped, each test once, groups in order of
+// their first test; the reader says so when they are not exactly equal.
+TEST(Measured, NearEqualPressuresAreGroupedAsReplicates) {
+  auto test = [](const std::string& m, Real s) {
+    MeasuredTest t;
+    t.material = m;
+    t.sigma3 = s;
+    return t;
+  };
+  const std::vector<MeasuredTest> tests = {test("A", 100e3), test("B", 100e3), test("A", 200e3), test("A", 101e3),
+                                           test("A", 102.5e3), test("B", 99e3), test("A", 100e3)};
+  // 102.5 is within 2% of 101 but not of 100, the group's first: it stands alone.
+  EXPECT_EQ(replicate_groups(tests), (std::vector<std::vector<std::size_t>>{{0, 3, 6}, {1, 5}, {2}, {4}}));
+  EXPECT_TRUE(replicate_groups({}).empty());
+  const MeasuredData d = load_measured(write("near.csv", "material,sigma3_kPa,q_peak_kPa\n"
+                                                         "A,100,300\nA,101,305\nA,200,500\nB,100,310\nB,300,700\n"));
+  ASSERT_EQ(d.tests.size(), 5u);
+  ASSERT_EQ(d.notes.size(), 1u);
+  EXPECT_NE(d.notes[0].find("near.csv: material A: tests at 100 and 101 kPa differ by less than 2%: taken as "
+                            "replicates of one pressure"),
+            std::string::npos) << d.notes[0];
+}
+
+TEST(Measured, UnknownColumnErrorListsTheOptionalColumns) {
+  const std::string e = error_of("material,sigma3_kPa,q_peak_kPa,density\nA,100,300,1\n");
+  EXPECT_NE(e.find("bad.csv:1:density: unknown column (allowed: material, test, sigma3_<unit>"), std::string::npos) << e;
+  for (const char* c :
+       {"<quantity>_sd_<unit>", "max_dilatancy_sd", "void_ratio or porosity", "void_ratio_sd", "porosity_sd"})
+    EXPECT_NE(e.find(c), std::string::npos) << c << " in " << e;
+}
+
+// The HDF5 form goes through the same parser: a label (a number there), standard deviations and a void ratio.
+TEST(Measured, Hdf5FormCarriesTheOptionalColumns) {
+  const std::string h5 = write("optional.h5", "");
+  write_measured_h5(h5, {"sigma3_kPa", "test", "eps_a_pct", "q_kPa", "q_sd_kPa", "void_ratio"},
+                    {{"A",
+                      {{100, 1, 0, 0, 2, 0.6}, {100, 1, 1, 90, 3, 0.6}, {100, 2, 0, 0, 2, 0.62}, {100, 2, 1, 95, 4, 0.62}}}},
+                    "test");
+  const MeasuredData d = load_measured(h5);
+  ASSERT_EQ(d.tests.size(), 2u);
+  EXPECT_EQ(d.tests[1].replicate, "2");
+  EXPECT_EQ(d.tests[1].q_sd, (std::vector<Real>{2e3, 4e3}));
+  EXPECT_DOUBLE_EQ(d.tests[1].void_ratio, 0.62);
+  write_measured_h5(h5, {"sigma3_kPa", "eps_a_pct", "q_kPa", "q_sd_kPa"}, {{"A", {{100, 0, 0, 2}, {100, 1, 90, 0}}}},
+                    "test");
+  try {
+    load_measured(h5);
+    ADD_FAILURE() << "accepted a zero standard deviation";
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("optional.h5:/A/table row 2:q_sd_kPa: standard deviation must be > 0"),
+              std::string::npos) << e.what();
+  }
+}

@@ -1,0 +1,514 @@
+#include "misfit.hpp"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <stdexcept>
+
+namespace dem {
+
+namespace {
+constexpr Real kNaN = std::numeric_limits<Real>::quiet_NaN();
+
+std::string fmt(const char* f, double v) {
+  char b[96];
+  std::snprintf(b, sizeof b, f, v);
+  return b;
+}
+}  // namespace
+
+const char* quantity_name(int q) {
+  static const char* names[kQuantities] = {"E_ini", "q_1pct", "q_3pct", "q_peak", "eps_a_peak", "q_end",
+                                           "max_dilatancy"};
+  return names[q];
+}
+
+std::array<Real, kQuantities> quantities(const MeasuredTest& t) {
+  return {t.e_ini, t.q_1pct, t.q_3pct, t.q_peak, t.eps_a_peak, t.q_end, t.max_dilatancy};
+}
+
+Real NoiseModel::sigma(int q, Real measured) const { return std::max(rel[q] * std::fabs(measured), abs[q]); }
+
+bool NoiseModel::is_stress(int q) { return q != kStrainAtPeak && q != kDilatancy; }
+
+namespace {
+
+/// Lab covariance of the summary quantities `idx` of measured values m (NoiseModel).
+Eigen::MatrixXd summary_covariance(const std::vector<int>& idx, const std::array<Real, kQuantities>& m,
+                                   const NoiseModel& noise) {
+  const int n = static_cast<int>(idx.size());
+  Eigen::VectorXd shared(n);
+  for (int i = 0; i < n; ++i) shared(i) = NoiseModel::is_stress(idx[i]) ? noise.specimen * m[idx[i]] : 0.0;
+  Eigen::MatrixXd cov = shared * shared.transpose();
+  for (int i = 0; i < n; ++i) {
+    const Real total = noise.sigma(idx[i], m[idx[i]]);
+    // The shared part cannot exceed the whole scatter; the floor keeps C positive definite when it nearly does.
+    cov(i, i) = std::max(total * total, cov(i, i) + 0.01 * total * total);
+  }
+  return cov;
+}
+
+/// r = L^-1 diff over the entries of `present`, L L^T = cov restricted to them; absent entries get
+/// kMissingResidual.
+std::vector<Real> whiten(const Eigen::MatrixXd& cov, const std::vector<Real>& diff) {
+  const int n = static_cast<int>(diff.size());
+  std::vector<int> idx;
+  for (int i = 0; i < n; ++i)
+    if (std::isfinite(diff[i])) idx.push_back(i);
+  std::vector<Real> r(n, kMissingResidual);
+  const int m = static_cast<int>(idx.size());
+  Eigen::MatrixXd c(m, m);
+  Eigen::VectorXd d(m);
+  for (int a = 0; a < m; ++a) {
+    d(a) = diff[idx[a]];
+    for (int b = 0; b < m; ++b) c(a, b) = cov(idx[a], idx[b]);
+  }
+  const Eigen::LLT<Eigen::MatrixXd> llt(c);
+  if (llt.info() != Eigen::Success) throw std::logic_error("misfit: noise covariance not positive definite");
+  const Eigen::VectorXd w = llt.matrixL().solve(d);
+  for (int a = 0; a < m; ++a) r[idx[a]] = w(a);
+  return r;
+}
+
+}  // namespace
+
+std::array<Real, kQuantities> test_residuals(const MeasuredTest& measured, const MeasuredTest& simulated,
+                                             const NoiseModel& noise) {
+  const auto m = quantities(measured), s = quantities(simulated);
+  std::array<Real, kQuantities> r;
+  r.fill(kNaN);
+  std::vector<int> idx;
+  std::vector<Real> diff;
+  for (int q = 0; q < kQuantities; ++q)
+    if (std::isfinite(m[q])) idx.push_back(q), diff.push_back(s[q] - m[q]);
+  const std::vector<Real> w = whiten(summary_covariance(idx, m, noise), diff);
+  for (std::size_t i = 0; i < idx.size(); ++i) r[idx[i]] = w[i];
+  return r;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Reading curves
+
+Real feature_window(Real e) { return std::min(0.3 * e, 0.0025); }
+
+Real curve_value(const std::vector<Real>& eps_a, const std::vector<Real>& v, Real e) {
+  if (eps_a.empty() || e < eps_a.front() || e > eps_a.back()) return kNaN;
+  const Real h = feature_window(e);
+  const auto lo = std::lower_bound(eps_a.begin(), eps_a.end(), e - h) - eps_a.begin();
+  const auto hi = std::upper_bound(eps_a.begin(), eps_a.end(), e + h) - eps_a.begin();
+  if (hi - lo >= 3) {
+    Real sx = 0, sy = 0, sxx = 0, sxy = 0;
+    const Real n = static_cast<Real>(hi - lo);
+    for (auto i = lo; i < hi; ++i) {
+      const Real x = eps_a[i] - e;
+      sx += x, sy += v[i], sxx += x * x, sxy += x * v[i];
+    }
+    const Real det = n * sxx - sx * sx;
+    if (det > 0) return (sxx * sy - sx * sxy) / det;  // the line's value at x = 0
+  }
+  const auto j = std::lower_bound(eps_a.begin(), eps_a.end(), e) - eps_a.begin();
+  if (j == 0 || eps_a[j] == e) return v[j];
+  const Real w = (e - eps_a[j - 1]) / (eps_a[j] - eps_a[j - 1]);
+  return (1 - w) * v[j - 1] + w * v[j];
+}
+
+/// Residuals about a least-squares line through the 2 kHalf + 1 rows around each row: the trend of a smooth
+/// curve is removed, its noise kept. The median absolute residual makes the scale robust to the few rows where
+/// the curve bends within a window (the first rows of a stiff start, the peak).
+RowNoise row_noise(const std::vector<Real>& eps_a, const std::vector<Real>& v) {
+  constexpr int kHalf = 5;
+  const int n = static_cast<int>(v.size());
+  if (n < kMinNoiseRows) return {kNaN, kNaN};
+  std::vector<Real> e;
+  for (int i = kHalf; i < n - kHalf; ++i) {
+    Real sx = 0, sy = 0, sxx = 0, sxy = 0;
+    for (int j = i - kHalf; j <= i + kHalf; ++j) {
+      const Real x = eps_a[j] - eps_a[i];
+      sx += x, sy += v[j], sxx += x * x, sxy += x * v[j];
+    }
+    const Real m = 2 * kHalf + 1, det = m * sxx - sx * sx;
+    e.push_back(v[i] - (sxx * sy - sx * sxy) / det);
+  }
+  std::vector<Real> a(e.size());
+  std::transform(e.begin(), e.end(), a.begin(), [](Real x) { return std::fabs(x); });
+  std::nth_element(a.begin(), a.begin() + a.size() / 2, a.end());
+  // 1.4826 MAD is the standard deviation of Gaussian noise; a line fitted to 2 kHalf + 1 rows takes two of
+  // their degrees of freedom, which the factor puts back.
+  const Real m = 2 * kHalf + 1;
+  const Real sd = 1.4826 * a[a.size() / 2] * std::sqrt(m / (m - 2));
+  Real s0 = 0, s1 = 0;
+  for (std::size_t i = 0; i + 1 < e.size(); ++i) s0 += e[i] * e[i], s1 += e[i] * e[i + 1];
+  // Residuals about a fitted line lean negative at lag 1 even for white noise; a negative estimate is read as 0.
+  const Real rho = s0 > 0 ? std::clamp(s1 / s0, Real(0), Real(0.95)) : 0;
+  return {sd, rho};
+}
+
+MeasuredTest mean_curve(const std::vector<MeasuredTest>& members) {
+  const MeasuredTest* first = nullptr;
+  for (const MeasuredTest& t : members)
+    if (!t.q.empty() && std::isfinite(t.q_peak)) {
+      first = &t;
+      break;
+    }
+  if (!first) return members.front();
+  MeasuredTest out = *first;
+  const bool volume = !first->eps_v.empty();
+  for (std::size_t i = 0; i < out.eps_a.size(); ++i) {
+    Real q = 0, ev = 0, vr = 0;
+    int n = 0;
+    for (const MeasuredTest& t : members) {
+      if (t.q.empty() || !std::isfinite(t.q_peak) || out.eps_a[i] > t.eps_a.back()) continue;
+      const auto j = std::lower_bound(t.eps_a.begin(), t.eps_a.end(), out.eps_a[i]) - t.eps_a.begin();
+      const auto at = [&](const std::vector<Real>& y) {
+        if (j == 0) return y[0];
+        const Real w = (out.eps_a[i] - t.eps_a[j - 1]) / (t.eps_a[j] - t.eps_a[j - 1]);
+        return (1 - w) * y[j - 1] + w * y[j];
+      };
+      q += at(t.q);
+      if (volume) ev += at(t.eps_v);
+      vr += t.void_ratio;
+      ++n;
+    }
+    out.q[i] = q / n;
+    if (volume) out.eps_v[i] = ev / n;
+    out.void_ratio = vr / n;
+  }
+  summarise(out);
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// The misfit
+
+namespace {
+
+/// The scale that makes a feature comparable across pressures: q in units of sigma3, eps_v as it is.
+Real pooled_scale(const Feature& f, Real sigma3) { return f.quantity == 0 ? sigma3 : 1.0; }
+
+/// Correlation along strain of two curve features.
+Real strain_correlation(const Feature& a, const Feature& b, Real length) {
+  if (a.quantity != b.quantity) return 0;
+  return std::exp(-std::fabs(std::log(a.strain / b.strain)) / length);
+}
+
+/// Key of a curve feature across tests: (quantity, strain).
+using FeatureKey = std::pair<int, Real>;
+FeatureKey key_of(const Feature& f) { return {f.quantity, f.strain}; }
+
+}  // namespace
+
+std::vector<Real> Misfit::values(std::size_t k, const MeasuredTest& t) const {
+  std::vector<Real> out;
+  if (!curves_) {
+    const auto q = quantities(t);
+    for (const Feature& f : features_[k]) out.push_back(q[f.quantity]);
+    return out;
+  }
+  for (const Feature& f : features_[k]) {
+    const std::vector<Real>& y = f.quantity == 0 ? t.q : t.eps_v;
+    out.push_back(y.empty() || !std::isfinite(t.q_peak) ? kNaN : curve_value(t.eps_a, y, f.strain));
+  }
+  return out;
+}
+
+Misfit::Misfit(const std::vector<MeasuredTest>& measured, const NoiseOptions& noise, const Ensemble& reference,
+               Real sim_end) {
+  if (measured.empty()) throw std::invalid_argument("misfit: no measured tests");
+  if (noise.mode != "data" && noise.mode != "lab")
+    throw std::invalid_argument("noise '" + noise.mode + "' (allowed: data, lab)");
+  if (reference.size() != measured.size()) throw std::logic_error("misfit: the reference ensemble has other tests");
+  members_ = static_cast<int>(reference.front().size());
+  curves_ = !measured.front().q.empty();
+  for (const MeasuredTest& t : measured) {
+    std::vector<Feature> fs;
+    if (!curves_) {
+      const auto m = quantities(t);
+      for (int q = 0; q < kQuantities; ++q)
+        if (std::isfinite(m[q])) fs.push_back({quantity_name(q), q, 0, m[q]});
+    } else {
+      const Real end = std::min(t.eps_a.back(), 0.999 * sim_end);
+      for (int quantity : {0, 1}) {
+        if (quantity == 1 && t.eps_v.empty()) continue;
+        for (Real e : kFeatureStrains) {
+          if (e < t.eps_a.front() || e > end) continue;
+          Feature f;
+          f.name = std::string(quantity == 0 ? "q" : "eps_v") + " at " + fmt("%g%%", 100 * e);
+          f.quantity = quantity;
+          f.strain = e;
+          f.measured = curve_value(t.eps_a, quantity == 0 ? t.q : t.eps_v, e);
+          fs.push_back(f);
+        }
+      }
+    }
+    features_.push_back(fs);
+  }
+  if (curves_)
+    build_curve_noise(measured, noise, reference);
+  else
+    build_summary_noise(measured, noise, reference);
+}
+
+int Misfit::data() const {
+  int n = 0;
+  for (const auto& f : features_) n += static_cast<int>(f.size());
+  return n;
+}
+
+void Misfit::build_summary_noise(const std::vector<MeasuredTest>& measured, const NoiseOptions& noise,
+                                 const Ensemble& ref) {
+  const bool given = std::any_of(measured.begin(), measured.end(), [](const MeasuredTest& t) {
+    return !t.summary_sd.empty();
+  });
+  source_ = given && noise.mode == "data" ? "the data's standard-deviation columns" : "the lab model (NoiseModel)";
+  for (std::size_t k = 0; k < measured.size(); ++k) {
+    std::vector<Feature>& fs = features_[k];
+    const int n = static_cast<int>(fs.size());
+    std::vector<int> idx;
+    for (const Feature& f : fs) idx.push_back(f.quantity);
+    Eigen::MatrixXd cov = summary_covariance(idx, quantities(measured[k]), noise.summary);
+    for (int i = 0; i < n; ++i) {
+      auto sd = measured[k].summary_sd.find(quantity_name(fs[i].quantity));
+      if (given && noise.mode == "data") {
+        if (sd == measured[k].summary_sd.end()) {
+          notes_.push_back(measured[k].material + " at " + fmt("%g kPa: ", 1e-3 * measured[k].sigma3) +
+                           quantity_name(fs[i].quantity) + " has no standard deviation: the lab model's is used");
+        } else {
+          for (int j = 0; j < n; ++j) cov(i, j) = cov(j, i) = 0;
+          cov(i, i) = sd->second * sd->second;
+        }
+      }
+      fs[i].data_sd = std::sqrt(cov(i, i));
+      // The ensemble's scatter of this quantity (sample variance over the members).
+      Real s = 0, s2 = 0;
+      int m = 0;
+      for (const MeasuredTest& t : ref[k]) {
+        const Real v = quantities(t)[fs[i].quantity];
+        if (std::isfinite(v)) s += v, s2 += v * v, ++m;
+      }
+      fs[i].ensemble_sd = m > 1 ? std::sqrt(std::max(Real(0), (s2 - s * s / m) / (m - 1))) : 0;
+      cov(i, i) += fs[i].ensemble_sd * fs[i].ensemble_sd / members_;
+    }
+    cov_.emplace_back(cov.data(), cov.data() + n * n);
+  }
+}
+
+void Misfit::build_curve_noise(const std::vector<MeasuredTest>& measured, const NoiseOptions& noise,
+                               const Ensemble& ref) {
+  // The simulator's scatter: member deviations from their test's mean, pooled over tests per feature key.
+  std::map<FeatureKey, Real> ens_var;
+  std::map<FeatureKey, int> ens_dof;
+  std::vector<std::vector<std::vector<Real>>> z(measured.size());  // [test][member][feature], scaled deviations
+  for (std::size_t k = 0; k < measured.size(); ++k) {
+    std::vector<std::vector<Real>> v;
+    for (const MeasuredTest& t : ref[k]) v.push_back(values(k, t));
+    const std::size_t nf = features_[k].size();
+    for (std::size_t f = 0; f < nf; ++f) {
+      Real s = 0;
+      int m = 0;
+      for (const auto& row : v)
+        if (std::isfinite(row[f])) s += row[f], ++m;
+      if (m < 2) continue;
+      const Real mean = s / m, scale = pooled_scale(features_[k][f], measured[k].sigma3);
+      for (const auto& row : v)
+        if (std::isfinite(row[f])) ens_var[key_of(features_[k][f])] += (row[f] - mean) * (row[f] - mean) / (scale * scale);
+      ens_dof[key_of(features_[k][f])] += m - 1;
+    }
+    for (const auto& row : v) {
+      std::vector<Real> d(nf);
+      for (std::size_t f = 0; f < nf; ++f) {
+        Real s = 0;
+        int m = 0;
+        for (const auto& r2 : v)
+          if (std::isfinite(r2[f])) s += r2[f], ++m;
+        d[f] = (row[f] - s / std::max(m, 1)) / pooled_scale(features_[k][f], measured[k].sigma3);
+      }
+      z[k].push_back(d);
+    }
+  }
+  for (auto& [key, var] : ens_var) var /= std::max(ens_dof[key], 1);
+  // The correlation length: ln rho = -|d ln e| / l fitted through the origin to the pooled sample correlations of
+  // pairs of one quantity (clamped to [0.3, 5]: from one strain decade of independence to near-rigid offsets).
+  Real num = 0, den = 0;
+  if (members_ > 2) {
+    const std::vector<Feature>& fs0 = features_.front();
+    for (std::size_t a = 0; a < fs0.size(); ++a)
+      for (std::size_t b = a + 1; b < fs0.size(); ++b) {
+        if (fs0[a].quantity != fs0[b].quantity) continue;
+        Real sab = 0, saa = 0, sbb = 0;
+        for (std::size_t k = 0; k < measured.size(); ++k) {
+          if (features_[k].size() != fs0.size()) continue;
+          for (const auto& d : z[k])
+            if (std::isfinite(d[a]) && std::isfinite(d[b])) sab += d[a] * d[b], saa += d[a] * d[a], sbb += d[b] * d[b];
+        }
+        const Real r = saa > 0 && sbb > 0 ? sab / std::sqrt(saa * sbb) : 0;
+        if (r <= 0.05 || r >= 0.999) continue;
+        const Real dl = std::fabs(std::log(fs0[a].strain / fs0[b].strain));
+        num += dl * dl, den += -dl * std::log(r);
+      }
+  }
+  length_ = den > 0 ? std::clamp(num / den, Real(0.3), Real(5)) : noise.lab.length;
+
+  // Replicates: the pooled scatter between the tests of one material and pressure holds data and specimen noise.
+  std::map<FeatureKey, Real> rep_var;
+  std::map<FeatureKey, int> rep_dof;
+  for (const auto& g : replicate_groups(measured)) {
+    if (g.size() < 2) continue;
+    std::map<FeatureKey, std::vector<Real>> vals;
+    for (std::size_t k : g)
+      for (const Feature& f : features_[k]) vals[key_of(f)].push_back(f.measured / pooled_scale(f, measured[k].sigma3));
+    for (const auto& [key, v] : vals) {
+      if (v.size() < 2) continue;
+      Real s = 0;
+      for (Real x : v) s += x;
+      for (Real x : v) rep_var[key] += (x - s / v.size()) * (x - s / v.size());
+      rep_dof[key] += static_cast<int>(v.size()) - 1;
+    }
+  }
+  for (auto& [key, var] : rep_var) var /= rep_dof[key];
+  const bool lab = noise.mode == "lab";
+  const bool no_ensemble = ens_var.empty();
+  source_ = lab ? "the lab model" : !rep_var.empty() ? "replicates" : "the data";
+  if (!lab && !rep_var.empty())
+    notes_.push_back("replicates: the scatter between tests of one material and pressure (pooled over " +
+                     std::to_string(rep_dof.begin()->second) + " degrees of freedom) is the data and specimen noise");
+  if (no_ensemble)
+    notes_.push_back("the simulator has one specimen: its scatter is not measured and counts as zero");
+
+  for (std::size_t k = 0; k < measured.size(); ++k) {
+    const MeasuredTest& t = measured[k];
+    std::vector<Feature>& fs = features_[k];
+    const int n = static_cast<int>(fs.size());
+    const std::string where = t.material + " at " + fmt("%g kPa", 1e-3 * t.sigma3);
+    // The data's own noise of each feature (variance), and whether this test falls back to the lab model.
+    bool use_lab = lab;
+    std::vector<Real> data_var(n, 0);
+    if (!lab) {
+      const RowNoise qn = row_noise(t.eps_a, t.q), vn = row_noise(t.eps_a, t.eps_v);
+      const bool rows_given = !t.q_sd.empty();
+      if (!rows_given && !std::isfinite(qn.sd)) {
+        use_lab = rep_var.empty();
+        notes_.push_back(where + ": " + std::to_string(t.q.size()) + " rows, fewer than " +
+                         std::to_string(kMinNoiseRows) + " to estimate noise from: " +
+                         (use_lab ? "the lab model is used" : "replicates alone give it"));
+      } else if (rows_given) {
+        notes_.push_back(where + ": noise from the standard-deviation columns");
+      } else {
+        notes_.push_back(where + ": noise estimated from the rows' scatter: q " + fmt("%.3g kPa", 1e-3 * qn.sd) +
+                         fmt(" (lag-1 correlation %.2f)", qn.rho) +
+                         (t.eps_v.empty() ? std::string() : ", eps_v " + fmt("%.3g%%", 100 * vn.sd) +
+                                                                fmt(" (%.2f)", vn.rho)));
+      }
+      for (int i = 0; i < n && !use_lab; ++i) {
+        const Feature& f = fs[i];
+        const std::vector<Real>& sdv = f.quantity == 0 ? t.q_sd : t.eps_v_sd;
+        const Real h = feature_window(f.strain);
+        const auto rows = std::upper_bound(t.eps_a.begin(), t.eps_a.end(), f.strain + h) -
+                          std::lower_bound(t.eps_a.begin(), t.eps_a.end(), f.strain - h);
+        const Real nw = std::max<Real>(1, static_cast<Real>(rows));
+        if (!sdv.empty()) {
+          const Real sd = curve_value(t.eps_a, sdv, f.strain);
+          data_var[i] = sd * sd / nw;  // rows given with their own errors: independent
+        } else if (std::isfinite(qn.sd)) {
+          const RowNoise& rn = f.quantity == 0 ? qn : vn;
+          data_var[i] = rn.sd * rn.sd * std::min<Real>(1, (1 + rn.rho) / ((1 - rn.rho) * nw));
+        }
+      }
+    }
+    Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(n, n);
+    for (int i = 0; i < n; ++i) {
+      Feature& f = fs[i];
+      const Real scale = pooled_scale(f, t.sigma3);
+      auto e = ens_var.find(key_of(f));
+      f.ensemble_sd = e == ens_var.end() ? 0 : std::sqrt(e->second) * scale;
+      auto r = rep_var.find(key_of(f));
+      const bool from_rep = !use_lab && !lab && r != rep_var.end();
+      if (use_lab) {
+        const Real lab_sd = f.quantity == 0 ? std::max(noise.lab.q_rel * std::fabs(f.measured), 2e-3 * t.sigma3)
+                                            : std::max(noise.lab.ev_rel * std::fabs(f.measured), noise.lab.ev_abs);
+        f.specimen_sd = lab_sd;
+      } else if (from_rep) {
+        f.specimen_sd = std::sqrt(r->second) * scale;
+        data_var[i] = 0;  // the replicates' scatter holds it
+      } else {
+        f.specimen_sd = f.ensemble_sd;
+      }
+      f.data_sd = std::sqrt(data_var[i]);
+    }
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) {
+        const Feature &a = fs[i], &b = fs[j];
+        const Real rho = i == j ? 1 : strain_correlation(a, b, use_lab ? noise.lab.length : length_);
+        Real c = rho * (a.specimen_sd * b.specimen_sd + a.ensemble_sd * b.ensemble_sd / members_);
+        if (use_lab && a.quantity == 0 && b.quantity == 0) {
+          // The lab's specimen factor moves the whole q curve together: rank one, beside the correlated rest.
+          const Real sh = noise.lab.q_shared;
+          const Real rest = rho * (a.specimen_sd * b.specimen_sd - sh * sh * std::fabs(a.measured * b.measured));
+          c = sh * sh * a.measured * b.measured + std::max(Real(0), rest) +
+              rho * a.ensemble_sd * b.ensemble_sd / members_;
+        }
+        cov(i, j) = c;
+      }
+    for (int i = 0; i < n; ++i) {
+      cov(i, i) += data_var[i];
+      // A floor of 1e-3 of the feature's own scale keeps Sigma invertible where every part is zero (a curve and an
+      // ensemble without noise): 0.1% of sigma3 on q, 1e-6 on eps_v.
+      const Real floor = fs[i].quantity == 0 ? 1e-3 * t.sigma3 : 1e-6;
+      cov(i, i) += floor * floor;
+    }
+    cov_.emplace_back(cov.data(), cov.data() + n * n);
+  }
+  if (lab) notes_.push_back("noise: the lab model (q 5% with a 2% specimen factor, eps_v 10% or 0.05%)");
+}
+
+Real Misfit::ensemble_ratio() const {
+  std::vector<Real> r;
+  for (const auto& fs : features_)
+    for (const Feature& f : fs) {
+      const Real data = std::hypot(f.data_sd, f.specimen_sd);
+      if (data > 0) r.push_back(f.ensemble_sd / std::sqrt(static_cast<Real>(members_)) / data);
+    }
+  if (r.empty()) return 0;
+  std::nth_element(r.begin(), r.begin() + r.size() / 2, r.end());
+  return r[r.size() / 2];
+}
+
+Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<MeasuredTest>& measured,
+                      const NoiseOptions& noise) {
+  return Misfit(measured, noise, lab.run_ensemble(base, measured), lab.config().periodic.triax.target_strain);
+}
+
+std::vector<Real> Misfit::mean_values(std::size_t k, const std::vector<MeasuredTest>& members) const {
+  std::vector<Real> sum(features_[k].size(), 0.0);
+  std::vector<int> n(sum.size(), 0);
+  for (const MeasuredTest& t : members) {
+    const std::vector<Real> v = values(k, t);
+    for (std::size_t f = 0; f < v.size(); ++f)
+      if (std::isfinite(v[f])) sum[f] += v[f], ++n[f];
+  }
+  for (std::size_t f = 0; f < sum.size(); ++f) sum[f] = n[f] ? sum[f] / n[f] : kNaN;
+  return sum;
+}
+
+std::vector<Real> Misfit::test_residuals(std::size_t k, const std::vector<MeasuredTest>& members) const {
+  const std::vector<Real> s = mean_values(k, members);
+  const int n = static_cast<int>(s.size());
+  std::vector<Real> diff(n);
+  for (int i = 0; i < n; ++i) diff[i] = s[i] - features_[k][i].measured;
+  const Eigen::Map<const Eigen::MatrixXd> cov(cov_[k].data(), n, n);
+  return whiten(cov, diff);
+}
+
+std::vector<Real> Misfit::residuals(const Ensemble& sim) const {
+  std::vector<Real> r;
+  for (std::size_t k = 0; k < features_.size(); ++k) {
+    const std::vector<Real> t = test_residuals(k, sim[k]);
+    r.insert(r.end(), t.begin(), t.end());
+  }
+  return r;
+}
+
+}  // namespace dem

@@ -1,0 +1,153 @@
+#pragma once
+/// The misfit between measured tests and the simulator's ensemble (issue 26): what is compared, with which
+/// noise, and the whitened residuals that calibration and diagnosis minimise.
+///
+/// What is compared. Curve data: q and eps_v at the strains of kFeatureStrains (log-spaced, where the stiffness
+/// and the early contraction live, then through the peak to the end), each read off a curve by a local
+/// straight-line fit over +-min(30%, 0.25% strain) of the strain (curve_value), for measured and simulated
+/// curves alike; a strain is used when both curves reach it. Summary data: the seven quantities of summarise.
+///
+/// With which noise, per test (the three kinds of scatter of ../shared/notes/discrepancy_methods.md, added):
+///   Sigma = Sigma_data + Sigma_specimen + Sigma_ensemble / K
+///   Sigma_data      the measured curve's own noise: its standard-deviation columns, or, without them, the
+///                   scatter of its rows about a smooth curve (difference-based, with the lag-1 correlation
+///                   along strain counted: a window of n rows counts n (1 - rho) / (1 + rho)); zero where
+///                   replicates give the specimen term, which holds it.
+///   Sigma_specimen  the measured specimen is one specimen: from replicates when the data have them (the pooled
+///                   scatter between replicates, q relative to sigma3), else as variable as one specimen of the
+///                   simulator's ensemble (measured, not assumed; a conservative stand-in for a larger cell).
+///   Sigma_ensemble  the simulator's specimen-to-specimen covariance, measured on its K members at the base
+///                   model: per-feature variances pooled over the tests (q in units of sigma3, eps_v as it is),
+///                   correlated along strain as exp(-|ln e1 - ln e2| / l), l fitted to the members.
+/// Tests are independent of each other. The `lab` noise replaces the data and specimen terms by a lab's
+/// scatter (LabCurveNoise); summary data use NoiseModel, with the ensemble's variance added.
+/// The residuals are whitened per test, r = L^-1 (mean of the members - measured), Sigma = L L^T, so that
+/// chi2 = sum r^2 is about the number of data for a model right within the noise.
+#include <array>
+#include <string>
+#include <vector>
+
+#include "measured.hpp"
+#include "periodic_lab.hpp"
+
+namespace dem {
+
+enum Quantity : int { kInitialStiffness = 0, kEarly, kMid, kPeak, kStrainAtPeak, kResidual, kDilatancy, kQuantities };
+
+/// Name of a quantity in tables ("E_ini", "q_peak", ...).
+const char* quantity_name(int q);
+
+/// The quantities of a test (NaN where absent).
+std::array<Real, kQuantities> quantities(const MeasuredTest& t);
+
+/// Lab noise of the summary quantities: s_q = max(rel_q |measured|, abs_q), of which a specimen factor of
+/// standard deviation `specimen` is shared by the stresses of one test (a denser specimen raises them all):
+///   C = diag(s_q^2 - (specimen m_q)^2) + specimen^2 m m^T,   m_q = measured stress quantity (0 for the others).
+struct NoiseModel {
+  std::array<Real, kQuantities> rel{0.10, 0.06, 0.06, 0.04, 0.0, 0.05, 0.20};
+  std::array<Real, kQuantities> abs{0.0, 0.0, 0.0, 0.0, 0.02, 0.0, 0.05};
+  Real specimen = 0.02;
+  Real sigma(int q, Real measured) const;
+  static bool is_stress(int q);
+};
+
+/// Lab noise of curve features: q scatters by `q_rel` of its value about the population's curve, of which
+/// `q_shared` is one factor for the whole curve (a denser specimen); eps_v by max(ev_rel |eps_v|, ev_abs).
+/// Both correlated along strain with length `length` in ln(strain).
+struct LabCurveNoise {
+  Real q_rel = 0.05, q_shared = 0.02, ev_rel = 0.10, ev_abs = 5e-4, length = 1.0;
+};
+
+/// Residual of a datum the simulation could not produce (no peak, a blow-up): ten standard deviations.
+constexpr Real kMissingResidual = 10;
+
+/// Whitened residuals of one summary test against one simulated test with lab noise, one per quantity (NaN where
+/// the measured test lacks it). L is lower triangular in quantity order: r_q is what datum q says beyond the
+/// quantities before it (E_ini first), the shared specimen factor counted once.
+std::array<Real, kQuantities> test_residuals(const MeasuredTest& measured, const MeasuredTest& simulated,
+                                             const NoiseModel& noise);
+
+/// The strains at which curves are compared.
+constexpr std::array<Real, 12> kFeatureStrains{2e-4, 5e-4, 1e-3, 2e-3, 5e-3, 0.01, 0.02, 0.03, 0.05, 0.075, 0.10, 0.15};
+
+/// Half-width of the window of curve_value at strain e.
+Real feature_window(Real e);
+
+/// The value of v at strain e: a least-squares line over the rows within feature_window(e), or the straight
+/// line between the rows around e when the window holds fewer than three. NaN outside the curve.
+Real curve_value(const std::vector<Real>& eps_a, const std::vector<Real>& v, Real e);
+
+/// Scatter of a curve's rows about a smooth trend: the standard deviation of the noise (difference-based, for
+/// uneven spacing, Gasser, Sroka & Jennen-Steinmetz 1986) and the lag-1 correlation of the rows about the
+/// trend (>= 0). NaN when the curve has fewer than kMinNoiseRows rows.
+struct RowNoise {
+  Real sd = 0, rho = 0;
+};
+constexpr int kMinNoiseRows = 20;
+RowNoise row_noise(const std::vector<Real>& eps_a, const std::vector<Real>& v);
+
+/// How the data's noise is taken: "data" (standard-deviation columns, else replicates, else the curves'
+/// own scatter; the lab model where none of these is possible) or "lab".
+struct NoiseOptions {
+  std::string mode = "data";
+  LabCurveNoise lab;
+  NoiseModel summary;
+};
+
+/// One compared datum of a test, with the parts of its noise (standard deviations, in its unit: Pa or -).
+struct Feature {
+  std::string name;          ///< "q at 0.1%", "eps_v at 2%", or a summary quantity's name
+  int quantity = 0;          ///< 0: q, 1: eps_v; summary data: the Quantity
+  Real strain = 0;           ///< curve features
+  Real measured = 0;
+  Real data_sd = 0, specimen_sd = 0, ensemble_sd = 0;  ///< ensemble_sd: one member's; the mean's is / sqrt(K)
+};
+
+class Misfit {
+ public:
+  /// `reference`: the ensemble at the base model ([test][member], tests as in `measured`), which measures the
+  /// simulator's scatter; `sim_end`: the simulator's last axial strain.
+  Misfit(const std::vector<MeasuredTest>& measured, const NoiseOptions& noise, const Ensemble& reference,
+         Real sim_end);
+  std::size_t tests() const { return features_.size(); }
+  int data() const;                               ///< compared data in all tests
+  int data(std::size_t test) const { return static_cast<int>(features_[test].size()); }
+  const std::vector<Feature>& features(std::size_t test) const { return features_[test]; }
+  /// Whitened residuals of test k against its members' runs.
+  std::vector<Real> test_residuals(std::size_t k, const std::vector<MeasuredTest>& members) const;
+  /// All tests', concatenated in test order.
+  std::vector<Real> residuals(const Ensemble& sim) const;
+  /// The members' mean feature values of test k (NaN where no member has one).
+  std::vector<Real> mean_values(std::size_t k, const std::vector<MeasuredTest>& members) const;
+  /// What noise was used, per test and in words, for the report.
+  const std::vector<std::string>& notes() const { return notes_; }
+  std::string source() const { return source_; }
+  Real correlation_length() const { return length_; }
+  /// The simulator's standard error over the data-side noise, median over the data: the ensemble is large
+  /// enough when it is below 1/2 (its mean then adds at most a quarter to the variance).
+  Real ensemble_ratio() const;
+  int members() const { return members_; }
+
+ private:
+  std::vector<Real> values(std::size_t k, const MeasuredTest& t) const;
+  void build_curve_noise(const std::vector<MeasuredTest>& measured, const NoiseOptions& noise, const Ensemble& ref);
+  void build_summary_noise(const std::vector<MeasuredTest>& measured, const NoiseOptions& noise, const Ensemble& ref);
+  std::vector<std::vector<Feature>> features_;
+  std::vector<std::vector<Real>> cov_;   ///< per test, Sigma (n x n, row-major)
+  std::vector<std::string> notes_;
+  std::string source_;
+  Real length_ = 1;
+  int members_ = 1;
+  bool curves_ = true;
+};
+
+/// The simulator's scatter measured: `lab`'s ensemble run at `base` on every measured test, and the misfit
+/// built on it.
+Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<MeasuredTest>& measured,
+                      const NoiseOptions& noise);
+
+/// The mean curve of an ensemble's members (each interpolated onto the first successful member's strains),
+/// summarised: what the figures and tables show for a parameter point.
+MeasuredTest mean_curve(const std::vector<MeasuredTest>& members);
+
+}  // namespace dem

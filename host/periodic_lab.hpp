@@ -1,0 +1,74 @@
+#pragma once
+/// The calibration simulator: periodic-cell triaxial runs (host/periodic_triaxial.hpp) on an ensemble of
+/// specimens, each prepared once from the base config with its own packing seed and reused at every parameter
+/// point (common random numbers: the difference between two points is then the parameters' effect, not the
+/// specimens'). Member k packs with seed first_seed + k; data made for tests draw their specimens from seeds
+/// outside that set (kForeignSeedOffset), as real data come from specimens the simulator never saw.
+#include <array>
+#include <string>
+#include <vector>
+
+#include "config.hpp"
+#include "host/builder.hpp"
+#include "measured.hpp"
+
+namespace dem {
+
+/// A model to simulate: contact law (with extensions) and the membrane extension (Pa, E_m t / R0).
+struct Model {
+  ContactParams law;
+  Real membrane = 0;
+};
+
+/// The model of a config: its ball law and the periodic cell's membrane.
+Model model_of(const Config& cfg);
+
+/// Simulated tests of an ensemble: [test][member], each summarised like measured curves.
+using Ensemble = std::vector<std::vector<MeasuredTest>>;
+
+/// Packing seeds of synthetic data start this far above the config's seed: never a member of an ensemble
+/// (at most 64 members, config.cpp).
+constexpr unsigned kForeignSeedOffset = 100000;
+
+class PeriodicLab {
+ public:
+  /// `members` specimens with packing seeds first_seed, first_seed + 1, ...
+  PeriodicLab(const Config& base, bool verbose, int members, unsigned first_seed);
+  /// The config's ensemble ([calibrate] ensemble) and seed ([run] seed).
+  PeriodicLab(const Config& base, bool verbose);
+  /// One simulated test (curves, summarised; its void ratio at the start of shear) of one member at sigma3 (Pa).
+  MeasuredTest run(const Model& m, Real sigma3, const std::string& material = "sim", int member = 0);
+  /// Every test of `like` (its materials and pressures) on every member; up to jobs() runs at once.
+  Ensemble run_ensemble(const Model& m, const std::vector<MeasuredTest>& like);
+  /// Runs at once: each in a child process (fork) with the same specimens; the results are the same as one at a
+  /// time, bit for bit. Only where that is safe: a host backend on one thread (OMP_NUM_THREADS=1); otherwise
+  /// the runs go one at a time with all threads. Returns the value in effect.
+  int set_jobs(int jobs);
+  int jobs() const { return jobs_; }
+  int members() const { return static_cast<int>(specimens_.size()); }
+  const Config& config() const { return cfg_; }
+  long runs() const { return runs_; }
+  double seconds() const { return seconds_; }
+  std::size_t balls() const { return specimens_.front().balls.size(); }
+  /// Void ratio of member k's specimen after its preparation (at the preparation pressure).
+  Real prepared_void_ratio(int k) const { return specimens_[static_cast<std::size_t>(k)].void_ratio; }
+
+ private:
+  struct Specimen {
+    std::vector<BallSpec> balls;
+    std::array<Real, 3> cell{};
+    Real void_ratio = 0;
+  };
+  Config cfg_;
+  std::vector<Specimen> specimens_;
+  long runs_ = 0;
+  double seconds_ = 0;
+  int jobs_ = 1;
+};
+
+/// Before Kokkos starts, in a program that will run `jobs` > 1 simulator runs at once: sets OpenMP to one
+/// thread (its runtime read OMP_NUM_THREADS when it was loaded, before main, so through its API), as
+/// PeriodicLab::set_jobs requires.
+void prepare_parallel_runs(int jobs);
+
+}  // namespace dem
