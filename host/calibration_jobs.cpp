@@ -105,17 +105,35 @@ struct Session {
   MeasuredData data;
   ReferenceValues ref;
   std::vector<FreeParam> free;
+  StateMatch state;  ///< the data's void ratio and the preparation that packs it
   PeriodicLab lab;
   std::string folder;
   Session(const Config& base, const CalibrationOptions& o, const std::string& kind)
       : data(load_measured(o.data)),
         ref(o.reference.empty() ? ReferenceValues{}
                                 : load_reference(o.reference, [](const std::string& n) { free_param(n); })),
-        free(free_params(base, o.free)), lab(base, true), folder(new_dated_folder(o.output, kind)) {
+        free(free_params(base, o.free)), lab(matched(base), true), folder(new_dated_folder(o.output, kind)) {
     lab.set_jobs(o.jobs);
     noise.mode = o.noise;
   }
   NoiseOptions noise;
+  Config matched(const Config& base) { return matched_state(base, data.tests, state, true); }
+  /// The report's line on the specimens' state.
+  std::string state_text(const Misfit& m, const std::vector<MeasuredTest>& tests) const {
+    if (state.tests == 0)
+      return "The data give no void ratio: the simulator's specimens have the density their preparation gives (" +
+             fmt("e = %.3f", lab.prepared_void_ratio(0)) + " for the first), and the calibrated friction absorbs "
+             "any difference in density.\n";
+    std::string s = "The simulator's specimens were prepared to the data's void ratio " + fmt("%.4f", state.target) +
+                    " (preparation friction " + fmt("%.4g", state.prep_mu_s) + ", which packs " +
+                    fmt("%.4f", state.reached) +
+                    "). At the start of shear, measured and simulated (mean of the scatter specimens at the base "
+                    "model):";
+    for (std::size_t k = 0; k < tests.size(); ++k)
+      s += fmt(" %g kPa", 1e-3 * tests[k].sigma3) + fmt(" %.4f", tests[k].void_ratio) +
+           fmt(" against %.4f;", m.reached_void_ratio(k));
+    return s + "\n";
+  }
   /// The misfit of a material's tests: the ensemble run at the base model, its scatter beside the data's noise.
   Misfit misfit_of(const Config& base, const std::string& material, const std::vector<MeasuredTest>& tests) {
     std::printf("%s: %s: measuring the simulator's scatter: %d specimens of %zu balls at the base model\n",
@@ -398,10 +416,7 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
     for (const std::string& n : dg.notes) md << "- " << n << "\n";
     md << "\nThe base model's calibrated values:\n\n```\n" << uncertainty_text(dg.base, material, "diagnose")
        << "```\n";
-    if (std::all_of(tests.begin(), tests.end(), [](const MeasuredTest& t) { return std::isnan(t.void_ratio); }))
-      md << "\nThe data give no void ratio: the simulator's specimens have the density their preparation gives ("
-         << fmt("e = %.3f", ss.lab.prepared_void_ratio(0)) << " for the first), and the calibrated friction absorbs "
-            "any difference in density.\n";
+    md << "\n" << ss.state_text(misfit, tests);
     const ExtensionFit* top = top_fit(dg);
     if (top) {
       md << gain_tables(misfit, tests, dg.base.best, top->best,
@@ -439,8 +454,9 @@ int synth_job(const Config& base, const SynthOptions& o) {
   }
   const unsigned specimen = o.specimen_seed >= 0 ? static_cast<unsigned>(o.specimen_seed)
                                                  : base.run.seed + kForeignSeedOffset;
-  comment += ", specimen seed " + std::to_string(specimen);
-  PeriodicLab lab(base, false, 1, specimen);
+  comment += ", a specimen per test (packing seeds from " + std::to_string(specimen) + ", " +
+             std::to_string(kGeneratorCellFactor) + " times the config's balls)";
+  PeriodicLab lab(larger_cell(base, kGeneratorCellFactor), false, static_cast<int>(o.sigma3.size()), specimen);
   const std::vector<MeasuredTest> tests = synthetic_tests(lab, truth, o.sigma3, o.material, o.seed);
   write_measured_curves(o.output, tests, comment);
   std::printf("synth: %s -> %s\n", comment.c_str(), o.output.c_str());

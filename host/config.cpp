@@ -345,6 +345,7 @@ Config parse_config(const std::string& text, const std::string& path) {
   TableReader cal = table("calibrate");
   cal.strings("free", c.calibrate.free);  // names checked against the registry by the calibration job
   cal.integer("ensemble", c.calibrate.ensemble, 1, 64);
+  cal.integer("scatter_specimens", c.calibrate.scatter_specimens, 1, 64);
   cal.finish();
 
   for (int d = 0; d < 3; ++d)

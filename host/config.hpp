@@ -125,6 +125,10 @@ struct CalibrateConfig {
   /// Specimens of the simulator's ensemble (packing seeds [run] seed, seed + 1, ...): every parameter point runs
   /// each of them and compares their mean (host/misfit.hpp).
   long ensemble = 4;
+  /// Specimens on which the simulator's scatter is measured, once, at the base model (the first `ensemble` of
+  /// them are the ensemble): a variance from few specimens is itself uncertain, and one that comes out small by
+  /// chance turns a foreign specimen into a false alarm.
+  long scatter_specimens = 16;
 };
 
 /// The [periodic] table: the periodic-cell triaxial test (host/periodic_triaxial.hpp).

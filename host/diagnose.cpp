@@ -313,6 +313,13 @@ Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreePa
   return dg;
 }
 
+Config larger_cell(const Config& base, int factor) {
+  Config c = base;
+  c.particles.count *= factor;
+  for (Real& side : c.box.size) side *= std::cbrt(static_cast<Real>(factor));
+  return c;
+}
+
 Real draw_strength(const Extension& e, unsigned seed) {
   std::mt19937_64 rng(seed * 7919u + 17u);
   std::uniform_real_distribution<Real> u(0, 1);
@@ -320,16 +327,18 @@ Real draw_strength(const Extension& e, unsigned seed) {
 }
 
 std::vector<MeasuredTest> synthetic_tests(PeriodicLab& lab, const Model& truth, const std::vector<Real>& sigma3,
-                                          const std::string& material, unsigned seed) {
+                                          const std::string& material, unsigned seed, Real noise) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<Real> gauss(0, 1);
   std::vector<MeasuredTest> out;
-  for (Real s3 : sigma3) {
-    MeasuredTest t = lab.run(truth, s3, material);
-    const Real factor = 1 + 0.02 * gauss(rng);
+  for (std::size_t j = 0; j < sigma3.size(); ++j) {
+    const Real s3 = sigma3[j];
+    MeasuredTest t = lab.run(truth, s3, material, static_cast<int>(j) % lab.members());
+    t.specimen_balls = static_cast<Real>(lab.balls());
+    const Real factor = 1 + noise * 0.02 * gauss(rng);
     for (std::size_t i = 0; i < t.q.size(); ++i) {
-      t.q[i] = factor * t.q[i] + 0.005 * s3 * gauss(rng);
-      t.eps_v[i] += 2e-4 * gauss(rng);
+      t.q[i] = factor * t.q[i] + noise * 0.005 * s3 * gauss(rng);
+      t.eps_v[i] += noise * 2e-4 * gauss(rng);
     }
     summarise(t);
     out.push_back(t);
@@ -340,8 +349,14 @@ std::vector<MeasuredTest> synthetic_tests(PeriodicLab& lab, const Model& truth, 
 void write_measured_curves(const std::string& path, const std::vector<MeasuredTest>& tests,
                            const std::string& comment) {
   const bool volume = std::all_of(tests.begin(), tests.end(), [](const MeasuredTest& t) { return !t.eps_v.empty(); });
+  auto all = [&](Real MeasuredTest::*m) {
+    return std::all_of(tests.begin(), tests.end(), [&](const MeasuredTest& t) { return std::isfinite(t.*m); });
+  };
+  const bool state = all(&MeasuredTest::void_ratio), size = all(&MeasuredTest::specimen_balls);
   std::vector<std::string> columns{"sigma3_kPa", "eps_a_pct", "q_kPa"};
   if (volume) columns.push_back("eps_v_pct");
+  if (state) columns.push_back("void_ratio");
+  if (size) columns.push_back("specimen_balls");
   std::map<std::string, std::vector<std::vector<double>>> rows;  // by material
   std::vector<std::string> order;                                 // materials in file order
   for (const MeasuredTest& t : tests) {
@@ -349,6 +364,8 @@ void write_measured_curves(const std::string& path, const std::vector<MeasuredTe
     for (std::size_t i = 0; i < t.q.size(); ++i) {
       rows[t.material].push_back({1e-3 * t.sigma3, 100 * t.eps_a[i], 1e-3 * t.q[i]});
       if (volume) rows[t.material].back().push_back(100 * t.eps_v[i]);
+      if (state) rows[t.material].back().push_back(t.void_ratio);
+      if (size) rows[t.material].back().push_back(t.specimen_balls);
     }
   }
   if (is_hdf5_path(path)) return write_measured_h5(path, columns, rows, comment);

@@ -73,14 +73,22 @@ Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreePa
 /// A hidden strength drawn from `seed`: log-uniform between the extension's lowest and highest level.
 Real draw_strength(const Extension& e, unsigned seed);
 
-/// Synthetic measured data: the simulator's tests of `truth` at `sigma3` (Pa), with lab-like noise from `seed`:
+/// Synthetic measured data: the simulator's tests of `truth` at `sigma3` (Pa), test j on member j of `lab` (modulo
+/// its members: a lab prepares a specimen per test), with lab-like noise from `seed`:
 /// a specimen-to-specimen factor on q (2% standard deviation), and on each row 0.5% of sigma3 on q and 0.02%
-/// on eps_v. Rows every 0.1% of axial strain, as the simulator records them.
+/// on eps_v, all scaled by `noise` (0: as precise as the simulation). Rows as the simulator records them.
 std::vector<MeasuredTest> synthetic_tests(PeriodicLab& lab, const Model& truth, const std::vector<Real>& sigma3,
-                                          const std::string& material, unsigned seed);
+                                          const std::string& material, unsigned seed, Real noise = 1);
 
-/// Writes tests as a measured-data curve file (kPa, pct; eps_v when every test has it): CSV, or HDF5 when the
-/// path ends in .h5 or .hdf5; through a temporary file and a rename.
+/// Synthetic data come from cells this many times larger than the simulator's, as real data come from specimens
+/// larger than a calibration cell (they scatter half as much from specimen to specimen).
+constexpr int kGeneratorCellFactor = 4;
+
+/// The base config with `factor` times the balls in a box as many times larger (same packing density).
+Config larger_cell(const Config& base, int factor);
+
+/// Writes tests as a measured-data curve file (kPa, pct; eps_v, void_ratio and specimen_balls when every test has
+/// them): CSV, or HDF5 when the path ends in .h5 or .hdf5; through a temporary file and a rename.
 void write_measured_curves(const std::string& path, const std::vector<MeasuredTest>& tests,
                            const std::string& comment);
 

@@ -33,7 +33,7 @@ const std::map<std::string, const std::map<std::string, Real>*> kQuantities = {
     {"q_1pct", &kStressUnits}, {"q_3pct", &kStressUnits},
     {"eps_a", &kStrainUnits},  {"eps_v", &kStrainUnits}, {"eps_a_peak", &kStrainUnits}};
 const std::set<std::string> kUnitless = {"material",   "test",          "max_dilatancy", "max_dilatancy_sd",
-                                         "void_ratio", "void_ratio_sd", "porosity",      "porosity_sd"};
+                                         "void_ratio", "void_ratio_sd", "porosity",      "porosity_sd", "specimen_balls"};
 /// The quantities whose standard deviation a file can give: a curve's rows are q and eps_v; a summary row is
 /// its values (sigma3 is the test's key, not a measurement).
 const std::vector<std::string> kCurveSd = {"q", "eps_v"};
@@ -90,7 +90,7 @@ ColumnSpec parse_header(const std::string& at, const std::string& name) {
   fail(at, name,
        "unknown column (allowed: material, test, sigma3_<unit>, eps_a_<unit>, q_<unit>, eps_v_<unit>, q_peak_<unit>, "
        "eps_a_peak_<unit>, q_end_<unit>, max_dilatancy, e_ini_<unit>, q_1pct_<unit>, q_3pct_<unit>, "
-       "<quantity>_sd_<unit>, max_dilatancy_sd, void_ratio or porosity, void_ratio_sd, porosity_sd)");
+       "<quantity>_sd_<unit>, max_dilatancy_sd, void_ratio or porosity, void_ratio_sd, porosity_sd, specimen_balls)");
 }
 
 /// The header: each column's quantity and scale, and the column of each quantity.
@@ -223,6 +223,8 @@ void check_same_state(const RowReader& r, const MeasuredTest& row, const Measure
   if (r.has(e) && row.void_ratio != t.void_ratio) r.refuse(e, "'" + r.cell(e) + "'" + why);
   if (r.has(e + "_sd") && row.void_ratio_sd != t.void_ratio_sd)
     r.refuse(e + "_sd", "'" + r.cell(e + "_sd") + "'" + why);
+  if (r.has("specimen_balls") && row.specimen_balls != t.specimen_balls)
+    r.refuse("specimen_balls", "'" + r.cell("specimen_balls") + "'" + why);
 }
 
 /// Tests by material, pressure and label, and the row where each begins.
@@ -239,6 +241,11 @@ MeasuredTest& test_of(const RowReader& r, MeasuredData& d, TestIndex& tests) {
   if (!(key.sigma3 > 0)) r.refuse("sigma3", "confining pressure must be > 0");
   if (r.has("test")) key.replicate = r.cell("test");
   std::tie(key.void_ratio, key.void_ratio_sd) = void_ratio_of(r);
+  if (r.has("specimen_balls")) {
+    key.specimen_balls = r.number("specimen_balls");
+    if (!(key.specimen_balls >= 1 && key.specimen_balls <= 1e12))
+      r.refuse("specimen_balls", "particles in the specimen must be in [1, 1e12]");
+  }
   const auto [it, is_new] = tests.of.emplace(std::make_tuple(key.material, key.sigma3, key.replicate), d.tests.size());
   if (is_new) {
     tests.first_at.push_back(r.row.at);

@@ -16,6 +16,7 @@
 ///                            max_dilatancy_sd): on every row of a test or on none, > 0
 ///     void_ratio or porosity the specimen's state after consolidation (one value per test, repeated on its
 ///                            rows), with optional void_ratio_sd / porosity_sd
+///     specimen_balls         particles in the specimen (DEM data), one value per test, >= 1
 ///     test                   a label that tells replicates apart: tests of one material and sigma3 with
 ///                            different labels are replicates (the scatter between them is measured noise)
 /// A file is a curve file when it has an eps_a column, a summary file when it has q_peak. Within a curve
@@ -51,6 +52,9 @@ struct MeasuredTest {
   std::map<std::string, Real> summary_sd;   ///< summary files: standard deviation by quantity (q_peak, ...), SI
   Real void_ratio = std::numeric_limits<Real>::quiet_NaN();     ///< after consolidation (NaN: not given)
   Real void_ratio_sd = std::numeric_limits<Real>::quiet_NaN();  ///< its standard deviation (NaN: not given)
+  /// Particles in the measured specimen where the data say (DEM data; NaN: not given, as for a lab's): a
+  /// specimen of N particles scatters from the next as 1 / sqrt(N) (host/misfit.hpp).
+  Real specimen_balls = std::numeric_limits<Real>::quiet_NaN();
 };
 
 struct MeasuredData {

@@ -116,33 +116,36 @@ Real curve_value(const std::vector<Real>& eps_a, const std::vector<Real>& v, Rea
   return (1 - w) * v[j - 1] + w * v[j];
 }
 
-/// Residuals about a least-squares line through the 2 kHalf + 1 rows around each row: the trend of a smooth
-/// curve is removed, its noise kept. The median absolute residual makes the scale robust to the few rows where
-/// the curve bends within a window (the first rows of a stiff start, the peak).
+/// Residuals about a least-squares parabola through the 21 rows around each row: the trend of a smooth curve, its
+/// bend included (the stiff start of a triaxial curve, the peak), is removed and its noise kept. The median
+/// absolute residual keeps the scale robust to the few rows where the trend still shows. A correlated noise is
+/// partly taken up as trend (an AR(1) of 0.7 reads 0.37, tests/test_misfit.cpp).
 RowNoise row_noise(const std::vector<Real>& eps_a, const std::vector<Real>& v) {
-  constexpr int kHalf = 5;
+  constexpr int kHalf = 10, kRows = 2 * kHalf + 1;
   const int n = static_cast<int>(v.size());
   if (n < kMinNoiseRows) return {kNaN, kNaN};
   std::vector<Real> e;
   for (int i = kHalf; i < n - kHalf; ++i) {
-    Real sx = 0, sy = 0, sxx = 0, sxy = 0;
-    for (int j = i - kHalf; j <= i + kHalf; ++j) {
-      const Real x = eps_a[j] - eps_a[i];
-      sx += x, sy += v[j], sxx += x * x, sxy += x * v[j];
+    Eigen::Matrix<Real, kRows, 3> A;
+    Eigen::Matrix<Real, kRows, 1> y;
+    const Real h = eps_a[i + kHalf] - eps_a[i - kHalf];  // scales x to O(1) for the conditioning
+    for (int j = 0; j < kRows; ++j) {
+      const Real x = (eps_a[i - kHalf + j] - eps_a[i]) / h;
+      A(j, 0) = 1, A(j, 1) = x, A(j, 2) = x * x;
+      y(j) = v[i - kHalf + j];
     }
-    const Real m = 2 * kHalf + 1, det = m * sxx - sx * sx;
-    e.push_back(v[i] - (sxx * sy - sx * sxy) / det);
+    const Eigen::Matrix<Real, 3, 1> c = A.colPivHouseholderQr().solve(y);
+    e.push_back(v[i] - c(0));
   }
   std::vector<Real> a(e.size());
   std::transform(e.begin(), e.end(), a.begin(), [](Real x) { return std::fabs(x); });
   std::nth_element(a.begin(), a.begin() + a.size() / 2, a.end());
-  // 1.4826 MAD is the standard deviation of Gaussian noise; a line fitted to 2 kHalf + 1 rows takes two of
-  // their degrees of freedom, which the factor puts back.
-  const Real m = 2 * kHalf + 1;
-  const Real sd = 1.4826 * a[a.size() / 2] * std::sqrt(m / (m - 2));
+  // 1.4826 MAD is the standard deviation of Gaussian noise; a parabola fitted to kRows rows takes three of their
+  // degrees of freedom, which the factor puts back.
+  const Real sd = 1.4826 * a[a.size() / 2] * std::sqrt(Real(kRows) / (kRows - 3));
   Real s0 = 0, s1 = 0;
   for (std::size_t i = 0; i + 1 < e.size(); ++i) s0 += e[i] * e[i], s1 += e[i] * e[i + 1];
-  // Residuals about a fitted line lean negative at lag 1 even for white noise; a negative estimate is read as 0.
+  // Residuals about a fitted curve lean negative at lag 1 even for white noise; a negative estimate is read as 0.
   const Real rho = s0 > 0 ? std::clamp(s1 / s0, Real(0), Real(0.95)) : 0;
   return {sd, rho};
 }
@@ -216,12 +219,19 @@ std::vector<Real> Misfit::values(std::size_t k, const MeasuredTest& t) const {
 }
 
 Misfit::Misfit(const std::vector<MeasuredTest>& measured, const NoiseOptions& noise, const Ensemble& reference,
-               Real sim_end) {
+               int members, Real sim_end, Real sim_balls) {
   if (measured.empty()) throw std::invalid_argument("misfit: no measured tests");
   if (noise.mode != "data" && noise.mode != "lab")
     throw std::invalid_argument("noise '" + noise.mode + "' (allowed: data, lab)");
   if (reference.size() != measured.size()) throw std::logic_error("misfit: the reference ensemble has other tests");
-  members_ = static_cast<int>(reference.front().size());
+  members_ = std::max(members, 1);
+  for (const auto& runs : reference) {
+    Real sum = 0;
+    int n = 0;
+    for (const MeasuredTest& t : runs)
+      if (std::isfinite(t.void_ratio)) sum += t.void_ratio, ++n;
+    void_ratio_.push_back(n ? sum / n : kNaN);
+  }
   curves_ = !measured.front().q.empty();
   for (const MeasuredTest& t : measured) {
     std::vector<Feature> fs;
@@ -247,7 +257,7 @@ Misfit::Misfit(const std::vector<MeasuredTest>& measured, const NoiseOptions& no
     features_.push_back(fs);
   }
   if (curves_)
-    build_curve_noise(measured, noise, reference);
+    build_curve_noise(measured, noise, reference, sim_balls);
   else
     build_summary_noise(measured, noise, reference);
 }
@@ -297,7 +307,7 @@ void Misfit::build_summary_noise(const std::vector<MeasuredTest>& measured, cons
 }
 
 void Misfit::build_curve_noise(const std::vector<MeasuredTest>& measured, const NoiseOptions& noise,
-                               const Ensemble& ref) {
+                               const Ensemble& ref, Real sim_balls) {
   // The simulator's scatter: member deviations from their test's mean, pooled over tests per feature key.
   std::map<FeatureKey, Real> ens_var;
   std::map<FeatureKey, int> ens_dof;
@@ -329,11 +339,14 @@ void Misfit::build_curve_noise(const std::vector<MeasuredTest>& measured, const 
       z[k].push_back(d);
     }
   }
-  for (auto& [key, var] : ens_var) var /= std::max(ens_dof[key], 1);
+  // Student's t: the variance of a deviation measured against an estimate of nu degrees of freedom.
+  const Real nu = static_cast<Real>(ref.front().size()) - 1;
+  const Real t_factor = nu > 2 ? nu / (nu - 2) : 3;
+  for (auto& [key, var] : ens_var) var = t_factor * var / std::max(ens_dof[key], 1);
   // The correlation length: ln rho = -|d ln e| / l fitted through the origin to the pooled sample correlations of
   // pairs of one quantity (clamped to [0.3, 5]: from one strain decade of independence to near-rigid offsets).
   Real num = 0, den = 0;
-  if (members_ > 2) {
+  if (ref.front().size() > 2) {
     const std::vector<Feature>& fs0 = features_.front();
     for (std::size_t a = 0; a < fs0.size(); ++a)
       for (std::size_t b = a + 1; b < fs0.size(); ++b) {
@@ -434,7 +447,9 @@ void Misfit::build_curve_noise(const std::vector<MeasuredTest>& measured, const 
         f.specimen_sd = std::sqrt(r->second) * scale;
         data_var[i] = 0;  // the replicates' scatter holds it
       } else {
-        f.specimen_sd = f.ensemble_sd;
+        const bool sized = std::isfinite(t.specimen_balls) && sim_balls > 0;
+        const Real floor = f.quantity == 0 ? noise.lab.q_shared * std::fabs(f.measured) : noise.lab.ev_abs;
+        f.specimen_sd = std::max(f.ensemble_sd * (sized ? std::sqrt(sim_balls / t.specimen_balls) : 1), floor);
       }
       f.data_sd = std::sqrt(data_var[i]);
     }
@@ -478,7 +493,8 @@ Real Misfit::ensemble_ratio() const {
 
 Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<MeasuredTest>& measured,
                       const NoiseOptions& noise) {
-  return Misfit(measured, noise, lab.run_ensemble(base, measured), lab.config().periodic.triax.target_strain);
+  return Misfit(measured, noise, lab.run_ensemble(base, measured, true), lab.members(),
+                lab.config().periodic.triax.target_strain, static_cast<Real>(lab.balls()));
 }
 
 std::vector<Real> Misfit::mean_values(std::size_t k, const std::vector<MeasuredTest>& members) const {

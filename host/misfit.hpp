@@ -10,15 +10,22 @@
 /// With which noise, per test (the three kinds of scatter of ../shared/notes/discrepancy_methods.md, added):
 ///   Sigma = Sigma_data + Sigma_specimen + Sigma_ensemble / K
 ///   Sigma_data      the measured curve's own noise: its standard-deviation columns, or, without them, the
-///                   scatter of its rows about a smooth curve (difference-based, with the lag-1 correlation
-///                   along strain counted: a window of n rows counts n (1 - rho) / (1 + rho)); zero where
-///                   replicates give the specimen term, which holds it.
+///                   scatter of its rows about a smooth curve (row_noise, with the lag-1 correlation along
+///                   strain counted: a window of n rows counts n (1 - rho) / (1 + rho)); zero where replicates
+///                   give the specimen term, which holds it.
 ///   Sigma_specimen  the measured specimen is one specimen: from replicates when the data have them (the pooled
 ///                   scatter between replicates, q relative to sigma3), else as variable as one specimen of the
-///                   simulator's ensemble (measured, not assumed; a conservative stand-in for a larger cell).
-///   Sigma_ensemble  the simulator's specimen-to-specimen covariance, measured on its K members at the base
-///                   model: per-feature variances pooled over the tests (q in units of sigma3, eps_v as it is),
-///                   correlated along strain as exp(-|ln e1 - ln e2| / l), l fitted to the members.
+///                   simulator's ensemble, times sqrt(N_sim / N) where the data say their specimen has N particles
+///                   (specimen_balls: a cell's scatter goes as 1 / sqrt(N)); without N, a conservative stand-in
+///                   for a larger specimen. Never below a lab's specimen scatter (LabCurveNoise: q_shared of q,
+///                   ev_abs on eps_v): a real specimen differs from the next by more than its particle count.
+///   Sigma_ensemble  the simulator's specimen-to-specimen covariance, measured once at the base model on the
+///                   scatter specimens (more than the K of the ensemble): per-feature variances pooled over the
+///                   tests (q in units of sigma3, eps_v as it is), correlated along strain as
+///                   exp(-|ln e1 - ln e2| / l), l fitted to the specimens. A variance estimated from S specimens
+///                   has S - 1 degrees of freedom (the tests share the specimens, so pooling over tests adds
+///                   none); a deviation measured against it follows Student's t, whose variance is
+///                   nu / (nu - 2) times the estimate: the estimate is inflated by that factor.
 /// Tests are independent of each other. The `lab` noise replaces the data and specimen terms by a lab's
 /// scatter (LabCurveNoise); summary data use NoiseModel, with the ensemble's variance added.
 /// The residuals are whitened per test, r = L^-1 (mean of the members - measured), Sigma = L L^T, so that
@@ -77,9 +84,8 @@ Real feature_window(Real e);
 /// line between the rows around e when the window holds fewer than three. NaN outside the curve.
 Real curve_value(const std::vector<Real>& eps_a, const std::vector<Real>& v, Real e);
 
-/// Scatter of a curve's rows about a smooth trend: the standard deviation of the noise (difference-based, for
-/// uneven spacing, Gasser, Sroka & Jennen-Steinmetz 1986) and the lag-1 correlation of the rows about the
-/// trend (>= 0). NaN when the curve has fewer than kMinNoiseRows rows.
+/// Scatter of a curve's rows about a smooth trend (local parabolas): the standard deviation of the noise and the
+/// lag-1 correlation of the rows about the trend (>= 0). NaN when the curve has fewer than kMinNoiseRows rows.
 struct RowNoise {
   Real sd = 0, rho = 0;
 };
@@ -105,10 +111,13 @@ struct Feature {
 
 class Misfit {
  public:
-  /// `reference`: the ensemble at the base model ([test][member], tests as in `measured`), which measures the
-  /// simulator's scatter; `sim_end`: the simulator's last axial strain.
+  /// `reference`: runs at the base model on the scatter specimens ([test][specimen], tests as in `measured`),
+  /// which measure the simulator's scatter; `members`: the ensemble size whose mean is compared; `sim_end`: the
+  /// simulator's last axial strain.
+  /// `sim_balls`: particles in a simulator specimen, against which a test's specimen_balls scales its specimen
+  /// term.
   Misfit(const std::vector<MeasuredTest>& measured, const NoiseOptions& noise, const Ensemble& reference,
-         Real sim_end);
+         int members, Real sim_end, Real sim_balls = 0);
   std::size_t tests() const { return features_.size(); }
   int data() const;                               ///< compared data in all tests
   int data(std::size_t test) const { return static_cast<int>(features_[test].size()); }
@@ -127,10 +136,14 @@ class Misfit {
   /// enough when it is below 1/2 (its mean then adds at most a quarter to the variance).
   Real ensemble_ratio() const;
   int members() const { return members_; }
+  /// The scatter specimens' mean void ratio at the start of shear of test k, at the base model.
+  Real reached_void_ratio(std::size_t k) const { return void_ratio_[k]; }
 
  private:
+  std::vector<Real> void_ratio_;
   std::vector<Real> values(std::size_t k, const MeasuredTest& t) const;
-  void build_curve_noise(const std::vector<MeasuredTest>& measured, const NoiseOptions& noise, const Ensemble& ref);
+  void build_curve_noise(const std::vector<MeasuredTest>& measured, const NoiseOptions& noise, const Ensemble& ref,
+                         Real sim_balls);
   void build_summary_noise(const std::vector<MeasuredTest>& measured, const NoiseOptions& noise, const Ensemble& ref);
   std::vector<std::vector<Feature>> features_;
   std::vector<std::vector<Real>> cov_;   ///< per test, Sigma (n x n, row-major)

@@ -40,8 +40,9 @@ Model model_of(const Config& cfg) {
   return m;
 }
 
-PeriodicLab::PeriodicLab(const Config& base, bool verbose, int members, unsigned first_seed) : cfg_(base) {
-  for (int k = 0; k < std::max(members, 1); ++k) {
+PeriodicLab::PeriodicLab(const Config& base, bool verbose, int members, unsigned first_seed, int specimens)
+    : cfg_(base), members_(std::max(members, 1)) {
+  for (int k = 0; k < std::max(members_, specimens); ++k) {
     Config c = base;
     c.run.seed = first_seed + static_cast<unsigned>(k);
     Specimen s;
@@ -53,8 +54,56 @@ PeriodicLab::PeriodicLab(const Config& base, bool verbose, int members, unsigned
   }
 }
 
+namespace {
+Real prepared_void_ratio(const Config& cfg) {
+  std::vector<BallSpec> balls;
+  std::array<Real, 3> cell{};
+  prepare_periodic_specimen(cfg, balls, cell, false);
+  Real solid = 0;
+  for (const BallSpec& b : balls) solid += 4.0 / 3.0 * M_PI * b.radius * b.radius * b.radius;
+  return cell[0] * cell[1] * cell[2] / solid - 1;
+}
+}  // namespace
+
+Real prep_friction_for(const Config& base, Real target, Real& reached, bool verbose) {
+  Config c = base;
+  auto at = [&](Real u) {
+    c.periodic.prep_mu_s = u * u;
+    return prepared_void_ratio(c);
+  };
+  Real lo = 0, hi = 1, e_lo = at(lo), e_hi = at(hi);
+  if (verbose)
+    std::printf("triaxdem: preparation friction 0 to 1 packs void ratios %.4f to %.4f; target %.4f\n", e_lo, e_hi,
+                target);
+  if (target <= e_lo) return reached = e_lo, 0;
+  if (target >= e_hi) return reached = e_hi, 1;
+  for (int k = 0; k < 8; ++k) {  // sqrt(mu) to 1/256
+    const Real mid = 0.5 * (lo + hi), e = at(mid);
+    (e < target ? lo : hi) = mid;
+    (e < target ? e_lo : e_hi) = e;
+  }
+  const bool low = target - e_lo < e_hi - target;
+  reached = low ? e_lo : e_hi;
+  return low ? lo * lo : hi * hi;
+}
+
+Config matched_state(const Config& base, const std::vector<MeasuredTest>& tests, StateMatch& m, bool verbose) {
+  Real sum = 0;
+  for (const MeasuredTest& t : tests)
+    if (std::isfinite(t.void_ratio)) sum += t.void_ratio, ++m.tests;
+  if (m.tests == 0) return base;
+  m.target = sum / m.tests;
+  Config c = base;
+  c.periodic.prep_mu_s = m.prep_mu_s = prep_friction_for(base, m.target, m.reached, verbose);
+  if (verbose)
+    std::printf("triaxdem: the data's void ratio %.4f (mean of %d tests): preparation friction %.4g packs %.4f\n",
+                m.target, m.tests, m.prep_mu_s, m.reached);
+  return c;
+}
+
 PeriodicLab::PeriodicLab(const Config& base, bool verbose)
-    : PeriodicLab(base, verbose, static_cast<int>(base.calibrate.ensemble), base.run.seed) {}
+    : PeriodicLab(base, verbose, static_cast<int>(base.calibrate.ensemble), base.run.seed,
+                  static_cast<int>(base.calibrate.scatter_specimens)) {}
 
 MeasuredTest PeriodicLab::run(const Model& m, Real sigma3, const std::string& material, int member) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -137,8 +186,9 @@ bool receive_curves(int fd, MeasuredTest& t) {
 
 }  // namespace
 
-Ensemble PeriodicLab::run_ensemble(const Model& m, const std::vector<MeasuredTest>& like) {
-  const std::size_t M = specimens_.size(), N = like.size() * M;  // run j: test j / M, member j % M
+Ensemble PeriodicLab::run_ensemble(const Model& m, const std::vector<MeasuredTest>& like, bool all) {
+  const std::size_t M = all ? specimens_.size() : static_cast<std::size_t>(members_);
+  const std::size_t N = like.size() * M;  // run j: test j / M, member j % M
   Ensemble out(like.size());
   if (jobs_ <= 1 || N <= 1) {
     for (std::size_t j = 0; j < N; ++j)

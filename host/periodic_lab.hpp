@@ -5,6 +5,7 @@
 /// specimens'). Member k packs with seed first_seed + k; data made for tests draw their specimens from seeds
 /// outside that set (kForeignSeedOffset), as real data come from specimens the simulator never saw.
 #include <array>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -32,20 +33,23 @@ constexpr unsigned kForeignSeedOffset = 100000;
 
 class PeriodicLab {
  public:
-  /// `members` specimens with packing seeds first_seed, first_seed + 1, ...
-  PeriodicLab(const Config& base, bool verbose, int members, unsigned first_seed);
-  /// The config's ensemble ([calibrate] ensemble) and seed ([run] seed).
+  /// `specimens` specimens with packing seeds first_seed, first_seed + 1, ..., of which the first `members`
+  /// (at most all) form the ensemble that run_ensemble runs.
+  PeriodicLab(const Config& base, bool verbose, int members, unsigned first_seed, int specimens = 0);
+  /// The config's ensemble ([calibrate] ensemble, scatter_specimens) and seed ([run] seed).
   PeriodicLab(const Config& base, bool verbose);
   /// One simulated test (curves, summarised; its void ratio at the start of shear) of one member at sigma3 (Pa).
   MeasuredTest run(const Model& m, Real sigma3, const std::string& material = "sim", int member = 0);
-  /// Every test of `like` (its materials and pressures) on every member; up to jobs() runs at once.
-  Ensemble run_ensemble(const Model& m, const std::vector<MeasuredTest>& like);
+  /// Every test of `like` (its materials and pressures) on every member (on every specimen with `all`); up to
+  /// jobs() runs at once.
+  Ensemble run_ensemble(const Model& m, const std::vector<MeasuredTest>& like, bool all = false);
   /// Runs at once: each in a child process (fork) with the same specimens; the results are the same as one at a
   /// time, bit for bit. Only where that is safe: a host backend on one thread (OMP_NUM_THREADS=1); otherwise
   /// the runs go one at a time with all threads. Returns the value in effect.
   int set_jobs(int jobs);
   int jobs() const { return jobs_; }
-  int members() const { return static_cast<int>(specimens_.size()); }
+  int members() const { return members_; }
+  int specimens() const { return static_cast<int>(specimens_.size()); }
   const Config& config() const { return cfg_; }
   long runs() const { return runs_; }
   double seconds() const { return seconds_; }
@@ -64,7 +68,26 @@ class PeriodicLab {
   long runs_ = 0;
   double seconds_ = 0;
   int jobs_ = 1;
+  int members_ = 1;
 };
+
+/// The preparation friction ([periodic] prep_mu_s) that packs the base config's first specimen to void ratio
+/// `target` after its preparation: bisection on sqrt(prep_mu_s) over [0, 1] (more friction, a looser packing; the
+/// root spreads the steps where the void ratio changes fastest). `reached` receives the void ratio of the
+/// answer; a target beyond what [0, 1] reaches gets the nearest end.
+Real prep_friction_for(const Config& base, Real target, Real& reached, bool verbose);
+
+/// The measured specimens' state and the preparation that packs it (matched_state).
+struct StateMatch {
+  int tests = 0;                                            ///< tests that give a void ratio
+  Real target = std::numeric_limits<Real>::quiet_NaN();     ///< their mean void ratio
+  Real reached = std::numeric_limits<Real>::quiet_NaN();    ///< the first specimen's after preparation
+  Real prep_mu_s = std::numeric_limits<Real>::quiet_NaN();
+};
+
+/// The base config with the preparation friction that packs the mean void ratio of the tests that give one
+/// (prep_friction_for); the base config itself when none does.
+Config matched_state(const Config& base, const std::vector<MeasuredTest>& tests, StateMatch& m, bool verbose);
 
 /// Before Kokkos starts, in a program that will run `jobs` > 1 simulator runs at once: sets OpenMP to one
 /// thread (its runtime read OMP_NUM_THREADS when it was loaded, before main, so through its API), as

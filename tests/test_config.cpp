@@ -240,3 +240,16 @@ TEST(Config, CalibrateFreeListIsRead) {
   EXPECT_NE(e.find("bad.toml: [calibrate] free: expected a non-empty array of strings"), std::string::npos) << e;
   EXPECT_NE(error_of("[calibrate]\nfree = []\n").find("non-empty"), std::string::npos);
 }
+
+// [calibrate] ensemble and scatter_specimens: integers in 1-64 (the seeds of synthetic data start 100000 above
+// the config's, out of any ensemble's reach); anything else is refused with the key and the range.
+TEST(Config, CalibrateEnsembleSizesAreRead) {
+  const dem::Config c =
+      dem::load_config(write_config("ens.toml", "[calibrate]\nensemble = 6\nscatter_specimens = 20\n"));
+  EXPECT_EQ(c.calibrate.ensemble, 6);
+  EXPECT_EQ(c.calibrate.scatter_specimens, 20);
+  for (const char* bad : {"ensemble = 0", "ensemble = 65", "scatter_specimens = -1", "ensemble = 2.5"}) {
+    const std::string e = error_of(std::string("[calibrate]\n") + bad + "\n");
+    EXPECT_NE(e.find("bad.toml: [calibrate] "), std::string::npos) << bad << ": " << e;
+  }
+}
