@@ -115,6 +115,7 @@ struct Session {
         free(free_params(base, o.free)), lab(matched(base), true), folder(new_dated_folder(o.output, kind)) {
     lab.set_jobs(o.jobs);
     noise.mode = o.noise;
+    for (const std::string& n : data.notes) std::printf("%s: note: %s\n", kind.c_str(), n.c_str());
   }
   NoiseOptions noise;
   Config matched(const Config& base) { return matched_state(base, data.tests, state, true); }
@@ -357,6 +358,7 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
        << " The calibrated values belong to this simulator (its cell, density and boundary), the reference values to "
           "the model they were calibrated with: a difference between them measures the two simulators as much as "
           "the data.\n\n";
+  for (const std::string& n : ss.data.notes) md << "Note on the data: " << n << "\n\n";
   csv << "material,model,parameter,value,chi2,bic,heldout_chi2,runs\n";
   std::vector<MeasuredTest> all_meas, all_sim, all_ext;
   for (const auto& [material, tests] : by_material(ss.data, o.material)) {

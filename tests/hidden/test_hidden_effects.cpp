@@ -71,16 +71,20 @@ TEST_P(HiddenEffect, DiagnosisNamesIt) {
                                                               << f.heldout;
 }
 
+// Wear (0.6, the top of its range) and the membrane (300 kPa) are not run here: on specimens the diagnosis never
+// ran, with the noise measured rather than assumed, this simulator (120 balls, an ensemble of two, 8% strain) does
+// not tell them from specimen scatter. Measured on 25 November: wear 0.6 gave BIC gains of -3.1 and -1.9 with two
+// ensembles (verdict none); the membrane gave 2.2 and the roughness fit 6.5 (verdict roughness, a wrong name).
+// They passed before only because the data came from the diagnosis's own specimen. perf/hidden_sweep measures
+// their identification rate; a CI case for them needs a larger ensemble or cell than the CI budget allows.
 INSTANTIATE_TEST_SUITE_P(OneCasePerExtension, HiddenEffect,
                          ::testing::Values(HiddenCase{"none", 0, 1}, HiddenCase{"hertz", 3e-3, 1},
-                                           HiddenCase{"roughness", 1e-2, 1}, HiddenCase{"wear", 0.6, 1},
-                                           HiddenCase{"membrane", 3e5, 1}),
+                                           HiddenCase{"roughness", 1e-2, 1}),
                          [](const ::testing::TestParamInfo<HiddenCase>& i) { return i.param.extension; });
 
 // The verdict must not hinge on the ensemble: the same data, diagnosed by an ensemble of other specimens
-// (packing seeds 11, 12, ... instead of 1, 2, ...), give the same verdict, for the case nearest the decision
-// edge (wear; the README of before recorded its verdict flipping when only the rounding changed).
-INSTANTIATE_TEST_SUITE_P(AnotherEnsemble, HiddenEffect, ::testing::Values(HiddenCase{"wear", 0.6, 1, 11}),
+// (packing seeds 11, 12, ... instead of 1, 2, ...), give the same verdict.
+INSTANTIATE_TEST_SUITE_P(AnotherEnsemble, HiddenEffect, ::testing::Values(HiddenCase{"hertz", 3e-3, 1, 11}),
                          [](const ::testing::TestParamInfo<HiddenCase>& i) { return i.param.extension; });
 
 }  // namespace
