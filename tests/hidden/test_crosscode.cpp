@@ -49,9 +49,9 @@ TEST_P(CrossCode, DiagnosisOfAnotherCodesCurves) {
   EXPECT_EQ(dg.verdict, c.verdict) << dg.explanation;
   if (c.verdict == "none") {
     // Printed, not asserted: whether the generating friction lies inside the joint 95% region hinges on the
-    // ensemble. Measured on 25 November with packing seeds from 1: inside (mu_s 0.296 [0.238, 0.382], mu_r 0.066
-    // [0.030, 0.080], chi2 103 on 60 data); from 11: mu_s 0.316 [0.257, 0.395], mu_r 0.074 [0.043, 0.080], chi2
-    // 124. Both lean to less sliding and more rolling friction than YADE's: the simulator misses these data by
+    // ensemble. Measured on 25 November with packing seeds from 1: inside (mu_s 0.297 [0.238, 0.382], mu_r 0.065
+    // [0.030, 0.080], chi2 100 on 60 data); from 11 (on a first version of the data, whose compaction servo
+    // differed slightly): mu_s 0.316 [0.257, 0.395], mu_r 0.074 [0.043, 0.080], chi2 124. Both lean to less sliding and more rolling friction than YADE's: the simulator misses these data by
     // more than their noise (it shears three times faster than the data's I = 1e-3, for the CI budget, in a cell
     // of 150 balls, with another rolling law), and friction absorbs the difference.
     std::printf("  generating friction (0.4, 0.04) %s the joint 95%% region\n",
