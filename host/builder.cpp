@@ -6,6 +6,12 @@
 
 namespace dem {
 
+Real solid_volume(const std::vector<BallSpec>& balls) {
+  Real v = 0;
+  for (const BallSpec& b : balls) v += 4.0 / 3.0 * M_PI * b.radius * b.radius * b.radius;
+  return v;
+}
+
 Particles make_particles(const std::vector<BallSpec>& balls) {
   Particles p(static_cast<int>(balls.size()));
   auto x = Kokkos::create_mirror_view(p.x), v = Kokkos::create_mirror_view(p.v), w = Kokkos::create_mirror_view(p.w);

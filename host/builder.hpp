@@ -24,6 +24,9 @@ struct WallSpec {
   int material = 0;
 };
 
+/// The balls' total volume (m^3): solid spheres.
+Real solid_volume(const std::vector<BallSpec>& balls);
+
 /// Particles with gids 0..n-1 in the given order.
 Particles make_particles(const std::vector<BallSpec>& balls);
 

@@ -9,16 +9,12 @@
 #include <map>
 #include <stdexcept>
 
+#include "text_format.hpp"
+
 namespace dem {
 
 namespace {
 constexpr Real kNaN = std::numeric_limits<Real>::quiet_NaN();
-
-std::string fmt(const char* f, double v) {
-  char b[96];
-  std::snprintf(b, sizeof b, f, v);
-  return b;
-}
 }  // namespace
 
 const char* quantity_name(int q) {
@@ -91,100 +87,6 @@ std::array<Real, kQuantities> test_residuals(const MeasuredTest& measured, const
 }
 
 // ---------------------------------------------------------------------------------------------------
-// Reading curves
-
-Real feature_window(Real e) { return std::min(0.3 * e, 0.0025); }
-
-Real curve_value(const std::vector<Real>& eps_a, const std::vector<Real>& v, Real e) {
-  if (eps_a.empty() || e < eps_a.front() || e > eps_a.back()) return kNaN;
-  const Real h = feature_window(e);
-  const auto lo = std::lower_bound(eps_a.begin(), eps_a.end(), e - h) - eps_a.begin();
-  const auto hi = std::upper_bound(eps_a.begin(), eps_a.end(), e + h) - eps_a.begin();
-  if (hi - lo >= 3) {
-    Real sx = 0, sy = 0, sxx = 0, sxy = 0;
-    const Real n = static_cast<Real>(hi - lo);
-    for (auto i = lo; i < hi; ++i) {
-      const Real x = eps_a[i] - e;
-      sx += x, sy += v[i], sxx += x * x, sxy += x * v[i];
-    }
-    const Real det = n * sxx - sx * sx;
-    if (det > 0) return (sxx * sy - sx * sxy) / det;  // the line's value at x = 0
-  }
-  const auto j = std::lower_bound(eps_a.begin(), eps_a.end(), e) - eps_a.begin();
-  if (j == 0 || eps_a[j] == e) return v[j];
-  const Real w = (e - eps_a[j - 1]) / (eps_a[j] - eps_a[j - 1]);
-  return (1 - w) * v[j - 1] + w * v[j];
-}
-
-/// Residuals about a least-squares parabola through the 21 rows around each row: the trend of a smooth curve, its
-/// bend included (the stiff start of a triaxial curve, the peak), is removed and its noise kept. The median
-/// absolute residual keeps the scale robust to the few rows where the trend still shows. A correlated noise is
-/// partly taken up as trend (an AR(1) of 0.7 reads 0.37, tests/test_misfit.cpp).
-RowNoise row_noise(const std::vector<Real>& eps_a, const std::vector<Real>& v) {
-  constexpr int kHalf = 10, kRows = 2 * kHalf + 1;
-  const int n = static_cast<int>(v.size());
-  if (n < kMinNoiseRows) return {kNaN, kNaN};
-  std::vector<Real> e;
-  for (int i = kHalf; i < n - kHalf; ++i) {
-    Eigen::Matrix<Real, kRows, 3> A;
-    Eigen::Matrix<Real, kRows, 1> y;
-    const Real h = eps_a[i + kHalf] - eps_a[i - kHalf];  // scales x to O(1) for the conditioning
-    for (int j = 0; j < kRows; ++j) {
-      const Real x = (eps_a[i - kHalf + j] - eps_a[i]) / h;
-      A(j, 0) = 1, A(j, 1) = x, A(j, 2) = x * x;
-      y(j) = v[i - kHalf + j];
-    }
-    const Eigen::Matrix<Real, 3, 1> c = A.colPivHouseholderQr().solve(y);
-    e.push_back(v[i] - c(0));
-  }
-  std::vector<Real> a(e.size());
-  std::transform(e.begin(), e.end(), a.begin(), [](Real x) { return std::fabs(x); });
-  std::nth_element(a.begin(), a.begin() + a.size() / 2, a.end());
-  // 1.4826 MAD is the standard deviation of Gaussian noise; a parabola fitted to kRows rows takes three of their
-  // degrees of freedom, which the factor puts back.
-  const Real sd = 1.4826 * a[a.size() / 2] * std::sqrt(Real(kRows) / (kRows - 3));
-  Real s0 = 0, s1 = 0;
-  for (std::size_t i = 0; i + 1 < e.size(); ++i) s0 += e[i] * e[i], s1 += e[i] * e[i + 1];
-  // Residuals about a fitted curve lean negative at lag 1 even for white noise; a negative estimate is read as 0.
-  const Real rho = s0 > 0 ? std::clamp(s1 / s0, Real(0), Real(0.95)) : 0;
-  return {sd, rho};
-}
-
-MeasuredTest mean_curve(const std::vector<MeasuredTest>& members) {
-  const MeasuredTest* first = nullptr;
-  for (const MeasuredTest& t : members)
-    if (!t.q.empty() && std::isfinite(t.q_peak)) {
-      first = &t;
-      break;
-    }
-  if (!first) return members.front();
-  MeasuredTest out = *first;
-  const bool volume = !first->eps_v.empty();
-  for (std::size_t i = 0; i < out.eps_a.size(); ++i) {
-    Real q = 0, ev = 0, vr = 0;
-    int n = 0;
-    for (const MeasuredTest& t : members) {
-      if (t.q.empty() || !std::isfinite(t.q_peak) || out.eps_a[i] > t.eps_a.back()) continue;
-      const auto j = std::lower_bound(t.eps_a.begin(), t.eps_a.end(), out.eps_a[i]) - t.eps_a.begin();
-      const auto at = [&](const std::vector<Real>& y) {
-        if (j == 0) return y[0];
-        const Real w = (out.eps_a[i] - t.eps_a[j - 1]) / (t.eps_a[j] - t.eps_a[j - 1]);
-        return (1 - w) * y[j - 1] + w * y[j];
-      };
-      q += at(t.q);
-      if (volume) ev += at(t.eps_v);
-      vr += t.void_ratio;
-      ++n;
-    }
-    out.q[i] = q / n;
-    if (volume) out.eps_v[i] = ev / n;
-    out.void_ratio = vr / n;
-  }
-  summarise(out);
-  return out;
-}
-
-// ---------------------------------------------------------------------------------------------------
 // The misfit
 
 namespace {
@@ -201,6 +103,93 @@ Real strain_correlation(const Feature& a, const Feature& b, Real length) {
 /// Key of a curve feature across tests: (quantity, strain).
 using FeatureKey = std::pair<int, Real>;
 FeatureKey key_of(const Feature& f) { return {f.quantity, f.strain}; }
+
+/// A variance per feature key, pooled over tests (q in units of sigma3), with its degrees of freedom.
+struct PooledVariance {
+  std::map<FeatureKey, Real> var;
+  std::map<FeatureKey, int> dof;
+};
+
+/// The simulator's scatter: member deviations from their test's mean (`values` [test][member][feature]),
+/// pooled over tests per feature key and inflated by Student's t; `z` receives the scaled deviations.
+PooledVariance ensemble_scatter(const std::vector<std::vector<Feature>>& features,
+                                const std::vector<MeasuredTest>& measured,
+                                const std::vector<std::vector<std::vector<Real>>>& values,
+                                std::vector<std::vector<std::vector<Real>>>& z) {
+  PooledVariance p;
+  for (std::size_t k = 0; k < measured.size(); ++k) {
+    const std::vector<std::vector<Real>>& v = values[k];
+    const std::size_t nf = features[k].size();
+    std::vector<Real> mean(nf);
+    for (std::size_t f = 0; f < nf; ++f) {
+      Real s = 0;
+      int m = 0;
+      for (const auto& row : v)
+        if (std::isfinite(row[f])) s += row[f], ++m;
+      mean[f] = s / std::max(m, 1);
+      if (m < 2) continue;
+      const Real scale = pooled_scale(features[k][f], measured[k].sigma3);
+      for (const auto& row : v)
+        if (std::isfinite(row[f])) p.var[key_of(features[k][f])] += (row[f] - mean[f]) * (row[f] - mean[f]) / (scale * scale);
+      p.dof[key_of(features[k][f])] += m - 1;
+    }
+    for (const auto& row : v) {
+      std::vector<Real> d(nf);
+      for (std::size_t f = 0; f < nf; ++f) d[f] = (row[f] - mean[f]) / pooled_scale(features[k][f], measured[k].sigma3);
+      z[k].push_back(d);
+    }
+  }
+  // Student's t: the variance of a deviation measured against an estimate of nu degrees of freedom.
+  const Real nu = static_cast<Real>(values.front().size()) - 1;
+  const Real t_factor = nu > 2 ? nu / (nu - 2) : 3;
+  for (auto& [key, var] : p.var) var = t_factor * var / std::max(p.dof[key], 1);
+  return p;
+}
+
+/// The correlation length along strain: ln rho = -|d ln e| / l fitted through the origin to the pooled sample
+/// correlations of the deviations z of pairs of one quantity (clamped to [0.3, 5]: from one strain decade of
+/// independence to near-rigid offsets); `fallback` when no pair is usable.
+Real fitted_length(const std::vector<std::vector<Feature>>& features,
+                   const std::vector<std::vector<std::vector<Real>>>& z, Real fallback) {
+  Real num = 0, den = 0;
+  const std::vector<Feature>& fs0 = features.front();
+  for (std::size_t a = 0; a < fs0.size(); ++a)
+    for (std::size_t b = a + 1; b < fs0.size(); ++b) {
+      if (fs0[a].quantity != fs0[b].quantity) continue;
+      Real sab = 0, saa = 0, sbb = 0;
+      for (std::size_t k = 0; k < features.size(); ++k) {
+        if (features[k].size() != fs0.size()) continue;
+        for (const auto& d : z[k])
+          if (std::isfinite(d[a]) && std::isfinite(d[b])) sab += d[a] * d[b], saa += d[a] * d[a], sbb += d[b] * d[b];
+      }
+      const Real r = saa > 0 && sbb > 0 ? sab / std::sqrt(saa * sbb) : 0;
+      if (r <= 0.05 || r >= 0.999) continue;
+      const Real dl = std::fabs(std::log(fs0[a].strain / fs0[b].strain));
+      num += dl * dl, den += -dl * std::log(r);
+    }
+  return den > 0 ? std::clamp(num / den, Real(0.3), Real(5)) : fallback;
+}
+
+/// Replicates: the pooled scatter between the tests of one material and pressure holds data and specimen noise.
+PooledVariance replicate_scatter(const std::vector<std::vector<Feature>>& features,
+                                 const std::vector<MeasuredTest>& measured) {
+  PooledVariance p;
+  for (const auto& g : replicate_groups(measured)) {
+    if (g.size() < 2) continue;
+    std::map<FeatureKey, std::vector<Real>> vals;
+    for (std::size_t k : g)
+      for (const Feature& f : features[k]) vals[key_of(f)].push_back(f.measured / pooled_scale(f, measured[k].sigma3));
+    for (const auto& [key, v] : vals) {
+      if (v.size() < 2) continue;
+      Real s = 0;
+      for (Real x : v) s += x;
+      for (Real x : v) p.var[key] += (x - s / v.size()) * (x - s / v.size());
+      p.dof[key] += static_cast<int>(v.size()) - 1;
+    }
+  }
+  for (auto& [key, var] : p.var) var /= p.dof[key];
+  return p;
+}
 
 }  // namespace
 
@@ -308,86 +297,21 @@ void Misfit::build_summary_noise(const std::vector<MeasuredTest>& measured, cons
 
 void Misfit::build_curve_noise(const std::vector<MeasuredTest>& measured, const NoiseOptions& noise,
                                const Ensemble& ref, Real sim_balls) {
-  // The simulator's scatter: member deviations from their test's mean, pooled over tests per feature key.
-  std::map<FeatureKey, Real> ens_var;
-  std::map<FeatureKey, int> ens_dof;
   std::vector<std::vector<std::vector<Real>>> z(measured.size());  // [test][member][feature], scaled deviations
-  for (std::size_t k = 0; k < measured.size(); ++k) {
-    std::vector<std::vector<Real>> v;
-    for (const MeasuredTest& t : ref[k]) v.push_back(values(k, t));
-    const std::size_t nf = features_[k].size();
-    for (std::size_t f = 0; f < nf; ++f) {
-      Real s = 0;
-      int m = 0;
-      for (const auto& row : v)
-        if (std::isfinite(row[f])) s += row[f], ++m;
-      if (m < 2) continue;
-      const Real mean = s / m, scale = pooled_scale(features_[k][f], measured[k].sigma3);
-      for (const auto& row : v)
-        if (std::isfinite(row[f])) ens_var[key_of(features_[k][f])] += (row[f] - mean) * (row[f] - mean) / (scale * scale);
-      ens_dof[key_of(features_[k][f])] += m - 1;
-    }
-    for (const auto& row : v) {
-      std::vector<Real> d(nf);
-      for (std::size_t f = 0; f < nf; ++f) {
-        Real s = 0;
-        int m = 0;
-        for (const auto& r2 : v)
-          if (std::isfinite(r2[f])) s += r2[f], ++m;
-        d[f] = (row[f] - s / std::max(m, 1)) / pooled_scale(features_[k][f], measured[k].sigma3);
-      }
-      z[k].push_back(d);
-    }
+  PooledVariance ens, rep = replicate_scatter(features_, measured);
+  {
+    std::vector<std::vector<std::vector<Real>>> v(measured.size());
+    for (std::size_t k = 0; k < measured.size(); ++k)
+      for (const MeasuredTest& t : ref[k]) v[k].push_back(values(k, t));
+    ens = ensemble_scatter(features_, measured, v, z);
   }
-  // Student's t: the variance of a deviation measured against an estimate of nu degrees of freedom.
-  const Real nu = static_cast<Real>(ref.front().size()) - 1;
-  const Real t_factor = nu > 2 ? nu / (nu - 2) : 3;
-  for (auto& [key, var] : ens_var) var = t_factor * var / std::max(ens_dof[key], 1);
-  // The correlation length: ln rho = -|d ln e| / l fitted through the origin to the pooled sample correlations of
-  // pairs of one quantity (clamped to [0.3, 5]: from one strain decade of independence to near-rigid offsets).
-  Real num = 0, den = 0;
-  if (ref.front().size() > 2) {
-    const std::vector<Feature>& fs0 = features_.front();
-    for (std::size_t a = 0; a < fs0.size(); ++a)
-      for (std::size_t b = a + 1; b < fs0.size(); ++b) {
-        if (fs0[a].quantity != fs0[b].quantity) continue;
-        Real sab = 0, saa = 0, sbb = 0;
-        for (std::size_t k = 0; k < measured.size(); ++k) {
-          if (features_[k].size() != fs0.size()) continue;
-          for (const auto& d : z[k])
-            if (std::isfinite(d[a]) && std::isfinite(d[b])) sab += d[a] * d[b], saa += d[a] * d[a], sbb += d[b] * d[b];
-        }
-        const Real r = saa > 0 && sbb > 0 ? sab / std::sqrt(saa * sbb) : 0;
-        if (r <= 0.05 || r >= 0.999) continue;
-        const Real dl = std::fabs(std::log(fs0[a].strain / fs0[b].strain));
-        num += dl * dl, den += -dl * std::log(r);
-      }
-  }
-  length_ = den > 0 ? std::clamp(num / den, Real(0.3), Real(5)) : noise.lab.length;
-
-  // Replicates: the pooled scatter between the tests of one material and pressure holds data and specimen noise.
-  std::map<FeatureKey, Real> rep_var;
-  std::map<FeatureKey, int> rep_dof;
-  for (const auto& g : replicate_groups(measured)) {
-    if (g.size() < 2) continue;
-    std::map<FeatureKey, std::vector<Real>> vals;
-    for (std::size_t k : g)
-      for (const Feature& f : features_[k]) vals[key_of(f)].push_back(f.measured / pooled_scale(f, measured[k].sigma3));
-    for (const auto& [key, v] : vals) {
-      if (v.size() < 2) continue;
-      Real s = 0;
-      for (Real x : v) s += x;
-      for (Real x : v) rep_var[key] += (x - s / v.size()) * (x - s / v.size());
-      rep_dof[key] += static_cast<int>(v.size()) - 1;
-    }
-  }
-  for (auto& [key, var] : rep_var) var /= rep_dof[key];
+  length_ = ref.front().size() > 2 ? fitted_length(features_, z, noise.lab.length) : noise.lab.length;
   const bool lab = noise.mode == "lab";
-  const bool no_ensemble = ens_var.empty();
-  source_ = lab ? "the lab model" : !rep_var.empty() ? "replicates" : "the data";
-  if (!lab && !rep_var.empty())
+  const bool no_ensemble = ens.var.empty();
+  source_ = lab ? "the lab model" : !rep.var.empty() ? "replicates" : "the data";
+  if (!lab && !rep.var.empty())
     notes_.push_back("replicates: the scatter between tests of one material and pressure (pooled over " +
-                     std::to_string(rep_dof.begin()->second) + " degrees of freedom) is the data and specimen noise");
+                     std::to_string(rep.dof.begin()->second) + " degrees of freedom) is the data and specimen noise");
   if (no_ensemble)
     notes_.push_back("the simulator has one specimen: its scatter is not measured and counts as zero");
 
@@ -403,7 +327,7 @@ void Misfit::build_curve_noise(const std::vector<MeasuredTest>& measured, const 
       const RowNoise qn = row_noise(t.eps_a, t.q), vn = row_noise(t.eps_a, t.eps_v);
       const bool rows_given = !t.q_sd.empty();
       if (!rows_given && !std::isfinite(qn.sd)) {
-        use_lab = rep_var.empty();
+        use_lab = rep.var.empty();
         notes_.push_back(where + ": " + std::to_string(t.q.size()) + " rows, fewer than " +
                          std::to_string(kMinNoiseRows) + " to estimate noise from: " +
                          (use_lab ? "the lab model is used" : "replicates alone give it"));
@@ -435,10 +359,10 @@ void Misfit::build_curve_noise(const std::vector<MeasuredTest>& measured, const 
     for (int i = 0; i < n; ++i) {
       Feature& f = fs[i];
       const Real scale = pooled_scale(f, t.sigma3);
-      auto e = ens_var.find(key_of(f));
-      f.ensemble_sd = e == ens_var.end() ? 0 : std::sqrt(e->second) * scale;
-      auto r = rep_var.find(key_of(f));
-      const bool from_rep = !use_lab && !lab && r != rep_var.end();
+      auto e = ens.var.find(key_of(f));
+      f.ensemble_sd = e == ens.var.end() ? 0 : std::sqrt(e->second) * scale;
+      auto r = rep.var.find(key_of(f));
+      const bool from_rep = !use_lab && !lab && r != rep.var.end();
       if (use_lab) {
         const Real lab_sd = f.quantity == 0 ? std::max(noise.lab.q_rel * std::fabs(f.measured), 2e-3 * t.sigma3)
                                             : std::max(noise.lab.ev_rel * std::fabs(f.measured), noise.lab.ev_abs);

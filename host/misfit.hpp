@@ -34,6 +34,7 @@
 #include <string>
 #include <vector>
 
+#include "curve_reading.hpp"
 #include "measured.hpp"
 #include "periodic_lab.hpp"
 
@@ -73,24 +74,6 @@ constexpr Real kMissingResidual = 10;
 /// quantities before it (E_ini first), the shared specimen factor counted once.
 std::array<Real, kQuantities> test_residuals(const MeasuredTest& measured, const MeasuredTest& simulated,
                                              const NoiseModel& noise);
-
-/// The strains at which curves are compared.
-constexpr std::array<Real, 12> kFeatureStrains{2e-4, 5e-4, 1e-3, 2e-3, 5e-3, 0.01, 0.02, 0.03, 0.05, 0.075, 0.10, 0.15};
-
-/// Half-width of the window of curve_value at strain e.
-Real feature_window(Real e);
-
-/// The value of v at strain e: a least-squares line over the rows within feature_window(e), or the straight
-/// line between the rows around e when the window holds fewer than three. NaN outside the curve.
-Real curve_value(const std::vector<Real>& eps_a, const std::vector<Real>& v, Real e);
-
-/// Scatter of a curve's rows about a smooth trend (local parabolas): the standard deviation of the noise and the
-/// lag-1 correlation of the rows about the trend (>= 0). NaN when the curve has fewer than kMinNoiseRows rows.
-struct RowNoise {
-  Real sd = 0, rho = 0;
-};
-constexpr int kMinNoiseRows = 20;
-RowNoise row_noise(const std::vector<Real>& eps_a, const std::vector<Real>& v);
 
 /// How the data's noise is taken: "data" (standard-deviation columns, else replicates, else the curves'
 /// own scatter; the lab model where none of these is possible) or "lab".
@@ -158,9 +141,5 @@ class Misfit {
 /// built on it.
 Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<MeasuredTest>& measured,
                       const NoiseOptions& noise);
-
-/// The mean curve of an ensemble's members (each interpolated onto the first successful member's strains),
-/// summarised: what the figures and tables show for a parameter point.
-MeasuredTest mean_curve(const std::vector<MeasuredTest>& members);
 
 }  // namespace dem

@@ -28,6 +28,11 @@ void mark_failed(MeasuredTest& t) {
       std::numeric_limits<Real>::quiet_NaN();
 }
 
+/// Cell volume over the balls' volume, less one.
+Real void_ratio_of(const std::vector<BallSpec>& balls, const std::array<Real, 3>& cell) {
+  return cell[0] * cell[1] * cell[2] / solid_volume(balls) - 1;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------------
@@ -47,9 +52,7 @@ PeriodicLab::PeriodicLab(const Config& base, bool verbose, int members, unsigned
     c.run.seed = first_seed + static_cast<unsigned>(k);
     Specimen s;
     prepare_periodic_specimen(c, s.balls, s.cell, verbose && k == 0);
-    Real solid = 0;
-    for (const BallSpec& b : s.balls) solid += 4.0 / 3.0 * M_PI * b.radius * b.radius * b.radius;
-    s.void_ratio = s.cell[0] * s.cell[1] * s.cell[2] / solid - 1;
+    s.void_ratio = void_ratio_of(s.balls, s.cell);
     specimens_.push_back(std::move(s));
   }
 }
@@ -59,9 +62,7 @@ Real prepared_void_ratio(const Config& cfg) {
   std::vector<BallSpec> balls;
   std::array<Real, 3> cell{};
   prepare_periodic_specimen(cfg, balls, cell, false);
-  Real solid = 0;
-  for (const BallSpec& b : balls) solid += 4.0 / 3.0 * M_PI * b.radius * b.radius * b.radius;
-  return cell[0] * cell[1] * cell[2] / solid - 1;
+  return void_ratio_of(balls, cell);
 }
 }  // namespace
 
