@@ -13,6 +13,7 @@
 #if !defined(KOKKOS_ENABLE_CUDA) && !defined(KOKKOS_ENABLE_HIP) && !defined(KOKKOS_ENABLE_SYCL)
 #define TRIAXDEM_HOST_PACKS 1
 #include <cmath>
+#include <cstring>
 #if defined(__AVX__)
 #include <immintrin.h>
 #endif
@@ -102,6 +103,23 @@ inline Pack4 max(const Pack4& a, const Pack4& b) { return select(a < b, b, a); }
 inline Real max_lane(const Pack4& a) {
   const Real l = a[0] < a[1] ? a[1] : a[0], h = a[2] < a[3] ? a[3] : a[2];
   return l < h ? h : l;
+}
+
+/// Lanes a, b, c, d of the eight lanes of x then y, and a pack from four doubles in memory. The two compilers
+/// spell a constant shuffle differently (GCC's __builtin_shuffle takes an index vector, clang's
+/// __builtin_shufflevector constant arguments); this is the one place that knows.
+template <int a, int b, int c, int d>
+inline Pack4::V shuffle(const Pack4::V& x, const Pack4::V& y) {
+#if defined(__clang__)
+  return __builtin_shufflevector(x, y, a, b, c, d);
+#else
+  return __builtin_shuffle(x, y, Mask4::V{a, b, c, d});
+#endif
+}
+inline Pack4::V load_pack(const double* p) {
+  Pack4::V r;
+  std::memcpy(&r, p, sizeof(r));
+  return r;
 }
 
 using ContactPack = Pack4;

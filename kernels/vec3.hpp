@@ -2,6 +2,7 @@
 /// Small device-callable 3-vector and the math shim that compiles on Kokkos 3.4 and 4.x
 /// (Kokkos::sqrt/min/max appeared in 3.7; 4.0 dropped Kokkos::Experimental math).
 #include <cstddef>
+#include <cstring>
 #include <type_traits>
 
 #include "simd.hpp"
@@ -124,16 +125,12 @@ KOKKOS_INLINE_FUNCTION Vec3T<T> load_rows(const V& v, int s0) {
 #ifdef TRIAXDEM_HOST_PACKS
   if constexpr (std::is_same<T, Pack4>::value) {
     static_assert(std::is_same<typename V::array_layout, Kokkos::LayoutRight>::value, "rows must be contiguous");
-    using P = Pack4::V;
-    using I = Mask4::V;
-    P r0, r1, r2;  // (x0 y0 z0 x1) (y1 z1 x2 y2) (z2 x3 y3 z3)
     const Real* a = &v(s0, 0);
-    __builtin_memcpy(&r0, a, sizeof(P));
-    __builtin_memcpy(&r1, a + 4, sizeof(P));
-    __builtin_memcpy(&r2, a + 8, sizeof(P));
-    return Vec3T<T>(Pack4(__builtin_shuffle(__builtin_shuffle(r0, r1, I{0, 3, 6, 0}), r2, I{0, 1, 2, 5})),
-                    Pack4(__builtin_shuffle(__builtin_shuffle(r0, r1, I{1, 4, 7, 0}), r2, I{0, 1, 2, 6})),
-                    Pack4(__builtin_shuffle(__builtin_shuffle(r0, r1, I{2, 5, 0, 0}), r2, I{0, 1, 4, 7})));
+    // (x0 y0 z0 x1) (y1 z1 x2 y2) (z2 x3 y3 z3)
+    const Pack4::V r0 = load_pack(a), r1 = load_pack(a + 4), r2 = load_pack(a + 8);
+    return Vec3T<T>(Pack4(shuffle<0, 1, 2, 5>(shuffle<0, 3, 6, 0>(r0, r1), r2)),
+                    Pack4(shuffle<0, 1, 2, 6>(shuffle<1, 4, 7, 0>(r0, r1), r2)),
+                    Pack4(shuffle<0, 1, 4, 7>(shuffle<2, 5, 0, 0>(r0, r1), r2)));
   } else
 #endif
     return load(v, s0);
@@ -143,12 +140,11 @@ KOKKOS_INLINE_FUNCTION void store_rows(const V& v, int s0, const Vec3T<T>& a) {
 #ifdef TRIAXDEM_HOST_PACKS
   if constexpr (std::is_same<T, Pack4>::value) {
     static_assert(std::is_same<typename V::array_layout, Kokkos::LayoutRight>::value, "rows must be contiguous");
-    using I = Mask4::V;
     const Pack4::V x = a.x.v, y = a.y.v, z = a.z.v;
-    const Pack4::V r[3] = {__builtin_shuffle(__builtin_shuffle(x, y, I{0, 4, 0, 1}), z, I{0, 1, 4, 3}),
-                           __builtin_shuffle(__builtin_shuffle(y, z, I{1, 5, 0, 2}), x, I{0, 1, 6, 3}),
-                           __builtin_shuffle(__builtin_shuffle(z, x, I{2, 7, 0, 3}), y, I{0, 1, 7, 3})};
-    __builtin_memcpy(&v(s0, 0), r, sizeof(r));
+    const Pack4::V r[3] = {shuffle<0, 1, 4, 3>(shuffle<0, 4, 0, 1>(x, y), z),
+                           shuffle<0, 1, 6, 3>(shuffle<1, 5, 0, 2>(y, z), x),
+                           shuffle<0, 1, 7, 3>(shuffle<2, 7, 0, 3>(z, x), y)};
+    std::memcpy(&v(s0, 0), r, sizeof(r));
   } else
 #endif
     store(v, s0, a);
