@@ -192,33 +192,51 @@ bool recentre(FreeParam& f, Real v) {
 
 namespace {
 
-CalibrationResult search(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,
-                         const std::vector<MeasuredTest>& measured, const Misfit& misfit, int rounds,
-                         const CalibrationProgress& progress, int widen) {
+CalibrationResult search(const Simulator& simulate, const Model& base, const std::vector<FreeParam>& free, int data,
+                         int rounds, int widen) {
   const int d = static_cast<int>(free.size());
   CalibrationResult res;
   res.free = free;
-  res.data = misfit.data();
-  long design_points = 1;
-  for (int k = 0; k < d; ++k) design_points *= 3;
-  const long planned = (design_points + rounds) * static_cast<long>(measured.size()) * lab.members();
+  res.data = data;
   auto model_at = [&](const std::vector<Real>& u) {
     Model m = base;
     for (int k = 0; k < d; ++k) set_param(m, free[k].name, free[k].value(u[k]));
     return m;
   };
+  auto run_before = [&](const std::vector<Real>& u) {
+    for (const Evaluation& e : res.design) {
+      Real d2 = 0;
+      for (int k = 0; k < d; ++k) d2 += (e.u[k] - u[k]) * (e.u[k] - u[k]);
+      if (d2 < 1e-6) return true;
+    }
+    return false;
+  };
   auto evaluate = [&](const std::vector<Real>& u) {
     Evaluation e;
     e.u = u;
-    const Ensemble ens = lab.run_ensemble(model_at(u), measured);
-    for (const auto& members : ens) e.sim.push_back(mean_curve(members));
-    e.r = misfit.residuals(ens);
+    SimulatedPoint s = simulate(model_at(u));
+    e.sim = std::move(s.sim);
+    e.r = std::move(s.r);
     e.chi2 = chi2_of(e.r);
     res.design.push_back(e);
-    if (res.design.size() == 1 || e.chi2 < res.best.chi2) res.best = e;
-    if (progress) progress(lab.runs(), planned, res.best.chi2);
+    const bool better = res.design.size() == 1 || e.chi2 < res.best.chi2;
+    if (better) res.best = e;
+    return better;
   };
-  std::vector<int> idx(d, 0);
+  // Runs the surrogate's optimum, the surfaces centred on the best run; false when that point was run before.
+  auto surrogate_step = [&]() {
+    const std::vector<QuadraticSurface> s = response_surfaces(res.design, res.best.u);
+    const std::vector<Real> u = minimise_unit_box([&](const std::vector<Real>& x) {
+      Real c = 0;
+      for (const QuadraticSurface& q : s) c += q(x) * q(x);
+      return c;
+    }, d);
+    if (run_before(u)) return false;
+    evaluate(u);
+    return true;
+  };
+  long design_points = 1;
+  for (int k = 0; k < d; ++k) design_points *= 3;
   for (long p = 0; p < design_points; ++p) {
     std::vector<Real> u(d);
     long c = p;
@@ -226,22 +244,29 @@ CalibrationResult search(PeriodicLab& lab, const Model& base, const std::vector<
     evaluate(u);
   }
   for (int round = 0; round < rounds && d > 0; ++round) {
-    const std::vector<QuadraticSurface> s = response_surfaces(res.design, res.best.u);
-    const std::vector<Real> u = minimise_unit_box([&](const std::vector<Real>& x) {
-      Real c = 0;
-      for (const QuadraticSurface& q : s) c += q(x) * q(x);
-      return c;
-    }, d);
-    bool seen = false;
-    for (const Evaluation& e : res.design) {
-      Real d2 = 0;
-      for (int k = 0; k < d; ++k) d2 += (e.u[k] - u[k]) * (e.u[k] - u[k]);
-      seen = seen || d2 < 1e-6;
-    }
-    if (seen) break;  // the surface points at a point already run: converged
     const Real before = res.best.chi2;
-    evaluate(u);
+    if (!surrogate_step()) break;  // the surface points at a point already run: converged
     if (round > 0 && res.best.chi2 > 0.98 * before) break;  // stopped improving
+  }
+  if (d > 0) {
+    bool moved = false;
+    for (Real step : {0.25, 0.125}) {
+      for (bool better = true; better;) {
+        better = false;
+        const std::vector<Real> from = res.best.u;
+        for (int k = 0; k < d && !better; ++k)
+          for (Real sign : {-1.0, 1.0}) {
+            std::vector<Real> u = from;
+            u[k] += sign * step;
+            if (u[k] < -1e-9 || u[k] > 1 + 1e-9 || run_before(u)) continue;
+            if (evaluate(u)) {
+              better = moved = true;
+              break;
+            }
+          }
+      }
+    }
+    if (moved) surrogate_step();
   }
   res.model = model_at(res.best.u);
   for (int k = 0; k < d; ++k) res.values.push_back(free[k].value(res.best.u[k]));
@@ -258,7 +283,7 @@ CalibrationResult search(PeriodicLab& lab, const Model& base, const std::vector<
     notes.push_back(line);
   }
   if (notes.empty()) return res;
-  CalibrationResult again = search(lab, base, moved, measured, misfit, rounds, progress, widen - 1);
+  CalibrationResult again = search(simulate, base, moved, data, rounds, widen - 1);
   if (again.best.chi2 >= res.best.chi2) {
     notes.push_back("the wider search found no better point");
     for (int k = 0; k < d; ++k)
@@ -345,6 +370,25 @@ bool CalibrationResult::inside_region(const std::vector<Real>& values) const {
   return surrogate_chi2(u) - surrogate_chi2(best.u) <= chi2_95(static_cast<int>(free.size())) * scale;
 }
 
+Real CalibrationResult::flat_share() const {
+  const int d = static_cast<int>(free.size());
+  if (d == 0 || surfaces.empty()) return 0;
+  const int n = d <= 3 ? 21 : 7;
+  const Real limit = surrogate_chi2(best.u) + chi2_95(d) * scale;
+  long inside = 0, all = 0;
+  std::vector<int> idx(d, 0);
+  std::vector<Real> u(d);
+  for (;;) {
+    for (int k = 0; k < d; ++k) u[k] = static_cast<Real>(idx[k]) / (n - 1);
+    inside += surrogate_chi2(u) <= limit;
+    ++all;
+    int k = 0;
+    while (k < d && ++idx[k] == n) idx[k++] = 0;
+    if (k == d) break;
+  }
+  return static_cast<Real>(inside) / all;
+}
+
 std::vector<std::string> CalibrationResult::inseparable() const {
   std::vector<std::string> out;
   for (std::size_t a = 0; a < correlation.size(); ++a)
@@ -357,12 +401,35 @@ std::vector<std::string> CalibrationResult::inseparable() const {
   return out;
 }
 
+long planned_points(int d, int rounds) {
+  long design = 1;
+  for (int k = 0; k < d; ++k) design *= 3;
+  return design + rounds + (d > 0 ? 4 * d + 1 : 0);  // the compass: both steps' polls once, and its last round
+}
+
+CalibrationResult calibrate(const Simulator& simulate, const Model& base, const std::vector<FreeParam>& free, int data,
+                            int rounds, int widen) {
+  CalibrationResult r = search(simulate, base, free, data, rounds, widen);
+  add_uncertainty(r);
+  return r;
+}
+
 CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,
                             const std::vector<MeasuredTest>& measured, const Misfit& misfit, int rounds,
                             const CalibrationProgress& progress, int widen) {
-  CalibrationResult r = search(lab, base, free, measured, misfit, rounds, progress, widen);
-  add_uncertainty(r);
-  return r;
+  const long planned = planned_points(static_cast<int>(free.size()), rounds) * static_cast<long>(measured.size()) *
+                       lab.members();
+  Real best = std::numeric_limits<Real>::infinity();
+  auto simulate = [&](const Model& m) {
+    SimulatedPoint s;
+    const Ensemble ens = lab.run_ensemble(m, measured);
+    for (const auto& members : ens) s.sim.push_back(mean_curve(members));
+    s.r = misfit.residuals(ens);
+    best = std::min(best, chi2_of(s.r));
+    if (progress) progress(lab.runs(), planned, best);
+    return s;
+  };
+  return calibrate(simulate, base, free, misfit.data(), rounds, widen);
 }
 
 }  // namespace dem

@@ -23,7 +23,13 @@
 ///      by a dense grid and then coordinate refinement;
 ///   3. a run at the surrogate's optimum, added to the design; the surface is refitted with weights that
 ///      favour points near the optimum; repeated until the run's chi2 stops improving (at most `rounds`);
-///   4. when the best point lies on the edge of a range that can move (not a hard limit such as mu_r = 0), the
+///   4. a compass stage on the simulator itself: from the best run, steps of 1/4 and then 1/8 of each unit
+///      range along every axis, moving to any better run. A quadratic surface cannot follow a misfit that
+///      saturates or has a second, narrower valley between the design's points, and stops at an edge of the range
+///      when the optimum lies inside (seen on another code's data: chi2 76 at the edge, 37 inside). 1/8 is
+///      the finest step worth a run: below it the runs of a small ensemble differ by their chaos more than by
+///      the step. A last surrogate round, centred on the compass's best, refines between its points;
+///   5. when the best point lies on the edge of a range that can move (not a hard limit such as mu_r = 0), the
 ///      range is re-centred on it and the search starts again (at most `widen` times); the better answer wins.
 /// The reported fit is the best point actually run, never a surrogate value.
 #include <array>
@@ -111,6 +117,10 @@ struct CalibrationResult {
   /// Pairs of parameters whose correlation is beyond +-0.9, in words ("mu_s and mu_r (-0.95)"): these data
   /// cannot separate them.
   std::vector<std::string> inseparable() const;
+  /// How flat the minimum is: the share of the searched box (unit coordinates, a grid) where the surrogate chi2
+  /// lies within the joint 95% rise of the best. A few % is a sharp optimum; tens of % say the data hardly
+  /// constrain the parameters over their ranges.
+  Real flat_share() const;
   std::vector<QuadraticSurface> surfaces;          ///< the residuals' surfaces around the best run
   std::vector<Real> offset;                        ///< best-run residual minus surface value there
 };
@@ -122,10 +132,23 @@ bool recentre(FreeParam& f, Real v);
 /// Called after each run with (runs done, runs planned, best chi2 so far).
 using CalibrationProgress = std::function<void(long, long, Real)>;
 
-/// Calibrates `free` on `measured` (one material, any number of pressures) from `base`; see the top of the file.
+/// What a search asks of its simulator at one model: the simulated tests and the normalised residuals.
+struct SimulatedPoint {
+  std::vector<MeasuredTest> sim;
+  std::vector<Real> r;
+};
+using Simulator = std::function<SimulatedPoint(const Model&)>;
+
+/// Calibrates `free` from `base` on a misfit of `data` data; see the top of the file.
+CalibrationResult calibrate(const Simulator& simulate, const Model& base, const std::vector<FreeParam>& free, int data,
+                            int rounds = 4, int widen = 2);
+/// The same on `measured` (one material, any number of pressures), simulated by the lab's ensemble.
 CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,
                             const std::vector<MeasuredTest>& measured, const Misfit& misfit, int rounds = 4,
                             const CalibrationProgress& progress = {}, int widen = 2);
+/// Parameter points a calibration of d free parameters runs at most before any widening: the design, the
+/// surrogate rounds and the compass stage (for a progress bar's plan).
+long planned_points(int d, int rounds = 4);
 
 /// One response surface per residual of the evaluations, weighted towards `centre` (unit coordinates).
 std::vector<QuadraticSurface> response_surfaces(const std::vector<Evaluation>& pts, const std::vector<Real>& centre);

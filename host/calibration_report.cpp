@@ -77,7 +77,10 @@ std::string uncertainty_text(const CalibrationResult& r, const std::string& mate
   if (r.scale > 1)
     o << at << "the misfit exceeds the noise (chi2 / dof " << fmt("%.2f", r.scale)
       << "): the intervals are widened by its square root\n";
-  o << at << r.design.size() << " parameter points run to find the optimum\n";
+  o << at << r.design.size() << " parameter points run to find the optimum; the chi2 stays within the joint 95% rise "
+    << "of its best over " << fmt("%.0f", 100 * r.flat_share()) << "% of the searched ranges ("
+    << (r.flat_share() > 0.25 ? "a flat minimum: the data hardly constrain these parameters" : "a defined minimum")
+    << ")\n";
   return o.str();
 }
 

@@ -121,10 +121,8 @@ Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreePa
   };
   say("diagnose: calibrating the base model (%d free parameters) on %zu tests, then %zu extensions\n", d,
       measured.size(), extensions().size());
-  long design = 1;
-  for (int k = 0; k < d; ++k) design *= 3;
   const long planned = static_cast<long>(measured.size()) * lab.members() *
-                       (design + 5 + static_cast<long>(extensions().size()) * 6);  // calibrate(): 4 rounds at most
+                       (planned_points(d) + static_cast<long>(extensions().size()) * 6);
   const long runs0 = lab.runs();
   Progress progress("diagnose", planned);
   Real best_chi2 = 0;
