@@ -71,7 +71,8 @@ struct Session {
                                 : load_reference(o.reference, [](const std::string& n) { free_param(n); })),
         free(free_params(base, o.free)), lab(matched(base), true), folder(new_dated_folder(o.output, kind)) {
     lab.set_jobs(o.jobs);
-    noise.mode = o.noise;
+    if (o.noise == "data" || o.noise == "lab") noise.mode = o.noise;
+    else noise = lab_noise_options(o.noise);
     for (const std::string& n : data.notes) std::printf("%s: note: %s\n", kind.c_str(), n.c_str());
   }
   NoiseOptions noise;
@@ -144,7 +145,7 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
   for (const auto& [material, tests] : by_material(ss.data, o.material)) {
     std::printf("calibrate: %s, %zu tests, free %zu parameters, %zu balls in the periodic cell\n", material.c_str(),
                 tests.size(), ss.free.size(), ss.lab.balls());
-    const long planned = (std::lround(std::pow(3.0, ss.free.size())) + 4) * static_cast<long>(tests.size()) *
+    const long planned = planned_points(static_cast<int>(ss.free.size())) * static_cast<long>(tests.size()) *
                          ss.lab.members();
     Progress progress("calibrate " + material, planned);
     const long runs0 = ss.lab.runs();
@@ -194,7 +195,7 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
   md << ". Misfit: chi2 over " << (ss.data.curves ? "q and eps_v at fixed axial strains (0.02% to 15%)"
                                                   : "the summary quantities given")
      << ", with the data's noise, the measured specimen's own scatter and the simulator's standard error "
-        "(host/misfit.hpp); noise: " << ss.noise.mode << ".\n\n";
+        "(host/misfit.hpp); noise: " << (ss.noise.mode == "lab" ? ss.noise.lab_name : "the data's") << ".\n\n";
   if (!ss.ref.values.empty())
     md << "Reference values: " << ss.ref.path << (ss.ref.comment.empty() ? "" : ": " + ss.ref.comment)
        << " The calibrated values belong to this simulator (its cell, density and boundary), the reference values to "

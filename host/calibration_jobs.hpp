@@ -15,7 +15,7 @@ struct CalibrationOptions {
   std::string material;                   ///< empty: every material of the file
   int jobs = 1;                           ///< simulator runs at once (PeriodicLab::set_jobs)
   std::string reference;                  ///< optional reference values (load_reference) to set beside the fit
-  std::string noise = "data";             ///< the data's noise (NoiseOptions::mode): data or lab
+  std::string noise = "data";             ///< the data's noise: data, lab or a lab noise file
 };
 
 /// Calibrates each material of the data; writes calibrate_<date>/ under options.output. Returns 0.

@@ -1,8 +1,10 @@
 #include "config.hpp"
 #include "config_checks.hpp"
+#include "noise_model.hpp"
 
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <set>
@@ -149,19 +151,16 @@ void check_memory(TableReader& t, const std::string& key, long balls) {
     t.fail(key, m.str());
   }
 }
-}  // namespace
-
-Config load_config(const std::string& path) {
+std::string file_text(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ConfigError(path + ": cannot be read");
   std::ostringstream text;
   text << in.rdbuf();
-  return parse_config(text.str(), path);
+  return text.str();
 }
 
-Config parse_config(const std::string& text, const std::string& path) {
-  Config c;
-  c.path = path;
+/// The TOML document of `text`, whose top-level entries must be tables named in `tables`.
+toml::table parse_tables(const std::string& text, const std::string& path, const std::vector<std::string>& tables) {
   check_ascii_outside_strings(text, path);
   toml::table root;
   try {
@@ -171,15 +170,24 @@ Config parse_config(const std::string& text, const std::string& path) {
     s << path << ":" << e.source().begin.line << ":" << e.source().begin.column << ": " << e.description();
     throw ConfigError(s.str());
   }
-  static const std::set<std::string> tables = {"run",    "particles", "box",     "material",
-                                               "wall_material", "solver", "specimen", "triaxial", "micro", "periodic",
-                                               "calibrate"};
   for (const auto& [k, v] : root) {
-    if (!tables.count(std::string(k.str())) || !v.is_table())
-      throw ConfigError(path + ": [" + std::string(k.str()) +
-                        "]: unknown table (allowed: run, particles, box, material, wall_material, solver, specimen, "
-                        "triaxial, micro, periodic, calibrate)");
+    if (std::find(tables.begin(), tables.end(), std::string(k.str())) == tables.end() || !v.is_table()) {
+      std::string list;
+      for (const std::string& t : tables) list += (list.empty() ? "" : ", ") + t;
+      throw ConfigError(path + ": [" + std::string(k.str()) + "]: unknown table (allowed: " + list + ")");
+    }
   }
+  return root;
+}
+}  // namespace
+
+Config load_config(const std::string& path) { return parse_config(file_text(path), path); }
+
+Config parse_config(const std::string& text, const std::string& path) {
+  Config c;
+  c.path = path;
+  toml::table root = parse_tables(text, path, {"run", "particles", "box", "material", "wall_material", "solver",
+                                                "specimen", "triaxial", "micro", "periodic", "calibrate"});
   auto table = [&](const char* name) { return TableReader(path, name, root[name].as_table()); };
 
   TableReader run = table("run");
@@ -353,6 +361,41 @@ Config parse_config(const std::string& text, const std::string& path) {
       throw ConfigError(path + ": [box] size_mm: every side must be at least 3 diameters (" +
                         std::to_string(3e3 * c.particles.diameter) + " mm)");
   return c;
+}
+
+LabNoise read_lab_noise(const std::string& path) {
+  const toml::table root = parse_tables(file_text(path), path, {"curve", "summary"});
+  LabNoise n;
+  TableReader curve(path, "curve", root["curve"].as_table());
+  // q's scatter is positive: a lab with none would make every curve datum exact.
+  curve.number("q_rel", n.curve.q_rel, 0, 1, 1, true);
+  curve.number("q_shared", n.curve.q_shared, 0, 1);
+  if (n.curve.q_shared > n.curve.q_rel)
+    curve.fail("q_shared", "the shared factor is part of q's scatter (allowed: up to q_rel = " +
+                               std::to_string(n.curve.q_rel) + ")");
+  curve.number("eps_v_rel", n.curve.ev_rel, 0, 1);
+  curve.number("eps_v_abs_pct", n.curve.ev_abs, 0, 5, 1e-2, true);
+  curve.number("length", n.curve.length, 0.05, 20);
+  curve.finish();
+  TableReader summary(path, "summary", root["summary"].as_table());
+  summary.number("specimen", n.summary.specimen, 0, 1);
+  for (int q = 0; q < kQuantities; ++q) {
+    const std::string name = quantity_name(q);
+    if (q == kStrainAtPeak) {
+      summary.number(name + "_pct", n.summary.abs[q], 0, 20, 1e-2, true);
+      continue;
+    }
+    summary.number(name, n.summary.rel[q], 0, 1, 1, q != kDilatancy);
+    if (q == kDilatancy) summary.number(name + "_abs", n.summary.abs[q], 0, 5);
+  }
+  for (int q = 0; q < kQuantities; ++q)
+    if (NoiseModel::is_stress(q) && n.summary.specimen > n.summary.rel[q])
+      summary.fail("specimen", "the shared factor is part of each stress's scatter (allowed: up to " +
+                                   std::string(quantity_name(q)) + " = " + std::to_string(n.summary.rel[q]) + ")");
+  if (n.summary.rel[kDilatancy] == 0 && n.summary.abs[kDilatancy] == 0)
+    summary.fail("max_dilatancy", "max_dilatancy and max_dilatancy_abs are both 0 (allowed: one of them above 0)");
+  summary.finish();
+  return n;
 }
 
 }  // namespace dem

@@ -91,8 +91,9 @@ int main(int argc, char** argv) {
     c->add_option("-j,--jobs", cal.jobs, "simulator runs at once, one thread each (default: one per core)")
         ->check(CLI::PositiveNumber);
     c->add_option("--noise", cal.noise, "the data's noise: data (its standard-deviation columns, replicates, or its "
-                  "curves' own scatter) or lab (a lab's fixed scatter); default data")
-        ->check(CLI::IsMember({"data", "lab"}));
+                  "curves' own scatter), lab (a lab's fixed scatter) or a lab noise file like "
+                  "configs/calibration/lab_noise.toml; default data")
+        ->check(CLI::IsMember({"data", "lab"}) | CLI::ExistingFile);
   };
   auto* calibrate = app.add_subcommand("calibrate", "fit the free parameters to measured triaxial data");
   add_calibration(calibrate);

@@ -27,6 +27,16 @@ std::array<Real, kQuantities> quantities(const MeasuredTest& t) {
   return {t.e_ini, t.q_1pct, t.q_3pct, t.q_peak, t.eps_a_peak, t.q_end, t.max_dilatancy};
 }
 
+NoiseOptions lab_noise_options(const std::string& path) {
+  const LabNoise file = read_lab_noise(path);
+  NoiseOptions o;
+  o.mode = "lab";
+  o.lab = file.curve;
+  o.summary = file.summary;
+  o.lab_name = "the lab model of " + path;
+  return o;
+}
+
 Real NoiseModel::sigma(int q, Real measured) const { return std::max(rel[q] * std::fabs(measured), abs[q]); }
 
 bool NoiseModel::is_stress(int q) { return q != kStrainAtPeak && q != kDilatancy; }
@@ -262,7 +272,7 @@ void Misfit::build_summary_noise(const std::vector<MeasuredTest>& measured, cons
   const bool given = std::any_of(measured.begin(), measured.end(), [](const MeasuredTest& t) {
     return !t.summary_sd.empty();
   });
-  source_ = given && noise.mode == "data" ? "the data's standard-deviation columns" : "the lab model (NoiseModel)";
+  source_ = given && noise.mode == "data" ? "the data's standard-deviation columns" : noise.lab_name;
   for (std::size_t k = 0; k < measured.size(); ++k) {
     std::vector<Feature>& fs = features_[k];
     const int n = static_cast<int>(fs.size());
@@ -308,7 +318,7 @@ void Misfit::build_curve_noise(const std::vector<MeasuredTest>& measured, const 
   length_ = ref.front().size() > 2 ? fitted_length(features_, z, noise.lab.length) : noise.lab.length;
   const bool lab = noise.mode == "lab";
   const bool no_ensemble = ens.var.empty();
-  source_ = lab ? "the lab model" : !rep.var.empty() ? "replicates" : "the data";
+  source_ = lab ? noise.lab_name : !rep.var.empty() ? "replicates" : "the data";
   if (!lab && !rep.var.empty())
     notes_.push_back("replicates: the scatter between tests of one material and pressure (pooled over " +
                      std::to_string(rep.dof.begin()->second) + " degrees of freedom) is the data and specimen noise");
@@ -400,7 +410,10 @@ void Misfit::build_curve_noise(const std::vector<MeasuredTest>& measured, const 
     }
     cov_.emplace_back(cov.data(), cov.data() + n * n);
   }
-  if (lab) notes_.push_back("noise: the lab model (q 5% with a 2% specimen factor, eps_v 10% or 0.05%)");
+  if (lab)
+    notes_.push_back("noise: " + noise.lab_name + fmt(" (q %.3g%%", 100 * noise.lab.q_rel) +
+                     fmt(" with a %.3g%% specimen factor", 100 * noise.lab.q_shared) +
+                     fmt(", eps_v %.3g%%", 100 * noise.lab.ev_rel) + fmt(" or %.3g%%)", 100 * noise.lab.ev_abs));
 }
 
 Real Misfit::ensemble_ratio() const {

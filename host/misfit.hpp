@@ -36,35 +36,13 @@
 
 #include "curve_reading.hpp"
 #include "measured.hpp"
+#include "noise_model.hpp"
 #include "periodic_lab.hpp"
 
 namespace dem {
 
-enum Quantity : int { kInitialStiffness = 0, kEarly, kMid, kPeak, kStrainAtPeak, kResidual, kDilatancy, kQuantities };
-
-/// Name of a quantity in tables ("E_ini", "q_peak", ...).
-const char* quantity_name(int q);
-
 /// The quantities of a test (NaN where absent).
 std::array<Real, kQuantities> quantities(const MeasuredTest& t);
-
-/// Lab noise of the summary quantities: s_q = max(rel_q |measured|, abs_q), of which a specimen factor of
-/// standard deviation `specimen` is shared by the stresses of one test (a denser specimen raises them all):
-///   C = diag(s_q^2 - (specimen m_q)^2) + specimen^2 m m^T,   m_q = measured stress quantity (0 for the others).
-struct NoiseModel {
-  std::array<Real, kQuantities> rel{0.10, 0.06, 0.06, 0.04, 0.0, 0.05, 0.20};
-  std::array<Real, kQuantities> abs{0.0, 0.0, 0.0, 0.0, 0.02, 0.0, 0.05};
-  Real specimen = 0.02;
-  Real sigma(int q, Real measured) const;
-  static bool is_stress(int q);
-};
-
-/// Lab noise of curve features: q scatters by `q_rel` of its value about the population's curve, of which
-/// `q_shared` is one factor for the whole curve (a denser specimen); eps_v by max(ev_rel |eps_v|, ev_abs).
-/// Both correlated along strain with length `length` in ln(strain).
-struct LabCurveNoise {
-  Real q_rel = 0.05, q_shared = 0.02, ev_rel = 0.10, ev_abs = 5e-4, length = 1.0;
-};
 
 /// Residual of a datum the simulation could not produce (no peak, a blow-up): ten standard deviations.
 constexpr Real kMissingResidual = 10;
@@ -76,12 +54,15 @@ std::array<Real, kQuantities> test_residuals(const MeasuredTest& measured, const
                                              const NoiseModel& noise);
 
 /// How the data's noise is taken: "data" (standard-deviation columns, else replicates, else the curves'
-/// own scatter; the lab model where none of these is possible) or "lab".
+/// own scatter; the lab model where none of these is possible) or "lab" (the lab model: the defaults, or a file's).
 struct NoiseOptions {
   std::string mode = "data";
   LabCurveNoise lab;
   NoiseModel summary;
+  std::string lab_name = "the lab model";  ///< how the report names the lab model (a file's path when read from one)
 };
+/// The lab noise of a file (`--noise FILE`, read_lab_noise) as the noise options of mode "lab".
+NoiseOptions lab_noise_options(const std::string& path);
 
 /// One compared datum of a test, with the parts of its noise (standard deviations, in its unit: Pa or -).
 struct Feature {

@@ -3,9 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <random>
 
+#include "host/config.hpp"
 #include "host/misfit.hpp"
+#include "test_util.hpp"
 
 using namespace dem;
 
@@ -138,4 +141,71 @@ TEST(Misfit, ReplicatesGiveTheSpecimenScatter) {
       EXPECT_NEAR(f.specimen_sd, 0.02 * std::sqrt(2.0) * f.measured, 1e-9 * f.measured) << f.name;
       EXPECT_EQ(f.data_sd, 0);
     }
+}
+
+// A lab noise file (--noise FILE): the shipped example holds the built-in model key for key (so `--noise lab`
+// and the file are one model), and a file's values reach every feature: a q datum scatters by max(q_rel |q|,
+// 0.2% of sigma3), an eps_v datum by max(eps_v_rel |eps_v|, eps_v_abs), exactly.
+TEST(Misfit, LabNoiseFileSetsTheLabModel) {
+  const LabNoise shipped = read_lab_noise(std::string(TRIAXDEM_SOURCE_DIR) + "/configs/calibration/lab_noise.toml");
+  const LabCurveNoise c;
+  const NoiseModel s;
+  EXPECT_EQ(shipped.curve.q_rel, c.q_rel);
+  EXPECT_EQ(shipped.curve.q_shared, c.q_shared);
+  EXPECT_EQ(shipped.curve.ev_rel, c.ev_rel);
+  EXPECT_DOUBLE_EQ(shipped.curve.ev_abs, c.ev_abs);  // read in %, times 1e-2
+  EXPECT_EQ(shipped.curve.length, c.length);
+  EXPECT_EQ(shipped.summary.specimen, s.specimen);
+  for (int q = 0; q < kQuantities; ++q) {
+    EXPECT_EQ(shipped.summary.rel[q], s.rel[q]) << quantity_name(q);
+    EXPECT_DOUBLE_EQ(shipped.summary.abs[q], s.abs[q]) << quantity_name(q);
+  }
+
+  const std::string path = (test::scratch_dir("lab_noise") / "mine.toml").string();
+  std::ofstream(path) << "[curve]\nq_rel = 0.08\nq_shared = 0.03\neps_v_rel = 0.2\neps_v_abs_pct = 0.1\n";
+  const NoiseOptions o = lab_noise_options(path);
+  const MeasuredTest t = smooth_test(100e3);
+  const Misfit m({t}, o, Ensemble{members_of(t, 1, 0)}, 1, 0.1);
+  int q_data = 0, ev_data = 0;
+  for (const Feature& f : m.features(0)) {
+    const Real expected = f.quantity == 0 ? std::max(0.08 * std::fabs(f.measured), 2e-3 * t.sigma3)
+                                          : std::max(0.2 * std::fabs(f.measured), 1e-3);
+    EXPECT_DOUBLE_EQ(f.specimen_sd, expected) << f.name;
+    EXPECT_EQ(f.data_sd, 0) << "the lab model replaces the data's own noise";
+    (f.quantity == 0 ? q_data : ev_data)++;
+  }
+  EXPECT_GT(q_data, 5);
+  EXPECT_GT(ev_data, 5);
+  bool named = false;
+  for (const std::string& n : m.notes()) named = named || n.find(path) != std::string::npos;
+  EXPECT_TRUE(named) << "the report names the file the noise came from";
+}
+
+// A bad lab noise file is refused with the file, the table, the key and the allowed range.
+TEST(Misfit, BadLabNoiseFilesAreRefused) {
+  const auto dir = test::scratch_dir("bad_lab_noise");
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {"[curve]\nq_rel = 0\n", "[curve] q_rel: value 0 out of range (allowed: (0, 1])"},
+      {"[curve]\nq_rel = nan\n", "[curve] q_rel: value nan out of range"},
+      {"[curve]\nq_rel = 0.01\n", "[curve] q_shared: the shared factor is part of q's scatter"},
+      {"[curve]\neps_v_abs_pct = -1\n", "[curve] eps_v_abs_pct: value -1 out of range (allowed: (0, 5])"},
+      {"[curve]\nlength = \"long\"\n", "[curve] length: expected a number"},
+      {"[curve]\nq_rell = 0.05\n", "[curve] q_rell: unknown key"},
+      {"[summary]\nspecimen = 0.05\n", "[summary] specimen: the shared factor is part of each stress's scatter"},
+      {"[summary]\nmax_dilatancy = 0\nmax_dilatancy_abs = 0\n", "[summary] max_dilatancy: max_dilatancy and"},
+      {"[curves]\nq_rel = 0.05\n", "[curves]: unknown table (allowed: curve, summary)"},
+  };
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    const std::string path = (dir / ("case" + std::to_string(k) + ".toml")).string();
+    std::ofstream(path) << cases[k].first;
+    try {
+      read_lab_noise(path);
+      ADD_FAILURE() << "accepted: " << cases[k].first;
+    } catch (const ConfigError& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.rfind(path + ": ", 0), 0u) << what;
+      EXPECT_NE(what.find(cases[k].second), std::string::npos) << what;
+    }
+  }
+  EXPECT_THROW(read_lab_noise((dir / "missing.toml").string()), ConfigError);
 }
