@@ -96,15 +96,24 @@ struct Session {
   /// The misfit of a material's tests: the ensemble run at the base model, its scatter beside the data's noise.
   Misfit misfit_of(const Config& base, const std::string& material, const std::vector<MeasuredTest>& tests) {
     std::printf("%s: %s: measuring the simulator's scatter: %d specimens of %zu balls at the base model\n",
-                folder.c_str(), material.c_str(), lab.members(), lab.balls());
+                folder.c_str(), material.c_str(), lab.specimens(), lab.balls());
     Misfit m = measure_misfit(lab, model_of(base), tests, noise);
     for (const std::string& n : m.notes()) std::printf("  noise: %s\n", n.c_str());
     const Real ratio = m.ensemble_ratio();
-    std::printf("  the simulator's standard error is %.2f of the data's noise (median; %d specimens)%s\n", ratio,
-                lab.members(), ratio > 0.5 ? "" : ": below 1/2, enough");
-    if (ratio > 0.5)
-      std::printf("  WARNING: above 1/2: [calibrate] ensemble = %ld would bring it to 1/2; the misfit counts it\n",
-                  std::lround(std::ceil(lab.members() * 4 * ratio * ratio)));
+    const bool chosen = base.calibrate.ensemble == kAutoEnsemble;
+    std::printf("  ensemble: %d specimens per parameter point (%s); the simulator's standard error is %.2f of the "
+                "data's noise (median)%s\n", lab.members(), chosen ? "chosen" : "[calibrate] ensemble", ratio,
+                ratio > kEnsembleRatioGoal ? "" : ": below 1/2, enough");
+    if (ratio > kEnsembleRatioGoal) {
+      // The mean of K specimens of N balls scatters as 1 / sqrt(K N): where K runs out, N makes up the rest.
+      const int k = m.members_for(kEnsembleRatioGoal);
+      const Real grow = static_cast<Real>(k) / lab.specimens();
+      std::printf("  WARNING: above 1/2, and the misfit counts it. %d specimens would bring it to 1/2", k);
+      if (grow > 1)
+        std::printf(" (scatter_specimens = %d), or all %d in a cell of about %.0f balls ([box] size_mm x %.2f)", k,
+                    lab.specimens(), grow * static_cast<Real>(lab.balls()), std::cbrt(grow));
+      std::printf("\n");
+    }
     return m;
   }
   /// The reference value of a parameter for a material, in the key's unit; NaN when there is none.

@@ -69,6 +69,15 @@ class TableReader {
     }
     out = *v;
   }
+  /// Whether the key holds the string `word`, which stands for `value`; any other string is refused with
+  /// `word` among the allowed values, and a non-string is left to the key's other reader.
+  bool word(const std::string& key, const std::string& word, long& out, long value) {
+    const toml::node* n = get(key);
+    if (!n || !n->is_string()) return false;
+    if (*n->value_exact<std::string>() != word) fail(key, "'" + *n->value_exact<std::string>() + "' is not allowed (allowed: \"" + word + "\" or a number)");
+    out = value;
+    return true;
+  }
   /// An array of strings (at least one).
   void strings(const std::string& key, std::vector<std::string>& out) {
     const toml::node* n = get(key);
@@ -352,7 +361,8 @@ Config parse_config(const std::string& text, const std::string& path) {
 
   TableReader cal = table("calibrate");
   cal.strings("free", c.calibrate.free);  // names checked against the registry by the calibration job
-  cal.integer("ensemble", c.calibrate.ensemble, 1, 64);
+  if (!cal.word("ensemble", "auto", c.calibrate.ensemble, kAutoEnsemble))
+    cal.integer("ensemble", c.calibrate.ensemble, 1, 64);
   cal.integer("scatter_specimens", c.calibrate.scatter_specimens, 1, 64);
   cal.finish();
 

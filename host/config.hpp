@@ -119,12 +119,15 @@ struct PeriodicTriaxialParams {
   bool verbose = true;               ///< progress lines and the summary on stdout
 };
 
+inline constexpr long kAutoEnsemble = 0;
+
 /// [calibrate]: the parameters `triaxdem calibrate` and `diagnose` free (host/calibrate.hpp lists the names).
 struct CalibrateConfig {
   std::vector<std::string> free{"mu_s", "mu_r"};
   /// Specimens of the simulator's ensemble (packing seeds [run] seed, seed + 1, ...): every parameter point runs
-  /// each of them and compares their mean (host/misfit.hpp).
-  long ensemble = 4;
+  /// each of them and compares their mean (host/misfit.hpp). kAutoEnsemble (the file's "auto"): the fewest of the
+  /// scatter specimens whose mean's standard error is below half the data's noise (measure_misfit).
+  long ensemble = kAutoEnsemble;
   /// Specimens on which the simulator's scatter is measured, once, at the base model (the first `ensemble` of
   /// them are the ensemble): a variance from few specimens is itself uncertain, and one that comes out small by
   /// chance turns a foreign specimen into a false alarm.

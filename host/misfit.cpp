@@ -428,10 +428,21 @@ Real Misfit::ensemble_ratio() const {
   return r[r.size() / 2];
 }
 
+int Misfit::members_for(Real target) const {
+  const Real r = ensemble_ratio() / target;
+  return std::max(1, static_cast<int>(std::ceil(members_ * r * r - 1e-9)));
+}
+
 Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<MeasuredTest>& measured,
                       const NoiseOptions& noise) {
-  return Misfit(measured, noise, lab.run_ensemble(base, measured, true), lab.members(),
-                lab.config().periodic.triax.target_strain, static_cast<Real>(lab.balls()));
+  const Ensemble scatter = lab.run_ensemble(base, measured, true);
+  auto misfit = [&] {
+    return Misfit(measured, noise, scatter, lab.members(), lab.config().periodic.triax.target_strain,
+                  static_cast<Real>(lab.balls()));
+  };
+  if (lab.config().calibrate.ensemble != kAutoEnsemble) return misfit();
+  lab.set_members(std::min(misfit().members_for(kEnsembleRatioGoal), lab.specimens()));
+  return misfit();
 }
 
 std::vector<Real> Misfit::mean_values(std::size_t k, const std::vector<MeasuredTest>& members) const {

@@ -44,6 +44,10 @@ namespace dem {
 /// The quantities of a test (NaN where absent).
 std::array<Real, kQuantities> quantities(const MeasuredTest& t);
 
+/// The simulator's standard error that an ensemble aims below, as a share of the data's noise: its mean then adds
+/// at most a quarter to the variance.
+constexpr Real kEnsembleRatioGoal = 0.5;
+
 /// Residual of a datum the simulation could not produce (no peak, a blow-up): ten standard deviations.
 constexpr Real kMissingResidual = 10;
 
@@ -99,6 +103,8 @@ class Misfit {
   /// The simulator's standard error over the data-side noise, median over the data: the ensemble is large
   /// enough when it is below 1/2 (its mean then adds at most a quarter to the variance).
   Real ensemble_ratio() const;
+  /// The ensemble size that brings ensemble_ratio() to `target` (the standard error goes as 1 / sqrt(K)).
+  int members_for(Real target) const;
   int members() const { return members_; }
   /// The scatter specimens' mean void ratio at the start of shear of test k, at the base model.
   Real reached_void_ratio(std::size_t k) const { return void_ratio_[k]; }
@@ -118,8 +124,10 @@ class Misfit {
   bool curves_ = true;
 };
 
-/// The simulator's scatter measured: `lab`'s ensemble run at `base` on every measured test, and the misfit
-/// built on it.
+/// The simulator's scatter measured: `lab`'s scatter specimens run at `base` on every measured test, and the
+/// misfit built on it. With an "auto" ensemble ([calibrate] ensemble), the lab's ensemble becomes the fewest
+/// specimens (at most all the scatter specimens) whose mean's standard error is below kEnsembleRatioGoal of the
+/// data's noise.
 Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<MeasuredTest>& measured,
                       const NoiseOptions& noise);
 

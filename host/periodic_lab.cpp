@@ -103,8 +103,17 @@ Config matched_state(const Config& base, const std::vector<MeasuredTest>& tests,
 }
 
 PeriodicLab::PeriodicLab(const Config& base, bool verbose)
-    : PeriodicLab(base, verbose, static_cast<int>(base.calibrate.ensemble), base.run.seed,
-                  static_cast<int>(base.calibrate.scatter_specimens)) {}
+    : PeriodicLab(base, verbose,
+                  static_cast<int>(base.calibrate.ensemble == kAutoEnsemble ? base.calibrate.scatter_specimens
+                                                                            : base.calibrate.ensemble),
+                  base.run.seed, static_cast<int>(base.calibrate.scatter_specimens)) {}
+
+void PeriodicLab::set_members(int k) {
+  if (k < 1 || k > specimens())
+    throw std::invalid_argument("ensemble of " + std::to_string(k) + " specimens (allowed: 1 to " +
+                                std::to_string(specimens()) + ")");
+  members_ = k;
+}
 
 MeasuredTest PeriodicLab::run(const Model& m, Real sigma3, const std::string& material, int member) {
   const auto t0 = std::chrono::steady_clock::now();

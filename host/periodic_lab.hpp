@@ -36,7 +36,8 @@ class PeriodicLab {
   /// `specimens` specimens with packing seeds first_seed, first_seed + 1, ..., of which the first `members`
   /// (at most all) form the ensemble that run_ensemble runs.
   PeriodicLab(const Config& base, bool verbose, int members, unsigned first_seed, int specimens = 0);
-  /// The config's ensemble ([calibrate] ensemble, scatter_specimens) and seed ([run] seed).
+  /// The config's ensemble ([calibrate] ensemble, scatter_specimens) and seed ([run] seed); an "auto" ensemble
+  /// starts as all the scatter specimens, until measure_misfit chooses.
   PeriodicLab(const Config& base, bool verbose);
   /// One simulated test (curves, summarised; its void ratio at the start of shear) of one member at sigma3 (Pa).
   MeasuredTest run(const Model& m, Real sigma3, const std::string& material = "sim", int member = 0);
@@ -49,6 +50,8 @@ class PeriodicLab {
   int set_jobs(int jobs);
   int jobs() const { return jobs_; }
   int members() const { return members_; }
+  /// Makes the first k specimens the ensemble (1 <= k <= specimens()).
+  void set_members(int k);
   int specimens() const { return static_cast<int>(specimens_.size()); }
   const Config& config() const { return cfg_; }
   long runs() const { return runs_; }

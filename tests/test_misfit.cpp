@@ -209,3 +209,18 @@ TEST(Misfit, BadLabNoiseFilesAreRefused) {
   }
   EXPECT_THROW(read_lab_noise((dir / "missing.toml").string()), ConfigError);
 }
+
+// The ensemble that an "auto" [calibrate] ensemble chooses: the fewest members whose mean's standard error is at
+// most half the data's noise. Members scattering by 4% of q against a lab's 5% (with floors) need several; the
+// answer K must reach the goal and K - 1 must not.
+TEST(Misfit, EnsembleSizeForTheGoalIsTheFewestThatReachIt) {
+  const MeasuredTest t = smooth_test(100e3);
+  const Ensemble ref{members_of(t, 16, 0.04)};
+  NoiseOptions lab;
+  lab.mode = "lab";
+  const int k = Misfit({t}, lab, ref, 1, 0.1).members_for(kEnsembleRatioGoal);
+  ASSERT_GT(k, 1);
+  EXPECT_LE(Misfit({t}, lab, ref, k, 0.1).ensemble_ratio(), kEnsembleRatioGoal);
+  EXPECT_GT(Misfit({t}, lab, ref, k - 1, 0.1).ensemble_ratio(), kEnsembleRatioGoal);
+  EXPECT_EQ(Misfit({t}, lab, ref, k, 0.1).members_for(kEnsembleRatioGoal), k) << "asking again changes nothing";
+}
