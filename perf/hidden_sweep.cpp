@@ -11,6 +11,7 @@
 #include <CLI/CLI.hpp>
 #include <Kokkos_Core.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <map>
@@ -52,6 +53,9 @@ int main(int argc, char** argv) {
   std::vector<std::string> hidden{"none"};
   for (const Extension& e : extensions()) hidden.push_back(e.name);
   std::map<std::string, std::map<std::string, int>> confusion;
+  // Per hidden extension: the strengths named right and those missed or misnamed, for the detection-power table.
+  std::map<std::string, std::vector<Real>> found, missed;
+  std::vector<std::string> mixups;  // wrong names, with both extensions' evidence
   std::ofstream csv(out);
   // Every extension's BIC gain and held-out chi2 too, so that a decision rule can be judged on the whole sweep.
   csv << "hidden,strength,seed,verdict,base_chi2,chi2_limit,base_heldout,true_heldout";
@@ -79,6 +83,15 @@ int main(int argc, char** argv) {
       // A tie ("a or b") counts for the first named; the CSV keeps the whole verdict.
       const std::string named = dg.verdict.substr(0, dg.verdict.find(' '));
       ++confusion[h][named];
+      if (h != "none") (named == h ? found : missed)[h].push_back(strength);
+      if (named != h && named != "none") {
+        std::string line = h + " " + std::to_string(strength) + " named " + named + ":";
+        for (const ExtensionFit& f : dg.fits)
+          if (f.ext.name == h || f.ext.name == named)
+            line += " " + f.ext.name + " BIC gain " + std::to_string(dg.base_bic - f.bic) + ", held-out " +
+                    std::to_string(dg.base_heldout) + " -> " + std::to_string(f.heldout) + ";";
+        mixups.push_back(line);
+      }
       char row[256];
       std::snprintf(row, sizeof row, "%s,%.4g,%u,%s,%.2f,%.2f,%.2f,%.2f", h.c_str(), strength, seed,
                     dg.verdict.c_str(), dg.base.best.chi2, dg.chi2_limit, dg.base_heldout, true_heldout);
@@ -108,5 +121,16 @@ int main(int argc, char** argv) {
     total += row;
   }
   std::printf("identified %d of %d cases (%.0f%%); cases in %s\n", right, total, 100.0 * right / total, out.c_str());
+  std::printf("\ndetection power (noise scale %g): per extension, the smallest strength named right and the largest "
+              "missed or misnamed\n%-10s %14s %14s %6s\n", noise, "hidden", "smallest found", "largest missed", "found");
+  for (const Extension& e : extensions()) {
+    const std::vector<Real>& f = found[e.name];
+    const std::vector<Real>& m = missed[e.name];
+    std::printf("%-10s %14s %14s %3zu/%zu\n", e.name.c_str(),
+                f.empty() ? "-" : std::to_string(*std::min_element(f.begin(), f.end())).c_str(),
+                m.empty() ? "-" : std::to_string(*std::max_element(m.begin(), m.end())).c_str(), f.size(),
+                f.size() + m.size());
+  }
+  for (const std::string& l : mixups) std::printf("told apart wrongly: %s\n", l.c_str());
   return 0;
 }
