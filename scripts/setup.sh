@@ -7,7 +7,8 @@ SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 
 pkgs=(cmake g++ make libeigen3-dev libhdf5-dev libcli11-dev libtomlplusplus-dev
-      libgtest-dev googletest libbenchmark-dev python3-matplotlib python3-h5py python3-numpy)
+      libgtest-dev googletest libbenchmark-dev python3-matplotlib python3-h5py python3-numpy
+      clang libclang-rt-dev libomp-dev)  # clang: the sanitizer and fuzz gates (tests/run_gates.sh)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

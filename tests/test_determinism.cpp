@@ -14,7 +14,10 @@
 #include <vector>
 
 #include "host/builder.hpp"
+#include "host/micro_report.hpp"
 #include "host/simulation.hpp"
+#include "host/triaxial.hpp"
+#include "test_util.hpp"
 
 using namespace dem;
 
@@ -50,7 +53,8 @@ struct ChildReport {
   std::string output;
 };
 
-ChildReport run_child(int threads) {
+/// Runs the helper test `helper` (Determinism.HashChild or .TriaxialHashChild) in a child with `threads` threads.
+ChildReport run_child(int threads, const std::string& helper = "HashChild") {
   ChildReport r;
   char exe[4096];
   const ssize_t len = readlink("/proc/self/exe", exe, sizeof exe - 1);
@@ -62,7 +66,7 @@ ChildReport run_child(int threads) {
   const std::string cmd = "env -u GTEST_OUTPUT -u GTEST_SHARD_INDEX -u GTEST_TOTAL_SHARDS OMP_NUM_THREADS=" +
                           std::to_string(threads) +
                           " OMP_PROC_BIND=false OMP_WAIT_POLICY=passive TRIAXDEM_HASH_CHILD=1 '" + std::string(exe) +
-                          "' --gtest_filter=Determinism.HashChild 2>&1";
+                          "' --gtest_filter=Determinism." + helper + " 2>&1";
   FILE* f = popen(cmd.c_str(), "r");
   if (f == nullptr) return r;
   char line[1024];
@@ -188,5 +192,43 @@ TEST(Determinism, SameBitsForOneAndTwoThreads) {
   EXPECT_EQ(one.sliding, two.sliding);
   EXPECT_EQ(one.rolling, two.rolling);
   EXPECT_EQ(one.rebuilds, two.rebuilds);
+  EXPECT_EQ(one.hash, two.hash) << std::hex << "1 thread: " << one.hash << ", 2 threads: " << two.hash;
+}
+
+// Helper run in the child processes: the whole membrane triaxial job on the tiny specimen (packing, layered
+// compaction, consolidation inside the membrane, shear to 2%, micro measures at every record). Prints a hash of
+// every record (platen and membrane stresses, the membrane's enclosed volume, energies) and micro row, with the
+// record count and the time steps in the places of the contact counts.
+TEST(Determinism, TriaxialHashChild) {
+  if (!child_mode()) GTEST_SKIP() << "helper of Determinism.TriaxialJobSameBitsForOneAndTwoThreads";
+  Config c = test::tiny_triaxial_config(0.3, 0.02);
+  c.triaxial.axial_strain_end = 0.02;
+  const TriaxialResult r = run_triaxial(c, build_specimen(c, false), nullptr, false);
+  Fnv1a h;
+  for (const TriaxialRecord& x : r.records) h.add(&x, sizeof x);
+  std::vector<double> micro;
+  for (const MicroRow& m : r.micro) append_micro_state(m, micro);
+  h.add(micro.data(), micro.size() * sizeof(double));
+  h.add(&r.void_ratio_consolidated, sizeof r.void_ratio_consolidated);
+  std::printf("TRIAXDEM_HASH threads=%d hash=%016llx touching=%ld sliding=%ld rolling=0 rebuilds=%ld\n",
+              static_cast<int>(ExecSpace().concurrency()), static_cast<unsigned long long>(h.h),
+              static_cast<long>(r.records.size()), static_cast<long>(micro.size()), r.steps);
+  std::fflush(stdout);
+}
+
+// The membrane (its node forces, servo and enclosed volume) and the whole job around it give the same bits with
+// 1 and 2 threads: the two children's hashes are compared with each other.
+TEST(Determinism, TriaxialJobSameBitsForOneAndTwoThreads) {
+  if (child_mode()) GTEST_SKIP() << "inside a child run";
+  const ChildReport one = run_child(1, "TriaxialHashChild");
+  const ChildReport two = run_child(2, "TriaxialHashChild");
+  ASSERT_TRUE(one.found) << "child with 1 thread printed no hash (status " << one.status << "):\n" << one.output;
+  ASSERT_TRUE(two.found) << "child with 2 threads printed no hash (status " << two.status << "):\n" << two.output;
+  EXPECT_EQ(one.threads, 1);
+  EXPECT_EQ(two.threads, 2);
+  EXPECT_GT(one.touching, 3) << "records: the shear ran";
+  EXPECT_GT(one.sliding, 0) << "micro rows were measured";
+  EXPECT_EQ(one.touching, two.touching);
+  EXPECT_EQ(one.rebuilds, two.rebuilds) << "time steps";
   EXPECT_EQ(one.hash, two.hash) << std::hex << "1 thread: " << one.hash << ", 2 threads: " << two.hash;
 }

@@ -15,26 +15,10 @@ using namespace dem;
 
 namespace {
 
-Config tiny_config(double mu_s, double mu_r) {
-  Config c = test::specimen_config(16e-3, 0.70, 3);
-  c.specimen.stop_ratio = 1e-2;  // the specimen only has to be at rest enough to be sheared
-  c.triaxial.sigma3 = 100e3;
-  c.triaxial.stop_ratio = 1e-2;
-  c.triaxial.max_consolidation_steps = 50000;
-  c.triaxial.inertial_number = 1e-2;
-  c.triaxial.record_every = 0.005;
-  c.triaxial.membrane_around = 24;
-  c.triaxial.membrane_segments = 8;
-  c.micro.rve_edge = 8e-3;
-  c.ball.mu_s = mu_s;
-  c.ball.mu_r = mu_r;
-  c.wall = c.ball;
-  return c;
-}
 
 class Triaxial : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() { specimen_ = new Specimen(build_specimen(tiny_config(0.3, 0.02), false)); }
+  static void SetUpTestSuite() { specimen_ = new Specimen(build_specimen(test::tiny_triaxial_config(0.3, 0.02), false)); }
   static void TearDownTestSuite() { delete specimen_; }
   static Specimen* specimen_;
 };
@@ -43,7 +27,7 @@ Specimen* Triaxial::specimen_ = nullptr;
 }  // namespace
 
 TEST_F(Triaxial, DenseFrictionalSpecimenContractsThenDilatesInsideTheMembrane) {
-  const Config c = tiny_config(0.3, 0.02);
+  const Config c = test::tiny_triaxial_config(0.3, 0.02);
   const TriaxialResult r = run_triaxial(c, *specimen_, nullptr, false);
   ASSERT_GT(r.records.size(), 10u);
   // Consolidated: the platens carry sigma3 when shear starts (the servo's 0.5% plus one record's motion).
@@ -91,7 +75,7 @@ TEST_F(Triaxial, CellPressureReachesTheBallsThroughShear) {
   // strain on an 8 mm radius) isolates the pressure path. Tolerances: this 452-ball specimen is sheared fast
   // (I = 1e-2) and its 8-band membrane leaves the corner bands next to the platens out of the measure, so
   // single records scatter by a few percent; their mean must be within 3% and every record within 8%.
-  Config c = tiny_config(0.3, 0.02);
+  Config c = test::tiny_triaxial_config(0.3, 0.02);
   c.triaxial.membrane_modulus = 1e4;
   const TriaxialResult r = run_triaxial(c, *specimen_, nullptr, false);
   ASSERT_GT(r.records.size(), 10u);
@@ -107,14 +91,14 @@ TEST_F(Triaxial, CellPressureReachesTheBallsThroughShear) {
 }
 
 TEST_F(Triaxial, HigherFrictionGivesHigherPeakStrength) {
-  const TriaxialResult low = run_triaxial(tiny_config(0.1, 0.02), *specimen_, nullptr, false);
-  const TriaxialResult high = run_triaxial(tiny_config(0.5, 0.02), *specimen_, nullptr, false);
+  const TriaxialResult low = run_triaxial(test::tiny_triaxial_config(0.1, 0.02), *specimen_, nullptr, false);
+  const TriaxialResult high = run_triaxial(test::tiny_triaxial_config(0.5, 0.02), *specimen_, nullptr, false);
   EXPECT_GT(high.q_peak, 1.1 * low.q_peak) << "q_peak " << low.q_peak << " -> " << high.q_peak;
 }
 
 TEST_F(Triaxial, MicromechanicsFromSavedStatesAndClearRefusals) {
   const auto dir = dem::test::scratch_dir("micro");
-  Config c = tiny_config(0.3, 0.02);
+  Config c = test::tiny_triaxial_config(0.3, 0.02);
   c.triaxial.axial_strain_end = 0.05;  // snapshots A (0%), B (1%) and D = C (5%)
   {
     io::Output out(dir.string());
@@ -175,7 +159,7 @@ TEST_F(Triaxial, MicromechanicsFromSavedStatesAndClearRefusals) {
 // the records and the series of the run that was never stopped, compared with == (bit for bit).
 TEST_F(Triaxial, StoppedInEachStageAndResumedMatchesTheUnstoppedRun) {
   const auto dir = dem::test::scratch_dir("triaxial_checkpoint");
-  Config c = tiny_config(0.3, 0.02);
+  Config c = test::tiny_triaxial_config(0.3, 0.02);
   c.triaxial.axial_strain_end = 0.03;
   c.micro.enabled = true;
   TriaxialResult whole;
@@ -247,7 +231,7 @@ TEST_F(Triaxial, DampingAboutTheFlowClosesThePlatenGap) {
       if (x.eps_a > 0.02) sum += x.sigma1 - x.sigma1_bottom, ++n;
     return sum / n;
   };
-  Config c = tiny_config(0.3, 0.02);
+  Config c = test::tiny_triaxial_config(0.3, 0.02);
   const double absolute = mean_gap(run_triaxial(c, *specimen_, nullptr, false));
   c.triaxial.damping_about_flow = true;
   const double about = mean_gap(run_triaxial(c, *specimen_, nullptr, false));

@@ -59,4 +59,23 @@ inline Config specimen_config(double size, double void_ratio, long layers) {
   return c;
 }
 
+/// The tiny drained triaxial test (16 mm x 16 mm, about 450 beads of 2 mm in 3 layers) of the job-level tests:
+/// quick settings (inertial number 1e-2, density scaling, a coarse 24 x 8 membrane) so that a run takes seconds.
+inline Config tiny_triaxial_config(double mu_s, double mu_r) {
+  Config c = specimen_config(16e-3, 0.70, 3);
+  c.specimen.stop_ratio = 1e-2;  // the specimen only has to be at rest enough to be sheared
+  c.triaxial.sigma3 = 100e3;
+  c.triaxial.stop_ratio = 1e-2;
+  c.triaxial.max_consolidation_steps = 50000;
+  c.triaxial.inertial_number = 1e-2;
+  c.triaxial.record_every = 0.005;
+  c.triaxial.membrane_around = 24;
+  c.triaxial.membrane_segments = 8;
+  c.micro.rve_edge = 8e-3;
+  c.ball.mu_s = mu_s;
+  c.ball.mu_r = mu_r;
+  c.wall = c.ball;
+  return c;
+}
+
 }  // namespace dem::test

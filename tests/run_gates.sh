@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# The gates after the suite (scripts/test.sh): one clang build with AddressSanitizer, UndefinedBehaviorSanitizer
+# and libFuzzer's coverage (build-gates/), in which
+#   1. the fast tests (unit tests and readers, one thread) run: any sanitizer report fails its test;
+#   2. each fuzz harness runs for a fixed time (tests/fuzz/run_fuzz.sh): a finding fails the gate.
+#   tests/run_gates.sh [FUZZ_SECONDS]        (default 45 s per harness)
+# The whole suite under sanitizers (gcc, slower): tests/run_sanitizers.sh.
+set -euo pipefail
+secs="${1:-45}"
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build="${TRIAXDEM_GATES_BUILD:-$root/build-gates}"
+cmake -S "$root" -B "$build" -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DTRIAXDEM_FUZZ=ON -DTRIAXDEM_SANITIZE=address,undefined -DTRIAXDEM_PERF=OFF >/dev/null
+targets=$(sed -n 's/^foreach(target \(.*\))$/\1/p' "$root/tests/fuzz/CMakeLists.txt")
+cmake --build "$build" -j"$(nproc)" --target triaxdem triaxdem_tests $targets
+# Leak reports from the OpenMP runtime's thread pool at exit are not ours; everything else stops the test.
+export ASAN_OPTIONS="detect_leaks=0:abort_on_error=1:${ASAN_OPTIONS:-}"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:${UBSAN_OPTIONS:-}"
+export OMP_WAIT_POLICY=passive
+fast='^(Config|Measured|Misfit|Calibrate|ContactLaw|Detection|SimdLanes|IoHdf5|Membrane|Stress|Micro|Untrusted)\.|^Reference\.ContactLaws'
+echo "gates: the fast tests under ASan and UBSan"
+(cd "$build" && ctest -j"$(nproc)" --output-on-failure -R "$fast" -E '\.omp2$')
+echo "gates: fuzzing, ${secs} s per harness"
+TRIAXDEM_FUZZ_BUILD="$build" TRIAXDEM_FUZZ_CONFIGURED=1 bash "$root/tests/fuzz/run_fuzz.sh" "$secs"
