@@ -7,12 +7,16 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 
 namespace dem {
 
 namespace {
+
+/// Where config_keys() collects the keys the reader asks for, with their kinds ("number", "integer", ...).
+std::map<std::string, std::string>* g_key_log = nullptr;
 
 /// Reads one table, remembering which keys were used so that leftovers (typos) are refused.
 class TableReader {
@@ -28,20 +32,20 @@ class TableReader {
 
   /// A number in [lo, hi]; `scale` converts the file's unit to SI.
   void number(const std::string& key, Real& out, Real lo, Real hi, Real scale = 1, bool open_lo = false) {
-    const toml::node* n = get(key);
+    const toml::node* n = get(key, "number");
+    if (n) out = checked_number(key, *n, lo, hi, open_lo) * scale;
+  }
+  /// Three numbers (x, y, z), each in [lo, hi], converted by `scale`.
+  void number_triple(const std::string& key, std::array<Real, 3>& out, Real lo, Real hi, Real scale = 1,
+                     bool open_lo = false) {
+    const toml::node* n = get(key, "triple");
     if (!n) return;
-    double v;
-    if (auto d = n->value<double>()) v = *d;
-    else fail(key, "expected a number");
-    if (!std::isfinite(v) || v < lo || v > hi || (open_lo && v == lo)) {
-      std::ostringstream r;
-      r << "value " << v << " out of range (allowed: " << (open_lo ? "(" : "[") << lo << ", " << hi << "])";
-      fail(key, r.str());
-    }
-    out = v * scale;
+    const toml::array* a = n->as_array();
+    if (!a || a->size() != 3) fail(key, "expected an array of 3 numbers (x, y, z)");
+    for (int d = 0; d < 3; ++d) out[d] = checked_number(key, (*a)[d], lo, hi, open_lo) * scale;
   }
   void integer(const std::string& key, long& out, long lo, long hi) {
-    const toml::node* n = get(key);
+    const toml::node* n = get(key, "integer");
     if (!n) return;
     auto v = n->value_exact<int64_t>();
     if (!v) fail(key, "expected an integer");
@@ -51,14 +55,14 @@ class TableReader {
     out = static_cast<long>(*v);
   }
   void boolean(const std::string& key, bool& out) {
-    const toml::node* n = get(key);
+    const toml::node* n = get(key, "boolean");
     if (!n) return;
     auto v = n->value_exact<bool>();
     if (!v) fail(key, "expected true or false");
     out = *v;
   }
   void string(const std::string& key, std::string& out, const std::set<std::string>& allowed = {}) {
-    const toml::node* n = get(key);
+    const toml::node* n = get(key, "string");
     if (!n) return;
     auto v = n->value_exact<std::string>();
     if (!v) fail(key, "expected a string");
@@ -72,15 +76,16 @@ class TableReader {
   /// Whether the key holds the string `word`, which stands for `value`; any other string is refused with
   /// `word` among the allowed values, and a non-string is left to the key's other reader.
   bool word(const std::string& key, const std::string& word, long& out, long value) {
-    const toml::node* n = get(key);
+    const toml::node* n = get(key, "integer or word");
     if (!n || !n->is_string()) return false;
-    if (*n->value_exact<std::string>() != word) fail(key, "'" + *n->value_exact<std::string>() + "' is not allowed (allowed: \"" + word + "\" or a number)");
+    const std::string given = *n->value_exact<std::string>();
+    if (given != word) fail(key, "'" + given + "' is not allowed (allowed: \"" + word + "\" or a number)");
     out = value;
     return true;
   }
   /// An array of strings (at least one).
   void strings(const std::string& key, std::vector<std::string>& out) {
-    const toml::node* n = get(key);
+    const toml::node* n = get(key, "strings");
     if (!n) return;
     const toml::array* a = n->as_array();
     if (!a || a->empty()) fail(key, "expected a non-empty array of strings");
@@ -93,7 +98,7 @@ class TableReader {
   }
   /// An array of numbers, each in [lo, hi], converted by `scale`.
   void numbers(const std::string& key, std::vector<Real>& out, Real lo, Real hi, Real scale) {
-    const toml::node* n = get(key);
+    const toml::node* n = get(key, "numbers");
     if (!n) return;
     const toml::array* a = n->as_array();
     if (!a) fail(key, "expected an array of numbers");
@@ -108,13 +113,17 @@ class TableReader {
       out.push_back(*v * scale);
     }
   }
-  template <class T, class F>
-  void triple(const std::string& key, std::array<T, 3>& out, F&& element) {
-    const toml::node* n = get(key);
+  /// Three booleans (x, y, z).
+  void boolean_triple(const std::string& key, std::array<bool, 3>& out) {
+    const toml::node* n = get(key, "booleans");
     if (!n) return;
     const toml::array* a = n->as_array();
-    if (!a || a->size() != 3) fail(key, "expected an array of 3 values (x, y, z)");
-    for (int d = 0; d < 3; ++d) element((*a)[d], out[d]);
+    if (!a || a->size() != 3) fail(key, "expected [true|false, true|false, true|false]");
+    for (int d = 0; d < 3; ++d) {
+      auto v = (*a)[d].value_exact<bool>();
+      if (!v) fail(key, "expected [true|false, true|false, true|false]");
+      out[d] = *v;
+    }
   }
   /// Refuses keys that were never read.
   void finish() const {
@@ -127,10 +136,23 @@ class TableReader {
   std::string file_, name_;
   const toml::table* t_;
   std::set<std::string> used_;
-  const toml::node* get(const std::string& key) {
+  const toml::node* get(const std::string& key, const char* kind) {
+    if (g_key_log) g_key_log->emplace(name_ + "." + key, kind);
     if (!t_) return nullptr;
     used_.insert(key);
     return t_->get(key);
+  }
+  /// A finite number in [lo, hi] (an integer is taken as a number).
+  double checked_number(const std::string& key, const toml::node& n, Real lo, Real hi, bool open_lo) const {
+    auto d = n.value<double>();
+    if (!d || n.is_boolean()) fail(key, "expected a number");
+    const double v = *d;
+    if (!std::isfinite(v) || v < lo || v > hi || (open_lo && v == lo)) {
+      std::ostringstream r;
+      r << "value " << v << " out of range (allowed: " << (open_lo ? "(" : "[") << lo << ", " << hi << "])";
+      fail(key, r.str());
+    }
+    return v;
   }
 };
 
@@ -223,16 +245,9 @@ Config parse_config(const std::string& text, const std::string& path) {
   pt.finish();
 
   TableReader box = table("box");
-  box.triple("size_mm", c.box.size, [&](const toml::node& n, Real& out) {
-    auto v = n.value<double>();
-    if (!v || !(*v > 0)) box.fail("size_mm", "each size must be a number > 0 (mm)");
-    out = *v * 1e-3;
-  });
-  box.triple("periodic", c.box.periodic, [&](const toml::node& n, bool& out) {
-    auto v = n.value_exact<bool>();
-    if (!v) box.fail("periodic", "expected [true|false, true|false, true|false]");
-    out = *v;
-  });
+  // Up to a kilometre: cell and lattice counts are cast to int, and the memory check bounds the balls.
+  box.number_triple("size_mm", c.box.size, 0, 1e6, 1e-3, true);
+  box.boolean_triple("periodic", c.box.periodic);
   box.boolean("walls", c.box.walls);
   box.string("fill", c.box.fill, {"random", "lattice"});
   box.number("lattice_spacing", c.box.lattice_spacing, 0.9, 2.0);
@@ -246,11 +261,7 @@ Config parse_config(const std::string& text, const std::string& path) {
 
   TableReader sv = table("solver");
   sv.number("damping", c.solver.damping, 0, 0.99);
-  sv.triple("gravity", c.solver.gravity, [&](const toml::node& n, Real& out) {
-    auto v = n.value<double>();
-    if (!v || std::fabs(*v) > 1e4) sv.fail("gravity", "expected 3 numbers in m/s^2 with |g| <= 1e4");
-    out = *v;
-  });
+  sv.number_triple("gravity", c.solver.gravity, -1e4, 1e4);
   sv.number("dt_safety", c.solver.dt_safety, 0, 1, 1, true);
   sv.number("dt_s", c.solver.dt, 0, 1);
   sv.number("mass_scale", c.solver.mass_scale, 1, 1e12);
@@ -371,6 +382,22 @@ Config parse_config(const std::string& text, const std::string& path) {
       throw ConfigError(path + ": [box] size_mm: every side must be at least 3 diameters (" +
                         std::to_string(3e3 * c.particles.diameter) + " mm)");
   return c;
+}
+
+std::map<std::string, std::string> config_keys() {
+  std::map<std::string, std::string> keys;
+  g_key_log = &keys;
+  try {
+    // Every table present (empty), so that the keys read only with a table (the specimen's) are asked for too.
+    parse_config("[run]\n[particles]\n[box]\n[material]\n[wall_material]\n[solver]\n[specimen]\n[triaxial]\n"
+                 "[micro]\n[periodic]\n[calibrate]\n",
+                 "<keys>");
+  } catch (...) {
+    g_key_log = nullptr;
+    throw;
+  }
+  g_key_log = nullptr;
+  return keys;
 }
 
 LabNoise read_lab_noise(const std::string& path) {

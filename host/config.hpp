@@ -3,6 +3,7 @@
 /// researchers use (mm, kPa, kg/m^3), named in each key. Unknown keys, wrong types and values out of
 /// range are refused with the file, the key and the allowed range.
 #include <array>
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -174,6 +175,9 @@ double run_memory_bytes(long balls);
 
 /// Reads and validates a config file. Throws ConfigError.
 Config load_config(const std::string& path);
+/// Every key the reader knows, as "table.key", with the kind of value it takes ("number", "integer", "boolean",
+/// "string", "strings", "numbers", "triple", "booleans", "integer or word"): what the tests try bad values on.
+std::map<std::string, std::string> config_keys();
 /// The same from the file's text; `path` names it in errors.
 Config parse_config(const std::string& text, const std::string& path);
 

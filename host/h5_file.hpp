@@ -103,37 +103,76 @@ class H5Writer {
   Handle file_;
 };
 
-/// One HDF5 file opened for reading; errors name the file.
+/// One HDF5 file opened for reading, as untrusted input: every shape, type and size is checked before HDF5
+/// writes into a buffer, and every error names the file and the dataset or attribute.
 class H5Reader {
  public:
   explicit H5Reader(std::string path)
       : path_(std::move(path)), file_(H5Fopen(path_.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose) {
     if (file_.get() < 0) throw std::runtime_error(path_ + ": not a readable HDF5 file");
+    hsize_t bytes = 0;
+    H5Fget_filesize(file_.get(), &bytes);
+    file_bytes_ = static_cast<double>(bytes);
   }
+  const std::string& path() const { return path_; }
   bool exists(const std::string& name) const { return H5Lexists(file_.get(), name.c_str(), H5P_DEFAULT) > 0; }
+  /// A dataset of `columns` values per row (rank 1 when columns is 1, else rank 2 with that many columns), stored
+  /// with the type class of `type` (integers may be read as floats, never floats as integers: an index must not be
+  /// a rounded number), no larger than the file can hold.
   template <class T>
   std::vector<T> read(const std::string& name, hid_t type, std::size_t columns) const {
     if (!exists(name.substr(0, name.find('/', 1))) || !exists(name))
       throw std::runtime_error(path_ + ": dataset '" + name + "' missing");
     Handle set(H5Dopen2(file_.get(), name.c_str(), H5P_DEFAULT), H5Dclose);
+    if (set.get() < 0 || H5Iget_type(set.get()) != H5I_DATASET)
+      throw std::runtime_error(path_ + ": '" + name + "' is not a dataset");
     Handle space(H5Dget_space(set.get()), H5Sclose);
+    // The rank first: the extents are written one per dimension, and the buffer below holds two.
+    const int rank = H5Sget_simple_extent_ndims(space.get());
+    if (rank < 1 || rank > 2)
+      throw std::runtime_error(path_ + ": dataset '" + name + "' has rank " + std::to_string(rank) +
+                               " (allowed: " + (columns == 1 ? "1" : "2") + ")");
     hsize_t dims[2] = {0, 0};
-    const int rank = H5Sget_simple_extent_dims(space.get(), dims, nullptr);
-    // The buffer holds rows x columns values: a shape that would make HDF5 write more is refused.
-    if (set.get() < 0 || (rank == 1 && columns != 1) || (rank == 2 && dims[1] != columns) || rank < 1 || rank > 2)
-      throw std::runtime_error(path_ + ": dataset '" + name + "' has an unexpected shape");
+    H5Sget_simple_extent_dims(space.get(), dims, nullptr);
+    if ((rank == 1 && columns != 1) || (rank == 2 && dims[1] != columns))
+      throw std::runtime_error(path_ + ": dataset '" + name + "' has " +
+                               (rank == 1 ? std::string("one column") : std::to_string(dims[1]) + " columns") +
+                               " (allowed: " + std::to_string(columns) + ")");
+    Handle stored(H5Dget_type(set.get()), H5Tclose);
+    const H5T_class_t have = H5Tget_class(stored.get()), want = H5Tget_class(type);
+    if (have != want && !(want == H5T_FLOAT && have == H5T_INTEGER))  // integers convert to floats exactly enough
+      throw std::runtime_error(path_ + ": dataset '" + name + "' holds " + class_name(H5Tget_class(stored.get())) +
+                               " (allowed: " + class_name(H5Tget_class(type)) + ")");
+    // A dataset may declare more rows than it stores (a few bytes on disk for billions of rows): its size in
+    // memory is bounded by the file's, with room for compression.
+    const double bytes = static_cast<double>(dims[0]) * static_cast<double>(columns) * sizeof(T);
+    if (bytes > kCompression * file_bytes_ + kSmallDataset)
+      throw std::runtime_error(path_ + ": dataset '" + name + "' declares " + std::to_string(dims[0]) +
+                               " rows, more than a file of " + std::to_string(static_cast<long long>(file_bytes_)) +
+                               " bytes can hold");
     std::vector<T> out(dims[0] * columns);
     if (!out.empty() && H5Dread(set.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()) < 0)
       throw std::runtime_error(path_ + ": cannot read dataset '" + name + "'");
     return out;
   }
-  /// A fixed-length string attribute of the object at `object` ("/" for the root); "" when absent.
+  /// A fixed-length string attribute of the object at `object` ("/" for the root); "" when absent. One string
+  /// (a scalar dataspace), of at most kMaxAttribute bytes: anything else is refused.
   std::string string_attribute(const std::string& object, const std::string& name) const {
     if (H5Aexists_by_name(file_.get(), object.c_str(), name.c_str(), H5P_DEFAULT) <= 0) return "";
+    const std::string what = path_ + ": attribute '" + name + "' of '" + object + "'";
     Handle attr(H5Aopen_by_name(file_.get(), object.c_str(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+    Handle space(H5Aget_space(attr.get()), H5Sclose);
     Handle type(H5Aget_type(attr.get()), H5Tclose);
-    std::string text(H5Tget_size(type.get()), '\0');
-    if (H5Aread(attr.get(), type.get(), text.data()) < 0) return "";
+    if (H5Sget_simple_extent_type(space.get()) != H5S_SCALAR)
+      throw std::runtime_error(what + " is not a single value (allowed: one string)");
+    if (H5Tget_class(type.get()) != H5T_STRING || H5Tis_variable_str(type.get()) != 0)
+      throw std::runtime_error(what + " is not a fixed-length string");
+    const std::size_t size = H5Tget_size(type.get());
+    if (size == 0 || size > kMaxAttribute)
+      throw std::runtime_error(what + " has " + std::to_string(size) + " bytes (allowed: 1 to " +
+                               std::to_string(kMaxAttribute) + ")");
+    std::string text(size, '\0');
+    if (H5Aread(attr.get(), type.get(), text.data()) < 0) throw std::runtime_error(what + " cannot be read");
     return text.substr(0, text.find('\0'));
   }
   /// Names of the groups directly under the root, in name order.
@@ -151,6 +190,11 @@ class H5Reader {
                &out);
     return out;
   }
+  /// Largest string attribute read, and the room a dataset gets beyond the file's size: compressed data may hold
+  /// up to kCompression times its bytes, and a small dataset is never refused.
+  static constexpr std::size_t kMaxAttribute = 1 << 20;
+  static constexpr double kCompression = 1024, kSmallDataset = 1 << 20;
+
   /// A 2-D dataset's column count (0 when it is not 2-D).
   std::size_t columns(const std::string& name) const {
     Handle set(H5Dopen2(file_.get(), name.c_str(), H5P_DEFAULT), H5Dclose);
@@ -163,8 +207,13 @@ class H5Reader {
   }
 
  private:
+  static std::string class_name(H5T_class_t c) {
+    return c == H5T_INTEGER ? "integers" : c == H5T_FLOAT ? "floating-point numbers" : c == H5T_STRING ? "strings"
+                                                                                                      : "other values";
+  }
   std::string path_;
   Handle file_;
+  double file_bytes_ = 0;
 };
 
 }  // namespace dem::io::h5

@@ -1,3 +1,4 @@
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -80,7 +81,82 @@ void check_count(const char* what, std::size_t got, std::size_t want) {
                              std::to_string(want) + " in this simulation (the config describes another system)");
 }
 
+[[noreturn]] void refuse(const std::string& what, std::size_t row, const std::string& allowed) {
+  throw std::runtime_error("state: " + what + ", row " + std::to_string(row) + ": " + allowed);
+}
+
+void check_finite(const char* what, const std::vector<double>& v, bool positive = false) {
+  for (std::size_t k = 0; k < v.size(); ++k)
+    if (!std::isfinite(v[k]) || (positive && !(v[k] > 0)))
+      refuse(what, k, positive ? "not a finite positive number" : "not a finite number");
+}
+
+/// A saved contact list against the particles it indexes: keys strictly increasing (the lists are sorted, and
+/// lookups rely on it), each key naming its particles (by gid) or its wall object, and the local indices i, j
+/// those of the key, as the remap after a rebuild sets them.
+void check_contacts(const SavedContacts& h, const char* which, bool ball_ball, const std::vector<int>& local_of_gid,
+                    std::size_t objects) {
+  const std::string list = std::string("the ") + which + " contacts";
+  auto local = [&](std::uint32_t gid, std::size_t k) {
+    if (gid >= local_of_gid.size()) refuse(list + ": key", k, "names particle " + std::to_string(gid) +
+                                                                  " (allowed: below " + std::to_string(local_of_gid.size()) + ")");
+    return local_of_gid[gid];
+  };
+  for (std::size_t k = 0; k < h.key.size(); ++k) {
+    if (k > 0 && h.key[k] <= h.key[k - 1]) refuse(list + ": key", k, "not above the previous key (keys are sorted)");
+    const std::uint32_t hi = key_hi(h.key[k]), lo = key_lo(h.key[k]);
+    int want_i, want_j;
+    if (ball_ball) {
+      if (hi >= lo) refuse(list + ": key", k, "its first particle must have the lower id");
+      want_i = local(hi, k);
+      want_j = local(lo, k);
+    } else {
+      if (hi >= objects)
+        refuse(list + ": key", k, "names object " + std::to_string(hi) + " (allowed: below " + std::to_string(objects) + ")");
+      want_i = local(lo, k);
+      want_j = static_cast<int>(hi);
+    }
+    if (h.i[k] != want_i || h.j[k] != want_j)
+      refuse(list + ": i, j", k, "(" + std::to_string(h.i[k]) + ", " + std::to_string(h.j[k]) + ") where the key gives (" +
+                                     std::to_string(want_i) + ", " + std::to_string(want_j) + ")");
+  }
+  for (const auto* v : {&h.fs, &h.mr, &h.slip, &h.fc, &h.mt, &h.fn}) check_finite((list + " history").c_str(), *v);
+}
+
 }  // namespace
+
+void check_state(const SimState& s, std::size_t walls, std::size_t facets, int materials) {
+  const std::size_t n = s.radius.size();
+  if (s.step < 0) refuse("step", 0, std::to_string(s.step) + " (allowed: 0 or more)");
+  if (!std::isfinite(s.time) || s.time < 0) refuse("time", 0, "not a finite time of 0 or more");
+  if (!std::isfinite(s.dt) || !(s.dt > 0)) refuse("dt", 0, "not a finite positive time step");
+  for (int d = 0; d < 3; ++d)
+    if (!std::isfinite(s.domain.lo[d]) || !std::isfinite(s.domain.hi[d]) || !std::isfinite(s.domain.strain_rate[d]) ||
+        (s.domain.periodic[d] && !(s.domain.hi[d] > s.domain.lo[d])))
+      refuse("domain", static_cast<std::size_t>(d), "bounds or strain rate not finite, or a periodic axis of no length");
+  for (const auto* v : {&s.x, &s.v, &s.w, &s.f, &s.m, &s.x_ref}) check_finite("a particle vector", *v);
+  check_finite("radius", s.radius, true);
+  check_finite("mass", s.mass, true);
+  check_finite("inertia", s.inertia, true);
+  std::vector<int> local_of_gid(n, -1);
+  for (std::size_t k = 0; k < s.gid.size(); ++k) {
+    if (s.gid[k] >= n) refuse("gid", k, std::to_string(s.gid[k]) + " (allowed: 0 to " + std::to_string(n - 1) + ")");
+    if (local_of_gid[s.gid[k]] >= 0) refuse("gid", k, std::to_string(s.gid[k]) + " given twice (ids are unique)");
+    local_of_gid[s.gid[k]] = static_cast<int>(k);
+  }
+  for (std::size_t k = 0; k < s.material.size(); ++k)
+    if (s.material[k] < 0 || s.material[k] >= materials)
+      refuse("material", k, std::to_string(s.material[k]) + " (allowed: 0 to " + std::to_string(materials - 1) + ")");
+  for (std::size_t k = 0; k < s.specimen.size(); ++k)
+    if (s.specimen[k] < 0) refuse("specimen", k, std::to_string(s.specimen[k]) + " (allowed: 0 or more)");
+  check_contacts(s.balls, "ball-ball", true, local_of_gid, 0);
+  check_contacts(s.walls, "ball-wall", false, local_of_gid, walls + facets);
+  for (const auto* v : {&s.wall_point, &s.wall_velocity, &s.node_x, &s.node_v}) check_finite("a wall or mesh node", *v);
+  if (!std::isfinite(s.cell_pressure) || !std::isfinite(s.wall_disp))
+    refuse("cell pressure or wall travel", 0, "not a finite number");
+  for (double v : {s.stats.unbalanced, s.stats.kinetic, s.stats.max_disp2, s.stats.max_move2})
+    if (!std::isfinite(v)) refuse("step statistics", 0, "not a finite number");
+}
 
 SimState Simulation::state() const {
   SimState s;
@@ -124,6 +200,11 @@ void Simulation::restore(const SimState& s) {
   check_count("wall velocities", s.wall_velocity.size() / 3, walls_.n);
   check_count("mesh nodes", s.node_x.size() / 3, mesh_.nnode);
   check_count("mesh node velocities", s.node_v.size() / 3, mesh_.nnode);
+  for (const SavedContacts* c : {&s.balls, &s.walls})
+    if (c->i.size() != c->key.size() || c->j.size() != c->key.size())
+      throw std::runtime_error("state: a contact list has arrays of unequal length");
+  check_state(s, static_cast<std::size_t>(walls_.n), static_cast<std::size_t>(mesh_.ntri),
+              static_cast<int>(params_.extent(0)));
   step_ = s.step;
   time_ = s.time;
   prm_.integ.dt = s.dt;

@@ -3,6 +3,7 @@
 /// bit for bit. The particles are kept in their current local order and both contact lists as they are
 /// (history, flags, slip), with the rebuild bookkeeping, so that the resumed run rebuilds its neighbour lists
 /// at the same steps and gathers forces in the same order as the run it continues.
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -36,5 +37,11 @@ struct SimState {
   StepStats stats;                                ///< of the last step (the next rebuild reads max_disp2)
   bool fresh = true;                              ///< no neighbour list yet
 };
+
+/// Checks a state read from a file before anything uses it: counts agree, every index is inside what it
+/// indexes (gids a permutation of 0 .. n-1, materials below `materials`, contact keys sorted and naming existing
+/// particles and wall objects, walls then facets, with i and j those of their key) and every value is finite
+/// (radius, mass and inertia positive). Throws std::runtime_error naming the array, the row and the allowed range.
+void check_state(const SimState& s, std::size_t walls, std::size_t facets, int materials);
 
 }  // namespace dem

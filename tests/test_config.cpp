@@ -258,3 +258,40 @@ TEST(Config, CalibrateEnsembleSizesAreRead) {
     EXPECT_NE(e.find("bad.toml: [calibrate] "), std::string::npos) << bad << ": " << e;
   }
 }
+
+// Every key the reader knows (config_keys(): so a new key cannot skip this test) refuses NaN, infinities, huge
+// values and values of the wrong type with an error naming the file, its table and the key; and every key is in
+// the README's config reference.
+TEST(Config, EveryKeyRefusesNonFiniteHugeAndWronglyTypedValues) {
+  const std::map<std::string, std::string> keys = dem::config_keys();
+  ASSERT_GT(keys.size(), 60u);
+  std::ifstream readme(std::string(TRIAXDEM_SOURCE_DIR) + "/README.md");
+  const std::string reference((std::istreambuf_iterator<char>(readme)), std::istreambuf_iterator<char>());
+  const std::vector<std::string> numeric{"nan", "inf", "-inf", "1e300", "-1e300", "\"x\"", "true", "{ a = 1 }"};
+  const std::vector<std::string> integer{"nan", "inf", "2.5", "9223372036854775807", "-9223372036854775807", "\"x\"",
+                                         "true"};
+  const std::map<std::string, std::vector<std::string>> bad{
+      {"number", numeric},
+      {"integer", integer},
+      {"integer or word", integer},
+      {"boolean", {"1", "nan", "\"true\"", "[true]"}},
+      {"string", {"1", "nan", "true", "[\"a\"]"}},
+      {"strings", {"\"a\"", "[1]", "nan", "[]"}},
+      {"numbers", {"[nan]", "[inf]", "[1e300]", "[\"x\"]", "1"}},
+      {"triple", {"nan", "[nan, 1, 1]", "[1, inf, 1]", "[1, 1, -inf]", "[1e300, 1, 1]", "[1, 1]", "[\"x\", 1, 1]"}},
+      {"booleans", {"true", "[true, true]", "[1, 0, 0]", "[nan, true, true]"}},
+  };
+  int tried = 0;
+  for (const auto& [full, kind] : keys) {
+    const std::string table = full.substr(0, full.find('.')), key = full.substr(full.find('.') + 1);
+    EXPECT_NE(reference.find(key), std::string::npos) << full << " is not in the README's config reference";
+    ASSERT_TRUE(bad.count(kind)) << full << ": kind " << kind;
+    for (const std::string& value : bad.at(kind)) {
+      const std::string e = error_of("[" + table + "]\n" + key + " = " + value + "\n");
+      EXPECT_NE(e.find("bad.toml: [" + table + "] " + key + ": "), std::string::npos)
+          << full << " = " << value << " gave: " << (e.empty() ? "accepted" : e);
+      ++tried;
+    }
+  }
+  std::printf("%zu keys, %d bad values refused\n", keys.size(), tried);
+}
