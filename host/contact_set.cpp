@@ -113,9 +113,14 @@ ContactSet contact_set(const io::SnapshotFile& f, const std::string& path) {
   const std::size_t n = f.particles.radius.size();
   s.x.resize(n);
   s.radius.resize(n);
+  std::vector<char> seen(n, 0);
   for (std::size_t q = 0; q < n; ++q) {
-    // Rows are in gid order (take_snapshot); the gid column says so.
+    // Rows are in gid order (take_snapshot); the gid column says so, and is used as an index: 0 .. n-1, once each.
     const std::size_t g = f.particles.gid.size() == n ? f.particles.gid[q] : q;
+    if (g >= n || seen[g])
+      throw std::runtime_error(path + ": /gid, row " + std::to_string(q) + ": " + std::to_string(g) +
+                               (g >= n ? " (allowed: 0 to " + std::to_string(n - 1) + ")" : " given twice"));
+    seen[g] = 1;
     if (g >= n) throw std::runtime_error(path + ": gid " + std::to_string(g) + " out of range");
     s.x[g] = Vec3(f.particles.x[3 * q], f.particles.x[3 * q + 1], f.particles.x[3 * q + 2]);
     s.radius[g] = f.particles.radius[q];
@@ -126,7 +131,7 @@ ContactSet contact_set(const io::SnapshotFile& f, const std::string& path) {
     ContactRecord c;
     c.a = t.a[k];
     c.b = t.b[k];
-    c.boundary = static_cast<Boundary>(std::clamp(t.boundary[k], 0, 2));
+    c.boundary = static_cast<Boundary>(t.boundary[k]);  // 0, 1 or 2, with b a ball exactly for 0 (read_snapshot)
     c.fn = t.fn[k];
     c.normal = v3(t.normal, k);
     c.point = v3(t.point, k);

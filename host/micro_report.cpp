@@ -70,16 +70,28 @@ void append_micro_state(const MicroRow& r, std::vector<double>& v) {
 MicroRow micro_row_from(const std::vector<double>& v, std::size_t& at) {
   auto next = [&]() {
     if (at >= v.size()) throw std::runtime_error("checkpoint: the micro rows end early");
+    if (!std::isfinite(v[at]))
+      throw std::runtime_error("checkpoint: micro value " + std::to_string(at) + " is not a finite number");
     return v[at++];
+  };
+  // A count read from the file: a whole number no larger than what is left (a histogram's length, a count).
+  auto count = [&](double most) {
+    const double c = next();
+    if (c < 0 || c > most || c != std::floor(c))
+      throw std::runtime_error("checkpoint: micro value " + std::to_string(at - 1) + " = " + std::to_string(c) +
+                               " is not a count (allowed: a whole number from 0 to " + std::to_string(most) + ")");
+    return c;
   };
   MicroRow r;
   each_field(r, [&](auto& x) {
     using T = std::decay_t<decltype(x)>;
     if constexpr (std::is_same_v<T, std::vector<long>>) {
-      x.resize(static_cast<std::size_t>(next()));
-      for (long& n : x) n = static_cast<long>(next());
+      x.resize(static_cast<std::size_t>(count(static_cast<double>(v.size() - at - 1))));
+      for (long& n : x) n = static_cast<long>(count(9e15));
     } else if constexpr (std::is_same_v<T, Tensor>) {
       for (Real& e : x) e = next();
+    } else if constexpr (std::is_integral_v<T>) {
+      x = static_cast<T>(count(9e15));
     } else {
       x = static_cast<T>(next());
     }

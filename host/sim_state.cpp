@@ -85,10 +85,12 @@ void check_count(const char* what, std::size_t got, std::size_t want) {
   throw std::runtime_error("state: " + what + ", row " + std::to_string(row) + ": " + allowed);
 }
 
-void check_finite(const char* what, const std::vector<double>& v, bool positive = false) {
+/// Values stored `columns` to a row (3 for vectors, interleaved); the error names the row.
+void check_finite(const std::string& what, const std::vector<double>& v, std::size_t columns = 1,
+                  bool positive = false) {
   for (std::size_t k = 0; k < v.size(); ++k)
     if (!std::isfinite(v[k]) || (positive && !(v[k] > 0)))
-      refuse(what, k, positive ? "not a finite positive number" : "not a finite number");
+      refuse(what, k / columns, positive ? "not a finite positive number" : "not a finite number");
 }
 
 /// A saved contact list against the particles it indexes: keys strictly increasing (the lists are sorted, and
@@ -120,7 +122,8 @@ void check_contacts(const SavedContacts& h, const char* which, bool ball_ball, c
       refuse(list + ": i, j", k, "(" + std::to_string(h.i[k]) + ", " + std::to_string(h.j[k]) + ") where the key gives (" +
                                      std::to_string(want_i) + ", " + std::to_string(want_j) + ")");
   }
-  for (const auto* v : {&h.fs, &h.mr, &h.slip, &h.fc, &h.mt, &h.fn}) check_finite((list + " history").c_str(), *v);
+  for (const auto* v : {&h.fs, &h.mr, &h.fc, &h.mt}) check_finite(list + " history", *v, 3);
+  for (const auto* v : {&h.slip, &h.fn}) check_finite(list + " history", *v);
 }
 
 }  // namespace
@@ -134,10 +137,10 @@ void check_state(const SimState& s, std::size_t walls, std::size_t facets, int m
     if (!std::isfinite(s.domain.lo[d]) || !std::isfinite(s.domain.hi[d]) || !std::isfinite(s.domain.strain_rate[d]) ||
         (s.domain.periodic[d] && !(s.domain.hi[d] > s.domain.lo[d])))
       refuse("domain", static_cast<std::size_t>(d), "bounds or strain rate not finite, or a periodic axis of no length");
-  for (const auto* v : {&s.x, &s.v, &s.w, &s.f, &s.m, &s.x_ref}) check_finite("a particle vector", *v);
-  check_finite("radius", s.radius, true);
-  check_finite("mass", s.mass, true);
-  check_finite("inertia", s.inertia, true);
+  for (const auto* v : {&s.x, &s.v, &s.w, &s.f, &s.m, &s.x_ref}) check_finite("a particle vector", *v, 3);
+  check_finite("radius", s.radius, 1, true);
+  check_finite("mass", s.mass, 1, true);
+  check_finite("inertia", s.inertia, 1, true);
   std::vector<int> local_of_gid(n, -1);
   for (std::size_t k = 0; k < s.gid.size(); ++k) {
     if (s.gid[k] >= n) refuse("gid", k, std::to_string(s.gid[k]) + " (allowed: 0 to " + std::to_string(n - 1) + ")");
@@ -151,7 +154,7 @@ void check_state(const SimState& s, std::size_t walls, std::size_t facets, int m
     if (s.specimen[k] < 0) refuse("specimen", k, std::to_string(s.specimen[k]) + " (allowed: 0 or more)");
   check_contacts(s.balls, "ball-ball", true, local_of_gid, 0);
   check_contacts(s.walls, "ball-wall", false, local_of_gid, walls + facets);
-  for (const auto* v : {&s.wall_point, &s.wall_velocity, &s.node_x, &s.node_v}) check_finite("a wall or mesh node", *v);
+  for (const auto* v : {&s.wall_point, &s.wall_velocity, &s.node_x, &s.node_v}) check_finite("a wall or mesh node", *v, 3);
   if (!std::isfinite(s.cell_pressure) || !std::isfinite(s.wall_disp))
     refuse("cell pressure or wall travel", 0, "not a finite number");
   for (double v : {s.stats.unbalanced, s.stats.kinetic, s.stats.max_disp2, s.stats.max_move2})

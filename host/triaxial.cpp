@@ -204,7 +204,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
       std::printf("shear: strain rate %.3g 1/s (inertial number %.1e%s), %ld steps to %.0f%%\n", res.shear_rate,
                   tc.inertial_number, cfg.solver.mass_scale != 1 ? ", with density scaling" : "", steps,
                   tc.axial_strain_end * 100);
-    const Real snaps[] = {0.0, 0.01, 0.05, tc.axial_strain_end};
+    const Real snaps[kSnapshotStrains] = {0.0, 0.01, 0.05, tc.axial_strain_end};
     const char* snap_labels[] = {"A", "B", "C", "D"};  // the paper's points A-D (Figure 8)
     Progress shear("shear", steps, static_cast<long>(st.step));
     for (long k = static_cast<long>(st.step); k <= steps; ++k) {
@@ -241,7 +241,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
           res.micro.push_back(m);
           for (const MicroRow& x : {m, micro_row(rve, mc.rve_edge * mc.rve_edge * mc.rve_edge)})
             for (double v : micro_values(x)) row.push_back(v);
-          const bool snap_due = next_snap < 4 && eps_a >= snaps[next_snap] - 1e-12;
+          const bool snap_due = next_snap < kSnapshotStrains && eps_a >= snaps[next_snap] - 1e-12;
           if (out && snap_due) write_micro_state(out->folder(), snap_labels[next_snap], cs, rve, mc.rose_bins);
           if (out && r.q > st.q_max) write_micro_state(out->folder(), "peak", cs, rve, mc.rose_bins);
         }
@@ -258,7 +258,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
         }
       }
       const int next_snap = static_cast<int>(st.next_snap);
-      if (out && next_snap < 4 && eps_a >= snaps[next_snap] - 1e-12) {
+      if (out && next_snap < kSnapshotStrains && eps_a >= snaps[next_snap] - 1e-12) {
         char label[48];
         std::snprintf(label, sizeof label, "shear eps_a=%.0f%%", 100 * snaps[next_snap]);
         const io::SurfaceSnapshot surface = membrane_surface(cell.membrane);

@@ -1,5 +1,6 @@
 #include "triaxial_state.hpp"
 
+#include <cmath>
 #include <stdexcept>
 
 #include "micro_report.hpp"
@@ -12,9 +13,28 @@ std::vector<double> stage_numbers(const Stage& s) {
   return {s.shear, s.step, s.h0, s.v0, s.v0_envelope, s.void_ratio, s.consolidation_steps, s.q_max, s.next_snap,
           s.next_record};
 }
+/// The stage as the file gives it, each value checked against what the loops do with it: the stage and the
+/// snapshot index select, the step starts a loop, the volumes divide.
 Stage stage_of(const std::vector<double>& v, const std::string& path) {
   if (v.size() != 10)
     throw std::runtime_error(path + ": the triaxial stage has " + std::to_string(v.size()) + " values, not 10");
+  const char* names[10] = {"shear", "step", "h0", "v0", "v0_envelope", "void_ratio", "consolidation_steps",
+                           "q_max", "next_snap", "next_record"};
+  auto refuse = [&](int k, const std::string& allowed) {
+    throw std::runtime_error(path + ": number_stage, row " + std::to_string(k) + " (" + names[k] + ") = " +
+                             std::to_string(v[k]) + " (allowed: " + allowed + ")");
+  };
+  auto whole = [&](int k, double most) {
+    if (!(v[k] >= 0 && v[k] <= most && v[k] == std::floor(v[k]))) refuse(k, "a whole number from 0 to " + std::to_string(most));
+  };
+  whole(0, 1);
+  whole(1, kMaxStageSteps);
+  for (int k : {2, 3, 4, 5})
+    if (!(std::isfinite(v[k]) && v[k] > 0)) refuse(k, "a finite positive number");
+  whole(6, kMaxStageSteps);
+  if (std::isnan(v[7]) || v[7] == INFINITY) refuse(7, "a finite number, or -inf before the first record");
+  whole(8, kSnapshotStrains);
+  if (!(std::isfinite(v[9]) && v[9] >= 0)) refuse(9, "a finite strain of 0 or more");
   return Stage{v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9]};
 }
 
@@ -26,7 +46,13 @@ std::vector<double> record_numbers(const std::vector<TriaxialRecord>& rs) {
                        r.unbalanced, r.kinetic});
   return v;
 }
-std::vector<TriaxialRecord> records_of(const std::vector<double>& v) {
+std::vector<TriaxialRecord> records_of(const std::vector<double>& v, const std::string& path) {
+  if (v.size() % kRecordValues != 0)
+    throw std::runtime_error(path + ": number_records has " + std::to_string(v.size()) + " values (allowed: " +
+                             std::to_string(kRecordValues) + " per record)");
+  for (std::size_t k = 0; k < v.size(); ++k)
+    if (!std::isfinite(v[k]))
+      throw std::runtime_error(path + ": number_records, value " + std::to_string(k) + " is not a finite number");
   std::vector<TriaxialRecord> rs(v.size() / kRecordValues);
   for (std::size_t i = 0; i < rs.size(); ++i) {
     const double* x = &v[kRecordValues * i];
@@ -52,13 +78,18 @@ void restore_triaxial(const Checkpoint& c, const std::string& path, Simulation& 
   if (c.job != "triaxial") throw std::runtime_error(path + ": written by the '" + c.job + "' job, not 'triaxial'");
   for (const char* key : {"stage", "records"})
     if (!c.numbers.count(key)) throw std::runtime_error(path + ": the triaxial '" + std::string(key) + "' is missing");
-  resume_from(c, sim, out);
-  st = stage_of(c.numbers.at("stage"), path);
-  res.records = records_of(c.numbers.at("records"));
-  if (c.numbers.count("wall_s") && c.numbers.at("wall_s").size() == 1) res.wall_seconds = c.numbers.at("wall_s")[0];
+  // Everything the file gives is checked before anything of the run changes.
+  const Stage checked = stage_of(c.numbers.at("stage"), path);
+  std::vector<TriaxialRecord> records = records_of(c.numbers.at("records"), path);
+  std::vector<MicroRow> micro;
   if (c.numbers.count("micro"))
     for (std::size_t at = 0; at < c.numbers.at("micro").size();)
-      res.micro.push_back(micro_row_from(c.numbers.at("micro"), at));
+      micro.push_back(micro_row_from(c.numbers.at("micro"), at));
+  resume_from(c, sim, out);
+  st = checked;
+  res.records = std::move(records);
+  res.micro = std::move(micro);
+  if (c.numbers.count("wall_s") && c.numbers.at("wall_s").size() == 1) res.wall_seconds = c.numbers.at("wall_s")[0];
 }
 
 }  // namespace dem

@@ -4,13 +4,19 @@
 #include <gtest/gtest.h>
 #include <hdf5.h>
 
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "host/builder.hpp"
 #include "host/checkpoint.hpp"
+#include "host/io_hdf5.hpp"
+#include "host/micro.hpp"
 #include "host/simulation.hpp"
+#include "host/triaxial_state.hpp"
 #include "test_util.hpp"
 
 using namespace dem;
@@ -42,7 +48,7 @@ std::unique_ptr<Simulation> settled_box() {
   return sim;
 }
 
-/// Overwrites one element of an integer or double dataset in place, as an edit with h5py would.
+/// Overwrites the first value of a row of a dataset in place, as an edit with h5py would.
 template <class T>
 void poke(const std::string& file, const std::string& dataset, hsize_t row, T value, hid_t type) {
   const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
@@ -50,8 +56,8 @@ void poke(const std::string& file, const std::string& dataset, hsize_t row, T va
   const hid_t set = H5Dopen2(f, dataset.c_str(), H5P_DEFAULT);
   ASSERT_GE(set, 0) << dataset;
   const hid_t space = H5Dget_space(set);
-  const hsize_t one = 1;
-  ASSERT_GE(H5Sselect_elements(space, H5S_SELECT_SET, 1, &row), 0);
+  const hsize_t one = 1, at[2] = {row, 0};  // the row's first value, in a vector or a table
+  ASSERT_GE(H5Sselect_elements(space, H5S_SELECT_SET, 1, at), 0);
   const hid_t mem = H5Screate_simple(1, &one, nullptr);
   ASSERT_GE(H5Dwrite(set, type, mem, space, H5P_DEFAULT, &value), 0);
   H5Sclose(mem);
@@ -129,4 +135,206 @@ TEST_F(Untrusted, ADatasetOfRankEightIsRefusedBeforeItsExtentsAreRead) {
   EXPECT_NE(e.find(path), std::string::npos) << e;
   EXPECT_NE(e.find("'/step'"), std::string::npos) << e;
   EXPECT_NE(e.find("rank 8"), std::string::npos) << e;
+}
+
+// The edits a hand-editor makes to a checkpoint, each refused at --resume with the dataset, the row and the
+// allowed range; the simulation is left as it was (resume_error checks it).
+TEST_F(Untrusted, EditedIndicesInACheckpointAreRefusedWithTheRow) {
+  struct Edit {
+    std::string dataset;
+    hsize_t row;
+    long long value;
+    hid_t type;
+    std::string expected;
+  };
+  const std::vector<Edit> edits{
+      {"/gid", 3, 99999999, H5T_NATIVE_UINT32, "state: gid, row 3: 99999999 (allowed: 0 to 11)"},
+      {"/gid", 3, 0, H5T_NATIVE_UINT32, "given twice"},
+      {"/material", 5, 7, H5T_NATIVE_INT, "state: material, row 5: 7 (allowed: 0 to 0)"},
+      {"/material", 5, -1, H5T_NATIVE_INT, "state: material, row 5: -1"},
+      {"/balls_i", 0, 99999, H5T_NATIVE_INT, "state: the ball-ball contacts: i, j, row 0"},
+      {"/balls_j", 0, -5, H5T_NATIVE_INT, "state: the ball-ball contacts: i, j, row 0"},
+      {"/walls_j", 0, 42, H5T_NATIVE_INT, "state: the ball-wall contacts: i, j, row 0"},
+      {"/walls_key", 0, (42LL << 32) | 1, H5T_NATIVE_INT64, "names object 42 (allowed: below 1)"},
+      {"/balls_key", 0, 0, H5T_NATIVE_INT64, "the ball-ball contacts: key, row 0"},
+      {"/step", 0, -1000000000000000LL, H5T_NATIVE_INT64, "state: step, row 0"},
+  };
+  for (const Edit& e : edits) {
+    const std::string path = checkpoint();
+    poke(path, e.dataset, e.row, e.value, e.type);
+    const std::string got = resume_error(path);
+    EXPECT_NE(got.find(e.expected), std::string::npos) << e.dataset << " = " << e.value << ": " << got;
+  }
+}
+
+// Non-finite values where the run divides or integrates by them.
+TEST_F(Untrusted, NonFiniteValuesInACheckpointAreRefused) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const std::vector<std::tuple<std::string, int, double, std::string>> edits{
+      {"/x", 4, std::nan(""), "a particle vector, row 4"},
+      {"/radius", 2, 0.0, "radius, row 2: not a finite positive number"},
+      {"/dt_s", 0, inf, "dt, row 0"},
+      {"/balls_fs", 1, -inf, "the ball-ball contacts history, row 1"}};
+  for (const auto& [dataset, row, value, expected] : edits) {
+    const std::string path = checkpoint();
+    poke(path, dataset, static_cast<hsize_t>(row), value, H5T_NATIVE_DOUBLE);
+    const std::string got = resume_error(path);
+    EXPECT_NE(got.find(expected), std::string::npos) << dataset << ": " << got;
+  }
+}
+
+// Shapes and sizes the reader must check before it allocates or HDF5 writes: a dataset declared with four
+// billion rows and nothing stored, floats where indices belong, a string attribute holding an array.
+TEST_F(Untrusted, DeclaredSizesTypesAndAttributeShapesAreChecked) {
+  {
+    const std::string path = checkpoint();
+    replace(path, "/x", {4000000000ull, 3}, 0, false);
+    const std::string e = resume_error(path);
+    EXPECT_NE(e.find("dataset '/x' declares 4000000000 rows, more than a file of"), std::string::npos) << e;
+  }
+  {
+    const std::string path = checkpoint();
+    replace(path, "/gid", {12}, 1.5);
+    const std::string e = resume_error(path);
+    EXPECT_NE(e.find("dataset '/gid' holds floating-point numbers (allowed: integers)"), std::string::npos) << e;
+  }
+  {
+    const std::string path = checkpoint();
+    const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    H5Adelete(f, "format");
+    const hsize_t four = 4;
+    const hid_t space = H5Screate_simple(1, &four, nullptr);
+    const hid_t type = H5Tcopy(H5T_C_S1);
+    H5Tset_size(type, 64);
+    const hid_t attr = H5Acreate2(f, "format", type, space, H5P_DEFAULT, H5P_DEFAULT);
+    const std::vector<char> text(4 * 64, 'x');
+    H5Awrite(attr, type, text.data());
+    H5Aclose(attr);
+    H5Tclose(type);
+    H5Sclose(space);
+    H5Fclose(f);
+    const std::string e = resume_error(path);
+    EXPECT_NE(e.find("attribute 'format' of '/' is not a single value"), std::string::npos) << e;
+  }
+}
+
+namespace {
+/// A snapshot of three balls in a row on a membrane patch, with two ball-ball contacts and one membrane contact,
+/// as the triaxial job writes it at a micro record.
+std::string snapshot_file(const std::filesystem::path& dir) {
+  io::Snapshot s;
+  s.step = 100;
+  s.label = "shear eps_a=1%";
+  for (int i = 0; i < 3; ++i) {
+    s.x.insert(s.x.end(), {2e-3 * i, 0.0, 0.0});
+    s.v.insert(s.v.end(), {0.0, 0.0, 0.0});
+    s.w.insert(s.w.end(), {0.0, 0.0, 0.0});
+    s.radius.push_back(1e-3);
+    s.gid.push_back(static_cast<std::uint32_t>(i));
+    s.specimen.push_back(0);
+  }
+  io::SurfaceSnapshot surface;
+  surface.nodes = {0, -1e-3, 0, 4e-3, -1e-3, 0, 0, -1e-3, 1e-3};
+  surface.triangles = {0, 1, 2};
+  io::ContactTable c;
+  c.a = {0, 1, 2};
+  c.b = {1, 2, -1};
+  c.boundary = {0, 0, 2};
+  for (int k = 0; k < 3; ++k) {
+    c.fn.push_back(1.0);
+    c.normal.insert(c.normal.end(), {1.0, 0.0, 0.0});
+    c.point.insert(c.point.end(), {1e-3 + 2e-3 * k, 0.0, 0.0});
+    c.branch.insert(c.branch.end(), {2e-3, 0.0, 0.0});
+    c.ft.insert(c.ft.end(), {0.0, 0.1, 0.0});
+  }
+  io::Output out((dir / "run").string());
+  out.write_snapshot(s, &surface, &c);
+  return (dir / "run" / "snap_000000100.h5").string();
+}
+
+/// The error of reading a snapshot and building its contact set, as `triaxdem micro` does; "" if both pass.
+std::string micro_error(const std::string& path) {
+  try {
+    contact_set(io::read_snapshot(path), path);
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+// `triaxdem micro` reads snapshots as they come: contact and triangle indices, gids used as row indices and the
+// lengths of the contact arrays are checked before they index anything.
+TEST_F(Untrusted, EditedSnapshotsAreRefusedBeforeMicroUsesThem) {
+  EXPECT_EQ(micro_error(snapshot_file(dir_ / "clean")), "");
+  struct Edit {
+    std::string dataset;
+    hsize_t row;
+    long long value;
+    std::string expected;
+  };
+  const std::vector<Edit> edits{
+      {"/contacts/b", 0, -1, "/contacts, row 0: boundary 0 with b = -1"},
+      {"/contacts/a", 1, 3, "/contacts, row 1: a ball that is not in the file"},
+      {"/contacts/boundary", 2, 7, "/contacts, row 2: boundary 7"},
+      {"/surface/triangles", 0, 9, "/surface/triangles, row 0: node 9 (allowed: 0 to 2)"},
+      {"/gid", 1, 5, "/gid, row 1: 5 (allowed: 0 to 2)"},
+      {"/gid", 1, 0, "/gid, row 1: 0 given twice"},
+  };
+  int k = 0;
+  for (const Edit& e : edits) {
+    const std::string path = snapshot_file(dir_ / std::to_string(k++));
+    poke(path, e.dataset, e.row, static_cast<int>(e.value), e.dataset == "/gid" ? H5T_NATIVE_UINT32 : H5T_NATIVE_INT);
+    const std::string got = micro_error(path);
+    EXPECT_NE(got.find(e.expected), std::string::npos) << e.dataset << " = " << e.value << ": " << got;
+  }
+  const std::string shorter = snapshot_file(dir_ / "short");
+  replace(shorter, "/contacts/branch", {2, 3}, 0.0);
+  EXPECT_NE(micro_error(shorter).find("/contacts datasets of unequal length"), std::string::npos) << micro_error(shorter);
+}
+
+// A triaxial checkpoint's stage values drive its loops: a snapshot index past the four snapshots indexed an array
+// past its end, a step of -1e15 started an almost endless loop, and records not a multiple of nine were cut.
+TEST_F(Untrusted, TriaxialStageValuesAreCheckedBeforeTheRunChanges) {
+  sim_ = settled_box();
+  Stage st;
+  st.shear = 1;
+  st.step = 10;
+  st.h0 = st.v0 = st.v0_envelope = 1e-6;
+  st.void_ratio = 0.7;
+  TriaxialResult res;
+  res.records.resize(3);
+  const std::string path = (dir_ / "triaxial.h5").string();
+  struct Case {
+    int row;
+    double value;
+    std::string expected;
+  };
+  for (const Case& c : std::vector<Case>{{8, -1, "row 8 (next_snap) = -1"},
+                                         {8, 4.5, "row 8 (next_snap) = 4.5"},
+                                         {1, -1e15, "row 1 (step) = -1"},
+                                         {0, 0.5, "row 0 (shear) = 0.5"},
+                                         {3, 0, "row 3 (v0) = 0"}}) {
+    save_triaxial(path, *sim_, nullptr, st, res);
+    poke(path, "/number_stage", static_cast<hsize_t>(c.row), c.value, H5T_NATIVE_DOUBLE);
+    Stage got;
+    TriaxialResult out;
+    try {
+      restore_triaxial(read_checkpoint(path), path, *sim_, nullptr, got, out);
+      ADD_FAILURE() << "accepted stage row " << c.row << " = " << c.value;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(path + ": number_stage, " + c.expected), std::string::npos) << e.what();
+    }
+  }
+  save_triaxial(path, *sim_, nullptr, st, res);
+  replace(path, "/number_records", {26}, 0.0);
+  Stage got;
+  TriaxialResult out;
+  try {
+    restore_triaxial(read_checkpoint(path), path, *sim_, nullptr, got, out);
+    ADD_FAILURE() << "accepted 26 record values";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("number_records has 26 values (allowed: 9 per record)"), std::string::npos)
+        << e.what();
+  }
 }
