@@ -15,43 +15,77 @@ using io::h5::H5Writer;
 
 namespace {
 
-constexpr const char* kFormat = "triaxdem checkpoint 1";
+constexpr const char* kFormatName = "triaxdem checkpoint ";
+constexpr int kFormatVersion = 2;
 
-template <class T>
-void put(H5Writer& f, const std::string& name, hid_t type, const std::vector<T>& v, std::size_t columns = 1) {
-  const hsize_t rows = v.size() / columns;
-  if (columns == 1)
-    f.dataset(f.root(), name, type, v.data(), {rows});
-  else
-    f.dataset(f.root(), name, type, v.data(), {rows, hsize_t(columns)});
-}
+/// A checksum of everything a checkpoint holds: the sum (mod 2^64) of each dataset's FNV-1a hash over its name
+/// and bytes, and of the job and config attributes. A sum, so that the order of reading does not matter; a hash
+/// per dataset, so that a value moved from one dataset to another does not cancel.
+struct Seal {
+  std::uint64_t sum = 0;
+  void add(const std::string& name, const void* data, std::size_t bytes) {
+    std::uint64_t h = 14695981039346656037ull;
+    auto mix = [&](const unsigned char* p, std::size_t n) {
+      for (std::size_t k = 0; k < n; ++k) h = (h ^ p[k]) * 1099511628211ull;
+    };
+    mix(reinterpret_cast<const unsigned char*>(name.data()), name.size() + 1);
+    mix(static_cast<const unsigned char*>(data), bytes);
+    sum += h;
+  }
+  std::string hex() const {
+    char b[17];
+    std::snprintf(b, sizeof b, "%016llx", static_cast<unsigned long long>(sum));
+    return b;
+  }
+};
 
-void put_history(H5Writer& f, const std::string& prefix, const SavedContacts& h) {
-  put(f, prefix + "key", H5T_NATIVE_UINT64, h.key);
-  put(f, prefix + "i", H5T_NATIVE_INT, h.i);
-  put(f, prefix + "j", H5T_NATIVE_INT, h.j);
-  put(f, prefix + "fs", H5T_NATIVE_DOUBLE, h.fs, 3);
-  put(f, prefix + "mr", H5T_NATIVE_DOUBLE, h.mr, 3);
-  put(f, prefix + "slip", H5T_NATIVE_DOUBLE, h.slip);
-  put(f, prefix + "flags", H5T_NATIVE_UINT8, h.flags);
-  put(f, prefix + "fc", H5T_NATIVE_DOUBLE, h.fc, 3);
-  put(f, prefix + "mt", H5T_NATIVE_DOUBLE, h.mt, 3);
-  put(f, prefix + "fn", H5T_NATIVE_DOUBLE, h.fn);
-}
+/// Writes datasets and seals them.
+struct SealedWriter {
+  H5Writer& f;
+  Seal seal;
+  template <class T>
+  void put(const std::string& name, hid_t type, const std::vector<T>& v, std::size_t columns = 1) {
+    const hsize_t rows = v.size() / columns;
+    if (columns == 1)
+      f.dataset(f.root(), name, type, v.data(), {rows});
+    else
+      f.dataset(f.root(), name, type, v.data(), {rows, hsize_t(columns)});
+    seal.add(name, v.data(), v.size() * sizeof(T));
+  }
+  void attribute(const std::string& name, const std::string& value) {
+    f.string_attribute(".", name, value);
+    seal.add("@" + name, value.data(), value.size());
+  }
+};
 
-SavedContacts get_history(const H5Reader& f, const std::string& prefix) {
-  SavedContacts h;
-  h.key = f.read<std::uint64_t>("/" + prefix + "key", H5T_NATIVE_UINT64, 1);
-  h.i = f.read<int>("/" + prefix + "i", H5T_NATIVE_INT, 1);
-  h.j = f.read<int>("/" + prefix + "j", H5T_NATIVE_INT, 1);
-  h.fs = f.read<double>("/" + prefix + "fs", H5T_NATIVE_DOUBLE, 3);
-  h.mr = f.read<double>("/" + prefix + "mr", H5T_NATIVE_DOUBLE, 3);
-  h.slip = f.read<double>("/" + prefix + "slip", H5T_NATIVE_DOUBLE, 1);
-  h.flags = f.read<std::uint8_t>("/" + prefix + "flags", H5T_NATIVE_UINT8, 1);
-  h.fc = f.read<double>("/" + prefix + "fc", H5T_NATIVE_DOUBLE, 3);
-  h.mt = f.read<double>("/" + prefix + "mt", H5T_NATIVE_DOUBLE, 3);
-  h.fn = f.read<double>("/" + prefix + "fn", H5T_NATIVE_DOUBLE, 1);
-  return h;
+/// Reads datasets and adds them to the seal, to be compared with the stored checksum at the end.
+struct SealedReader {
+  const H5Reader& f;
+  Seal seal;
+  template <class T>
+  std::vector<T> read(const std::string& name, hid_t type, std::size_t columns = 1) {
+    std::vector<T> v = f.read<T>("/" + name, type, columns);
+    seal.add(name, v.data(), v.size() * sizeof(T));
+    return v;
+  }
+  std::string attribute(const std::string& name) {
+    const std::string v = f.string_attribute("/", name);
+    seal.add("@" + name, v.data(), v.size());
+    return v;
+  }
+};
+
+void put_history(SealedWriter& f, const std::string& prefix, const SavedContacts& h) {
+  f.put(prefix + "key", H5T_NATIVE_UINT64, h.key);
+  f.put(prefix + "i", H5T_NATIVE_INT, h.i);
+  f.put(prefix + "j", H5T_NATIVE_INT, h.j);
+  f.put(prefix + "fs", H5T_NATIVE_DOUBLE, h.fs, 3);
+  f.put(prefix + "mr", H5T_NATIVE_DOUBLE, h.mr, 3);
+  f.put(prefix + "slip", H5T_NATIVE_DOUBLE, h.slip);
+  f.put(prefix + "flags", H5T_NATIVE_UINT8, h.flags);
+  f.put(prefix + "fc", H5T_NATIVE_DOUBLE, h.fc, 3);
+  f.put(prefix + "mt", H5T_NATIVE_DOUBLE, h.mt, 3);
+  f.put(prefix + "fn", H5T_NATIVE_DOUBLE, h.fn);
 }
 
 std::string join_names(const std::vector<std::string>& names) {
@@ -68,13 +102,38 @@ std::vector<std::string> split_names(const std::string& s) {
   return out;
 }
 
-/// One value of a one-value dataset.
+SavedContacts get_history(SealedReader& f, const std::string& prefix) {
+  SavedContacts h;
+  h.key = f.read<std::uint64_t>(prefix + "key", H5T_NATIVE_UINT64);
+  h.i = f.read<int>(prefix + "i", H5T_NATIVE_INT);
+  h.j = f.read<int>(prefix + "j", H5T_NATIVE_INT);
+  h.fs = f.read<double>(prefix + "fs", H5T_NATIVE_DOUBLE, 3);
+  h.mr = f.read<double>(prefix + "mr", H5T_NATIVE_DOUBLE, 3);
+  h.slip = f.read<double>(prefix + "slip", H5T_NATIVE_DOUBLE);
+  h.flags = f.read<std::uint8_t>(prefix + "flags", H5T_NATIVE_UINT8);
+  h.fc = f.read<double>(prefix + "fc", H5T_NATIVE_DOUBLE, 3);
+  h.mt = f.read<double>(prefix + "mt", H5T_NATIVE_DOUBLE, 3);
+  h.fn = f.read<double>(prefix + "fn", H5T_NATIVE_DOUBLE);
+  return h;
+}
+
+/// The values a dataset of exactly `count` values holds.
 template <class T>
-T get_one(const H5Reader& f, const std::string& path, const std::string& name, hid_t type, std::size_t count = 1,
-          std::size_t at = 0) {
-  const std::vector<T> v = f.read<T>("/" + name, type, 1);
-  if (v.size() != count) throw std::runtime_error(path + ": dataset '" + name + "' has the wrong length");
-  return v[at];
+std::vector<T> exactly(SealedReader& f, const std::string& path, const std::string& name, hid_t type,
+                       std::size_t count, std::size_t columns = 1) {
+  std::vector<T> v = f.read<T>(name, type, columns);
+  if (v.size() != count)
+    throw std::runtime_error(path + ": dataset '/" + name + "' has " + std::to_string(v.size()) + " values (allowed: " +
+                             std::to_string(count) + ")");
+  return v;
+}
+
+/// The counts a checkpoint declares (balls, ball-ball and ball-wall contacts, walls, mesh nodes), against which
+/// every array's rows are checked: a truncated or spliced file disagrees with them.
+std::vector<std::int64_t> counts_of(const SimState& s) {
+  return {static_cast<std::int64_t>(s.radius.size()), static_cast<std::int64_t>(s.balls.key.size()),
+          static_cast<std::int64_t>(s.walls.key.size()), static_cast<std::int64_t>(s.wall_point.size() / 3),
+          static_cast<std::int64_t>(s.node_x.size() / 3)};
 }
 
 }  // namespace
@@ -82,69 +141,79 @@ T get_one(const H5Reader& f, const std::string& path, const std::string& name, h
 void write_checkpoint(const std::string& path, const Checkpoint& c) {
   const SimState& s = c.sim;
   io::h5::replace_atomically(path, [&](const std::string& tmp) {
-    H5Writer f(tmp, path);
-    f.string_attribute(".", "format", kFormat);
-    f.string_attribute(".", "job", c.job);
-    put(f, "step", H5T_NATIVE_INT64, std::vector<std::int64_t>{s.step});
-    put(f, "time_s", H5T_NATIVE_DOUBLE, std::vector<double>{s.time});
-    put(f, "dt_s", H5T_NATIVE_DOUBLE, std::vector<double>{s.dt});
-    put(f, "cell_pressure_Pa", H5T_NATIVE_DOUBLE, std::vector<double>{s.cell_pressure});
-    put(f, "wall_disp_m", H5T_NATIVE_DOUBLE, std::vector<double>{s.wall_disp});
-    put(f, "stats", H5T_NATIVE_DOUBLE, std::vector<double>{s.stats.unbalanced, s.stats.kinetic, s.stats.max_disp2,
+    H5Writer h5(tmp, path);
+    SealedWriter f{h5, {}};
+    h5.string_attribute(".", "format", kFormatName + std::to_string(kFormatVersion));
+    f.attribute("job", c.job);
+    f.attribute("config", c.config);
+    f.put("counts", H5T_NATIVE_INT64, counts_of(s));
+    f.put("step", H5T_NATIVE_INT64, std::vector<std::int64_t>{s.step});
+    f.put("time_s", H5T_NATIVE_DOUBLE, std::vector<double>{s.time});
+    f.put("dt_s", H5T_NATIVE_DOUBLE, std::vector<double>{s.dt});
+    f.put("cell_pressure_Pa", H5T_NATIVE_DOUBLE, std::vector<double>{s.cell_pressure});
+    f.put("wall_disp_m", H5T_NATIVE_DOUBLE, std::vector<double>{s.wall_disp});
+    f.put("stats", H5T_NATIVE_DOUBLE, std::vector<double>{s.stats.unbalanced, s.stats.kinetic, s.stats.max_disp2,
                                                           s.stats.max_move2});
-    put(f, "flags", H5T_NATIVE_INT, std::vector<int>{s.fresh ? 1 : 0, s.stats.bad});
+    f.put("flags", H5T_NATIVE_INT, std::vector<int>{s.fresh ? 1 : 0, s.stats.bad});
     const Domain& d = s.domain;
-    put(f, "domain", H5T_NATIVE_DOUBLE,
-        std::vector<double>{d.lo[0], d.lo[1], d.lo[2], d.hi[0], d.hi[1], d.hi[2], d.strain_rate[0],
-                            d.strain_rate[1], d.strain_rate[2]}, 3);
-    put(f, "periodic", H5T_NATIVE_INT, std::vector<int>{d.periodic[0], d.periodic[1], d.periodic[2]});
+    f.put("domain", H5T_NATIVE_DOUBLE,
+          std::vector<double>{d.lo[0], d.lo[1], d.lo[2], d.hi[0], d.hi[1], d.hi[2], d.strain_rate[0],
+                              d.strain_rate[1], d.strain_rate[2]}, 3);
+    f.put("periodic", H5T_NATIVE_INT, std::vector<int>{d.periodic[0], d.periodic[1], d.periodic[2]});
     for (const auto& [name, v] : {std::make_pair("x", &s.x), std::make_pair("v", &s.v), std::make_pair("w", &s.w),
                                   std::make_pair("f", &s.f), std::make_pair("m", &s.m), std::make_pair("x_ref", &s.x_ref),
                                   std::make_pair("wall_point", &s.wall_point),
                                   std::make_pair("wall_velocity", &s.wall_velocity),
                                   std::make_pair("node_x", &s.node_x), std::make_pair("node_v", &s.node_v)})
-      put(f, name, H5T_NATIVE_DOUBLE, *v, 3);
-    put(f, "radius", H5T_NATIVE_DOUBLE, s.radius);
-    put(f, "mass", H5T_NATIVE_DOUBLE, s.mass);
-    put(f, "inertia", H5T_NATIVE_DOUBLE, s.inertia);
-    put(f, "gid", H5T_NATIVE_UINT32, s.gid);
-    put(f, "specimen", H5T_NATIVE_INT, s.specimen);
-    put(f, "material", H5T_NATIVE_INT, s.material);
+      f.put(name, H5T_NATIVE_DOUBLE, *v, 3);
+    f.put("radius", H5T_NATIVE_DOUBLE, s.radius);
+    f.put("mass", H5T_NATIVE_DOUBLE, s.mass);
+    f.put("inertia", H5T_NATIVE_DOUBLE, s.inertia);
+    f.put("gid", H5T_NATIVE_UINT32, s.gid);
+    f.put("specimen", H5T_NATIVE_INT, s.specimen);
+    f.put("material", H5T_NATIVE_INT, s.material);
     put_history(f, "balls_", s.balls);
     put_history(f, "walls_", s.walls);
     std::vector<std::string> numbers, texts;
     for (const auto& [name, v] : c.numbers) {
-      put(f, "number_" + name, H5T_NATIVE_DOUBLE, v);
+      f.put("number_" + name, H5T_NATIVE_DOUBLE, v);
       numbers.push_back(name);
     }
     for (const auto& [name, text] : c.texts) {
-      put(f, "text_" + name, H5T_NATIVE_CHAR, std::vector<char>(text.begin(), text.end()));
+      f.put("text_" + name, H5T_NATIVE_CHAR, std::vector<char>(text.begin(), text.end()));
       texts.push_back(name);
     }
-    f.string_attribute(".", "numbers", join_names(numbers));
-    f.string_attribute(".", "texts", join_names(texts));
-    f.close();
+    f.attribute("numbers", join_names(numbers));
+    f.attribute("texts", join_names(texts));
+    h5.string_attribute(".", "checksum", f.seal.hex());
+    h5.close();
   });
 }
 
 Checkpoint read_checkpoint(const std::string& path) {
-  const H5Reader f(path);
-  if (f.string_attribute("/", "format") != kFormat)
-    throw std::runtime_error(path + ": not a triaxdem checkpoint (root attribute 'format' is not '" + kFormat + "')");
+  const H5Reader h5(path);
+  const std::string format = h5.string_attribute("/", "format");
+  const std::string version = kFormatName + std::to_string(kFormatVersion);
+  if (format.rfind(kFormatName, 0) == 0 && format != version)
+    throw std::runtime_error(path + ": checkpoint format '" + format + "', this triaxdem reads '" + version +
+                             "' (written by another version: run afresh without --resume)");
+  if (format != version)
+    throw std::runtime_error(path + ": not a triaxdem checkpoint (root attribute 'format' is not '" + version + "')");
+  SealedReader f{h5, {}};
   Checkpoint c;
-  c.job = f.string_attribute("/", "job");
+  c.job = f.attribute("job");
+  c.config = f.attribute("config");
+  const std::vector<std::int64_t> counts = exactly<std::int64_t>(f, path, "counts", H5T_NATIVE_INT64, 5);
   SimState& s = c.sim;
-  s.step = get_one<std::int64_t>(f, path, "step", H5T_NATIVE_INT64);
-  s.time = get_one<double>(f, path, "time_s", H5T_NATIVE_DOUBLE);
-  s.dt = get_one<double>(f, path, "dt_s", H5T_NATIVE_DOUBLE);
-  s.cell_pressure = get_one<double>(f, path, "cell_pressure_Pa", H5T_NATIVE_DOUBLE);
-  s.wall_disp = get_one<double>(f, path, "wall_disp_m", H5T_NATIVE_DOUBLE);
-  const std::vector<double> stats = f.read<double>("/stats", H5T_NATIVE_DOUBLE, 1);
-  const std::vector<int> flags = f.read<int>("/flags", H5T_NATIVE_INT, 1);
-  const std::vector<double> dom = f.read<double>("/domain", H5T_NATIVE_DOUBLE, 3);
-  const std::vector<int> periodic = f.read<int>("/periodic", H5T_NATIVE_INT, 1);
-  if (stats.size() != 4 || flags.size() != 2 || dom.size() != 9 || periodic.size() != 3)
-    throw std::runtime_error(path + ": stats, flags, domain or periodic has the wrong length");
+  s.step = exactly<std::int64_t>(f, path, "step", H5T_NATIVE_INT64, 1)[0];
+  s.time = exactly<double>(f, path, "time_s", H5T_NATIVE_DOUBLE, 1)[0];
+  s.dt = exactly<double>(f, path, "dt_s", H5T_NATIVE_DOUBLE, 1)[0];
+  s.cell_pressure = exactly<double>(f, path, "cell_pressure_Pa", H5T_NATIVE_DOUBLE, 1)[0];
+  s.wall_disp = exactly<double>(f, path, "wall_disp_m", H5T_NATIVE_DOUBLE, 1)[0];
+  const std::vector<double> stats = exactly<double>(f, path, "stats", H5T_NATIVE_DOUBLE, 4);
+  const std::vector<int> flags = exactly<int>(f, path, "flags", H5T_NATIVE_INT, 2);
+  const std::vector<double> dom = exactly<double>(f, path, "domain", H5T_NATIVE_DOUBLE, 9, 3);
+  const std::vector<int> periodic = exactly<int>(f, path, "periodic", H5T_NATIVE_INT, 3);
   s.stats.unbalanced = stats[0];
   s.stats.kinetic = stats[1];
   s.stats.max_disp2 = stats[2];
@@ -162,27 +231,39 @@ Checkpoint read_checkpoint(const std::string& path) {
                                 std::make_pair("wall_point", &s.wall_point),
                                 std::make_pair("wall_velocity", &s.wall_velocity),
                                 std::make_pair("node_x", &s.node_x), std::make_pair("node_v", &s.node_v)})
-    *v = f.read<double>(std::string("/") + name, H5T_NATIVE_DOUBLE, 3);
-  s.radius = f.read<double>("/radius", H5T_NATIVE_DOUBLE, 1);
-  s.mass = f.read<double>("/mass", H5T_NATIVE_DOUBLE, 1);
-  s.inertia = f.read<double>("/inertia", H5T_NATIVE_DOUBLE, 1);
-  s.gid = f.read<std::uint32_t>("/gid", H5T_NATIVE_UINT32, 1);
-  s.specimen = f.read<int>("/specimen", H5T_NATIVE_INT, 1);
-  s.material = f.read<int>("/material", H5T_NATIVE_INT, 1);
+    *v = f.read<double>(name, H5T_NATIVE_DOUBLE, 3);
+  s.radius = f.read<double>("radius", H5T_NATIVE_DOUBLE);
+  s.mass = f.read<double>("mass", H5T_NATIVE_DOUBLE);
+  s.inertia = f.read<double>("inertia", H5T_NATIVE_DOUBLE);
+  s.gid = f.read<std::uint32_t>("gid", H5T_NATIVE_UINT32);
+  s.specimen = f.read<int>("specimen", H5T_NATIVE_INT);
+  s.material = f.read<int>("material", H5T_NATIVE_INT);
   s.balls = get_history(f, "balls_");
   s.walls = get_history(f, "walls_");
-  for (const std::string& name : split_names(f.string_attribute("/", "numbers")))
-    c.numbers[name] = f.read<double>("/number_" + name, H5T_NATIVE_DOUBLE, 1);
-  for (const std::string& name : split_names(f.string_attribute("/", "texts"))) {
-    const std::vector<char> bytes = f.read<char>("/text_" + name, H5T_NATIVE_CHAR, 1);
+  for (const std::string& name : split_names(f.attribute("numbers")))
+    c.numbers[name] = f.read<double>("number_" + name, H5T_NATIVE_DOUBLE);
+  for (const std::string& name : split_names(f.attribute("texts"))) {
+    const std::vector<char> bytes = f.read<char>("text_" + name, H5T_NATIVE_CHAR);
     c.texts[name] = std::string(bytes.begin(), bytes.end());
   }
+  const std::string stored = h5.string_attribute("/", "checksum");
+  if (stored != f.seal.hex())
+    throw std::runtime_error(path + ": checksum " + f.seal.hex() + " where the file says " + stored +
+                             ": the checkpoint was edited or damaged after triaxdem wrote it");
+  const std::vector<std::int64_t> have = counts_of(s);
+  const char* what[5] = {"balls", "ball-ball contacts", "ball-wall contacts", "walls", "mesh nodes"};
+  for (int k = 0; k < 5; ++k)
+    if (have[k] != counts[k])
+      throw std::runtime_error(path + ": the file declares " + std::to_string(counts[k]) + " " + what[k] + " and holds " +
+                               std::to_string(have[k]));
   return c;
 }
 
-Checkpoint checkpoint_of(const std::string& job, const Simulation& sim, const io::Output* out) {
+Checkpoint checkpoint_of(const std::string& job, const Simulation& sim, const io::Output* out,
+                         const std::string& config) {
   Checkpoint c;
   c.job = job;
+  c.config = config;
   c.sim = sim.state();
   const StageTimes& t = sim.times();
   c.numbers["stage_times_s"] = {t.rebuild, t.forces, t.integrate, t.boundaries, t.membrane,
@@ -194,11 +275,14 @@ Checkpoint checkpoint_of(const std::string& job, const Simulation& sim, const io
   return c;
 }
 
-Checkpoint resume_checkpoint(const std::string& path, const std::string& job) {
+Checkpoint resume_checkpoint(const std::string& path, const std::string& job, const std::string& config) {
   if (!std::filesystem::exists(path))
     throw std::runtime_error("--resume: no checkpoint " + path + " (run without --resume to start afresh)");
   Checkpoint c = read_checkpoint(path);
   if (c.job != job) throw std::runtime_error(path + ": written by the '" + c.job + "' job, not by '" + job + "'");
+  if (!c.config.empty() && !config.empty() && c.config != config)
+    throw std::runtime_error(path + ": written with another config (fingerprint " + c.config + ", this config " +
+                             config + "): resume with the config that ran it, or start afresh without --resume");
   return c;
 }
 

@@ -8,7 +8,9 @@
 /// (3); per ball (local order) x, v, w, f, m, x_ref (n x 3), radius, mass, inertia, gid, specimen, material;
 /// per contact list (balls_*, walls_*): key, i, j, fs, mr, slip, flags, fc, mt, fn; wall_point, wall_velocity,
 /// node_x, node_v; the job's arrays as number_<name> (double) and text_<name> (bytes), their names in the
-/// root attributes `numbers` and `texts`; the root attributes `format` and `job`.
+/// root attributes `numbers` and `texts`; counts (balls, ball-ball and ball-wall contacts, walls, mesh nodes); the
+/// root attributes `format` ("triaxdem checkpoint 2"), `job`, `config` (the config's fingerprint) and `checksum`
+/// (over every dataset and attribute but format and itself).
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -25,20 +27,24 @@ struct Checkpoint {
   SimState sim;
   std::map<std::string, std::vector<double>> numbers;   ///< the job's state: counters, records so far
   std::map<std::string, std::string> texts;             ///< the job's state in words (e.g. the snapshot index)
+  std::string config;                                   ///< the fingerprint of the config that ran it (Config)
 };
 
 /// The part every job's checkpoint shares: the job name, the simulation's state and, when `out` is given, the
 /// output's series rows and snapshot index.
-Checkpoint checkpoint_of(const std::string& job, const Simulation& sim, const io::Output* out);
-/// The checkpoint a `--resume` continues from: refuses a missing file (saying how to start afresh) and one
-/// written by another job.
-Checkpoint resume_checkpoint(const std::string& path, const std::string& job);
+Checkpoint checkpoint_of(const std::string& job, const Simulation& sim, const io::Output* out,
+                         const std::string& config = "");
+/// The checkpoint a `--resume` continues from: refuses a missing file (saying how to start afresh), one written by
+/// another job and one written with another config (fingerprints that differ; one built in code has none).
+Checkpoint resume_checkpoint(const std::string& path, const std::string& job, const std::string& config = "");
 /// Puts a simulation and an output (may be null) back where the checkpoint left them.
 void resume_from(const Checkpoint& c, Simulation& sim, io::Output* out);
 
 /// Writes atomically; throws std::runtime_error naming the path.
 void write_checkpoint(const std::string& path, const Checkpoint& c);
-/// Throws std::runtime_error naming the file and what is missing or malformed.
+/// Throws std::runtime_error naming the file and what is missing or malformed: another format version, a
+/// dataset of another shape, a checksum that does not match (an edited or damaged file), arrays whose rows
+/// disagree with the declared counts. The values' ranges are checked when they are restored (check_state).
 Checkpoint read_checkpoint(const std::string& path);
 
 /// The name of a run folder's checkpoint, and of the state saved at a blow-up (for inspection, never resumed
@@ -65,6 +71,7 @@ struct CheckpointPlan {
   CheckpointClock clock{0, 0};
   const Checkpoint* from = nullptr;    ///< continue from this
   long stop_at_step = -1;              ///< write a checkpoint after this step and stop (a batch slot's end)
+  std::string config;                  ///< the config's fingerprint, written into every checkpoint
   /// Due now, after step `step` has been taken: by the clock, a signal or stop_at_step.
   bool due(long step) const;
   /// Whether the job must stop after this checkpoint.

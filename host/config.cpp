@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <fstream>
 #include <map>
 #include <set>
@@ -220,6 +222,19 @@ Config parse_config(const std::string& text, const std::string& path) {
   toml::table root = parse_tables(text, path, {"run", "particles", "box", "material", "wall_material", "solver",
                                                 "specimen", "triaxial", "micro", "periodic", "calibrate"});
   auto table = [&](const char* name) { return TableReader(path, name, root[name].as_table()); };
+  {
+    toml::table settings = root;
+    if (toml::table* run = settings["run"].as_table())
+      for (const char* free : {"steps", "name", "output", "stop_ratio", "checkpoint_every", "checkpoint_minutes"})
+        run->erase(free);
+    std::ostringstream text;
+    text << settings;  // toml++ prints keys in order: equal settings print alike
+    std::uint64_t h = 14695981039346656037ull;  // FNV-1a
+    for (unsigned char ch : text.str()) h = (h ^ ch) * 1099511628211ull;
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+    c.fingerprint = hex;
+  }
 
   TableReader run = table("run");
   run.string("name", c.run.name);

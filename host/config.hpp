@@ -148,6 +148,10 @@ struct PeriodicConfig {
 
 struct Config {
   std::string path;  ///< file it came from (for messages)
+  /// What decides a run's physics and outputs, as a hash of the file's settings ("" for a config built in code):
+  /// a checkpoint carries it, so that --resume with another config is refused. The keys a continued run may
+  /// change are left out: [run] steps, name, output, stop_ratio, checkpoint_every, checkpoint_minutes.
+  std::string fingerprint;
   RunConfig run;
   ParticleConfig particles;
   BoxConfig box;

@@ -1,9 +1,12 @@
 #pragma once
 /// HDF5 files written atomically and read with errors that name the file: the small layer under
 /// io_hdf5.cpp (run output) and measured_h5.cpp (measured data). Internal to host/.
+#include <fcntl.h>
 #include <hdf5.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <filesystem>
 #include <stdexcept>
 #include <string>
@@ -18,20 +21,54 @@ namespace fs = std::filesystem;
   throw std::runtime_error("cannot write '" + path + "': " + what);
 }
 
-/// Writes through "<path>.tmp" so that a crash or a concurrent reader never sees a half-written file under
-/// the final name, and the previous complete version stays in place until the new one is.
+/// A file written under a temporary name of its own (the process and a counter: two writers of one path never
+/// share it) and flushed to the disk, waiting to replace `path` by a rename. Until commit() the previous complete
+/// version stays in place; a Staged file never committed is removed.
+class Staged {
+ public:
+  template <class Write>
+  Staged(std::string path, Write write) : path_(std::move(path)) {
+    static std::atomic<unsigned> counter{0};
+    tmp_ = path_ + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
+    try {
+      write(tmp_);
+      // Flushed before the rename, so that a crash of the machine cannot leave a renamed file with no data.
+      const int fd = ::open(tmp_.c_str(), O_RDONLY);
+      if (fd < 0 || ::fsync(fd) != 0) {
+        if (fd >= 0) ::close(fd);
+        fail(path_, "flush '" + tmp_ + "' to disk");
+      }
+      ::close(fd);
+    } catch (...) {
+      std::error_code ec;
+      fs::remove(tmp_, ec);
+      throw;
+    }
+  }
+  Staged(const Staged&) = delete;
+  Staged& operator=(const Staged&) = delete;
+  ~Staged() {
+    std::error_code ec;
+    if (!committed_) fs::remove(tmp_, ec);
+  }
+  const std::string& tmp() const { return tmp_; }
+  void commit() {
+    std::error_code ec;
+    fs::rename(tmp_, path_, ec);
+    if (ec) fail(path_, "rename from '" + tmp_ + "': " + ec.message());
+    committed_ = true;
+  }
+
+ private:
+  std::string path_, tmp_;
+  bool committed_ = false;
+};
+
+/// Writes through a Staged file, so that a crash or a concurrent reader never sees a half-written file under the
+/// final name, and the previous complete version stays in place until the new one is.
 template <class Write>
 void replace_atomically(const std::string& path, Write write) {
-  const std::string tmp = path + ".tmp";
-  std::error_code ec;
-  try {
-    write(tmp);
-    fs::rename(tmp, path, ec);
-    if (ec) fail(path, "rename from '" + tmp + "': " + ec.message());
-  } catch (...) {
-    fs::remove(tmp, ec);
-    throw;
-  }
+  Staged(path, write).commit();
 }
 
 /// Owns one HDF5 identifier, so that every exit path, exceptions included, releases it.

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <numeric>
 #include <set>
 #include <sstream>
@@ -59,9 +60,10 @@ void check_names(const std::vector<std::string>& names, std::set<std::string> ta
 
 
 
-void write_series_h5(const std::string& path, const std::vector<std::string>& columns,
+/// series.h5 written at `tmp` (errors name `path`).
+void write_series_h5(const std::string& tmp, const std::string& path, const std::vector<std::string>& columns,
                      const std::vector<double>& rows) {
-  replace_atomically(path, [&](const std::string& tmp) {
+  {
     H5Writer f(tmp, path);
     const hsize_t ncol = columns.size(), nrow = ncol ? rows.size() / ncol : 0;
     f.dataset(f.root(), "table", H5T_NATIVE_DOUBLE, rows.data(), {nrow, ncol});
@@ -74,7 +76,7 @@ void write_series_h5(const std::string& path, const std::vector<std::string>& co
       f.string_attribute(name, "name", columns[c]);
     }
     f.close();
-  });
+  }
 }
 
 std::string series_csv(const std::vector<std::string>& columns, const std::vector<double>& rows) {
@@ -228,6 +230,37 @@ std::string temporal_collection(const char* name, const std::string& grids) {
 
 }  // namespace
 
+namespace {
+constexpr const char* kSeriesMarker = ".series_commit";
+
+/// Text written at `tmp` (errors name `path`).
+void write_text_file(const std::string& tmp, const std::string& path, const std::string& text) {
+  std::FILE* f = std::fopen(tmp.c_str(), "wb");
+  bool ok = f && std::fwrite(text.data(), 1, text.size(), f) == text.size();
+  int err = errno;
+  // fclose flushes the buffer, so it can be the call that fails (e.g. disk full).
+  if (f && std::fclose(f) != 0 && ok) ok = false, err = errno;
+  if (!ok) fail(path, "write '" + tmp + "': " + std::strerror(err));
+}
+
+/// Finishes a series commit that a crash interrupted (flush_series): each file the marker names that is still
+/// there is renamed to its final name (the name before ".tmp."), then the marker goes.
+void recover_series(const std::string& folder) {
+  const std::string marker = in_folder(folder, kSeriesMarker);
+  std::ifstream in(marker);
+  if (!in) return;
+  std::error_code ec;
+  for (std::string tmp; std::getline(in, tmp);) {
+    const std::size_t at = tmp.rfind(".tmp.");
+    const std::string final_name = at == std::string::npos ? "" : tmp.substr(0, at);
+    if (fs::path(final_name).parent_path() != fs::path(folder) || !fs::exists(tmp)) continue;
+    fs::rename(tmp, final_name, ec);
+  }
+  in.close();
+  fs::remove(marker, ec);
+}
+}  // namespace
+
 Output::Output(std::string folder) : folder_(std::move(folder)) {
   const auto refuse = [&](const std::string& reason) {
     throw std::runtime_error("output folder '" + folder_ + "' is not writable: " + reason);
@@ -241,6 +274,7 @@ Output::Output(std::string folder) : folder_(std::move(folder)) {
   if (!f) refuse(std::strerror(errno));
   std::fclose(f);
   if (!fs::remove(probe, ec)) refuse("cannot remove probe file: " + ec.message());
+  recover_series(folder_);
 }
 
 void Output::set_series_columns(std::vector<std::string> names) {
@@ -257,9 +291,19 @@ void Output::append_series(const std::vector<double>& row) {
   rows_.insert(rows_.end(), row.begin(), row.end());
 }
 
+// The pair is committed as one step: both files are written and flushed under temporary names, a marker names
+// them, then both are renamed and the marker goes. A crash between the renames leaves the marker, and the next
+// Output of the folder finishes the renames (recover_series), so series.h5 and series.csv never disagree.
 void Output::flush_series() {
-  write_series_h5(in_folder(folder_, "series.h5"), columns_, rows_);
-  write_text_atomic(in_folder(folder_, "series.csv"), series_csv(columns_, rows_));
+  const std::string h5 = in_folder(folder_, "series.h5"), csv = in_folder(folder_, "series.csv");
+  h5::Staged a(h5, [&](const std::string& tmp) { write_series_h5(tmp, h5, columns_, rows_); });
+  h5::Staged b(csv, [&](const std::string& tmp) { write_text_file(tmp, csv, series_csv(columns_, rows_)); });
+  const std::string marker = in_folder(folder_, kSeriesMarker);
+  write_text_atomic(marker, a.tmp() + "\n" + b.tmp() + "\n");
+  a.commit();
+  b.commit();
+  std::error_code ec;
+  fs::remove(marker, ec);
 }
 
 void Output::write_snapshot(const Snapshot& s, const SurfaceSnapshot* surface, const ContactTable* contacts) {
@@ -323,15 +367,28 @@ void Output::write_xdmf() const {
                         "</Domain>\n</Xdmf>\n");
 }
 
+void claim_output_folder(const std::string& folder, bool resume, bool overwrite) {
+  if (resume || !fs::is_directory(folder)) return;
+  std::vector<fs::path> outputs;
+  for (const auto& e : fs::directory_iterator(folder)) {
+    const std::string name = e.path().filename().string();
+    if (name == "checkpoint.h5" || name == "blowup_state.h5" || name == "series.h5" || name == "series.csv" ||
+        name == "snapshots.xdmf" || (name.rfind("snap_", 0) == 0 && e.path().extension() == ".h5"))
+      outputs.push_back(e.path());
+  }
+  if (outputs.empty()) return;
+  if (!overwrite) {
+    std::sort(outputs.begin(), outputs.end());
+    throw std::runtime_error("output folder '" + folder + "' holds another run's outputs (" +
+                             outputs.front().filename().string() + " and " + std::to_string(outputs.size() - 1) +
+                             " more): continue that run with --resume, replace it with --overwrite, or choose "
+                             "another folder with -o");
+  }
+  for (const fs::path& p : outputs) fs::remove(p);
+}
+
 void write_text_atomic(const std::string& path, const std::string& text) {
-  replace_atomically(path, [&](const std::string& tmp) {
-    std::FILE* f = std::fopen(tmp.c_str(), "wb");
-    bool ok = f && std::fwrite(text.data(), 1, text.size(), f) == text.size();
-    int err = errno;
-    // fclose flushes the buffer, so it can be the call that fails (e.g. disk full).
-    if (f && std::fclose(f) != 0 && ok) ok = false, err = errno;
-    if (!ok) fail(path, "write '" + tmp + "': " + std::strerror(err));
-  });
+  replace_atomically(path, [&](const std::string& tmp) { write_text_file(tmp, path, text); });
 }
 
 

@@ -88,7 +88,14 @@ class Output {
   void write_xdmf() const;
 };
 
-/// Writes text to path atomically (path.tmp then rename). Throws std::runtime_error naming the path.
+/// Makes `folder` the output of a new run (resume: the continuation of the run there). A folder that holds
+/// another run's outputs (checkpoint, series, snapshots) is refused, so that a later --resume cannot mix two runs,
+/// unless `overwrite`: then those files are removed first. Throws std::runtime_error naming the folder and what
+/// it holds.
+void claim_output_folder(const std::string& folder, bool resume, bool overwrite);
+
+/// Writes text to path atomically (a temporary file of this process, flushed, then renamed). Throws
+/// std::runtime_error naming the path.
 void write_text_atomic(const std::string& path, const std::string& text);
 
 }  // namespace dem::io

@@ -79,7 +79,7 @@ int run_job(const Config& cfg, bool resume, long stop_at_step) {
                           "contacts_ball_wall", "wall_force_sum_N"});
   const std::string ckpt = checkpoint_path(out.folder());
   if (resume) {
-    resume_from(resume_checkpoint(ckpt, "run"), *sim, &out);
+    resume_from(resume_checkpoint(ckpt, "run", cfg.fingerprint), *sim, &out);
     std::printf("triaxdem: resuming %s at step %ld (t = %.6g s)\n", ckpt.c_str(), sim->step_count(), sim->time());
   } else {
     out.write_snapshot(take_snapshot(*sim, "initial"));
@@ -117,7 +117,7 @@ int run_job(const Config& cfg, bool resume, long stop_at_step) {
       // The series is flushed with every checkpoint, so that a killed run's files agree with its checkpoint.
       if (plan.due(s)) {
         out.flush_series();
-        write_checkpoint(ckpt, checkpoint_of("run", *sim, &out));
+        write_checkpoint(ckpt, checkpoint_of("run", *sim, &out, cfg.fingerprint));
         plan.clock.written();
       }
       if (plan.stop(s)) {
@@ -129,7 +129,7 @@ int run_job(const Config& cfg, bool resume, long stop_at_step) {
   } catch (const BlowUp& e) {
     out.flush_series();
     out.write_snapshot(take_snapshot(*sim, "blow-up"));
-    write_checkpoint(blowup_path(out.folder()), checkpoint_of("run", *sim, &out));
+    write_checkpoint(blowup_path(out.folder()), checkpoint_of("run", *sim, &out, cfg.fingerprint));
     std::fprintf(stderr, "\ntriaxdem: %s\n  state at the blow-up saved in %s (snapshot) and %s (for inspection); "
                  "the last good checkpoint, %s, continues with --resume once the cause is fixed\n",
                  e.what(), out.folder().c_str(), blowup_path(out.folder()).c_str(), ckpt.c_str());
@@ -137,7 +137,7 @@ int run_job(const Config& cfg, bool resume, long stop_at_step) {
   }
   out.flush_series();
   out.write_snapshot(take_snapshot(*sim, "final"));
-  write_checkpoint(ckpt, checkpoint_of("run", *sim, &out));
+  write_checkpoint(ckpt, checkpoint_of("run", *sim, &out, cfg.fingerprint));
   progress.finish("");
   std::printf("time loop: %s\n", describe(sim->times(), sim->particles().n, sim->step_count()).c_str());
   std::printf("output: %s/snapshots.xdmf (ParaView), %s/series.csv; checkpoint %s (more steps: --resume -n N)\n",

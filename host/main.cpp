@@ -10,6 +10,7 @@
 
 #include "host/calibrate.hpp"
 #include "host/calibration_jobs.hpp"
+#include "host/io_hdf5.hpp"
 #include "host/measured.hpp"
 #include "host/config.hpp"
 #include "host/job.hpp"
@@ -31,6 +32,9 @@ int main(int argc, char** argv) {
   bool resume = false;
   long stop_at = -1;
   run->add_flag("--resume", resume, "continue from the output folder's checkpoint.h5 to the step count");
+  bool overwrite = false;
+  const char* overwrite_help = "replace another run's outputs in the output folder (refused without it)";
+  run->add_flag("--overwrite", overwrite, overwrite_help)->excludes("--resume");
   run->add_option("--stop-at-step", stop_at, "write a checkpoint after this step and stop (exit status 3)")
       ->check(CLI::NonNegativeNumber);
 
@@ -41,13 +45,15 @@ int main(int argc, char** argv) {
   auto* triaxial = app.add_subcommand("triaxial", "specimen, membrane, consolidation and shear (drained triaxial test)");
   triaxial->add_option("config", config_path, "TOML config file")->required()->check(CLI::ExistingFile);
   triaxial->add_option("-o,--output", output, "output folder (overrides [run] output)");
-  triaxial->add_flag("--resume", resume, "continue from the output folder's checkpoint.h5");
+  auto* triaxial_resume = triaxial->add_flag("--resume", resume, "continue from the output folder's checkpoint.h5");
+  triaxial->add_flag("--overwrite", overwrite, overwrite_help)->excludes(triaxial_resume);
   triaxial->add_option("--stop-at-step", stop_at, "write a checkpoint after this step and stop (exit status 3)")
       ->check(CLI::NonNegativeNumber);
 
   auto* periodic = app.add_subcommand("periodic", "periodic-cell drained triaxial test (no platens, no membrane)");
   periodic->add_option("config", config_path, "TOML config file")->required()->check(CLI::ExistingFile);
   periodic->add_option("-o,--output", output, "output folder (overrides [run] output)");
+  periodic->add_flag("--overwrite", overwrite, overwrite_help);
 
   std::vector<std::string> study_inputs;
   dem::StudyOptions study_opt;
@@ -152,6 +158,8 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (specimen->parsed()) return dem::specimen_job(cfg);
+    if (run->parsed() || triaxial->parsed() || periodic->parsed())
+      dem::io::claim_output_folder(cfg.run.output, resume, overwrite);
     if (triaxial->parsed()) return dem::triaxial_job(cfg, resume, stop_at);
     if (periodic->parsed()) return dem::run_periodic_job(cfg);
     if (calibrate->parsed() || diagnose->parsed()) {

@@ -155,7 +155,7 @@ int run_periodic_job(const Config& cfg) {
     out.flush_series();
     if (sim) {
       out.write_snapshot(take_snapshot(*sim, "blow-up"));
-      write_checkpoint(blowup_path(out.folder()), checkpoint_of("periodic", *sim, &out));
+      write_checkpoint(blowup_path(out.folder()), checkpoint_of("periodic", *sim, &out, cfg.fingerprint));
     }
     std::fprintf(stderr, "\ntriaxdem: %s\n  state at the blow-up saved in %s (snapshot and %s)\n", e.what(),
                  out.folder().c_str(), blowup_path(out.folder()).c_str());

@@ -132,7 +132,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
     if (!plan || !plan->due(sim.step_count())) return;
     if (out) out->flush_series();
     res.wall_seconds = elapsed();
-    save_triaxial(plan->path, sim, out, now, res);
+    save_triaxial(plan->path, sim, out, now, res, plan->config);
     plan->clock.written();
     if (plan->stop(sim.step_count())) throw run_stopped(*plan, sim.step_count());
   };
@@ -284,7 +284,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
       const io::SurfaceSnapshot surface = membrane_surface(cell.membrane);
       const io::ContactTable contacts = contact_table(contact_set(sim));
       out->write_snapshot(take_snapshot(sim, "blow-up"), &surface, &contacts);
-      if (plan) save_triaxial(blowup_path(out->folder()), sim, out, st, res);
+      if (plan) save_triaxial(blowup_path(out->folder()), sim, out, st, res, plan->config);
       std::fprintf(stderr, "triaxdem: state at the blow-up saved in %s (snapshots.xdmf, last entry; %s)\n",
                    out->folder().c_str(), blowup_path(out->folder()).c_str());
     }
@@ -310,10 +310,10 @@ int triaxial_job(const Config& cfg, bool resume, long stop_at_step) {
   if (!cfg.has_specimen) throw ConfigError(cfg.path + ": [specimen]: table missing (the triaxial job needs it)");
   io::Output out(cfg.run.output);
   CheckpointPlan plan{checkpoint_path(out.folder()), CheckpointClock(cfg.run.checkpoint_every,
-                      cfg.run.checkpoint_minutes), nullptr, stop_at_step};
+                      cfg.run.checkpoint_minutes), nullptr, stop_at_step, cfg.fingerprint};
   Checkpoint from;
   if (resume) {
-    from = resume_checkpoint(plan.path, "triaxial");
+    from = resume_checkpoint(plan.path, "triaxial", cfg.fingerprint);
     plan.from = &from;
   }
   StopSignals signals;

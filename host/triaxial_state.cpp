@@ -29,8 +29,10 @@ Stage stage_of(const std::vector<double>& v, const std::string& path) {
   };
   whole(0, 1);
   whole(1, kMaxStageSteps);
+  // The shear divides by the heights and volumes taken at its start; consolidation has none yet (zeros).
   for (int k : {2, 3, 4, 5})
-    if (!(std::isfinite(v[k]) && v[k] > 0)) refuse(k, "a finite positive number");
+    if (!(std::isfinite(v[k]) && (v[0] == 0 ? v[k] >= 0 : v[k] > 0)))
+      refuse(k, v[0] == 0 ? "a finite number of 0 or more" : "a finite positive number (in shear)");
   whole(6, kMaxStageSteps);
   if (std::isnan(v[7]) || v[7] == INFINITY) refuse(7, "a finite number, or -inf before the first record");
   whole(8, kSnapshotStrains);
@@ -63,8 +65,8 @@ std::vector<TriaxialRecord> records_of(const std::vector<double>& v, const std::
 }  // namespace
 
 void save_triaxial(const std::string& path, const Simulation& sim, const io::Output* out, const Stage& st,
-                   const TriaxialResult& res) {
-  Checkpoint c = checkpoint_of("triaxial", sim, out);
+                   const TriaxialResult& res, const std::string& config) {
+  Checkpoint c = checkpoint_of("triaxial", sim, out, config);
   c.numbers["stage"] = stage_numbers(st);
   c.numbers["records"] = record_numbers(res.records);
   c.numbers["wall_s"] = {res.wall_seconds};

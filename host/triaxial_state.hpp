@@ -25,7 +25,7 @@ struct Stage {
 
 /// Writes the checkpoint of a triaxial run to `path`.
 void save_triaxial(const std::string& path, const Simulation& sim, const io::Output* out, const Stage& st,
-                   const TriaxialResult& res);
+                   const TriaxialResult& res, const std::string& config = "");
 /// Continues from a checkpoint: the simulation, the stage, the records and micromechanics, the output.
 /// Throws std::runtime_error naming `path` when it is not a triaxial checkpoint or is malformed.
 void restore_triaxial(const Checkpoint& c, const std::string& path, Simulation& sim, io::Output* out, Stage& st,

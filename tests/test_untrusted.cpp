@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <string>
 #include <tuple>
@@ -137,50 +138,92 @@ TEST_F(Untrusted, ADatasetOfRankEightIsRefusedBeforeItsExtentsAreRead) {
   EXPECT_NE(e.find("rank 8"), std::string::npos) << e;
 }
 
-// The edits a hand-editor makes to a checkpoint, each refused at --resume with the dataset, the row and the
-// allowed range; the simulation is left as it was (resume_error checks it).
+/// Reads a checkpoint, edits it in memory and writes it again, sealed: what an editor who also recomputes the
+/// checksum, or a faulty writer, produces. The checks of the values must catch what the checksum no longer can.
+void edit_sealed(const std::string& path, const std::function<void(Checkpoint&)>& edit) {
+  Checkpoint c = read_checkpoint(path);
+  edit(c);
+  write_checkpoint(path, c);
+}
+
+// An edit with h5py leaves the checksum behind: the file is refused as edited or damaged.
+TEST_F(Untrusted, AnEditedCheckpointFailsItsChecksum) {
+  const std::string path = checkpoint();
+  poke(path, "/x", 4, 1e-3, H5T_NATIVE_DOUBLE);
+  const std::string e = resume_error(path);
+  EXPECT_NE(e.find("the checkpoint was edited or damaged after triaxdem wrote it"), std::string::npos) << e;
+}
+
+// Edits behind a valid checksum, each refused at --resume with the array, the row and the allowed range; the
+// simulation is left as it was (resume_error checks it).
 TEST_F(Untrusted, EditedIndicesInACheckpointAreRefusedWithTheRow) {
-  struct Edit {
-    std::string dataset;
-    hsize_t row;
-    long long value;
-    hid_t type;
-    std::string expected;
+  const std::vector<std::pair<std::function<void(Checkpoint&)>, std::string>> edits{
+      {[](Checkpoint& c) { c.sim.gid[3] = 99999999; }, "state: gid, row 3: 99999999 (allowed: 0 to 11)"},
+      {[](Checkpoint& c) { c.sim.gid[3] = c.sim.gid[0]; }, "given twice"},
+      {[](Checkpoint& c) { c.sim.material[5] = 7; }, "state: material, row 5: 7 (allowed: 0 to 0)"},
+      {[](Checkpoint& c) { c.sim.material[5] = -1; }, "state: material, row 5: -1"},
+      {[](Checkpoint& c) { c.sim.balls.i[0] = 99999; }, "state: the ball-ball contacts: i, j, row 0"},
+      {[](Checkpoint& c) { c.sim.balls.j[0] = -5; }, "state: the ball-ball contacts: i, j, row 0"},
+      {[](Checkpoint& c) { c.sim.walls.j[0] = 42; }, "state: the ball-wall contacts: i, j, row 0"},
+      {[](Checkpoint& c) { c.sim.walls.key[0] = (42ull << 32) | 1; }, "names object 42 (allowed: below 1)"},
+      {[](Checkpoint& c) { c.sim.balls.key[0] = 0; }, "the ball-ball contacts: key, row 0"},
+      {[](Checkpoint& c) { c.sim.step = -1000000000000000L; }, "state: step, row 0"},
   };
-  const std::vector<Edit> edits{
-      {"/gid", 3, 99999999, H5T_NATIVE_UINT32, "state: gid, row 3: 99999999 (allowed: 0 to 11)"},
-      {"/gid", 3, 0, H5T_NATIVE_UINT32, "given twice"},
-      {"/material", 5, 7, H5T_NATIVE_INT, "state: material, row 5: 7 (allowed: 0 to 0)"},
-      {"/material", 5, -1, H5T_NATIVE_INT, "state: material, row 5: -1"},
-      {"/balls_i", 0, 99999, H5T_NATIVE_INT, "state: the ball-ball contacts: i, j, row 0"},
-      {"/balls_j", 0, -5, H5T_NATIVE_INT, "state: the ball-ball contacts: i, j, row 0"},
-      {"/walls_j", 0, 42, H5T_NATIVE_INT, "state: the ball-wall contacts: i, j, row 0"},
-      {"/walls_key", 0, (42LL << 32) | 1, H5T_NATIVE_INT64, "names object 42 (allowed: below 1)"},
-      {"/balls_key", 0, 0, H5T_NATIVE_INT64, "the ball-ball contacts: key, row 0"},
-      {"/step", 0, -1000000000000000LL, H5T_NATIVE_INT64, "state: step, row 0"},
-  };
-  for (const Edit& e : edits) {
+  for (const auto& [edit, expected] : edits) {
     const std::string path = checkpoint();
-    poke(path, e.dataset, e.row, e.value, e.type);
+    edit_sealed(path, edit);
     const std::string got = resume_error(path);
-    EXPECT_NE(got.find(e.expected), std::string::npos) << e.dataset << " = " << e.value << ": " << got;
+    EXPECT_NE(got.find(expected), std::string::npos) << got;
   }
 }
 
-// Non-finite values where the run divides or integrates by them.
+// Non-finite values where the run divides or integrates by them, behind a valid checksum.
 TEST_F(Untrusted, NonFiniteValuesInACheckpointAreRefused) {
   const double inf = std::numeric_limits<double>::infinity();
-  const std::vector<std::tuple<std::string, int, double, std::string>> edits{
-      {"/x", 4, std::nan(""), "a particle vector, row 4"},
-      {"/radius", 2, 0.0, "radius, row 2: not a finite positive number"},
-      {"/dt_s", 0, inf, "dt, row 0"},
-      {"/balls_fs", 1, -inf, "the ball-ball contacts history, row 1"}};
-  for (const auto& [dataset, row, value, expected] : edits) {
+  const std::vector<std::pair<std::function<void(Checkpoint&)>, std::string>> edits{
+      {[](Checkpoint& c) { c.sim.x[3 * 4 + 1] = std::nan(""); }, "a particle vector, row 4"},
+      {[](Checkpoint& c) { c.sim.radius[2] = 0; }, "radius, row 2: not a finite positive number"},
+      {[&](Checkpoint& c) { c.sim.dt = inf; }, "dt, row 0"},
+      {[&](Checkpoint& c) { c.sim.balls.fs[3 * 1] = -inf; }, "the ball-ball contacts history, row 1"}};
+  for (const auto& [edit, expected] : edits) {
     const std::string path = checkpoint();
-    poke(path, dataset, static_cast<hsize_t>(row), value, H5T_NATIVE_DOUBLE);
+    edit_sealed(path, edit);
     const std::string got = resume_error(path);
-    EXPECT_NE(got.find(expected), std::string::npos) << dataset << ": " << got;
+    EXPECT_NE(got.find(expected), std::string::npos) << got;
   }
+}
+
+// A checkpoint of another config, of another format version, or whose arrays disagree with its counts.
+TEST_F(Untrusted, CheckpointsOfAnotherConfigOrVersionAreRefused) {
+  const std::string path = checkpoint();
+  edit_sealed(path, [](Checkpoint& c) { c.config = "0123456789abcdef"; });
+  try {
+    resume_checkpoint(path, "run", "fedcba9876543210");
+    ADD_FAILURE() << "resumed with another config";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("written with another config (fingerprint 0123456789abcdef, this config "
+                                         "fedcba9876543210)"), std::string::npos) << e.what();
+  }
+  EXPECT_NO_THROW(resume_checkpoint(path, "run", "0123456789abcdef"));
+  const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  H5Adelete(f, "format");
+  H5Fclose(f);
+  {
+    const hid_t g = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    const hid_t type = H5Tcopy(H5T_C_S1);
+    const std::string old = "triaxdem checkpoint 1";
+    H5Tset_size(type, old.size() + 1);
+    const hid_t space = H5Screate(H5S_SCALAR);
+    const hid_t attr = H5Acreate2(g, "format", type, space, H5P_DEFAULT, H5P_DEFAULT);
+    H5Awrite(attr, type, old.c_str());
+    H5Aclose(attr);
+    H5Sclose(space);
+    H5Tclose(type);
+    H5Fclose(g);
+  }
+  const std::string e = resume_error(path);
+  EXPECT_NE(e.find("checkpoint format 'triaxdem checkpoint 1', this triaxdem reads 'triaxdem checkpoint 2'"),
+            std::string::npos) << e;
 }
 
 // Shapes and sizes the reader must check before it allocates or HDF5 writes: a dataset declared with four
@@ -316,7 +359,7 @@ TEST_F(Untrusted, TriaxialStageValuesAreCheckedBeforeTheRunChanges) {
                                          {0, 0.5, "row 0 (shear) = 0.5"},
                                          {3, 0, "row 3 (v0) = 0"}}) {
     save_triaxial(path, *sim_, nullptr, st, res);
-    poke(path, "/number_stage", static_cast<hsize_t>(c.row), c.value, H5T_NATIVE_DOUBLE);
+    edit_sealed(path, [&](Checkpoint& k) { k.numbers.at("stage").at(static_cast<std::size_t>(c.row)) = c.value; });
     Stage got;
     TriaxialResult out;
     try {
@@ -327,7 +370,7 @@ TEST_F(Untrusted, TriaxialStageValuesAreCheckedBeforeTheRunChanges) {
     }
   }
   save_triaxial(path, *sim_, nullptr, st, res);
-  replace(path, "/number_records", {26}, 0.0);
+  edit_sealed(path, [](Checkpoint& k) { k.numbers.at("records").resize(26); });
   Stage got;
   TriaxialResult out;
   try {
