@@ -425,3 +425,13 @@ TEST(Measured, Hdf5FormCarriesTheOptionalColumns) {
               std::string::npos) << e.what();
   }
 }
+
+// The Mohr-Coulomb friction angle of a drained triaxial test, sin(phi) = (sigma1 - sigma3) / (sigma1 + sigma3):
+// q = 2 sigma3 gives sigma1 = 3 sigma3 and sin(phi) = 1/2, 30 degrees; q = 0 none; q = 8 sigma3 gives 4/5
+// (53.13 degrees). The study's tables rest on this function.
+TEST(Measured, FrictionAngleOfTheTriaxialTestIsMohrCoulombs) {
+  EXPECT_NEAR(friction_angle_deg(200e3, 100e3), 30.0, 1e-12);
+  EXPECT_NEAR(friction_angle_deg(0, 100e3), 0.0, 1e-12);
+  EXPECT_NEAR(friction_angle_deg(800e3, 100e3), std::asin(0.8) * 180 / M_PI, 1e-12);
+  EXPECT_NEAR(friction_angle_deg(2, 1), 30.0, 1e-12) << "a ratio: the unit does not matter";
+}
