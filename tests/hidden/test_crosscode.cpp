@@ -58,7 +58,10 @@ TEST_P(CrossCode, DiagnosisOfAnotherCodesCurves) {
                 dg.base.inside_region({0.4, 0.04}) ? "inside" : "OUTSIDE");
   } else {
     for (const ExtensionFit& f : dg.fits)
-      if (f.ext.name == c.verdict) EXPECT_GE(dg.base_heldout - f.heldout, kStrongEvidence);
+      if (f.ext.name == c.verdict) {  // the report's claim: both tests passed by the margin
+        EXPECT_GE(dg.base_bic - f.bic, kStrongEvidence) << "BIC " << dg.base_bic << " -> " << f.bic;
+        EXPECT_GE(dg.base_heldout - f.heldout, kStrongEvidence) << "held-out " << dg.base_heldout << " -> " << f.heldout;
+      }
   }
 }
 
