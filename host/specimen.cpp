@@ -251,8 +251,9 @@ bool load_specimen(const std::string& path, const std::string& key, Specimen& sp
       BallSpec b;
       char c1, c2, c3, c4;
       if (!(s >> b.x.x >> c1 >> b.x.y >> c2 >> b.x.z >> c3 >> b.radius >> c4 >> b.density) || c1 != ',' || c2 != ',' ||
-          c3 != ',' || c4 != ',' || !(b.radius > 0))
-        damaged("expected x_m,y_m,z_m,radius_m,density_kg_m3");
+          c3 != ',' || c4 != ',' || !(b.radius > 0) || !std::isfinite(b.x.x) || !std::isfinite(b.x.y) ||
+          !std::isfinite(b.x.z) || !std::isfinite(b.radius) || !(b.density > 0) || !std::isfinite(b.density))
+        damaged("expected x_m,y_m,z_m,radius_m,density_kg_m3, finite, radius and density positive");
       out.balls.push_back(b);
     }
   }
