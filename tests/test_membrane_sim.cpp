@@ -2,6 +2,8 @@
 // every step (the membrane kernels themselves are checked in test_membrane.cpp).
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include <cmath>
 
 #include "host/builder.hpp"
@@ -41,10 +43,16 @@ TEST(MembraneInSimulation, CellPressureSqueezesTheMiddleAndNotTheTiedEnds) {
   sim.set_dt(1e-7);
   const double mid0 = ring_radius(m.mesh, n_around, n_seg / 2);
   sim.run(300);
-  // 100 kPa on a 0.5 mm latex tube of 5 mm radius: a free node accelerates inwards at p / (rho t)
-  // = 100e3 / (930 * 5e-4), about 2e5 m/s^2, so it moves by tens of micrometres in 30 us; the tied rings
-  // do not move at all.
-  EXPECT_LT(ring_radius(m.mesh, n_around, n_seg / 2), mid0 - 1e-6);
+  // 100 kPa on a 0.5 mm latex tube of 5 mm radius: a free node is pushed inwards at p / (rho t) = 100e3 /
+  // (930 * 5e-4) = 2.15e5 m/s^2, of which local damping (alpha 0.7) leaves 30% against a motion that never
+  // reverses, so in T = 30 us it moves 0.3 p/(rho t) T^2 / 2 = 29.0 um. The membrane's own stiffness holds it back
+  // by (omega T)^2 / 12 with omega^2 = E / (rho R^2): 0.5%; the 16-gon's facet normals lean by up to pi/16 from the
+  // radius (cos: 2%); the leapfrog's first half step is 1/600 of T. 3% covers these and no gross error. The tied
+  // rings do not move at all.
+  const double moved = mid0 - ring_radius(m.mesh, n_around, n_seg / 2);
+  const double expected = 0.3 * 100e3 / (930 * 5e-4) * 3e-5 * 3e-5 / 2;
+  std::printf("middle ring moved %.3f um inwards, closed form %.3f um\n", 1e6 * moved, 1e6 * expected);
+  EXPECT_NEAR(moved, expected, 0.03 * expected);
   auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), m.mesh.node_x);
   for (int k = 0; k < n_around; ++k) {
     const double ang = 2 * M_PI * k / n_around;
