@@ -333,6 +333,18 @@ Config parse_config(const std::string& text, const std::string& path) {
   long around = c.triaxial.membrane_around, segs = c.triaxial.membrane_segments;
   tx.integer("membrane_nodes_around", around, 8, 10000);
   tx.integer("membrane_segments", segs, 1, 10000);
+  {
+    // A node holds position, velocity, force and mass (about 80 bytes), and owns two triangles of three indices,
+    // rest geometry and facet contacts: 1 kB per node bounds it from above.
+    const double nodes = static_cast<double>(around) * static_cast<double>(segs + 1), have = available_memory();
+    if (have > 0 && nodes * kBytesPerMembraneNode > 0.5 * have) {
+      std::ostringstream m;
+      m << around << " x " << segs + 1 << " nodes need up to " << nodes * kBytesPerMembraneNode / 1e9
+        << " GB, more than half the " << have / 1e9 << " GB available (allowed: nodes_around x (segments + 1) up to "
+        << static_cast<long>(0.5 * have / kBytesPerMembraneNode) << ")";
+      tx.fail("membrane_nodes_around", m.str());
+    }
+  }
   c.triaxial.membrane_around = static_cast<int>(around);
   c.triaxial.membrane_segments = static_cast<int>(segs);
   tx.number("membrane_modulus_MPa", c.triaxial.membrane_modulus, 0, 1e5, 1e6, true);

@@ -175,6 +175,8 @@ Real time_step(const SolverConfig& solver, Real critical, const std::string& pat
 /// (perf/bench_engine: particle arrays and contact lists at 6-7 contacts per ball), doubled for the rebuild,
 /// when the old and the new contact lists live side by side (perf/scaling.sh measured 1,259 at 10^6 balls).
 constexpr double kBytesPerBall = 2 * 667;
+/// Upper bound of a membrane node's memory, its triangles and facet contacts included (the config check).
+constexpr double kBytesPerMembraneNode = 1000;
 double run_memory_bytes(long balls);
 
 /// Reads and validates a config file. Throws ConfigError.

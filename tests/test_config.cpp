@@ -295,3 +295,12 @@ TEST(Config, EveryKeyRefusesNonFiniteHugeAndWronglyTypedValues) {
   }
   std::printf("%zu keys, %d bad values refused\n", keys.size(), tried);
 }
+
+// A membrane mesh too large for the machine is refused when the config is read, naming the key and the limit
+// (10,000 x 10,001 nodes are 100 GB at the bound, more than this machine has).
+TEST(Config, MembraneMeshThatCannotFitInMemoryRefused) {
+  const std::string e = error_of("[triaxial]\nmembrane_nodes_around = 10000\nmembrane_segments = 10000\n");
+  EXPECT_NE(e.find("bad.toml: [triaxial] membrane_nodes_around: 10000 x 10001 nodes need up to"), std::string::npos)
+      << e;
+  EXPECT_EQ(error_of("[triaxial]\nmembrane_nodes_around = 81\nmembrane_segments = 20\n"), "") << "the paper's mesh";
+}
