@@ -184,6 +184,39 @@ void check_memory(TableReader& t, const std::string& key, long balls) {
     t.fail(key, m.str());
   }
 }
+/// The settings of a TOML node as text, equal for equal settings: tables in key order (toml++ keeps them sorted),
+/// numbers exactly (%a). Not toml++'s formatter, which reaches undefined behaviour on NaN (UBSan, the gates).
+void canonical_text(const toml::node& n, std::string& out) {
+  char buf[64];
+  if (const toml::table* t = n.as_table()) {
+    out += '{';
+    for (const auto& [k, v] : *t) {
+      out += std::string(k.str()) + '=';
+      canonical_text(v, out);
+      out += ';';
+    }
+    out += '}';
+  } else if (const toml::array* a = n.as_array()) {
+    out += '[';
+    for (const toml::node& e : *a) {
+      canonical_text(e, out);
+      out += ',';
+    }
+    out += ']';
+  } else if (auto i = n.value_exact<int64_t>()) {
+    out += std::to_string(*i);
+  } else if (auto d = n.value_exact<double>()) {
+    std::snprintf(buf, sizeof buf, "%a", *d);
+    out += buf;
+  } else if (auto b = n.value_exact<bool>()) {
+    out += *b ? "true" : "false";
+  } else if (auto s = n.value_exact<std::string>()) {
+    out += '"' + *s + '"';
+  } else {
+    out += '?';  // dates and times: no key takes them, and the reader refuses them
+  }
+}
+
 std::string file_text(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ConfigError(path + ": cannot be read");
@@ -227,10 +260,10 @@ Config parse_config(const std::string& text, const std::string& path) {
     if (toml::table* run = settings["run"].as_table())
       for (const char* free : {"steps", "name", "output", "stop_ratio", "checkpoint_every", "checkpoint_minutes"})
         run->erase(free);
-    std::ostringstream text;
-    text << settings;  // toml++ prints keys in order: equal settings print alike
+    std::string text;
+    canonical_text(settings, text);
     std::uint64_t h = 14695981039346656037ull;  // FNV-1a
-    for (unsigned char ch : text.str()) h = (h ^ ch) * 1099511628211ull;
+    for (unsigned char ch : text) h = (h ^ ch) * 1099511628211ull;
     char hex[17];
     std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
     c.fingerprint = hex;

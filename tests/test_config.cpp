@@ -304,3 +304,16 @@ TEST(Config, MembraneMeshThatCannotFitInMemoryRefused) {
       << e;
   EXPECT_EQ(error_of("[triaxial]\nmembrane_nodes_around = 81\nmembrane_segments = 20\n"), "") << "the paper's mesh";
 }
+
+// The fingerprint a checkpoint carries: equal for equal settings however they are written (comments, key order,
+// 0.3 or 3e-1), and for the keys a continued run may change ([run] steps, output, ...); different for a changed
+// setting. NaN-free by construction here; NaN values never get this far (EveryKey... above).
+TEST(Config, FingerprintFollowsTheSettingsNotTheirSpelling) {
+  auto fp = [](const std::string& text) { return dem::load_config(write_config("fp.toml", text)).fingerprint; };
+  const std::string base = fp("[material]\nmu_s = 0.3\nmu_r = 0.05\n[run]\nsteps = 100\n");
+  EXPECT_EQ(base.size(), 16u);
+  EXPECT_EQ(fp("# a comment\n[run]\nsteps = 5000\noutput = \"elsewhere\"\n[material]\nmu_r = 0.05  # rolling\nmu_s = 3e-1\n"),
+            base);
+  EXPECT_NE(fp("[material]\nmu_s = 0.31\nmu_r = 0.05\n[run]\nsteps = 100\n"), base);
+  EXPECT_NE(fp("[material]\nmu_s = 0.3\nmu_r = 0.05\n[run]\nsteps = 100\nseed = 2\n"), base);
+}
