@@ -80,7 +80,9 @@ TEST(PeriodicTriaxial, LateralStressesHeldAtSigma3ThroughShear) {
   ASSERT_GT(r.series.size(), 40u);
   EXPECT_NEAR(r.series.back().eps_a, 0.04, 0.001);
   EXPECT_LT(r.inertial, 1e-3);
-  EXPECT_GT(r.q_peak, 0.5 * kSigma3);  // the specimen carries a deviator (observed about 1.4 sigma3)
+  // Only that the specimen carries a deviator: its size is pinned by tests/reference/periodic_cell.csv (bits at
+  // seed 1, and the 99% interval of eight other specimens, which a halved strength leaves).
+  EXPECT_GT(r.q_peak, 0.5 * kSigma3);
   // Consolidated state: every axis within the 0.5% consolidation tolerance.
   EXPECT_NEAR(r.series.front().sigma1, kSigma3, 0.005 * kSigma3);
   // Shear: both lateral stresses within 1% of sigma3 at every row (observed: within 0.3%).

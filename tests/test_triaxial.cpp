@@ -36,7 +36,7 @@ TEST_F(Triaxial, DenseFrictionalSpecimenContractsThenDilatesInsideTheMembrane) {
   for (const TriaxialRecord& x : r.records) max_contraction = std::max(max_contraction, x.eps_v);
   EXPECT_GT(max_contraction, 0.0) << "no initial contraction";
   EXPECT_LT(r.records.back().eps_v, max_contraction - 0.005) << "no dilation after the contraction";
-  EXPECT_GT(r.q_peak, 0.5 * c.triaxial.sigma3);
+  EXPECT_GT(r.q_peak, 0.5 * c.triaxial.sigma3);  // a deviator; its size: tests/reference/membrane_triaxial.csv
   EXPECT_EQ(r.escaped, 0);
   EXPECT_LE(r.inertial_number, 1e-2);
   // Love-Weber stress of all contacts (platens and membrane included) is the specimen's mean stress: when
