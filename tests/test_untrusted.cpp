@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <hdf5.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -87,6 +88,33 @@ void replace(const std::string& file, const std::string& dataset, const std::vec
   H5Fclose(f);
 }
 
+/// Replaces the root attribute `format` by `text`: one string (count 0), or an array of `count` of them.
+void replace_format(const std::string& file, const std::string& text, hsize_t count) {
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  ASSERT_GE(f, 0) << file;
+  H5Adelete(f, "format");
+  const hid_t type = H5Tcopy(H5T_C_S1);
+  H5Tset_size(type, text.size() + 1);
+  const hid_t space = count == 0 ? H5Screate(H5S_SCALAR) : H5Screate_simple(1, &count, nullptr);
+  const hid_t attr = H5Acreate2(f, "format", type, space, H5P_DEFAULT, H5P_DEFAULT);
+  std::vector<char> values;
+  for (hsize_t k = 0; k < std::max<hsize_t>(count, 1); ++k)
+    values.insert(values.end(), text.c_str(), text.c_str() + text.size() + 1);
+  H5Awrite(attr, type, values.data());
+  H5Aclose(attr);
+  H5Sclose(space);
+  H5Tclose(type);
+  H5Fclose(f);
+}
+
+/// Reads a checkpoint, edits it in memory and writes it again, sealed: what an editor who also recomputes the
+/// checksum, or a faulty writer, produces. The checks of the values must catch what the checksum no longer can.
+void edit_sealed(const std::string& path, const std::function<void(Checkpoint&)>& edit) {
+  Checkpoint c = read_checkpoint(path);
+  edit(c);
+  write_checkpoint(path, c);
+}
+
 class Untrusted : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -113,6 +141,16 @@ class Untrusted : public ::testing::Test {
     }
     return "";
   }
+  /// Each edit, made behind a valid checksum on a fresh checkpoint, must be refused with its message.
+  using SealedEdit = std::pair<std::function<void(Checkpoint&)>, std::string>;
+  void expect_refused(const std::vector<SealedEdit>& edits) {
+    for (const auto& [edit, expected] : edits) {
+      const std::string path = checkpoint();
+      edit_sealed(path, edit);
+      const std::string got = resume_error(path);
+      EXPECT_NE(got.find(expected), std::string::npos) << got;
+    }
+  }
   std::filesystem::path dir_;
   std::unique_ptr<Simulation> sim_;
 };
@@ -138,13 +176,6 @@ TEST_F(Untrusted, ADatasetOfRankEightIsRefusedBeforeItsExtentsAreRead) {
   EXPECT_NE(e.find("rank 8"), std::string::npos) << e;
 }
 
-/// Reads a checkpoint, edits it in memory and writes it again, sealed: what an editor who also recomputes the
-/// checksum, or a faulty writer, produces. The checks of the values must catch what the checksum no longer can.
-void edit_sealed(const std::string& path, const std::function<void(Checkpoint&)>& edit) {
-  Checkpoint c = read_checkpoint(path);
-  edit(c);
-  write_checkpoint(path, c);
-}
 
 // An edit with h5py leaves the checksum behind: the file is refused as edited or damaged.
 TEST_F(Untrusted, AnEditedCheckpointFailsItsChecksum) {
@@ -157,7 +188,7 @@ TEST_F(Untrusted, AnEditedCheckpointFailsItsChecksum) {
 // Edits behind a valid checksum, each refused at --resume with the array, the row and the allowed range; the
 // simulation is left as it was (resume_error checks it).
 TEST_F(Untrusted, EditedIndicesInACheckpointAreRefusedWithTheRow) {
-  const std::vector<std::pair<std::function<void(Checkpoint&)>, std::string>> edits{
+  const std::vector<SealedEdit> edits{
       {[](Checkpoint& c) { c.sim.gid[3] = 99999999; }, "state: gid, row 3: 99999999 (allowed: 0 to 11)"},
       {[](Checkpoint& c) { c.sim.gid[3] = c.sim.gid[0]; }, "given twice"},
       {[](Checkpoint& c) { c.sim.material[5] = 7; }, "state: material, row 5: 7 (allowed: 0 to 0)"},
@@ -169,28 +200,18 @@ TEST_F(Untrusted, EditedIndicesInACheckpointAreRefusedWithTheRow) {
       {[](Checkpoint& c) { c.sim.balls.key[0] = 0; }, "the ball-ball contacts: key, row 0"},
       {[](Checkpoint& c) { c.sim.step = -1000000000000000L; }, "state: step, row 0"},
   };
-  for (const auto& [edit, expected] : edits) {
-    const std::string path = checkpoint();
-    edit_sealed(path, edit);
-    const std::string got = resume_error(path);
-    EXPECT_NE(got.find(expected), std::string::npos) << got;
-  }
+  expect_refused(edits);
 }
 
 // Non-finite values where the run divides or integrates by them, behind a valid checksum.
 TEST_F(Untrusted, NonFiniteValuesInACheckpointAreRefused) {
   const double inf = std::numeric_limits<double>::infinity();
-  const std::vector<std::pair<std::function<void(Checkpoint&)>, std::string>> edits{
+  const std::vector<SealedEdit> edits{
       {[](Checkpoint& c) { c.sim.x[3 * 4 + 1] = std::nan(""); }, "a particle vector, row 4"},
       {[](Checkpoint& c) { c.sim.radius[2] = 0; }, "radius, row 2: not a finite positive number"},
       {[&](Checkpoint& c) { c.sim.dt = inf; }, "dt, row 0"},
       {[&](Checkpoint& c) { c.sim.balls.fs[3 * 1] = -inf; }, "the ball-ball contacts history, row 1"}};
-  for (const auto& [edit, expected] : edits) {
-    const std::string path = checkpoint();
-    edit_sealed(path, edit);
-    const std::string got = resume_error(path);
-    EXPECT_NE(got.find(expected), std::string::npos) << got;
-  }
+  expect_refused(edits);
 }
 
 // A checkpoint of another config, of another format version, or whose arrays disagree with its counts.
@@ -205,22 +226,7 @@ TEST_F(Untrusted, CheckpointsOfAnotherConfigOrVersionAreRefused) {
                                          "fedcba9876543210)"), std::string::npos) << e.what();
   }
   EXPECT_NO_THROW(resume_checkpoint(path, "run", "0123456789abcdef"));
-  const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
-  H5Adelete(f, "format");
-  H5Fclose(f);
-  {
-    const hid_t g = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
-    const hid_t type = H5Tcopy(H5T_C_S1);
-    const std::string old = "triaxdem checkpoint 1";
-    H5Tset_size(type, old.size() + 1);
-    const hid_t space = H5Screate(H5S_SCALAR);
-    const hid_t attr = H5Acreate2(g, "format", type, space, H5P_DEFAULT, H5P_DEFAULT);
-    H5Awrite(attr, type, old.c_str());
-    H5Aclose(attr);
-    H5Sclose(space);
-    H5Tclose(type);
-    H5Fclose(g);
-  }
+  replace_format(path, "triaxdem checkpoint 1", 0);
   const std::string e = resume_error(path);
   EXPECT_NE(e.find("checkpoint format 'triaxdem checkpoint 1', this triaxdem reads 'triaxdem checkpoint 2'"),
             std::string::npos) << e;
@@ -243,19 +249,7 @@ TEST_F(Untrusted, DeclaredSizesTypesAndAttributeShapesAreChecked) {
   }
   {
     const std::string path = checkpoint();
-    const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
-    H5Adelete(f, "format");
-    const hsize_t four = 4;
-    const hid_t space = H5Screate_simple(1, &four, nullptr);
-    const hid_t type = H5Tcopy(H5T_C_S1);
-    H5Tset_size(type, 64);
-    const hid_t attr = H5Acreate2(f, "format", type, space, H5P_DEFAULT, H5P_DEFAULT);
-    const std::vector<char> text(4 * 64, 'x');
-    H5Awrite(attr, type, text.data());
-    H5Aclose(attr);
-    H5Tclose(type);
-    H5Sclose(space);
-    H5Fclose(f);
+    replace_format(path, std::string(63, 'x'), 4);
     const std::string e = resume_error(path);
     EXPECT_NE(e.find("attribute 'format' of '/' is not a single value"), std::string::npos) << e;
   }
