@@ -1,9 +1,9 @@
 #!/usr/bin/python3
 """Seed files for the file-reader fuzz harnesses (tests/fuzz/run_fuzz.sh), in the formats triaxdem writes:
 a snapshot with contacts and a membrane surface (as the triaxial job writes at a micro record), measured data
-in HDF5 form, and the tables of fuzz_tables (its first byte picks the reader). Checkpoints and plain snapshots
+in HDF5 form (for the raw HDF5 harness), and the tables of fuzz_tables (its first byte picks the reader). Checkpoints and plain snapshots
 come from a short run of triaxdem itself.
-    make_seeds.py OUT_DIR        (writes OUT_DIR/snapshot/ and OUT_DIR/tables/)"""
+    make_seeds.py OUT_DIR        (writes OUT_DIR/snapshot/, OUT_DIR/measured.h5 and OUT_DIR/tables/)"""
 import os
 import sys
 
@@ -29,11 +29,9 @@ with h5py.File(os.path.join(out, "snapshot", "micro_snapshot.h5"), "w") as f:
     for name, row in (("normal", [1, 0, 0]), ("point", [1e-3, 0, 0]), ("branch", [2e-3, 0, 0]), ("ft", [0, 0.1, 0])):
         c[name] = np.tile(np.array(row, dtype=float), (3, 1))
 
-with h5py.File(os.path.join(out, "tables", "measured.h5.seed"), "w") as f:
+with h5py.File(os.path.join(out, "measured.h5"), "w") as f:
     t = f.create_dataset("S-1/table", data=np.array([[100, 0, 0], [100, 1, 150], [100, 2, 160]], dtype=float))
     t.attrs["columns"] = np.bytes_("sigma3_kPa,eps_a_pct,q_kPa")
-with open(os.path.join(out, "tables", "measured.h5.seed"), "rb") as f:
-    measured = f.read()
 
 tables = {
     "summary": (0, b"case,material,sigma3_kPa,q_peak_kPa,eps_a_peak_pct,phi_peak_deg\nS1,S-1,100,150.2,3.1,27.5\n"),
@@ -41,9 +39,7 @@ tables = {
     "specimen": (2, b"# triaxdem specimen\n# key fuzz\n# height_m 0.016 void_ratio 0.7\n"
                     b"# layer 0 0.008 0.0081 0.71 1200 0.001\n# profile 0.4 0.41\nx_m,y_m,z_m,radius_m,density_kg_m3\n"
                     b"0.001,0.002,0.001,0.001,2500\n0.003,0.002,0.001,0.001,2500\n"),
-    "measured_h5": (3, measured),
 }
 for name, (selector, body) in tables.items():
     with open(os.path.join(out, "tables", name), "wb") as f:
         f.write(bytes([selector]) + body)
-os.remove(os.path.join(out, "tables", "measured.h5.seed"))
