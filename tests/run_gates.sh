@@ -3,10 +3,10 @@
 # and libFuzzer's coverage (build-gates/), in which
 #   1. the fast tests (unit tests and readers, one thread) run: any sanitizer report fails its test;
 #   2. each fuzz harness runs for a fixed time (tests/fuzz/run_fuzz.sh): a finding fails the gate.
-#   tests/run_gates.sh [FUZZ_SECONDS]        (default 45 s per harness)
+#   tests/run_gates.sh [FUZZ_SECONDS]        (default 30 s per harness)
 # The whole suite under sanitizers (gcc, slower): tests/run_sanitizers.sh.
 set -euo pipefail
-secs="${1:-45}"
+secs="${1:-30}"
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${TRIAXDEM_GATES_BUILD:-$root/build-gates}"
 cmake -S "$root" -B "$build" -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
