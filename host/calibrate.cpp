@@ -361,13 +361,13 @@ Real CalibrationResult::surrogate_chi2(const std::vector<Real>& u) const {
   return c;
 }
 
-bool CalibrationResult::inside_region(const std::vector<Real>& values) const {
+Real CalibrationResult::region_rise(const std::vector<Real>& values) const {
   std::vector<Real> u;
   for (std::size_t k = 0; k < free.size(); ++k) {
-    if (values[k] < free[k].lo || values[k] > free[k].hi) return false;
+    if (values[k] < free[k].lo || values[k] > free[k].hi) return std::numeric_limits<Real>::infinity();
     u.push_back(free[k].unit(values[k]));
   }
-  return surrogate_chi2(u) - surrogate_chi2(best.u) <= chi2_95(static_cast<int>(free.size())) * scale;
+  return (surrogate_chi2(u) - surrogate_chi2(best.u)) / (chi2_95(static_cast<int>(free.size())) * scale);
 }
 
 Real CalibrationResult::flat_share() const {

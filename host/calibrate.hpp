@@ -112,8 +112,9 @@ struct CalibrationResult {
   Real scale = 1;
   /// The surrogate chi2 at unit coordinates u.
   Real surrogate_chi2(const std::vector<Real>& u) const;
-  /// Whether parameter values (SI, in free order) lie inside the joint 95% region.
-  bool inside_region(const std::vector<Real>& values) const;
+  /// How far parameter values (SI, in free order) lie from the best, as the surrogate chi2's rise over the
+  /// joint 95% region's: at most 1 inside the region; infinite outside the searched ranges.
+  Real region_rise(const std::vector<Real>& values) const;
   /// Pairs of parameters whose correlation is beyond +-0.9, in words ("mu_s and mu_r (-0.95)"): these data
   /// cannot separate them.
   std::vector<std::string> inseparable() const;

@@ -1,7 +1,7 @@
 /// Diagnosis of curves made by another DEM code (tests/data/crosscode/, YADE 2023.02a, see its README): data the
 /// simulator did not make, from a larger cell (1000-1500 balls against 150), another preparation, rate and
-/// rolling law. Linear contacts: no extension may be named (the calibrated friction is printed beside the
-/// generating mu_s 0.4, mu_r 0.04). Hertz-Mindlin contacts: the diagnosis must name hertz. The base configs hold what a user knows of the other code's set-up and generic
+/// rolling law. Linear contacts: no extension may be named (how far the generating mu_s 0.4, mu_r 0.04 lie
+/// inside the calibration's joint 95% region is printed). Hertz-Mindlin contacts: the diagnosis must name hertz. The base configs hold what a user knows of the other code's set-up and generic
 /// friction to start from; the data's void ratio sets the preparation, as `triaxdem diagnose` does.
 #include <gtest/gtest.h>
 
@@ -48,14 +48,15 @@ TEST_P(CrossCode, DiagnosisOfAnotherCodesCurves) {
   for (const ExtensionFit& f : dg.fits) std::printf("  %s: %s\n", f.ext.name.c_str(), f.reason.c_str());
   EXPECT_EQ(dg.verdict, c.verdict) << dg.explanation;
   if (c.verdict == "none") {
-    // Printed, not asserted: whether the generating friction lies inside the joint 95% region hinges on the
-    // ensemble. Measured on 25 November with packing seeds from 1: inside (mu_s 0.297 [0.238, 0.382], mu_r 0.065
-    // [0.030, 0.080], chi2 100 on 60 data); from 11 (on a first version of the data, whose compaction servo
-    // differed slightly): mu_s 0.316 [0.257, 0.395], mu_r 0.074 [0.043, 0.080], chi2 124. Both lean to less sliding and more rolling friction than YADE's: the simulator misses these data by
-    // more than their noise (it shears three times faster than the data's I = 1e-3, for the CI budget, in a cell
-    // of 150 balls, with another rolling law), and friction absorbs the difference.
-    std::printf("  generating friction (0.4, 0.04) %s the joint 95%% region\n",
-                dg.base.inside_region({0.4, 0.04}) ? "inside" : "OUTSIDE");
+    // Whether the generating friction lies inside the reported joint 95% region (issue 26) is printed with its
+    // margin, not asserted: it holds here only narrowly, 0.94 of the region's chi2 rise on 25 November (mu_s 0.293
+    // [0.233, 0.378], mu_r 0.064 [0.029, 0.080], chi2 100 on 60 data), so it would turn on the rounding of the
+    // next kernel change. The fits lean to less sliding and more rolling friction than YADE's: the simulator
+    // misses these data by more than their noise. Not because it shears three times faster than the data (at
+    // the data's I = 1e-3, `triaxdem calibrate` gives mu_s 0.30 [0.23, 0.37], mu_r 0.08 on its range's edge);
+    // the cell (150 balls against 1500) and the rolling laws' details remain.
+    std::printf("  generating friction (0.4, 0.04): chi2 rise %.2f of the joint 95%% region's (inside at most 1)\n",
+                dg.base.region_rise({0.4, 0.04}));
   } else {
     for (const ExtensionFit& f : dg.fits)
       if (f.ext.name == c.verdict) {  // the report's claim: both tests passed by the margin
