@@ -53,8 +53,9 @@ TEST_P(CrossCode, DiagnosisOfAnotherCodesCurves) {
     // [0.233, 0.378], mu_r 0.064 [0.029, 0.080], chi2 100 on 60 data), so it would turn on the rounding of the
     // next kernel change. The fits lean to less sliding and more rolling friction than YADE's: the simulator
     // misses these data by more than their noise. Not because it shears three times faster than the data (at
-    // the data's I = 1e-3, `triaxdem calibrate` gives mu_s 0.30 [0.23, 0.37], mu_r 0.08 on its range's edge);
-    // the cell (150 balls against 1500) and the rolling laws' details remain.
+    // the data's I = 1e-3, `triaxdem calibrate` gives mu_s 0.30 [0.23, 0.37], mu_r 0.08 on its range's edge),
+    // but because its cell is small: with 600 balls (24.76 mm) instead of 150 it gives mu_s 0.375 [0.324, 0.471],
+    // mu_r 0.034 [0.009, 0.051], each interval holding YADE's value, in four times the CI's time.
     std::printf("  generating friction (0.4, 0.04): chi2 rise %.2f of the joint 95%% region's (inside at most 1)\n",
                 dg.base.region_rise({0.4, 0.04}));
   } else {
