@@ -10,7 +10,7 @@ cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j2
 log="$(mktemp)"
 trap 'rm -f "$log"' EXIT
-(cd build && ctest --output-on-failure) | tee "$log"
+(cd build && ctest --output-on-failure -LE long) | tee "$log"  # the long cases: ctest -L long
 # ctest's summary: "100% tests passed, 0 tests failed out of N"; skipped tests are listed as "Not Run" / "Skipped".
 total=$(sed -n 's/.*tests failed out of \([0-9]*\).*/\1/p' "$log" | tail -1)
 skipped=$(grep -c '\*\*\*Skipped\|Not Run' "$log" || true)
