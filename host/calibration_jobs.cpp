@@ -154,11 +154,11 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
   for (const auto& [material, tests] : by_material(ss.data, o.material)) {
     std::printf("calibrate: %s, %zu tests, free %zu parameters, %zu balls in the periodic cell\n", material.c_str(),
                 tests.size(), ss.free.size(), ss.lab.balls());
-    const long planned = planned_points(static_cast<int>(ss.free.size())) * static_cast<long>(tests.size()) *
-                         ss.lab.members();
-    Progress progress("calibrate " + material, planned);
     const long runs0 = ss.lab.runs();
-    const Misfit misfit = ss.misfit_of(base, material, tests);
+    const Misfit misfit = ss.misfit_of(base, material, tests);  // sets the ensemble ("auto": from the scatter)
+    const long planned = ss.lab.runs() - runs0 + planned_points(static_cast<int>(ss.free.size())) *
+                                                     static_cast<long>(tests.size()) * ss.lab.members();
+    Progress progress("calibrate " + material, planned);
     const CalibrationResult r = calibrate(ss.lab, model_of(base), ss.free, tests, misfit, 4,
                                           [&](long done, long, Real chi2) {
                                             char extra[64];

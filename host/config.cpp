@@ -203,10 +203,8 @@ void canonical_text(const toml::node& n, std::string& out) {
       out += ',';
     }
     out += ']';
-  } else if (auto i = n.value_exact<int64_t>()) {
-    out += std::to_string(*i);
-  } else if (auto d = n.value_exact<double>()) {
-    std::snprintf(buf, sizeof buf, "%a", *d);
+  } else if (n.is_number()) {  // by value: the reader takes 1 and 1.0 as the same setting
+    std::snprintf(buf, sizeof buf, "%a", *n.value<double>());
     out += buf;
   } else if (auto b = n.value_exact<bool>()) {
     out += *b ? "true" : "false";

@@ -121,7 +121,6 @@ ContactSet contact_set(const io::SnapshotFile& f, const std::string& path) {
       throw std::runtime_error(path + ": /gid, row " + std::to_string(q) + ": " + std::to_string(g) +
                                (g >= n ? " (allowed: 0 to " + std::to_string(n - 1) + ")" : " given twice"));
     seen[g] = 1;
-    if (g >= n) throw std::runtime_error(path + ": gid " + std::to_string(g) + " out of range");
     s.x[g] = Vec3(f.particles.x[3 * q], f.particles.x[3 * q + 1], f.particles.x[3 * q + 2]);
     s.radius[g] = f.particles.radius[q];
   }

@@ -151,7 +151,6 @@ class H5Reader {
     H5Fget_filesize(file_.get(), &bytes);
     file_bytes_ = static_cast<double>(bytes);
   }
-  const std::string& path() const { return path_; }
   bool exists(const std::string& name) const { return H5Lexists(file_.get(), name.c_str(), H5P_DEFAULT) > 0; }
   /// A dataset of `columns` values per row (rank 1 when columns is 1, else rank 2 with that many columns), stored
   /// with the type class of `type` (integers may be read as floats, never floats as integers: an index must not be

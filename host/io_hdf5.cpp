@@ -233,6 +233,8 @@ std::string temporal_collection(const char* name, const std::string& grids) {
 namespace {
 constexpr const char* kSeriesMarker = ".series_commit";
 
+bool is_series_file(const std::string& name) { return name == "series.h5" || name == "series.csv"; }
+
 /// Text written at `tmp` (errors name `path`).
 void write_text_file(const std::string& tmp, const std::string& path, const std::string& text) {
   std::FILE* f = std::fopen(tmp.c_str(), "wb");
@@ -244,7 +246,8 @@ void write_text_file(const std::string& tmp, const std::string& path, const std:
 }
 
 /// Finishes a series commit that a crash interrupted (flush_series): each file the marker names that is still
-/// there is renamed to its final name (the name before ".tmp."), then the marker goes.
+/// there is renamed to its final name (the name before ".tmp."), then the marker goes. Only series.h5 and
+/// series.csv of this folder are ever replaced (the folder compared as a file, so "out/" is "out").
 void recover_series(const std::string& folder) {
   const std::string marker = in_folder(folder, kSeriesMarker);
   std::ifstream in(marker);
@@ -253,7 +256,10 @@ void recover_series(const std::string& folder) {
   for (std::string tmp; std::getline(in, tmp);) {
     const std::size_t at = tmp.rfind(".tmp.");
     const std::string final_name = at == std::string::npos ? "" : tmp.substr(0, at);
-    if (fs::path(final_name).parent_path() != fs::path(folder) || !fs::exists(tmp)) continue;
+    const fs::path target(final_name);
+    if (!is_series_file(target.filename().string()) || !fs::equivalent(target.parent_path(), folder, ec) ||
+        !fs::exists(tmp))
+      continue;
     fs::rename(tmp, final_name, ec);
   }
   in.close();
@@ -293,7 +299,8 @@ void Output::append_series(const std::vector<double>& row) {
 
 // The pair is committed as one step: both files are written and flushed under temporary names, a marker names
 // them, then both are renamed and the marker goes. A crash between the renames leaves the marker, and the next
-// Output of the folder finishes the renames (recover_series), so series.h5 and series.csv never disagree.
+// Output of the folder finishes the renames (recover_series), so a crash never leaves series.h5 and series.csv
+// disagreeing. A rename that fails is an error that stops the run; the pair is then rewritten by the next flush.
 void Output::flush_series() {
   const std::string h5 = in_folder(folder_, "series.h5"), csv = in_folder(folder_, "series.csv");
   h5::Staged a(h5, [&](const std::string& tmp) { write_series_h5(tmp, h5, columns_, rows_); });
@@ -369,12 +376,20 @@ void Output::write_xdmf() const {
 
 void claim_output_folder(const std::string& folder, bool resume, bool overwrite) {
   if (resume || !fs::is_directory(folder)) return;
-  std::vector<fs::path> outputs;
+  // What marks a folder as a run's (every run writes these), and what else a run leaves there: the triaxial
+  // job's tables and micro files, and a crashed writer's temporaries and series marker, which the next Output
+  // of the folder would otherwise roll forward into the new run's series.
+  const auto starts = [](const std::string& name, const char* prefix) { return name.rfind(prefix, 0) == 0; };
+  std::vector<fs::path> outputs, leftovers;
   for (const auto& e : fs::directory_iterator(folder)) {
-    const std::string name = e.path().filename().string();
-    if (name == "checkpoint.h5" || name == "blowup_state.h5" || name == "series.h5" || name == "series.csv" ||
-        name == "snapshots.xdmf" || (name.rfind("snap_", 0) == 0 && e.path().extension() == ".h5"))
+    const std::string name = e.path().filename().string(), ext = e.path().extension().string();
+    if (name == "checkpoint.h5" || name == "blowup_state.h5" || is_series_file(name) || name == "snapshots.xdmf" ||
+        (starts(name, "snap_") && ext == ".h5"))
       outputs.push_back(e.path());
+    else if (name == kSeriesMarker || name.find(".tmp.") != std::string::npos || name == "summary.csv" ||
+             name == "layers.csv" || name == "porosity_profile.csv" || (starts(name, "micro_") && ext == ".csv") ||
+             (starts(name, "force_chains_") && ext == ".vtk"))
+      leftovers.push_back(e.path());
   }
   if (outputs.empty()) return;
   if (!overwrite) {
@@ -385,6 +400,7 @@ void claim_output_folder(const std::string& folder, bool resume, bool overwrite)
                              "another folder with -o");
   }
   for (const fs::path& p : outputs) fs::remove(p);
+  for (const fs::path& p : leftovers) fs::remove(p);
 }
 
 void write_text_atomic(const std::string& path, const std::string& text) {

@@ -137,6 +137,19 @@ void check_state(const SimState& s, std::size_t walls, std::size_t facets, int m
     if (!std::isfinite(s.domain.lo[d]) || !std::isfinite(s.domain.hi[d]) || !std::isfinite(s.domain.strain_rate[d]) ||
         (s.domain.periodic[d] && !(s.domain.hi[d] > s.domain.lo[d])))
       refuse("domain", static_cast<std::size_t>(d), "bounds or strain rate not finite, or a periodic axis of no length");
+  // Counts first: everything below indexes these arrays by particle and by contact row.
+  const auto count = [](const char* what, std::size_t got, std::size_t want) {
+    if (got != want)
+      throw std::runtime_error(std::string("state: ") + what + ": " + std::to_string(got) + " values where " +
+                               std::to_string(want) + " belong");
+  };
+  for (const auto* v : {&s.x, &s.v, &s.w, &s.f, &s.m, &s.x_ref}) count("a particle vector", v->size(), 3 * n);
+  for (std::size_t size : {s.mass.size(), s.inertia.size(), s.gid.size(), s.specimen.size(), s.material.size()})
+    count("a particle value", size, n);
+  for (const SavedContacts* c : {&s.balls, &s.walls}) {
+    count("a contact list's i", c->i.size(), c->key.size());
+    count("a contact list's j", c->j.size(), c->key.size());
+  }
   for (const auto* v : {&s.x, &s.v, &s.w, &s.f, &s.m, &s.x_ref}) check_finite("a particle vector", *v, 3);
   check_finite("radius", s.radius, 1, true);
   check_finite("mass", s.mass, 1, true);
@@ -203,9 +216,6 @@ void Simulation::restore(const SimState& s) {
   check_count("wall velocities", s.wall_velocity.size() / 3, walls_.n);
   check_count("mesh nodes", s.node_x.size() / 3, mesh_.nnode);
   check_count("mesh node velocities", s.node_v.size() / 3, mesh_.nnode);
-  for (const SavedContacts* c : {&s.balls, &s.walls})
-    if (c->i.size() != c->key.size() || c->j.size() != c->key.size())
-      throw std::runtime_error("state: a contact list has arrays of unequal length");
   check_state(s, static_cast<std::size_t>(walls_.n), static_cast<std::size_t>(mesh_.ntri),
               static_cast<int>(params_.extent(0)));
   step_ = s.step;

@@ -11,11 +11,11 @@
 
 namespace dem {
 
-/// Where a triaxial run stands. Numbers only (counters as Real), so that the stage is one array of the file.
 /// Snapshots of a triaxial run's shear (0%, 1%, 5% and the end), and the most steps a stage may have.
 inline constexpr int kSnapshotStrains = 4;
 inline constexpr double kMaxStageSteps = 1e15;
 
+/// Where a triaxial run stands. Numbers only (counters as Real), so that the stage is one array of the file.
 struct Stage {
   Real shear = 0;            ///< 0 consolidation, 1 shear
   Real step = 0;             ///< the next loop step of the stage

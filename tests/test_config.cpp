@@ -316,4 +316,7 @@ TEST(Config, FingerprintFollowsTheSettingsNotTheirSpelling) {
             base);
   EXPECT_NE(fp("[material]\nmu_s = 0.31\nmu_r = 0.05\n[run]\nsteps = 100\n"), base);
   EXPECT_NE(fp("[material]\nmu_s = 0.3\nmu_r = 0.05\n[run]\nsteps = 100\nseed = 2\n"), base);
+  // A number is its value, written as an integer or not: the reader takes both as the same setting.
+  EXPECT_EQ(fp("[material]\nmu_s = 0.3\nmu_r = 0.05\nemod_Pa = 100000000\n"),
+            fp("[material]\nmu_s = 0.3\nmu_r = 0.05\nemod_Pa = 1.0e8\n"));
 }

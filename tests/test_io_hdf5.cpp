@@ -217,3 +217,28 @@ TEST_F(IoHdf5, WriteTextAtomicReplacesAndCleansUpOnFailure) {
   EXPECT_THROW(dem::io::write_text_atomic(path("missing/a.txt"), "x"), std::runtime_error);
   expect_no_tmp_files(dir_);
 }
+
+// A crash between the two renames of a series commit leaves a marker naming the temporaries; the next Output of
+// the folder finishes the renames, however the folder is spelled, and never renames anything but the series.
+TEST_F(IoHdf5, InterruptedSeriesCommitIsFinishedAndOverwriteClearsWhatARunLeaves) {
+  fs::create_directories(dir_);
+  auto put = [&](const std::string& name, const std::string& text) { std::ofstream(path(name)) << text; };
+  put("series.csv", "old");
+  put("series.csv.tmp.1.0", "new");
+  put("checkpoint.h5.tmp.1.1", "not a series");
+  put(".series_commit", path("series.csv.tmp.1.0") + "\n" + path("checkpoint.h5.tmp.1.1") + "\n");
+  Output out(dir_.string() + "/");
+  EXPECT_EQ(read_text(path("series.csv")), "new");
+  EXPECT_FALSE(fs::exists(path(".series_commit")));
+  EXPECT_FALSE(fs::exists(path("checkpoint.h5"))) << "the marker named a file that is not a series";
+  // --overwrite: the run's files, its tables and a crashed writer's leftovers go; the user's own stay.
+  put(".series_commit", path("series.csv.tmp.2.0") + "\n");
+  put("series.csv.tmp.2.0", "a crashed run's");
+  for (const char* name : {"summary.csv", "micro_A.csv", "force_chains_A.vtk", "layers.csv", "notes.txt"})
+    put(name, "x");
+  dem::io::claim_output_folder(dir_.string(), false, true);
+  for (const char* gone : {"series.csv", "checkpoint.h5.tmp.1.1", ".series_commit", "series.csv.tmp.2.0",
+                           "summary.csv", "micro_A.csv", "force_chains_A.vtk", "layers.csv"})
+    EXPECT_FALSE(fs::exists(path(gone))) << gone;
+  EXPECT_TRUE(fs::exists(path("notes.txt")));
+}
