@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <sstream>
 
+#include "fnv1a.hpp"
 #include "h5_file.hpp"
 
 namespace dem {
@@ -24,19 +25,9 @@ constexpr int kFormatVersion = 2;
 struct Seal {
   std::uint64_t sum = 0;
   void add(const std::string& name, const void* data, std::size_t bytes) {
-    std::uint64_t h = 14695981039346656037ull;
-    auto mix = [&](const unsigned char* p, std::size_t n) {
-      for (std::size_t k = 0; k < n; ++k) h = (h ^ p[k]) * 1099511628211ull;
-    };
-    mix(reinterpret_cast<const unsigned char*>(name.data()), name.size() + 1);
-    mix(static_cast<const unsigned char*>(data), bytes);
-    sum += h;
+    sum += fnv1a(data, bytes, fnv1a(name.c_str(), name.size() + 1));
   }
-  std::string hex() const {
-    char b[17];
-    std::snprintf(b, sizeof b, "%016llx", static_cast<unsigned long long>(sum));
-    return b;
-  }
+  std::string hex() const { return hex16(sum); }
 };
 
 /// Writes datasets and seals them.

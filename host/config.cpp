@@ -1,5 +1,6 @@
 #include "config.hpp"
 #include "config_checks.hpp"
+#include "fnv1a.hpp"
 #include "noise_model.hpp"
 
 #include <toml++/toml.h>
@@ -260,11 +261,7 @@ Config parse_config(const std::string& text, const std::string& path) {
         run->erase(free);
     std::string text;
     canonical_text(settings, text);
-    std::uint64_t h = 14695981039346656037ull;  // FNV-1a
-    for (unsigned char ch : text) h = (h ^ ch) * 1099511628211ull;
-    char hex[17];
-    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
-    c.fingerprint = hex;
+    c.fingerprint = hex16(fnv1a(text.data(), text.size()));
   }
 
   TableReader run = table("run");
