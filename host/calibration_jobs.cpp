@@ -101,6 +101,12 @@ struct Session {
     for (const std::string& n : m.notes()) std::printf("  noise: %s\n", n.c_str());
     const Real ratio = m.ensemble_ratio();
     const bool chosen = base.calibrate.ensemble == kAutoEnsemble;
+    // An "auto" cell grows only with an "auto" ensemble: a fixed ensemble fixes the cost per point.
+    const bool cell_chosen = chosen && base.calibrate.cell_factor == kAutoCell;
+    std::printf("  cell: %zu balls, %d x the config's (%s)%s\n", lab.balls(), lab.cell_factor(),
+                base.calibrate.cell_factor != kAutoCell ? "[calibrate] cell_factor" : cell_chosen ? "chosen" : "kept",
+                lab.cell_factor() > 1 && cell_chosen ? ": all the scatter specimens of the config's cell fell short"
+                                                     : "");
     std::printf("  ensemble: %d specimens per parameter point (%s); the simulator's standard error is %.2f of the "
                 "data's noise (median)%s\n", lab.members(), chosen ? "chosen" : "[calibrate] ensemble", ratio,
                 ratio > kEnsembleRatioGoal ? "" : ": below 1/2, enough");
@@ -108,10 +114,13 @@ struct Session {
       // The mean of K specimens of N balls scatters as 1 / sqrt(K N): where K runs out, N makes up the rest.
       const int k = m.members_for(kEnsembleRatioGoal);
       const Real grow = static_cast<Real>(k) / lab.specimens();
+      const std::string beyond =
+          cell_chosen ? ", beyond the " + std::to_string(kMaxCellFactor) + " x that an \"auto\" cell grows to" : "";
       std::printf("  WARNING: above 1/2, and the misfit counts it. %d specimens would bring it to 1/2", k);
       if (grow > 1)
-        std::printf(" (scatter_specimens = %d), or all %d in a cell of about %.0f balls ([box] size_mm x %.2f)", k,
-                    lab.specimens(), grow * static_cast<Real>(lab.balls()), std::cbrt(grow));
+        std::printf(" (scatter_specimens = %d), or all %d in a cell of about %.0f balls (cell_factor = %.0f%s)", k,
+                    lab.specimens(), grow * static_cast<Real>(lab.balls()), std::ceil(grow * lab.cell_factor()),
+                    beyond.c_str());
       std::printf("\n");
     }
     return m;

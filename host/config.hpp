@@ -121,6 +121,7 @@ struct PeriodicTriaxialParams {
 };
 
 inline constexpr long kAutoEnsemble = 0;
+inline constexpr long kAutoCell = 0;
 
 /// [calibrate]: the parameters `triaxdem calibrate` and `diagnose` free (host/calibrate.hpp lists the names).
 struct CalibrateConfig {
@@ -133,6 +134,10 @@ struct CalibrateConfig {
   /// them are the ensemble): a variance from few specimens is itself uncertain, and one that comes out small by
   /// chance turns a foreign specimen into a false alarm.
   long scatter_specimens = 16;
+  /// The simulator's cell as a multiple of the config's balls (box sides times its cube root). kAutoCell (the
+  /// file's "auto"): the config's cell, grown (host/misfit.hpp, measure_misfit) only where an "auto" ensemble of
+  /// all the scatter specimens still misses half the data's noise.
+  long cell_factor = kAutoCell;
 };
 
 /// The [periodic] table: the periodic-cell triaxial test (host/periodic_triaxial.hpp).

@@ -311,13 +311,6 @@ Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreePa
   return dg;
 }
 
-Config larger_cell(const Config& base, int factor) {
-  Config c = base;
-  c.particles.count *= factor;
-  for (Real& side : c.box.size) side *= std::cbrt(static_cast<Real>(factor));
-  return c;
-}
-
 Real draw_strength(const Extension& e, unsigned seed) {
   std::mt19937_64 rng(seed * 7919u + 17u);
   std::uniform_real_distribution<Real> u(0, 1);

@@ -224,6 +224,7 @@ Misfit::Misfit(const std::vector<MeasuredTest>& measured, const NoiseOptions& no
     throw std::invalid_argument("noise '" + noise.mode + "' (allowed: data, lab)");
   if (reference.size() != measured.size()) throw std::logic_error("misfit: the reference ensemble has other tests");
   members_ = std::max(members, 1);
+  sim_balls_ = sim_balls;
   for (const auto& runs : reference) {
     Real sum = 0;
     int n = 0;
@@ -435,12 +436,18 @@ int Misfit::members_for(Real target) const {
 
 Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<MeasuredTest>& measured,
                       const NoiseOptions& noise) {
-  const Ensemble scatter = lab.run_ensemble(base, measured, true);
+  Ensemble scatter = lab.run_ensemble(base, measured, true);
   auto misfit = [&] {
     return Misfit(measured, noise, scatter, lab.members(), lab.config().periodic.triax.target_strain,
                   static_cast<Real>(lab.balls()));
   };
   if (lab.config().calibrate.ensemble != kAutoEnsemble) return misfit();
+  lab.set_members(lab.specimens());
+  const int wanted = misfit().members_for(kEnsembleRatioGoal);
+  if (wanted > lab.specimens() && lab.config().calibrate.cell_factor == kAutoCell) {
+    lab.grow_cell(std::min(kMaxCellFactor, (wanted + lab.specimens() - 1) / lab.specimens()));
+    scatter = lab.run_ensemble(base, measured, true);
+  }
   lab.set_members(std::min(misfit().members_for(kEnsembleRatioGoal), lab.specimens()));
   return misfit();
 }

@@ -48,6 +48,9 @@ std::array<Real, kQuantities> quantities(const MeasuredTest& t);
 /// at most a quarter to the variance.
 constexpr Real kEnsembleRatioGoal = 0.5;
 
+/// The largest cell an "auto" cell grows to, in multiples of the config's balls: a run's cost grows with it.
+constexpr int kMaxCellFactor = 8;
+
 /// Residual of a datum the simulation could not produce (no peak, a blow-up): ten standard deviations.
 constexpr Real kMissingResidual = 10;
 
@@ -106,6 +109,8 @@ class Misfit {
   /// The ensemble size that brings ensemble_ratio() to `target` (the standard error goes as 1 / sqrt(K)).
   int members_for(Real target) const;
   int members() const { return members_; }
+  /// Particles in a simulator specimen (0: not given).
+  Real sim_balls() const { return sim_balls_; }
   /// The scatter specimens' mean void ratio at the start of shear of test k, at the base model.
   Real reached_void_ratio(std::size_t k) const { return void_ratio_[k]; }
 
@@ -121,13 +126,16 @@ class Misfit {
   std::string source_;
   Real length_ = 1;
   int members_ = 1;
+  Real sim_balls_ = 0;
   bool curves_ = true;
 };
 
 /// The simulator's scatter measured: `lab`'s scatter specimens run at `base` on every measured test, and the
 /// misfit built on it. With an "auto" ensemble ([calibrate] ensemble), the lab's ensemble becomes the fewest
 /// specimens (at most all the scatter specimens) whose mean's standard error is below kEnsembleRatioGoal of the
-/// data's noise.
+/// data's noise. Where all of them fall short and the cell is "auto" too ([calibrate] cell_factor), the cell grows
+/// by the factor that makes up the rest (at most kMaxCellFactor; the mean of K specimens of N balls scatters as
+/// 1 / sqrt(K N)) and the scatter is measured again on it.
 Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<MeasuredTest>& measured,
                       const NoiseOptions& noise);
 

@@ -45,16 +45,35 @@ Model model_of(const Config& cfg) {
   return m;
 }
 
+Config larger_cell(const Config& base, int factor) {
+  Config c = base;
+  c.particles.count *= factor;
+  for (Real& side : c.box.size) side *= std::cbrt(static_cast<Real>(factor));
+  return c;
+}
+
 PeriodicLab::PeriodicLab(const Config& base, bool verbose, int members, unsigned first_seed, int specimens)
-    : cfg_(base), members_(std::max(members, 1)) {
-  for (int k = 0; k < std::max(members_, specimens); ++k) {
-    Config c = base;
-    c.run.seed = first_seed + static_cast<unsigned>(k);
+    : cfg_(base), members_(std::max(members, 1)), first_seed_(first_seed) {
+  pack(std::max(members_, specimens), verbose);
+}
+
+void PeriodicLab::pack(int count, bool verbose) {
+  specimens_.clear();
+  for (int k = 0; k < count; ++k) {
+    Config c = cfg_;
+    c.run.seed = first_seed_ + static_cast<unsigned>(k);
     Specimen s;
     prepare_periodic_specimen(c, s.balls, s.cell, verbose && k == 0);
     s.void_ratio = void_ratio_of(s.balls, s.cell);
     specimens_.push_back(std::move(s));
   }
+}
+
+void PeriodicLab::grow_cell(int factor) {
+  if (factor < 1) throw std::invalid_argument("cell factor " + std::to_string(factor) + " (allowed: 1 or more)");
+  cfg_ = larger_cell(cfg_, factor);
+  cell_factor_ *= factor;
+  pack(specimens(), false);
 }
 
 namespace {
@@ -103,10 +122,12 @@ Config matched_state(const Config& base, const std::vector<MeasuredTest>& tests,
 }
 
 PeriodicLab::PeriodicLab(const Config& base, bool verbose)
-    : PeriodicLab(base, verbose,
+    : PeriodicLab(larger_cell(base, static_cast<int>(std::max(base.calibrate.cell_factor, 1L))), verbose,
                   static_cast<int>(base.calibrate.ensemble == kAutoEnsemble ? base.calibrate.scatter_specimens
                                                                             : base.calibrate.ensemble),
-                  base.run.seed, static_cast<int>(base.calibrate.scatter_specimens)) {}
+                  base.run.seed, static_cast<int>(base.calibrate.scatter_specimens)) {
+  cell_factor_ = static_cast<int>(std::max(base.calibrate.cell_factor, 1L));
+}
 
 void PeriodicLab::set_members(int k) {
   if (k < 1 || k > specimens())

@@ -31,13 +31,17 @@ using Ensemble = std::vector<std::vector<MeasuredTest>>;
 /// (at most 64 members, config.cpp).
 constexpr unsigned kForeignSeedOffset = 100000;
 
+/// The base config with `factor` times the balls in a box as many times larger (same packing density).
+Config larger_cell(const Config& base, int factor);
+
 class PeriodicLab {
  public:
   /// `specimens` specimens with packing seeds first_seed, first_seed + 1, ..., of which the first `members`
   /// (at most all) form the ensemble that run_ensemble runs.
   PeriodicLab(const Config& base, bool verbose, int members, unsigned first_seed, int specimens = 0);
-  /// The config's ensemble ([calibrate] ensemble, scatter_specimens) and seed ([run] seed); an "auto" ensemble
-  /// starts as all the scatter specimens, until measure_misfit chooses.
+  /// The config's ensemble ([calibrate] ensemble, scatter_specimens), cell ([calibrate] cell_factor) and seed
+  /// ([run] seed); an "auto" ensemble starts as all the scatter specimens and an "auto" cell as the config's,
+  /// until measure_misfit chooses.
   PeriodicLab(const Config& base, bool verbose);
   /// One simulated test (curves, summarised; its void ratio at the start of shear) of one member at sigma3 (Pa).
   MeasuredTest run(const Model& m, Real sigma3, const std::string& material = "sim", int member = 0);
@@ -52,6 +56,10 @@ class PeriodicLab {
   int members() const { return members_; }
   /// Makes the first k specimens the ensemble (1 <= k <= specimens()).
   void set_members(int k);
+  /// Packs every specimen again (same seeds) in a cell of `factor` times the balls (larger_cell).
+  void grow_cell(int factor);
+  /// The cell's balls as a multiple of the config's.
+  int cell_factor() const { return cell_factor_; }
   int specimens() const { return static_cast<int>(specimens_.size()); }
   const Config& config() const { return cfg_; }
   long runs() const { return runs_; }
@@ -72,6 +80,9 @@ class PeriodicLab {
   double seconds_ = 0;
   int jobs_ = 1;
   int members_ = 1;
+  int cell_factor_ = 1;
+  unsigned first_seed_ = 0;
+  void pack(int count, bool verbose);
 };
 
 /// The preparation friction ([periodic] prep_mu_s) that packs the base config's first specimen to void ratio

@@ -3,6 +3,7 @@
 /// dated result folders and the synthetic-data writer.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -12,6 +13,7 @@
 #include "host/calibration_jobs.hpp"
 #include "host/diagnose.hpp"
 #include "host/measured.hpp"
+#include "host/misfit.hpp"
 #include "test_util.hpp"
 
 using namespace dem;
@@ -175,15 +177,13 @@ TEST(Calibrate, MeasuredCurvesRoundTrip) {
   EXPECT_EQ(d.tests[0].sigma3, 200e3);
 }
 
-// Parallel runs (child processes) give the same tests as runs one at a time, bit for bit: each child runs the
-// same specimen and law as the parent would, for each member of a two-specimen ensemble. A tiny cell (64 balls, 1% strain) keeps this to a few seconds.
-// It runs at one thread only (tests/CMakeLists.txt): with two, set_jobs refuses (forking a multithreaded OpenMP
-// process is unsafe) and both paths would be the in-process one.
-TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
+namespace {
+// A tiny periodic cell: 100 balls sheared to 1%, a few seconds a run. 100 balls: consolidated and sheared, the
+// cell's side is about 1.19 times the 3 contact cut-offs a periodic cell needs. 64 balls (1.03) ended 0.1% short of
+// it in the sanitizer build, whose rounding differs; the config check now refuses them
+// (PeriodicCell.TooFewBallsForTheCellAreRefused).
+Config tiny_cell() {
   Config cfg;
-  // 100 balls: consolidated and sheared, the cell's side is about 1.19 times the 3 contact cut-offs a periodic
-  // cell needs. 64 balls (1.03) ended 0.1% short of it in the sanitizer build, whose rounding differs; the
-  // config check now refuses them (PeriodicCell.TooFewBallsForTheCellAreRefused).
   cfg.particles.count = 100;
   cfg.particles.diameter = 2e-3;
   const Real L = std::cbrt(100 * M_PI / 6 * 8e-9 / 0.1);  // loose: insertion keeps off the seams of a small box
@@ -199,6 +199,16 @@ TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
   cfg.periodic.triax.target_strain = 0.01;
   cfg.periodic.triax.target_inertial = 1e-3;
   cfg.periodic.triax.record_strain = 0.001;
+  return cfg;
+}
+}  // namespace
+
+// Parallel runs (child processes) give the same tests as runs one at a time, bit for bit: each child runs the
+// same specimen and law as the parent would, for each member of a two-specimen ensemble.
+// It runs at one thread only (tests/CMakeLists.txt): with two, set_jobs refuses (forking a multithreaded OpenMP
+// process is unsafe) and both paths would be the in-process one.
+TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
+  const Config cfg = tiny_cell();
   PeriodicLab lab(cfg, false, 2, 1);
   Model m;
   m.law = cfg.ball;
@@ -221,6 +231,44 @@ TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
     EXPECT_NE(one[k][0].q, one[k][1].q) << "the two members are different specimens";
   }
   EXPECT_EQ(lab.runs(), 12);
+}
+
+// The cell an "auto" [calibrate] cell_factor chooses (measure_misfit): where even all the scatter specimens leave the
+// simulator's standard error above half a lab's noise (2 specimens of the 100-ball cell against q 5%), the cell
+// grows by the factor that makes up the rest, at most kMaxCellFactor, and its specimens scatter less. A fixed
+// cell_factor, or a fixed ensemble, keeps the cell.
+TEST(Calibrate, AutoCellGrowsWhereAllScatterSpecimensFallShort) {
+  Config cfg = tiny_cell();
+  cfg.periodic.triax.target_strain = 0.005;  // the scatter at small strain is enough to decide; the cells grow 8 x
+  cfg.calibrate.scatter_specimens = 2;
+  Model m;
+  m.law = cfg.ball;
+  PeriodicLab foreign(cfg, false, 1, 1000);  // the "measured" test: a specimen no lab below runs
+  const std::vector<MeasuredTest> data{foreign.run(m, 100e3)};
+  NoiseOptions lab_noise;
+  lab_noise.mode = "lab";
+
+  cfg.calibrate.cell_factor = 1;
+  PeriodicLab kept(cfg, false);
+  const Misfit small = measure_misfit(kept, m, data, lab_noise);
+  EXPECT_EQ(kept.balls(), 100u);
+  ASSERT_GT(small.ensemble_ratio(), kEnsembleRatioGoal) << "the premise: two specimens of the tiny cell fall short";
+  const int wanted = small.members_for(kEnsembleRatioGoal);
+  ASSERT_GT(wanted, 2);
+
+  cfg.calibrate.cell_factor = kAutoCell;
+  PeriodicLab grown(cfg, false);
+  const Misfit large = measure_misfit(grown, m, data, lab_noise);
+  const int factor = std::min(kMaxCellFactor, (wanted + 1) / 2);
+  EXPECT_EQ(grown.cell_factor(), factor);
+  EXPECT_EQ(grown.balls(), 100u * static_cast<unsigned>(factor));
+  EXPECT_EQ(large.sim_balls(), 100.0 * factor);
+  EXPECT_LT(large.ensemble_ratio(), small.ensemble_ratio()) << "a larger cell's specimens scatter less";
+
+  cfg.calibrate.ensemble = 2;
+  PeriodicLab fixed_ensemble(cfg, false);
+  measure_misfit(fixed_ensemble, m, data, lab_noise);
+  EXPECT_EQ(fixed_ensemble.cell_factor(), 1);
 }
 
 // A best point on the edge of the search range is flagged (the Table 6 fits of S-2 and S-3 ended on mu_s = 3 x

@@ -242,18 +242,22 @@ TEST(Config, CalibrateFreeListIsRead) {
 }
 
 // [calibrate] ensemble and scatter_specimens: integers in 1-64 (the seeds of synthetic data start 100000 above
-// the config's, out of any ensemble's reach), or "auto" for the ensemble (the default); anything else is refused
-// with the key and the range.
+// the config's, out of any ensemble's reach), or "auto" for the ensemble (the default); cell_factor 1-16 or "auto"
+// (the default); anything else is refused with the key and the range.
 TEST(Config, CalibrateEnsembleSizesAreRead) {
   const dem::Config c =
-      dem::load_config(write_config("ens.toml", "[calibrate]\nensemble = 6\nscatter_specimens = 20\n"));
+      dem::load_config(write_config("ens.toml", "[calibrate]\nensemble = 6\nscatter_specimens = 20\n"
+                                                "cell_factor = 3\n"));
   EXPECT_EQ(c.calibrate.ensemble, 6);
+  EXPECT_EQ(c.calibrate.cell_factor, 3);
+  EXPECT_EQ(dem::Config().calibrate.cell_factor, dem::kAutoCell);
   EXPECT_EQ(c.calibrate.scatter_specimens, 20);
   EXPECT_EQ(dem::Config().calibrate.ensemble, dem::kAutoEnsemble);
   EXPECT_EQ(dem::load_config(write_config("auto.toml", "[calibrate]\nensemble = \"auto\"\n")).calibrate.ensemble,
             dem::kAutoEnsemble);
   for (const char* bad : {"ensemble = 0", "ensemble = 65", "scatter_specimens = -1", "ensemble = 2.5",
-                          "ensemble = \"many\"", "scatter_specimens = \"auto\""}) {
+                          "ensemble = \"many\"", "scatter_specimens = \"auto\"", "cell_factor = 0",
+                          "cell_factor = 17", "cell_factor = \"big\""}) {
     const std::string e = error_of(std::string("[calibrate]\n") + bad + "\n");
     EXPECT_NE(e.find("bad.toml: [calibrate] "), std::string::npos) << bad << ": " << e;
   }
