@@ -114,13 +114,14 @@ struct Session {
       // The mean of K specimens of N balls scatters as 1 / sqrt(K N): where K runs out, N makes up the rest.
       const int k = m.members_for(kEnsembleRatioGoal);
       const Real grow = static_cast<Real>(k) / lab.specimens();
-      const std::string beyond =
-          cell_chosen ? ", beyond the " + std::to_string(kMaxCellFactor) + " x that an \"auto\" cell grows to" : "";
+      const Real factor = std::ceil(grow * lab.cell_factor());
+      const std::string beyond = cell_chosen && factor > kMaxCellFactor
+                                     ? ", beyond the " + std::to_string(kMaxCellFactor) + " x an \"auto\" cell grows to"
+                                     : "";
       std::printf("  WARNING: above 1/2, and the misfit counts it. %d specimens would bring it to 1/2", k);
       if (grow > 1)
         std::printf(" (scatter_specimens = %d), or all %d in a cell of about %.0f balls (cell_factor = %.0f%s)", k,
-                    lab.specimens(), grow * static_cast<Real>(lab.balls()), std::ceil(grow * lab.cell_factor()),
-                    beyond.c_str());
+                    lab.specimens(), grow * static_cast<Real>(lab.balls()), factor, beyond.c_str());
       std::printf("\n");
     }
     return m;
