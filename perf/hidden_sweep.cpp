@@ -43,15 +43,26 @@ int main(int argc, char** argv) {
   double noise = 1;
   app.add_option("--noise-scale", noise, "the synthetic data's lab-like noise times this (0: as precise as a "
                  "simulation; default 1)");
+  std::vector<std::string> hidden{"none"};
+  for (const Extension& e : extensions()) hidden.push_back(e.name);
+  std::vector<std::string> only;
+  app.add_option("--hidden", only, "only these hidden effects (default all)")
+      ->delimiter(',')
+      ->check(CLI::IsMember(hidden));
+  std::string ensemble;
+  app.add_option("--ensemble", ensemble, "the diagnosis's ensemble instead of the config's: a number of specimens, "
+                 "or auto (chosen from the measured scatter, the cell grown where that falls short)")
+      ->check(CLI::IsMember({"auto"}) | CLI::Range(1, 64));
   app.add_flag("--own-specimen", own, "generate the data on the diagnosis's own first specimen (the old, easier test)");
   CLI11_PARSE(app, argc, argv);
   prepare_parallel_runs(jobs);
   Kokkos::ScopeGuard guard(argc, argv);
-  const Config cfg = load_config(config);
+  Config cfg = load_config(config);
+  if (ensemble == "auto") cfg.calibrate.ensemble = kAutoEnsemble;
+  else if (!ensemble.empty()) cfg.calibrate.ensemble = std::stol(ensemble);
   const Model base = model_of(cfg);
   const std::vector<FreeParam> free{free_param("mu_s", base), free_param("mu_r", base)};
-  std::vector<std::string> hidden{"none"};
-  for (const Extension& e : extensions()) hidden.push_back(e.name);
+  const std::vector<std::string> run = only.empty() ? hidden : only;
   std::map<std::string, std::map<std::string, int>> confusion;
   // Per hidden extension: the strengths named right and those missed or misnamed, for the detection-power table.
   std::map<std::string, std::vector<Real>> found, missed;
@@ -66,10 +77,10 @@ int main(int argc, char** argv) {
   csv << "\n";
   std::vector<unsigned> seeds = listed;
   for (unsigned s = first; listed.empty() && s <= last; ++s) seeds.push_back(s);
-  Progress progress("hidden sweep", static_cast<long>(hidden.size() * seeds.size()));
+  Progress progress("hidden sweep", static_cast<long>(run.size() * seeds.size()));
   long done = 0;
   for (unsigned seed : seeds)
-    for (const std::string& h : hidden) {
+    for (const std::string& h : run) {
       Model truth = base;
       Real strength = 0;
       if (h != "none") set_param(truth, extension(h).param, strength = draw_strength(extension(h), seed));
