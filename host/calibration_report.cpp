@@ -89,8 +89,8 @@ std::string noise_table(const Misfit& mf, const std::vector<MeasuredTest>& tests
   std::ostringstream md;
   md << "Noise (" << mf.source() << "; median standard deviation over each test's data; the simulator's is that of "
      << "the mean of " << mf.members() << " specimens"
-     << (mf.sim_balls() > 0 ? fmt(" of %.0f balls", mf.sim_balls()) : std::string()) << "; correlation length along strain "
-     << fmt("%.2f", mf.correlation_length()) << " in ln strain):\n\n| sigma3 kPa | quantity | data | measured specimen | "
+     << (mf.sim_balls() > 0 ? fmt(" of %.0f balls", mf.sim_balls()) : std::string())
+     << "; correlation length along strain " << fmt("%.2f", mf.correlation_length()) << " in ln strain):\n\n| sigma3 kPa | quantity | data | measured specimen | "
         "simulator mean |\n|---|---|---|---|---|\n";
   for (std::size_t k = 0; k < mf.tests(); ++k) {
     std::map<std::string, std::vector<std::array<Real, 3>>> by;

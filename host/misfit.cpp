@@ -444,8 +444,10 @@ Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<Mea
   if (lab.config().calibrate.ensemble != kAutoEnsemble) return misfit();
   lab.set_members(lab.specimens());
   const int wanted = misfit().members_for(kEnsembleRatioGoal);
-  if (wanted > lab.specimens() && lab.config().calibrate.cell_factor == kAutoCell) {
-    lab.grow_cell(std::min(kMaxCellFactor, (wanted + lab.specimens() - 1) / lab.specimens()));
+  // The cap is on the cell, not on one step: a lab shared by several materials may have grown for an earlier one.
+  const int room = kMaxCellFactor / lab.cell_factor();
+  if (wanted > lab.specimens() && room > 1 && lab.config().calibrate.cell_factor == kAutoCell) {
+    lab.grow_cell(std::min(room, (wanted + lab.specimens() - 1) / lab.specimens()));
     scatter = lab.run_ensemble(base, measured, true);
   }
   lab.set_members(std::min(misfit().members_for(kEnsembleRatioGoal), lab.specimens()));
