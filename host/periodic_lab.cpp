@@ -45,6 +45,11 @@ Model model_of(const Config& cfg) {
   return m;
 }
 
+namespace {
+/// The config's fixed cell factor; an "auto" cell starts as the config's own (1).
+int fixed_cell_factor(const Config& c) { return static_cast<int>(std::max(c.calibrate.cell_factor, 1L)); }
+}  // namespace
+
 Config larger_cell(const Config& base, int factor) {
   Config c = base;
   c.particles.count *= factor;
@@ -122,11 +127,11 @@ Config matched_state(const Config& base, const std::vector<MeasuredTest>& tests,
 }
 
 PeriodicLab::PeriodicLab(const Config& base, bool verbose)
-    : PeriodicLab(larger_cell(base, static_cast<int>(std::max(base.calibrate.cell_factor, 1L))), verbose,
+    : PeriodicLab(larger_cell(base, fixed_cell_factor(base)), verbose,
                   static_cast<int>(base.calibrate.ensemble == kAutoEnsemble ? base.calibrate.scatter_specimens
                                                                             : base.calibrate.ensemble),
                   base.run.seed, static_cast<int>(base.calibrate.scatter_specimens)) {
-  cell_factor_ = static_cast<int>(std::max(base.calibrate.cell_factor, 1L));
+  cell_factor_ = fixed_cell_factor(base);
 }
 
 void PeriodicLab::set_members(int k) {
