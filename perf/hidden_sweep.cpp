@@ -53,6 +53,9 @@ int main(int argc, char** argv) {
   app.add_option("--ensemble", ensemble, "the diagnosis's ensemble instead of the config's: a number of specimens, "
                  "or auto (chosen from the measured scatter, the cell grown where that falls short)")
       ->check(CLI::IsMember({"auto"}) | CLI::Range(1, 64));
+  double strain_pct = 0;
+  app.add_option("--axial-strain-pct", strain_pct, "end every test at this axial strain instead of the config's "
+                 "(the paper's tests end at 15%; the CI's simulator at 8%)")->check(CLI::Range(1.0, 30.0));
   app.add_flag("--own-specimen", own, "generate the data on the diagnosis's own first specimen (the old, easier test)");
   CLI11_PARSE(app, argc, argv);
   prepare_parallel_runs(jobs);
@@ -60,6 +63,7 @@ int main(int argc, char** argv) {
   Config cfg = load_config(config);
   if (ensemble == "auto") cfg.calibrate.ensemble = kAutoEnsemble;
   else if (!ensemble.empty()) cfg.calibrate.ensemble = std::stol(ensemble);
+  if (strain_pct > 0) cfg.periodic.triax.target_strain = strain_pct / 100;
   const Model base = model_of(cfg);
   const std::vector<FreeParam> free{free_param("mu_s", base), free_param("mu_r", base)};
   const std::vector<std::string> run = only.empty() ? hidden : only;
