@@ -12,6 +12,7 @@
 #include <Kokkos_Core.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <map>
@@ -56,6 +57,9 @@ int main(int argc, char** argv) {
   double strain_pct = 0;
   app.add_option("--axial-strain-pct", strain_pct, "end every test at this axial strain instead of the config's "
                  "(the paper's tests end at 15%; the CI's simulator at 8%)")->check(CLI::Range(1.0, 30.0));
+  int data_cell = kGeneratorCellFactor;
+  app.add_option("--data-cell-factor", data_cell, "the data's specimens have this many times the simulator's balls "
+                 "(default " + std::to_string(kGeneratorCellFactor) + ")")->check(CLI::Range(1, 64));
   app.add_flag("--own-specimen", own, "generate the data on the diagnosis's own first specimen (the old, easier test)");
   CLI11_PARSE(app, argc, argv);
   prepare_parallel_runs(jobs);
@@ -66,7 +70,10 @@ int main(int argc, char** argv) {
   if (strain_pct > 0) cfg.periodic.triax.target_strain = strain_pct / 100;
   const Model base = model_of(cfg);
   const std::vector<FreeParam> free{free_param("mu_s", base), free_param("mu_r", base)};
-  const std::vector<std::string> run = only.empty() ? hidden : only;
+  // "none" first at every seed: the other cases of a seed share its data specimens and are compared with it.
+  std::vector<std::string> run;
+  for (const std::string& h : hidden)
+    if (only.empty() || std::find(only.begin(), only.end(), h) != only.end()) run.push_back(h);
   std::map<std::string, std::map<std::string, int>> confusion;
   // Per hidden extension: the strengths named right and those missed or misnamed, for the detection-power table.
   std::map<std::string, std::vector<Real>> found, missed;
@@ -74,9 +81,19 @@ int main(int argc, char** argv) {
   // verdict. Where it does not, no diagnosis under this rule could name it: the data, not the search, fall short.
   int shown = 0, shown_right = 0;
   std::vector<std::string> mixups;  // wrong names, with both extensions' evidence
+  // What a hidden effect leaves once the base model is recalibrated: the base chi2 above that of the null case of the
+  // same seed (the same data specimens, nothing hidden). Set against the null cases' spread across seeds, which is
+  // what changing the data specimens alone does, it says whether any decision rule could see the effect.
+  std::map<unsigned, Real> null_chi2;
+  struct Residue {
+    std::string hidden;
+    Real strength, over_null;
+    bool named;
+  };
+  std::vector<Residue> residues;
   std::ofstream csv(out);
   // Every extension's BIC gain and held-out chi2 too, so that a decision rule can be judged on the whole sweep.
-  csv << "hidden,strength,seed,verdict,base_chi2,chi2_limit,base_heldout,true_heldout,data_show";
+  csv << "hidden,strength,seed,verdict,base_chi2,chi2_limit,base_heldout,true_heldout,data_show,base_chi2_over_null";
   for (const Extension& e : extensions()) csv << "," << e.name << "_bic_gain," << e.name << "_heldout";
   csv << "\n";
   std::vector<unsigned> seeds = listed;
@@ -89,7 +106,7 @@ int main(int argc, char** argv) {
       Real strength = 0;
       if (h != "none") set_param(truth, extension(h).param, strength = draw_strength(extension(h), seed));
       // The data come from a specimen per pressure that the diagnosis never runs (own: its first member, as before).
-      PeriodicLab generator(own ? cfg : larger_cell(cfg, kGeneratorCellFactor), false, own ? 1 : 3, own ? cfg.run.seed : cfg.run.seed + kForeignSeedOffset + 3 * seed);
+      PeriodicLab generator(own ? cfg : larger_cell(cfg, data_cell), false, own ? 1 : 3, own ? cfg.run.seed : cfg.run.seed + kForeignSeedOffset + 3 * seed);
       const std::vector<MeasuredTest> data = synthetic_tests(generator, truth, {100e3, 200e3, 300e3}, "hidden", seed, noise);
       StateMatch state;  // the data's void ratio sets the preparation, as triaxdem diagnose does
       PeriodicLab matched(matched_state(cfg, data, state, false), false);
@@ -113,10 +130,18 @@ int main(int argc, char** argv) {
                     std::to_string(dg.base_heldout) + " -> " + std::to_string(f.heldout) + ";";
         mixups.push_back(line);
       }
+      if (h == "none") null_chi2[seed] = dg.base.best.chi2;
+      const bool has_null = null_chi2.count(seed) > 0;
+      const Real over_null = has_null ? dg.base.best.chi2 - null_chi2[seed] : 0;
+      if (h != "none" && has_null) residues.push_back({h, strength, over_null, named == h});
       char row[256];
-      std::snprintf(row, sizeof row, "%s,%.4g,%u,%s,%.2f,%.2f,%.2f,%.2f,%d", h.c_str(), strength, seed,
+      std::snprintf(row, sizeof row, "%s,%.4g,%u,%s,%.2f,%.2f,%.2f,%.2f,%d,", h.c_str(), strength, seed,
                     dg.verdict.c_str(), dg.base.best.chi2, dg.chi2_limit, dg.base_heldout, true_heldout, data_show);
       csv << row;
+      if (has_null) {
+        std::snprintf(row, sizeof row, "%.2f", over_null);
+        csv << row;
+      }
       for (const ExtensionFit& f : dg.fits) {
         std::snprintf(row, sizeof row, ",%.2f,%.2f", dg.base_bic - f.bic, f.heldout);
         csv << row;
@@ -158,5 +183,19 @@ int main(int argc, char** argv) {
                 f.size() + m.size());
   }
   for (const std::string& l : mixups) std::printf("told apart wrongly: %s\n", l.c_str());
+  if (null_chi2.size() >= 2 && !residues.empty()) {
+    Real mean = 0, var = 0;
+    for (const auto& [seed, c] : null_chi2) mean += c / static_cast<Real>(null_chi2.size());
+    for (const auto& [seed, c] : null_chi2) var += (c - mean) * (c - mean) / static_cast<Real>(null_chi2.size() - 1);
+    std::printf("\nwhat each hidden effect leaves once the base model is recalibrated: its base chi2 above the null "
+                "case's on the same data specimens,\nagainst the spread of the null cases' base chi2 across seeds "
+                "(sd %.1f: what changing the data specimens alone does)\n%-10s %12s %14s %s\n",
+                std::sqrt(var), "hidden", "strength", "chi2 over null", "named right");
+    std::sort(residues.begin(), residues.end(), [](const Residue& a, const Residue& b) {
+      return a.hidden != b.hidden ? a.hidden < b.hidden : a.strength < b.strength;
+    });
+    for (const Residue& r : residues)
+      std::printf("%-10s %12.4g %14.1f %s\n", r.hidden.c_str(), r.strength, r.over_null, r.named ? "yes" : "no");
+  }
   return 0;
 }
