@@ -53,7 +53,7 @@ struct MeasuredTest {
   Real void_ratio = std::numeric_limits<Real>::quiet_NaN();     ///< after consolidation (NaN: not given)
   Real void_ratio_sd = std::numeric_limits<Real>::quiet_NaN();  ///< its standard deviation (NaN: not given)
   /// Particles in the measured specimen where the data say (DEM data; NaN: not given, as for a lab's): a
-  /// specimen of N particles scatters from the next as 1 / sqrt(N) (host/misfit.hpp).
+  /// specimen of N particles scatters from the next as N^-kSpecimenScatterExponent (host/misfit.hpp).
   Real specimen_balls = std::numeric_limits<Real>::quiet_NaN();
 };
 

@@ -384,7 +384,8 @@ void Misfit::build_curve_noise(const std::vector<MeasuredTest>& measured, const 
       } else {
         const bool sized = std::isfinite(t.specimen_balls) && sim_balls > 0;
         const Real floor = f.quantity == 0 ? noise.lab.q_shared * std::fabs(f.measured) : noise.lab.ev_abs;
-        f.specimen_sd = std::max(f.ensemble_sd * (sized ? std::sqrt(sim_balls / t.specimen_balls) : 1), floor);
+        const Real size = sized ? std::pow(sim_balls / t.specimen_balls, kSpecimenScatterExponent) : 1;
+        f.specimen_sd = std::max(f.ensemble_sd * size, floor);
       }
       f.data_sd = std::sqrt(data_var[i]);
     }

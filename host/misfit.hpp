@@ -15,8 +15,8 @@
 ///                   give the specimen term, which holds it.
 ///   Sigma_specimen  the measured specimen is one specimen: from replicates when the data have them (the pooled
 ///                   scatter between replicates, q relative to sigma3), else as variable as one specimen of the
-///                   simulator's ensemble, times sqrt(N_sim / N) where the data say their specimen has N particles
-///                   (specimen_balls: a cell's scatter goes as 1 / sqrt(N)); without N, a conservative stand-in
+///                   simulator's ensemble, times (N_sim / N)^kSpecimenScatterExponent where the data say their
+///                   specimen has N particles (specimen_balls); without N, a conservative stand-in
 ///                   for a larger specimen. Never below a lab's specimen scatter (LabCurveNoise: q_shared of q,
 ///                   ev_abs on eps_v): a real specimen differs from the next by more than its particle count.
 ///   Sigma_ensemble  the simulator's specimen-to-specimen covariance, measured once at the base model on the
@@ -47,6 +47,14 @@ std::array<Real, kQuantities> quantities(const MeasuredTest& t);
 /// The simulator's standard error that an ensemble aims below, as a share of the data's noise: its mean then adds
 /// at most a quarter to the variance.
 constexpr Real kEnsembleRatioGoal = 0.5;
+
+/// A periodic cell of N balls scatters from the next as N^-kSpecimenScatterExponent, which scales the simulator's
+/// measured scatter to a data specimen of another size. Independent fluctuations would give 1/2. Between cells of
+/// this simulator of 120 and 1920 balls (12-16 specimens each, 100 and 300 kPa, q and eps_v at nine strains from
+/// 0.05% to 8%: perf/specimen_scatter.sh) it came out 0.17 to 0.74, 0.44 on average, lowest at large strain, where
+/// deformation organises over the whole cell. 1/2 understated a 1920-ball specimen's scatter at 8% about 1.6 times
+/// (docs/calibration.md has what that did to a diagnosis). 1/3 lies below 30 of the 36 exponents.
+constexpr Real kSpecimenScatterExponent = 1.0 / 3;
 
 /// The largest cell an "auto" cell grows to, in multiples of the config's balls: a run's cost grows with it.
 constexpr int kMaxCellFactor = 8;

@@ -1,0 +1,56 @@
+#!/usr/bin/env python3
+"""Scatter of periodic cells against their size, from the runs of perf/specimen_scatter.sh: per pressure and size,
+the standard deviation of q / sigma3 and of eps_v across the specimens at a few strains (each a mean over
++-min(30%, 0.25%) of strain, as the misfit reads a curve), then the exponent a of sd ~ N^-a from the smallest cell
+to each larger one."""
+import csv
+import glob
+import math
+import os
+import statistics
+import sys
+
+STRAINS = [0.05, 0.2, 0.5, 1, 2, 3, 4, 6, 8]  # percent
+
+
+def read(folder):
+    rows = list(csv.DictReader(open(os.path.join(folder, "series.csv"))))
+    col = lambda k: [float(r[k]) for r in rows]
+    return col("eps_a_pct"), col("q_kPa"), col("eps_v_pct")
+
+
+def at(eps, values, strain):
+    half = min(0.3 * strain, 0.25)
+    inside = [v for e, v in zip(eps, values) if abs(e - strain) < half]
+    return statistics.fmean(inside) if inside else math.nan
+
+
+def main(work):
+    sd = {}
+    for folder in sorted(glob.glob(os.path.join(work, "n*_*_*"))):
+        if not os.path.isdir(folder):
+            continue
+        n, s3, _ = os.path.basename(folder)[1:].split("_")
+        eps, q, ev = read(folder)
+        sd.setdefault((int(s3), int(n)), []).append(
+            ([at(eps, q, s) / float(s3) for s in STRAINS], [at(eps, ev, s) for s in STRAINS]))
+    print("strain (%):" + "".join(f"{s:7g}" for s in STRAINS))
+    spread = {}
+    for (s3, n), runs in sorted(sd.items()):
+        for k, name in ((0, "q/s3"), (1, "eps_v %")):
+            cols = list(zip(*(r[k] for r in runs)))
+            spread[(s3, n, k)] = [statistics.stdev(c) if len(c) > 1 else math.nan for c in cols]
+            print(f"{s3:4d} kPa {n:5d} balls ({len(runs)}) sd {name:8s}" +
+                  "".join(f"{v:7.3f}" for v in spread[(s3, n, k)]))
+    print("exponent a of sd ~ N^-a")
+    for (s3, n, k) in sorted(spread):
+        small = min(m for (p, m, _) in spread if p == s3)
+        if n == small:
+            continue
+        a = [math.log(x / y) / math.log(n / small) if x > 0 and y > 0 else math.nan
+             for x, y in zip(spread[(s3, small, k)], spread[(s3, n, k)])]
+        print(f"{s3:4d} kPa {small}->{n} {'q/s3' if k == 0 else 'eps_v':6s}" + "".join(f"{v:7.2f}" for v in a))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1] if len(sys.argv) > 1 else "runs/specimen_scatter")
