@@ -2,8 +2,11 @@
 # How a periodic cell's scatter falls with its size (host/misfit.hpp, kSpecimenScatterExponent): the hidden-effect
 # simulator (tests/data/hidden_effects.toml, base model) in cells of 120, 480 and 1920 balls (the box scaled to the
 # same solid fraction), SEEDS specimens a size at 100 and 300 kPa, then q / sigma3 and eps_v read at 0.05-8% strain
-# and the exponent a of sd ~ N^-a between the sizes (tools/specimen_scatter.py). About 10 minutes on 2 cores.
-#   bash perf/specimen_scatter.sh              # SEEDS=12 BUILD=build WORK=runs/specimen_scatter
+# and the exponent a of sd ~ N^-a between the sizes, with each size's mean and its standard error
+# (tools/specimen_scatter.py). SMALL_PREP_MU_S prepares the 120-ball cells with that friction instead of the
+# config's, to set them at the larger cells' void ratio as diagnose matches a specimen's state (0.012 for 0.03).
+# About 10 minutes on 2 cores.
+#   bash perf/specimen_scatter.sh              # SEEDS=12 BUILD=build WORK=runs/specimen_scatter SMALL_PREP_MU_S=
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="$(realpath "${BUILD:-$root/build}")"; work="$(realpath -m "${WORK:-$root/runs/specimen_scatter}")"
@@ -17,6 +20,7 @@ for s3 in 100 300; do
       sed -e "s/^seed = .*/seed = $((1000 + seed))/" -e "s/^sigma3_kPa = .*/sigma3_kPa = $s3.0/" \
           -e "s/^count = .*/count = $n/" -e "s/^size_mm = .*/size_mm = [$edge, $edge, $edge]/" \
           "$root/tests/data/hidden_effects.toml" > "$cfg"
+      if [ "$factor" = 1 ] && [ -n "${SMALL_PREP_MU_S:-}" ]; then sed -i "s/^prep_mu_s = .*/prep_mu_s = $SMALL_PREP_MU_S/" "$cfg"; fi
       "$build/triaxdem" periodic "$cfg" -o "$work/n${n}_${s3}_$seed" --overwrite > "$work/n${n}_${s3}_$seed.log" 2>&1
       echo "specimen scatter: $n balls, $s3 kPa, specimen $seed of $seeds done"
     done

@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Scatter of periodic cells against their size, from the runs of perf/specimen_scatter.sh: per pressure and size,
-the standard deviation of q / sigma3 and of eps_v across the specimens at a few strains (each a mean over
-+-min(30%, 0.25%) of strain, as the misfit reads a curve), then the exponent a of sd ~ N^-a from the smallest cell
-to each larger one."""
+the void ratio after consolidation, the mean of q / sigma3 and of eps_v across the specimens at a few strains
+(each read as a mean over +-min(30%, 0.25%) of strain, as the misfit reads a curve) with its standard error, their
+standard deviation, then the exponent a of sd ~ N^-a from the smallest cell to each larger one."""
 import csv
 import glob
 import math
@@ -16,7 +16,7 @@ STRAINS = [0.05, 0.2, 0.5, 1, 2, 3, 4, 6, 8]  # percent
 def read(folder):
     rows = list(csv.DictReader(open(os.path.join(folder, "series.csv"))))
     col = lambda k: [float(r[k]) for r in rows]
-    return col("eps_a_pct"), col("q_kPa"), col("eps_v_pct")
+    return col("eps_a_pct"), col("q_kPa"), col("eps_v_pct"), float(rows[0]["void_ratio"])
 
 
 def at(eps, values, strain):
@@ -26,20 +26,25 @@ def at(eps, values, strain):
 
 
 def main(work):
-    sd = {}
+    sd, voids = {}, {}
     for folder in sorted(glob.glob(os.path.join(work, "n*_*_*"))):
         if not os.path.isdir(folder):
             continue
         n, s3, _ = os.path.basename(folder)[1:].split("_")
-        eps, q, ev = read(folder)
+        eps, q, ev, e0 = read(folder)
+        voids.setdefault((int(s3), int(n)), []).append(e0)
         sd.setdefault((int(s3), int(n)), []).append(
             ([at(eps, q, s) / float(s3) for s in STRAINS], [at(eps, ev, s) for s in STRAINS]))
     print("strain (%):" + "".join(f"{s:7g}" for s in STRAINS))
     spread = {}
     for (s3, n), runs in sorted(sd.items()):
+        print(f"{s3:4d} kPa {n:5d} balls ({len(runs)}) void ratio {statistics.fmean(voids[(s3, n)]):.4f}")
         for k, name in ((0, "q/s3"), (1, "eps_v %")):
             cols = list(zip(*(r[k] for r in runs)))
             spread[(s3, n, k)] = [statistics.stdev(c) if len(c) > 1 else math.nan for c in cols]
+            print(f"{s3:4d} kPa {n:5d} balls mean {name:8s}" + "".join(f"{statistics.fmean(c):7.3f}" for c in cols))
+            print(f"{s3:4d} kPa {n:5d} balls s.e. {name:8s}" +
+                  "".join(f"{v / math.sqrt(len(runs)):7.3f}" for v in spread[(s3, n, k)]))
             print(f"{s3:4d} kPa {n:5d} balls ({len(runs)}) sd {name:8s}" +
                   "".join(f"{v:7.3f}" for v in spread[(s3, n, k)]))
     print("exponent a of sd ~ N^-a")
