@@ -82,8 +82,8 @@ int main(int argc, char** argv) {
   int shown = 0, shown_right = 0;
   std::vector<std::string> mixups;  // wrong names, with both extensions' evidence
   // What a hidden effect leaves once the base model is recalibrated: the base chi2 above that of the null case of the
-  // same seed (the same data specimens, nothing hidden). Set against the null cases' spread across seeds, which is
-  // what changing the data specimens alone does, it says whether any decision rule could see the effect.
+  // same seed (the same data specimens, nothing hidden), set against the null cases' spread across seeds: what
+  // changing the data specimens alone does.
   std::map<unsigned, Real> null_chi2;
   struct Residue {
     std::string hidden;

@@ -26,4 +26,4 @@ for s3 in 100 300; do
     done
   done
 done
-python3 "$root/tools/specimen_scatter.py" "$work"
+/usr/bin/python3 "$root/tools/specimen_scatter.py" "$work"

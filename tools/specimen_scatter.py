@@ -1,22 +1,17 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Scatter of periodic cells against their size, from the runs of perf/specimen_scatter.sh: per pressure and size,
 the void ratio after consolidation, the mean of q / sigma3 and of eps_v across the specimens at a few strains
 (each read as a mean over +-min(30%, 0.25%) of strain, as the misfit reads a curve) with its standard error, their
 standard deviation, then the exponent a of sd ~ N^-a from the smallest cell to each larger one."""
-import csv
 import glob
 import math
 import os
 import statistics
 import sys
 
+from plot_triaxial import read_series
+
 STRAINS = [0.05, 0.2, 0.5, 1, 2, 3, 4, 6, 8]  # percent
-
-
-def read(folder):
-    rows = list(csv.DictReader(open(os.path.join(folder, "series.csv"))))
-    col = lambda k: [float(r[k]) for r in rows]
-    return col("eps_a_pct"), col("q_kPa"), col("eps_v_pct"), float(rows[0]["void_ratio"])
 
 
 def at(eps, values, strain):
@@ -31,7 +26,8 @@ def main(work):
         if not os.path.isdir(folder):
             continue
         n, s3, _ = os.path.basename(folder)[1:].split("_")
-        eps, q, ev, e0 = read(folder)
+        _, s = read_series(folder)
+        eps, q, ev, e0 = s["eps_a_pct"], s["q_kPa"], s["eps_v_pct"], s["void_ratio"][0]
         voids.setdefault((int(s3), int(n)), []).append(e0)
         sd.setdefault((int(s3), int(n)), []).append(
             ([at(eps, q, s) / float(s3) for s in STRAINS], [at(eps, ev, s) for s in STRAINS]))
