@@ -91,17 +91,17 @@ std::string noise_table(const Misfit& mf, const std::vector<MeasuredTest>& tests
      << "the mean of " << mf.members() << " specimens"
      << (mf.sim_balls() > 0 ? fmt(" of %.0f balls", mf.sim_balls()) : std::string())
      << "; correlation length along strain " << fmt("%.2f", mf.correlation_length()) << " in ln strain):\n\n| sigma3 kPa | quantity | data | measured specimen | "
-        "simulator mean |\n|---|---|---|---|---|\n";
+        "simulator mean | simulator cell |\n|---|---|---|---|---|---|\n";
   for (std::size_t k = 0; k < mf.tests(); ++k) {
-    std::map<std::string, std::vector<std::array<Real, 3>>> by;
+    std::map<std::string, std::vector<std::array<Real, 4>>> by;
     for (const Feature& f : mf.features(k)) {
       const std::string q = f.strain > 0 ? (f.quantity == 0 ? "q (kPa)" : "eps_v (%)") : f.name;
       const Real u = feature_unit(f, 1).first;
-      by[q].push_back({u * f.data_sd, u * f.specimen_sd, u * f.ensemble_sd / std::sqrt(Real(mf.members()))});
+      by[q].push_back({u * f.data_sd, u * f.specimen_sd, u * f.ensemble_sd / std::sqrt(Real(mf.members())), u * f.cell_sd});
     }
     for (auto& [q, v] : by) {
       md << "| " << fmt("%g", 1e-3 * tests[k].sigma3) << " | " << q;
-      for (int c = 0; c < 3; ++c) {
+      for (int c = 0; c < 4; ++c) {
         std::vector<Real> x;
         for (const auto& a : v) x.push_back(a[c]);
         std::nth_element(x.begin(), x.begin() + x.size() / 2, x.end());
@@ -148,7 +148,7 @@ std::string gain_tables(const Misfit& mf, const std::vector<MeasuredTest>& tests
         at(*t, key).second += ce;
       }
       const Real s = std::sqrt(f.data_sd * f.data_sd + f.specimen_sd * f.specimen_sd +
-                               f.ensemble_sd * f.ensemble_sd / mf.members());
+                               f.ensemble_sd * f.ensemble_sd / mf.members() + f.cell_sd * f.cell_sd);
       const auto u = feature_unit(f, f.measured);
       rows << "| " << fmt("%g", 1e-3 * tests[k].sigma3) << " | " << f.name << " | " << u.second << " | "
            << fmt("%.4g", u.first) << " | " << fmt("%.4g", feature_unit(f, b[i]).first) << " | "

@@ -9,6 +9,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "cell_bias.hpp"
 #include "text_format.hpp"
 
 namespace dem {
@@ -418,6 +419,23 @@ void Misfit::build_curve_noise(const std::vector<MeasuredTest>& measured, const 
                      fmt(", eps_v %.3g%%", 100 * noise.lab.ev_rel) + fmt(" or %.3g%%)", 100 * noise.lab.ev_abs));
 }
 
+void Misfit::add_cell_bias(const std::vector<std::vector<Real>>& sd, const std::string& note) {
+  if (sd.size() != features_.size()) throw std::logic_error("misfit: a cell bias for other tests");
+  for (std::size_t k = 0; k < features_.size(); ++k) {
+    std::vector<Feature>& fs = features_[k];
+    const int n = static_cast<int>(fs.size());
+    if (static_cast<int>(sd[k].size()) != n) throw std::logic_error("misfit: a cell bias for other data");
+    for (int i = 0; i < n; ++i) fs[i].cell_sd = sd[k][i];
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) {
+        // Summary quantities are all of one strain (0): a bias of one is taken as independent of the others'.
+        const Real rho = i == j ? 1 : curves_ ? strain_correlation(fs[i], fs[j], length_) : 0;
+        cov_[k][static_cast<std::size_t>(i) * n + j] += rho * fs[i].cell_sd * fs[j].cell_sd;
+      }
+  }
+  notes_.push_back(note);
+}
+
 Real Misfit::ensemble_ratio() const {
   std::vector<Real> r;
   for (const auto& fs : features_)
@@ -442,17 +460,20 @@ Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<Mea
     return Misfit(measured, noise, scatter, lab.members(), lab.config().periodic.triax.target_strain,
                   static_cast<Real>(lab.balls()));
   };
-  if (lab.config().calibrate.ensemble != kAutoEnsemble) return misfit();
-  lab.set_members(lab.specimens());
-  const int wanted = misfit().members_for(kEnsembleRatioGoal);
-  // The cap is on the cell, not on one step: a lab shared by several materials may have grown for an earlier one.
-  const int room = kMaxCellFactor / lab.cell_factor();
-  if (wanted > lab.specimens() && room > 1 && lab.config().calibrate.cell_factor == kAutoCell) {
-    lab.grow_cell(std::min(room, (wanted + lab.specimens() - 1) / lab.specimens()));
-    scatter = lab.run_ensemble(base, measured, true);
+  if (lab.config().calibrate.ensemble == kAutoEnsemble) {
+    lab.set_members(lab.specimens());
+    const int wanted = misfit().members_for(kEnsembleRatioGoal);
+    // The cap is on the cell, not on one step: a lab shared by several materials may have grown for an earlier one.
+    const int room = kMaxCellFactor / lab.cell_factor();
+    if (wanted > lab.specimens() && room > 1 && lab.config().calibrate.cell_factor == kAutoCell) {
+      lab.grow_cell(std::min(room, (wanted + lab.specimens() - 1) / lab.specimens()));
+      scatter = lab.run_ensemble(base, measured, true);
+    }
+    lab.set_members(std::min(misfit().members_for(kEnsembleRatioGoal), lab.specimens()));
   }
-  lab.set_members(std::min(misfit().members_for(kEnsembleRatioGoal), lab.specimens()));
-  return misfit();
+  Misfit m = misfit();
+  measure_cell_bias(lab, base, measured, scatter, m);
+  return m;
 }
 
 std::vector<Real> Misfit::mean_values(std::size_t k, const std::vector<MeasuredTest>& members) const {

@@ -8,7 +8,7 @@
 /// curves alike; a strain is used when both curves reach it. Summary data: the seven quantities of summarise.
 ///
 /// With which noise, per test (the three kinds of scatter of ../shared/notes/discrepancy_methods.md, added):
-///   Sigma = Sigma_data + Sigma_specimen + Sigma_ensemble / K
+///   Sigma = Sigma_data + Sigma_specimen + Sigma_ensemble / K + Sigma_cell
 ///   Sigma_data      the measured curve's own noise: its standard-deviation columns, or, without them, the
 ///                   scatter of its rows about a smooth curve (row_noise, with the lag-1 correlation along
 ///                   strain counted: a window of n rows counts n (1 - rho) / (1 + rho)); zero where replicates
@@ -26,6 +26,8 @@
 ///                   has S - 1 degrees of freedom (the tests share the specimens, so pooling over tests adds
 ///                   none); a deviation measured against it follows Student's t, whose variance is
 ///                   nu / (nu - 2) times the estimate: the estimate is inflated by that factor.
+///   Sigma_cell      the simulator's finite-cell bias against the data's specimen (host/cell_bias.hpp), measured
+///                   by measure_misfit on larger cells, correlated along strain as Sigma_ensemble.
 /// Tests are independent of each other. The `lab` noise replaces the data and specimen terms by a lab's
 /// scatter (LabCurveNoise); summary data use NoiseModel, with the ensemble's variance added.
 /// The residuals are whitened per test, r = L^-1 (mean of the members - measured), Sigma = L L^T, so that
@@ -85,6 +87,7 @@ struct Feature {
   Real strain = 0;           ///< curve features
   Real measured = 0;
   Real data_sd = 0, specimen_sd = 0, ensemble_sd = 0;  ///< ensemble_sd: one member's; the mean's is / sqrt(K)
+  Real cell_sd = 0;  ///< the simulator's finite-cell bias against the data's specimen (host/cell_bias.hpp)
 };
 
 class Misfit {
@@ -118,6 +121,9 @@ class Misfit {
   int members() const { return members_; }
   /// Particles in a simulator specimen (0: not given).
   Real sim_balls() const { return sim_balls_; }
+  /// Sigma_cell: adds the simulator's finite-cell bias, sd[test][feature] (host/cell_bias.hpp), correlated along
+  /// strain as the ensemble's scatter is (a bias moves a curve smoothly); `note` says how it was measured.
+  void add_cell_bias(const std::vector<std::vector<Real>>& sd, const std::string& note);
   /// The scatter specimens' mean void ratio at the start of shear of test k, at the base model.
   Real reached_void_ratio(std::size_t k) const { return void_ratio_[k]; }
 
@@ -142,7 +148,8 @@ class Misfit {
 /// specimens (at most all the scatter specimens) whose mean's standard error is below kEnsembleRatioGoal of the
 /// data's noise. Where all of them fall short and the cell is "auto" too ([calibrate] cell_factor), the cell grows
 /// by the factor that makes up the rest (at most kMaxCellFactor; the mean of K specimens of N balls scatters as
-/// 1 / sqrt(K N)) and the scatter is measured again on it.
+/// 1 / sqrt(K N)) and the scatter is measured again on it. Then the cell's bias is measured and counted
+/// (measure_cell_bias).
 Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<MeasuredTest>& measured,
                       const NoiseOptions& noise);
 
