@@ -23,7 +23,8 @@ void measure_cell_bias(PeriodicLab& lab, const Model& base, const std::vector<Me
   // Prepared as the simulator's specimens are: to the data's void ratio where they give one (on this cell's own
   // preparation friction), else with the same preparation.
   StateMatch state;
-  const Config cfg = matched_state(larger_cell(lab.config(), kCellCheckFactor), measured, state, false);
+  const Config cfg = matched_state(larger_cell(lab.config(), kCellCheckFactor), measured, state, false,
+                                   kCellCheckPrepSteps);
   PeriodicLab check(cfg, false, kCellCheckSpecimens, lab.config().run.seed + kCellCheckSeedOffset,
                     kCellCheckSpecimens);
   check.set_jobs(lab.jobs());

@@ -90,7 +90,7 @@ Real prepared_void_ratio(const Config& cfg) {
 }
 }  // namespace
 
-Real prep_friction_for(const Config& base, Real target, Real& reached, bool verbose) {
+Real prep_friction_for(const Config& base, Real target, Real& reached, bool verbose, int steps) {
   Config c = base;
   auto at = [&](Real u) {
     c.periodic.prep_mu_s = u * u;
@@ -102,7 +102,7 @@ Real prep_friction_for(const Config& base, Real target, Real& reached, bool verb
                 target);
   if (target <= e_lo) return reached = e_lo, 0;
   if (target >= e_hi) return reached = e_hi, 1;
-  for (int k = 0; k < 8; ++k) {  // sqrt(mu) to 1/256
+  for (int k = 0; k < steps; ++k) {
     const Real mid = 0.5 * (lo + hi), e = at(mid);
     (e < target ? lo : hi) = mid;
     (e < target ? e_lo : e_hi) = e;
@@ -112,14 +112,15 @@ Real prep_friction_for(const Config& base, Real target, Real& reached, bool verb
   return low ? lo * lo : hi * hi;
 }
 
-Config matched_state(const Config& base, const std::vector<MeasuredTest>& tests, StateMatch& m, bool verbose) {
+Config matched_state(const Config& base, const std::vector<MeasuredTest>& tests, StateMatch& m, bool verbose,
+                     int steps) {
   Real sum = 0;
   for (const MeasuredTest& t : tests)
     if (std::isfinite(t.void_ratio)) sum += t.void_ratio, ++m.tests;
   if (m.tests == 0) return base;
   m.target = sum / m.tests;
   Config c = base;
-  c.periodic.prep_mu_s = m.prep_mu_s = prep_friction_for(base, m.target, m.reached, verbose);
+  c.periodic.prep_mu_s = m.prep_mu_s = prep_friction_for(base, m.target, m.reached, verbose, steps);
   if (verbose)
     std::printf("triaxdem: the data's void ratio %.4f (mean of %d tests): preparation friction %.4g packs %.4f\n",
                 m.target, m.tests, m.prep_mu_s, m.reached);

@@ -88,8 +88,9 @@ class PeriodicLab {
 /// The preparation friction ([periodic] prep_mu_s) that packs the base config's first specimen to void ratio
 /// `target` after its preparation: bisection on sqrt(prep_mu_s) over [0, 1] (more friction, a looser packing; the
 /// root spreads the steps where the void ratio changes fastest). `reached` receives the void ratio of the
-/// answer; a target beyond what [0, 1] reaches gets the nearest end.
-Real prep_friction_for(const Config& base, Real target, Real& reached, bool verbose);
+/// answer; a target beyond what [0, 1] reaches gets the nearest end. `steps` halvings: 8 take sqrt(prep_mu_s) to
+/// 1/256 of its range.
+Real prep_friction_for(const Config& base, Real target, Real& reached, bool verbose, int steps = 8);
 
 /// The measured specimens' state and the preparation that packs it (matched_state).
 struct StateMatch {
@@ -100,8 +101,9 @@ struct StateMatch {
 };
 
 /// The base config with the preparation friction that packs the mean void ratio of the tests that give one
-/// (prep_friction_for); the base config itself when none does.
-Config matched_state(const Config& base, const std::vector<MeasuredTest>& tests, StateMatch& m, bool verbose);
+/// (prep_friction_for, in `steps` halvings); the base config itself when none does.
+Config matched_state(const Config& base, const std::vector<MeasuredTest>& tests, StateMatch& m, bool verbose,
+                     int steps = 8);
 
 /// Before Kokkos starts, in a program that will run `jobs` > 1 simulator runs at once: sets OpenMP to one
 /// thread (its runtime read OMP_NUM_THREADS when it was loaded, before main, so through its API), as
