@@ -454,7 +454,7 @@ int Misfit::members_for(Real target) const {
 }
 
 Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<MeasuredTest>& measured,
-                      const NoiseOptions& noise) {
+                      const NoiseOptions& noise, bool cell_bias) {
   Ensemble scatter = lab.run_ensemble(base, measured, true);
   auto misfit = [&] {
     return Misfit(measured, noise, scatter, lab.members(), lab.config().periodic.triax.target_strain,
@@ -472,7 +472,7 @@ Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<Mea
     lab.set_members(std::min(misfit().members_for(kEnsembleRatioGoal), lab.specimens()));
   }
   Misfit m = misfit();
-  measure_cell_bias(lab, base, measured, scatter, m);
+  if (cell_bias) measure_cell_bias(lab, base, measured, scatter, m);
   return m;
 }
 

@@ -149,8 +149,8 @@ class Misfit {
 /// data's noise. Where all of them fall short and the cell is "auto" too ([calibrate] cell_factor), the cell grows
 /// by the factor that makes up the rest (at most kMaxCellFactor; the mean of K specimens of N balls scatters as
 /// 1 / sqrt(K N)) and the scatter is measured again on it. Then the cell's bias is measured and counted
-/// (measure_cell_bias).
+/// (measure_cell_bias) unless `cell_bias` is false.
 Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<MeasuredTest>& measured,
-                      const NoiseOptions& noise);
+                      const NoiseOptions& noise, bool cell_bias = true);
 
 }  // namespace dem
