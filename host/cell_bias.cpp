@@ -47,11 +47,11 @@ void measure_cell_bias(PeriodicLab& lab, const Model& base, const std::vector<Me
   }
   std::sort(share.begin(), share.end());
   const Real median = share.empty() ? 0 : share[share.size() / 2], top = share.empty() ? 0 : share.back();
-  std::string note = fmt("the simulator's cell: %d cells of ", kCellCheckSpecimens) + fmt("%zu balls", check.balls()) +
+  std::string note = fmt("the simulator's cell: %.0f cells of ", kCellCheckSpecimens) + fmt("%.0f balls", factor * n) +
                      " at the base model" +
                      (state.tests > 0 ? fmt(" (prepared to e = %.4f", state.target) + fmt(", reached %.4f)", state.reached)
                                       : std::string()) +
-                     fmt(" differ from the %zu scatter specimens beyond their own scatter by ", reference.front().size()) +
+                     fmt(" differ from the %.0f scatter specimens beyond their own scatter by ", static_cast<Real>(reference.front().size())) +
                      fmt("%.2f of the data's noise (median; at most ", median) + fmt("%.2f),", top) +
                      " extrapolated to the data's specimen size and counted as noise";
   misfit.add_cell_bias(sd, note);

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <string>
 
 #include "host/calibrate.hpp"
@@ -275,6 +276,28 @@ TEST(Calibrate, AutoCellGrowsWhereAllScatterSpecimensFallShort) {
   PeriodicLab fixed_ensemble(cfg, false);
   measure_misfit(fixed_ensemble, m, data, noise, false);
   EXPECT_EQ(fixed_ensemble.cell_factor(), 1);
+}
+
+// measure_misfit measures the cell's bias on 4 cells of 4 times the balls and says so in the report's words; a data
+// specimen of the simulator's own size has no bias against it, whatever the cells show (host/cell_bias.hpp).
+TEST(Calibrate, MeasureMisfitCountsTheCellsBias) {
+  Config cfg = tiny_cell();
+  cfg.periodic.triax.target_strain = 0.005;
+  cfg.calibrate.scatter_specimens = 2;
+  cfg.calibrate.ensemble = 2;
+  Model m;
+  m.law = cfg.ball;
+  PeriodicLab foreign(cfg, false, 1, 1000);
+  std::vector<MeasuredTest> data{foreign.run(m, 100e3)};
+  data[0].specimen_balls = 100;
+  data[0].void_ratio = std::numeric_limits<Real>::quiet_NaN();  // no state to match: the check packs 4 cells, not 11
+  PeriodicLab lab(cfg, false);
+  const Misfit misfit = measure_misfit(lab, m, data, NoiseOptions());
+  bool said = false;
+  for (const std::string& n : misfit.notes())
+    said = said || n.find("the simulator's cell: 4 cells of 400 balls") != std::string::npos;
+  EXPECT_TRUE(said) << "the report names the check cells";
+  for (const Feature& f : misfit.features(0)) EXPECT_EQ(f.cell_sd, 0) << f.name;
 }
 
 // A best point on the edge of the search range is flagged (the Table 6 fits of S-2 and S-3 ended on mu_s = 3 x
