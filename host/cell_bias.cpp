@@ -41,7 +41,7 @@ void measure_cell_bias(PeriodicLab& lab, const Model& base, const std::vector<Me
       // Both means scatter as the simulator's specimens do, the larger cells' less by the size law of the scatter.
       const Real var = f.ensemble_sd * f.ensemble_sd * (1 / s + std::pow(factor, -2 * kSpecimenScatterExponent) / sc);
       sd[k].push_back(cell_bias_sd(big[i] - small[i], var, g));
-      const Real data = std::hypot(f.data_sd, f.specimen_sd);
+      const Real data = f.data_noise();
       if (data > 0) share.push_back(sd[k].back() / data);
     }
   }

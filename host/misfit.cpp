@@ -440,7 +440,7 @@ Real Misfit::ensemble_ratio() const {
   std::vector<Real> r;
   for (const auto& fs : features_)
     for (const Feature& f : fs) {
-      const Real data = std::hypot(f.data_sd, f.specimen_sd);
+      const Real data = f.data_noise();
       if (data > 0) r.push_back(f.ensemble_sd / std::sqrt(static_cast<Real>(members_)) / data);
     }
   if (r.empty()) return 0;

@@ -33,6 +33,7 @@
 /// The residuals are whitened per test, r = L^-1 (mean of the members - measured), Sigma = L L^T, so that
 /// chi2 = sum r^2 is about the number of data for a model right within the noise.
 #include <array>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -88,6 +89,9 @@ struct Feature {
   Real measured = 0;
   Real data_sd = 0, specimen_sd = 0, ensemble_sd = 0;  ///< ensemble_sd: one member's; the mean's is / sqrt(K)
   Real cell_sd = 0;  ///< the simulator's finite-cell bias against the data's specimen (host/cell_bias.hpp)
+  /// The data side's noise: the measured curve's and the measured specimen's, what the simulator's parts are set
+  /// against.
+  Real data_noise() const { return std::hypot(data_sd, specimen_sd); }
 };
 
 class Misfit {
