@@ -70,6 +70,12 @@ TEST(Config, NonAsciiOutsideStringsAndCommentsRefused) {
   EXPECT_NE(e.find("bad.toml:2:10: a non-ASCII character"), std::string::npos) << e;
   e = error_of("[triaxial]\n\u03c33_kPa = 100.0\n");
   EXPECT_NE(e.find("bad.toml:2:1: a non-ASCII character"), std::string::npos) << e;
+  // A quote that cannot begin a string does not hide what follows (fuzz_config: U+FE7F after 200''''').
+  e = error_of("[particles]\ncount = 200'''''\ufe7f \n");
+  EXPECT_NE(e.find("bad.toml:2:17: a non-ASCII character"), std::string::npos) << e;
+  // Strings at the start of an array's line and after ',' are strings (the document parses; only the type is wrong).
+  e = error_of("[run]\noutput = 'a#\u03c3'  # \u03c3\nname = [\n  '\u03bc', \"\u03c3\"]\n");
+  EXPECT_NE(e.find("[run] name: expected a string"), std::string::npos) << e;
 }
 
 TEST(Config, TimeStepAboveCriticalRefused) {
