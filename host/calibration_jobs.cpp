@@ -69,8 +69,7 @@ struct Session {
       : data(load_measured(o.data)),
         ref(o.reference.empty() ? ReferenceValues{}
                                 : load_reference(o.reference, [](const std::string& n) { free_param(n); })),
-        free(free_params(base, o.free)), lab(matched(base), true), folder(new_dated_folder(o.output, kind)) {
-    lab.set_jobs(o.jobs);
+        free(free_params(base, o.free)), lab(matched(base), true, o.jobs), folder(new_dated_folder(o.output, kind)) {
     if (o.noise == "data" || o.noise == "lab") noise.mode = o.noise;
     else noise = lab_noise_options(o.noise);
     for (const std::string& n : data.notes) std::printf("%s: note: %s\n", kind.c_str(), n.c_str());

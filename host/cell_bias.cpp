@@ -26,8 +26,7 @@ void measure_cell_bias(PeriodicLab& lab, const Model& base, const std::vector<Me
   const Config cfg = matched_state(larger_cell(lab.config(), kCellCheckFactor), measured, state, false,
                                    kCellCheckPrepSteps);
   PeriodicLab check(cfg, false, kCellCheckSpecimens, lab.config().run.seed + kCellCheckSeedOffset,
-                    kCellCheckSpecimens);
-  check.set_jobs(lab.jobs());
+                    kCellCheckSpecimens, lab.jobs());
   const Ensemble larger = check.run_ensemble(base, measured, true);
   const Real n = static_cast<Real>(lab.balls()), factor = static_cast<Real>(check.balls()) / n;
   std::vector<std::vector<Real>> sd(measured.size());

@@ -321,10 +321,12 @@ std::vector<MeasuredTest> synthetic_tests(PeriodicLab& lab, const Model& truth, 
                                           const std::string& material, unsigned seed, Real noise) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<Real> gauss(0, 1);
-  std::vector<MeasuredTest> out;
+  std::vector<MeasuredTest> like(sigma3.size());
+  for (std::size_t j = 0; j < sigma3.size(); ++j) like[j].sigma3 = sigma3[j], like[j].material = material;
+  std::vector<MeasuredTest> out = lab.run_each(truth, like);
   for (std::size_t j = 0; j < sigma3.size(); ++j) {
     const Real s3 = sigma3[j];
-    MeasuredTest t = lab.run(truth, s3, material, static_cast<int>(j) % lab.members());
+    MeasuredTest& t = out[j];
     t.specimen_balls = static_cast<Real>(lab.balls());
     const Real factor = 1 + noise * 0.02 * gauss(rng);
     for (std::size_t i = 0; i < t.q.size(); ++i) {
@@ -332,7 +334,6 @@ std::vector<MeasuredTest> synthetic_tests(PeriodicLab& lab, const Model& truth, 
       t.eps_v[i] += noise * 2e-4 * gauss(rng);
     }
     summarise(t);
-    out.push_back(t);
   }
   return out;
 }

@@ -1,12 +1,8 @@
 #include "periodic_lab.hpp"
 
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <iostream>
 #include <limits>
 #include <stdexcept>
 #include <type_traits>
@@ -16,6 +12,7 @@
 #include <omp.h>
 #endif
 
+#include "forked_runs.hpp"
 #include "periodic_triaxial.hpp"
 
 namespace dem {
@@ -57,21 +54,47 @@ Config larger_cell(const Config& base, int factor) {
   return c;
 }
 
-PeriodicLab::PeriodicLab(const Config& base, bool verbose, int members, unsigned first_seed, int specimens)
+PeriodicLab::PeriodicLab(const Config& base, bool verbose, int members, unsigned first_seed, int specimens, int jobs)
     : cfg_(base), members_(std::max(members, 1)), first_seed_(first_seed) {
+  set_jobs(jobs);
   pack(std::max(members_, specimens), verbose);
 }
 
 void PeriodicLab::pack(int count, bool verbose) {
-  specimens_.clear();
-  for (int k = 0; k < count; ++k) {
+  specimens_.assign(static_cast<std::size_t>(count), Specimen{});
+  auto prepare = [&](std::size_t k) {
     Config c = cfg_;
     c.run.seed = first_seed_ + static_cast<unsigned>(k);
-    Specimen s;
+    Specimen& s = specimens_[k];
     prepare_periodic_specimen(c, s.balls, s.cell, verbose && k == 0);
     s.void_ratio = void_ratio_of(s.balls, s.cell);
-    specimens_.push_back(std::move(s));
+  };
+  if (jobs_ <= 1 || count <= 1) {
+    for (std::size_t k = 0; k < specimens_.size(); ++k) prepare(k);
+    return;
   }
+  // Each specimen in a child, sent back as its ball count, balls (plain data), cell and void ratio.
+  static_assert(std::is_trivially_copyable<BallSpec>::value, "BallSpec goes through a pipe as bytes");
+  forked_runs(
+      specimens_.size(), jobs_,
+      [&](std::size_t k, int fd) {
+        prepare(k);
+        const Specimen& s = specimens_[k];
+        const std::size_t n = s.balls.size();
+        put_bytes(fd, &n, sizeof n);
+        put_bytes(fd, s.balls.data(), n * sizeof(BallSpec));
+        put_bytes(fd, s.cell.data(), sizeof s.cell);
+        put_bytes(fd, &s.void_ratio, sizeof s.void_ratio);
+      },
+      [&](std::size_t k, int fd) {
+        Specimen& s = specimens_[k];
+        std::size_t n = 0;
+        if (!get_bytes(fd, &n, sizeof n)) return false;
+        s.balls.resize(n);
+        return get_bytes(fd, s.balls.data(), n * sizeof(BallSpec)) && get_bytes(fd, s.cell.data(), sizeof s.cell) &&
+               get_bytes(fd, &s.void_ratio, sizeof s.void_ratio);
+      },
+      "specimen preparation");
 }
 
 void PeriodicLab::grow_cell(int factor) {
@@ -127,11 +150,11 @@ Config matched_state(const Config& base, const std::vector<MeasuredTest>& tests,
   return c;
 }
 
-PeriodicLab::PeriodicLab(const Config& base, bool verbose)
+PeriodicLab::PeriodicLab(const Config& base, bool verbose, int jobs)
     : PeriodicLab(larger_cell(base, fixed_cell_factor(base)), verbose,
                   static_cast<int>(base.calibrate.ensemble == kAutoEnsemble ? base.calibrate.scatter_specimens
                                                                             : base.calibrate.ensemble),
-                  base.run.seed, static_cast<int>(base.calibrate.scatter_specimens)) {
+                  base.run.seed, static_cast<int>(base.calibrate.scatter_specimens), jobs) {
   cell_factor_ = fixed_cell_factor(base);
 }
 
@@ -184,38 +207,23 @@ namespace {
 
 /// The curves of a test through a pipe: row count, then eps_a, q, eps_v (a count of -1: the run blew up).
 void send_curves(int fd, const MeasuredTest& t) {
-  auto put = [&](const void* p, std::size_t n) {
-    for (const char* c = static_cast<const char*>(p); n > 0;) {
-      const ssize_t w = ::write(fd, c, n);
-      if (w <= 0) ::_exit(3);
-      c += w, n -= static_cast<std::size_t>(w);
-    }
-  };
   const long n = std::isfinite(t.q_peak) ? static_cast<long>(t.q.size()) : -1;
-  put(&n, sizeof n);
-  put(&t.void_ratio, sizeof t.void_ratio);
+  put_bytes(fd, &n, sizeof n);
+  put_bytes(fd, &t.void_ratio, sizeof t.void_ratio);
   for (const std::vector<Real>* v : {&t.eps_a, &t.q, &t.eps_v})
-    if (n > 0) put(v->data(), sizeof(Real) * v->size());
+    if (n > 0) put_bytes(fd, v->data(), sizeof(Real) * v->size());
 }
 
 bool receive_curves(int fd, MeasuredTest& t) {
-  auto get = [&](void* p, std::size_t n) {
-    for (char* c = static_cast<char*>(p); n > 0;) {
-      const ssize_t r = ::read(fd, c, n);
-      if (r <= 0) return false;
-      c += r, n -= static_cast<std::size_t>(r);
-    }
-    return true;
-  };
   long n = 0;
-  if (!get(&n, sizeof n) || !get(&t.void_ratio, sizeof t.void_ratio)) return false;
+  if (!get_bytes(fd, &n, sizeof n) || !get_bytes(fd, &t.void_ratio, sizeof t.void_ratio)) return false;
   if (n < 0) {
     mark_failed(t);
     return true;
   }
   for (std::vector<Real>* v : {&t.eps_a, &t.q, &t.eps_v}) {
     v->resize(static_cast<std::size_t>(n));
-    if (n > 0 && !get(v->data(), sizeof(Real) * v->size())) return false;
+    if (n > 0 && !get_bytes(fd, v->data(), sizeof(Real) * v->size())) return false;
   }
   summarise(t);
   return true;
@@ -223,52 +231,46 @@ bool receive_curves(int fd, MeasuredTest& t) {
 
 }  // namespace
 
-Ensemble PeriodicLab::run_ensemble(const Model& m, const std::vector<MeasuredTest>& like, bool all) {
-  const std::size_t M = all ? specimens_.size() : static_cast<std::size_t>(members_);
-  const std::size_t N = like.size() * M;  // run j: test j / M, member j % M
-  Ensemble out(like.size());
-  if (jobs_ <= 1 || N <= 1) {
-    for (std::size_t j = 0; j < N; ++j)
-      out[j / M].push_back(run(m, like[j / M].sigma3, like[j / M].material, static_cast<int>(j % M)));
+std::vector<MeasuredTest> PeriodicLab::run_cases(const Model& m, const std::vector<MeasuredTest>& like,
+                                                 const std::vector<int>& member) {
+  std::vector<MeasuredTest> out(like.size());
+  if (jobs_ <= 1 || like.size() <= 1) {
+    for (std::size_t j = 0; j < like.size(); ++j) out[j] = run(m, like[j].sigma3, like[j].material, member[j]);
     return out;
   }
   const auto t0 = std::chrono::steady_clock::now();
-  std::cout.flush();
-  std::fflush(nullptr);  // a child must not write the parent's buffered output again
-  for (std::size_t first = 0; first < N; first += static_cast<std::size_t>(jobs_)) {
-    const std::size_t last = std::min(N, first + static_cast<std::size_t>(jobs_));
-    std::vector<std::pair<pid_t, int>> children;
-    for (std::size_t j = first; j < last; ++j) {
-      int fd[2];
-      if (::pipe(fd) != 0) throw std::runtime_error("calibration: cannot create a pipe for a parallel run");
-      const pid_t pid = ::fork();
-      if (pid < 0) throw std::runtime_error("calibration: cannot start a parallel run (fork failed)");
-      if (pid == 0) {
-        ::close(fd[0]);
-        send_curves(fd[1], run(m, like[j / M].sigma3, like[j / M].material, static_cast<int>(j % M)));
-        ::_exit(0);  // no atexit handlers, no Kokkos finalize: the parent owns those
-      }
-      ::close(fd[1]);
-      children.emplace_back(pid, fd[0]);
-    }
-    bool ok = true;
-    for (std::size_t c = 0; c < children.size(); ++c) {
-      const MeasuredTest& like_it = like[(first + c) / M];
-      MeasuredTest t;
-      t.material = like_it.material;
-      t.sigma3 = like_it.sigma3;
-      ok = receive_curves(children[c].second, t) && ok;
-      ::close(children[c].second);
-      int status = 0;
-      ::waitpid(children[c].first, &status, 0);
-      ok = ok && WIFEXITED(status) && WEXITSTATUS(status) == 0;
-      out[(first + c) / M].push_back(t);
-    }
-    if (!ok) throw std::runtime_error("calibration: a parallel run failed (set OMP_NUM_THREADS=1 and -j 1 to see it)");
-  }
-  runs_ += static_cast<long>(N);
+  forked_runs(
+      like.size(), jobs_,
+      [&](std::size_t j, int fd) { send_curves(fd, run(m, like[j].sigma3, like[j].material, member[j])); },
+      [&](std::size_t j, int fd) {
+        out[j].material = like[j].material;
+        out[j].sigma3 = like[j].sigma3;
+        return receive_curves(fd, out[j]);
+      },
+      "calibration");
+  runs_ += static_cast<long>(like.size());
   seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
+}
+
+Ensemble PeriodicLab::run_ensemble(const Model& m, const std::vector<MeasuredTest>& like, bool all) {
+  const std::size_t M = all ? specimens_.size() : static_cast<std::size_t>(members_);
+  std::vector<MeasuredTest> cases;  // case j: test j / M on member j % M
+  std::vector<int> member;
+  for (std::size_t j = 0; j < like.size() * M; ++j) {
+    cases.push_back(like[j / M]);
+    member.push_back(static_cast<int>(j % M));
+  }
+  const std::vector<MeasuredTest> done = run_cases(m, cases, member);
+  Ensemble out(like.size());
+  for (std::size_t j = 0; j < done.size(); ++j) out[j / M].push_back(done[j]);
+  return out;
+}
+
+std::vector<MeasuredTest> PeriodicLab::run_each(const Model& m, const std::vector<MeasuredTest>& like) {
+  std::vector<int> member;
+  for (std::size_t j = 0; j < like.size(); ++j) member.push_back(static_cast<int>(j % static_cast<std::size_t>(members_)));
+  return run_cases(m, like, member);
 }
 
 }  // namespace dem

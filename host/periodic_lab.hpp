@@ -37,17 +37,19 @@ Config larger_cell(const Config& base, int factor);
 class PeriodicLab {
  public:
   /// `specimens` specimens with packing seeds first_seed, first_seed + 1, ..., of which the first `members`
-  /// (at most all) form the ensemble that run_ensemble runs.
-  PeriodicLab(const Config& base, bool verbose, int members, unsigned first_seed, int specimens = 0);
+  /// (at most all) form the ensemble that run_ensemble runs. They are packed up to `jobs` at once (set_jobs).
+  PeriodicLab(const Config& base, bool verbose, int members, unsigned first_seed, int specimens = 0, int jobs = 1);
   /// The config's ensemble ([calibrate] ensemble, scatter_specimens), cell ([calibrate] cell_factor) and seed
   /// ([run] seed); an "auto" ensemble starts as all the scatter specimens and an "auto" cell as the config's,
   /// until measure_misfit chooses.
-  PeriodicLab(const Config& base, bool verbose);
+  PeriodicLab(const Config& base, bool verbose, int jobs = 1);
   /// One simulated test (curves, summarised; its void ratio at the start of shear) of one member at sigma3 (Pa).
   MeasuredTest run(const Model& m, Real sigma3, const std::string& material = "sim", int member = 0);
   /// Every test of `like` (its materials and pressures) on every member (on every specimen with `all`); up to
   /// jobs() runs at once.
   Ensemble run_ensemble(const Model& m, const std::vector<MeasuredTest>& like, bool all = false);
+  /// Test j of `like` (its material and pressure) on member j % members(): data made on a specimen per test.
+  std::vector<MeasuredTest> run_each(const Model& m, const std::vector<MeasuredTest>& like);
   /// Runs at once: each in a child process (fork) with the same specimens; the results are the same as one at a
   /// time, bit for bit. Only where that is safe: a host backend on one thread (OMP_NUM_THREADS=1); otherwise
   /// the runs go one at a time with all threads. Returns the value in effect.
@@ -56,7 +58,7 @@ class PeriodicLab {
   int members() const { return members_; }
   /// Makes the first k specimens the ensemble (1 <= k <= specimens()).
   void set_members(int k);
-  /// Packs every specimen again (same seeds) in a cell of `factor` times the balls (larger_cell).
+  /// Packs every specimen again (same seeds) in a cell of `factor` times the balls (larger_cell), jobs() at once.
   void grow_cell(int factor);
   /// The cell's balls as a multiple of the config's.
   int cell_factor() const { return cell_factor_; }
@@ -83,6 +85,9 @@ class PeriodicLab {
   int cell_factor_ = 1;
   unsigned first_seed_ = 0;
   void pack(int count, bool verbose);
+  /// like[j] on specimen member[j], up to jobs() at once.
+  std::vector<MeasuredTest> run_cases(const Model& m, const std::vector<MeasuredTest>& like,
+                                      const std::vector<int>& member);
 };
 
 /// The preparation friction ([periodic] prep_mu_s) that packs the base config's first specimen to void ratio

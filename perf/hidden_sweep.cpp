@@ -106,11 +106,11 @@ int main(int argc, char** argv) {
       Real strength = 0;
       if (h != "none") set_param(truth, extension(h).param, strength = draw_strength(extension(h), seed));
       // The data come from a specimen per pressure that the diagnosis never runs (own: its first member, as before).
-      PeriodicLab generator(own ? cfg : larger_cell(cfg, data_cell), false, own ? 1 : 3, own ? cfg.run.seed : cfg.run.seed + kForeignSeedOffset + 3 * seed);
+      PeriodicLab generator(own ? cfg : larger_cell(cfg, data_cell), false, own ? 1 : 3,
+                            own ? cfg.run.seed : cfg.run.seed + kForeignSeedOffset + 3 * seed, 0, jobs);
       const std::vector<MeasuredTest> data = synthetic_tests(generator, truth, {100e3, 200e3, 300e3}, "hidden", seed, noise);
       StateMatch state;  // the data's void ratio sets the preparation, as triaxdem diagnose does
-      PeriodicLab matched(matched_state(cfg, data, state, false), false);
-      matched.set_jobs(jobs);
+      PeriodicLab matched(matched_state(cfg, data, state, false), false, jobs);
       const Diagnosis dg = diagnose(matched, base, free, data, measure_misfit(matched, base, data, NoiseOptions()), false);
       Real true_heldout = dg.base_heldout;
       bool data_show = false;

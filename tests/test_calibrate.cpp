@@ -205,7 +205,8 @@ Config tiny_cell() {
 }  // namespace
 
 // Parallel runs (child processes) give the same tests as runs one at a time, bit for bit: each child runs the
-// same specimen and law as the parent would, for each member of a two-specimen ensemble.
+// same specimen and law as the parent would, for each member of a two-specimen ensemble; and specimens packed in
+// children are those the parent would pack.
 // It runs at one thread only (tests/CMakeLists.txt): with two, set_jobs refuses (forking a multithreaded OpenMP
 // process is unsafe) and both paths would be the in-process one.
 TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
@@ -232,6 +233,13 @@ TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
     EXPECT_NE(one[k][0].q, one[k][1].q) << "the two members are different specimens";
   }
   EXPECT_EQ(lab.runs(), 12);
+  // Specimens packed side by side are those packed one at a time; run_each runs test k on member k % 2.
+  PeriodicLab packed_apart(cfg, false, 2, 1, 0, 2);
+  ASSERT_EQ(packed_apart.jobs(), 2);
+  for (int j = 0; j < 2; ++j) EXPECT_EQ(packed_apart.prepared_void_ratio(j), lab.prepared_void_ratio(j));
+  const std::vector<MeasuredTest> each = packed_apart.run_each(m, like);
+  ASSERT_EQ(each.size(), 3u);
+  for (int k = 0; k < 3; ++k) EXPECT_EQ(each[k].q, one[k][k % 2].q) << "sigma3 " << like[k].sigma3;
 }
 
 // The cell an "auto" [calibrate] cell_factor chooses (measure_misfit): where even all the scatter specimens leave the

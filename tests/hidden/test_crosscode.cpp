@@ -37,8 +37,7 @@ TEST_P(CrossCode, DiagnosisOfAnotherCodesCurves) {
   // The preparation's reach in void ratio is coarse on one small specimen; 0.02 is about the spread between
   // specimens of 150 balls at one friction.
   EXPECT_NEAR(state.reached, state.target, 0.02) << "preparation friction " << state.prep_mu_s;
-  PeriodicLab lab(cfg, false);
-  lab.set_jobs(2);
+  PeriodicLab lab(cfg, false, 2);
   const Model base = model_of(cfg);
   const Misfit misfit = measure_misfit(lab, base, data.tests, NoiseOptions());
   const Diagnosis dg =

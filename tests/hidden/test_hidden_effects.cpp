@@ -49,7 +49,8 @@ TEST_P(HiddenEffect, DiagnosisNamesIt) {
     Model truth = model_of(cfg);
     if (c.extension != "none") set_param(truth, extension(c.extension).param, c.strength);
     // A specimen the diagnosis never sees: its ensemble packs with seeds [run] seed, seed + 1, ...
-    PeriodicLab generator(larger_cell(cfg, kGeneratorCellFactor), false, 3, cfg.run.seed + kForeignSeedOffset + 3 * c.seed);
+    PeriodicLab generator(larger_cell(cfg, kGeneratorCellFactor), false, 3, cfg.run.seed + kForeignSeedOffset + 3 * c.seed,
+                          0, 2);
     write_measured_curves(file, synthetic_tests(generator, truth, {100e3, 200e3, 300e3}, "hidden", c.seed, c.noise),
                           "hidden-effect test");
   }
@@ -58,8 +59,7 @@ TEST_P(HiddenEffect, DiagnosisNamesIt) {
   analyser.run.seed = c.ensemble;
   if (c.auto_ensemble) analyser.calibrate.ensemble = kAutoEnsemble;
   StateMatch state;  // the data's void ratio sets the preparation, as triaxdem diagnose does
-  PeriodicLab lab(matched_state(analyser, data.tests, state, false), false);
-  lab.set_jobs(2);
+  PeriodicLab lab(matched_state(analyser, data.tests, state, false), false, 2);
   const Model base = model_of(cfg);
   const Diagnosis dg = diagnose(lab, base, {free_param("mu_s", base), free_param("mu_r", base)}, data.tests,
                                 measure_misfit(lab, base, data.tests, NoiseOptions()), false);
