@@ -95,6 +95,8 @@ int main(int argc, char** argv) {
   // Every extension's BIC gain and held-out chi2 too, so that a decision rule can be judged on the whole sweep.
   csv << "hidden,strength,seed,verdict,base_chi2,chi2_limit,base_heldout,true_heldout,data_show,base_chi2_over_null";
   for (const Extension& e : extensions()) csv << "," << e.name << "_bic_gain," << e.name << "_heldout";
+  // The recalibrated base parameters: what absorbs a hidden effect the verdict does not name.
+  for (const FreeParam& p : free) csv << ",base_" << p.name;
   csv << "\n";
   std::vector<unsigned> seeds = listed;
   for (unsigned s = first; listed.empty() && s <= last; ++s) seeds.push_back(s);
@@ -144,6 +146,10 @@ int main(int argc, char** argv) {
       }
       for (const ExtensionFit& f : dg.fits) {
         std::snprintf(row, sizeof row, ",%.2f,%.2f", dg.base_bic - f.bic, f.heldout);
+        csv << row;
+      }
+      for (std::size_t k = 0; k < free.size(); ++k) {
+        std::snprintf(row, sizeof row, ",%.4g", free[k].shown * dg.base.values[k]);
         csv << row;
       }
       csv << "\n" << std::flush;
