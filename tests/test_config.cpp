@@ -271,12 +271,13 @@ TEST(Config, CalibrateEnsembleSizesAreRead) {
 
 // Every key the reader knows (config_keys(): so a new key cannot skip this test) refuses NaN, infinities, huge
 // values and values of the wrong type with an error naming the file, its table and the key; and every key is in
-// the README's config reference.
+// the config reference, docs/config.md.
 TEST(Config, EveryKeyRefusesNonFiniteHugeAndWronglyTypedValues) {
   const std::map<std::string, std::string> keys = dem::config_keys();
   ASSERT_GT(keys.size(), 60u);
-  std::ifstream readme(std::string(TRIAXDEM_SOURCE_DIR) + "/README.md");
-  const std::string reference((std::istreambuf_iterator<char>(readme)), std::istreambuf_iterator<char>());
+  std::ifstream doc(std::string(TRIAXDEM_SOURCE_DIR) + "/docs/config.md");
+  ASSERT_TRUE(doc) << "docs/config.md cannot be read";
+  const std::string reference((std::istreambuf_iterator<char>(doc)), std::istreambuf_iterator<char>());
   const std::vector<std::string> numeric{"nan", "inf", "-inf", "1e300", "-1e300", "\"x\"", "true", "{ a = 1 }"};
   const std::vector<std::string> integer{"nan", "inf", "2.5", "9223372036854775807", "-9223372036854775807", "\"x\"",
                                          "true"};
@@ -294,7 +295,7 @@ TEST(Config, EveryKeyRefusesNonFiniteHugeAndWronglyTypedValues) {
   int tried = 0;
   for (const auto& [full, kind] : keys) {
     const std::string table = full.substr(0, full.find('.')), key = full.substr(full.find('.') + 1);
-    EXPECT_NE(reference.find(key), std::string::npos) << full << " is not in the README's config reference";
+    EXPECT_NE(reference.find(key), std::string::npos) << full << " is not in docs/config.md";
     ASSERT_TRUE(bad.count(kind)) << full << ": kind " << kind;
     for (const std::string& value : bad.at(kind)) {
       const std::string e = error_of("[" + table + "]\n" + key + " = " + value + "\n");
