@@ -231,46 +231,43 @@ bool receive_curves(int fd, MeasuredTest& t) {
 
 }  // namespace
 
-std::vector<MeasuredTest> PeriodicLab::run_cases(const Model& m, const std::vector<MeasuredTest>& like,
-                                                 const std::vector<int>& member) {
-  std::vector<MeasuredTest> out(like.size());
-  if (jobs_ <= 1 || like.size() <= 1) {
-    for (std::size_t j = 0; j < like.size(); ++j) out[j] = run(m, like[j].sigma3, like[j].material, member[j]);
+std::vector<MeasuredTest> PeriodicLab::run_cases(const Model& m, const std::vector<Case>& cases) {
+  std::vector<MeasuredTest> out(cases.size());
+  if (jobs_ <= 1 || cases.size() <= 1) {
+    for (std::size_t j = 0; j < cases.size(); ++j) out[j] = run(m, cases[j].sigma3, cases[j].material, cases[j].member);
     return out;
   }
   const auto t0 = std::chrono::steady_clock::now();
   forked_runs(
-      like.size(), jobs_,
-      [&](std::size_t j, int fd) { send_curves(fd, run(m, like[j].sigma3, like[j].material, member[j])); },
+      cases.size(), jobs_,
+      [&](std::size_t j, int fd) { send_curves(fd, run(m, cases[j].sigma3, cases[j].material, cases[j].member)); },
       [&](std::size_t j, int fd) {
-        out[j].material = like[j].material;
-        out[j].sigma3 = like[j].sigma3;
+        out[j].material = cases[j].material;
+        out[j].sigma3 = cases[j].sigma3;
         return receive_curves(fd, out[j]);
       },
       "calibration");
-  runs_ += static_cast<long>(like.size());
+  runs_ += static_cast<long>(cases.size());
   seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }
 
 Ensemble PeriodicLab::run_ensemble(const Model& m, const std::vector<MeasuredTest>& like, bool all) {
   const std::size_t M = all ? specimens_.size() : static_cast<std::size_t>(members_);
-  std::vector<MeasuredTest> cases;  // case j: test j / M on member j % M
-  std::vector<int> member;
-  for (std::size_t j = 0; j < like.size() * M; ++j) {
-    cases.push_back(like[j / M]);
-    member.push_back(static_cast<int>(j % M));
-  }
-  const std::vector<MeasuredTest> done = run_cases(m, cases, member);
+  std::vector<Case> cases;  // case j: test j / M on member j % M
+  for (std::size_t j = 0; j < like.size() * M; ++j)
+    cases.push_back({like[j / M].material, like[j / M].sigma3, static_cast<int>(j % M)});
+  const std::vector<MeasuredTest> done = run_cases(m, cases);
   Ensemble out(like.size());
   for (std::size_t j = 0; j < done.size(); ++j) out[j / M].push_back(done[j]);
   return out;
 }
 
 std::vector<MeasuredTest> PeriodicLab::run_each(const Model& m, const std::vector<MeasuredTest>& like) {
-  std::vector<int> member;
-  for (std::size_t j = 0; j < like.size(); ++j) member.push_back(static_cast<int>(j % static_cast<std::size_t>(members_)));
-  return run_cases(m, like, member);
+  std::vector<Case> cases;
+  for (std::size_t j = 0; j < like.size(); ++j)
+    cases.push_back({like[j].material, like[j].sigma3, static_cast<int>(j % static_cast<std::size_t>(members_))});
+  return run_cases(m, cases);
 }
 
 }  // namespace dem

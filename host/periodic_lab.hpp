@@ -85,9 +85,14 @@ class PeriodicLab {
   int cell_factor_ = 1;
   unsigned first_seed_ = 0;
   void pack(int count, bool verbose);
-  /// like[j] on specimen member[j], up to jobs() at once.
-  std::vector<MeasuredTest> run_cases(const Model& m, const std::vector<MeasuredTest>& like,
-                                      const std::vector<int>& member);
+  /// One run to make: a test's material and pressure on one member's specimen.
+  struct Case {
+    std::string material;
+    Real sigma3;
+    int member;
+  };
+  /// The cases in order, up to jobs() at once.
+  std::vector<MeasuredTest> run_cases(const Model& m, const std::vector<Case>& cases);
 };
 
 /// The preparation friction ([periodic] prep_mu_s) that packs the base config's first specimen to void ratio
