@@ -49,8 +49,8 @@ TEST_P(HiddenEffect, DiagnosisNamesIt) {
     Model truth = model_of(cfg);
     if (c.extension != "none") set_param(truth, extension(c.extension).param, c.strength);
     // A specimen the diagnosis never sees: its ensemble packs with seeds [run] seed, seed + 1, ...
-    PeriodicLab generator(larger_cell(cfg, kGeneratorCellFactor), false, 3, cfg.run.seed + kForeignSeedOffset + 3 * c.seed,
-                          0, 2);
+    const unsigned first_seed = cfg.run.seed + kForeignSeedOffset + 3 * c.seed;
+    PeriodicLab generator(larger_cell(cfg, kGeneratorCellFactor), false, 3, first_seed, 0, 2);
     write_measured_curves(file, synthetic_tests(generator, truth, {100e3, 200e3, 300e3}, "hidden", c.seed, c.noise),
                           "hidden-effect test");
   }
@@ -77,7 +77,8 @@ TEST_P(HiddenEffect, DiagnosisNamesIt) {
                                                << f.heldout;
     } else if (c.extension == "none") {
       EXPECT_FALSE(bic_gain >= kStrongEvidence && heldout_gain >= kStrongEvidence)
-          << f.ext.name << " passes both tests on null data: BIC gain " << bic_gain << ", held-out gain " << heldout_gain;
+          << f.ext.name << " passes both tests on null data: BIC gain " << bic_gain
+          << ", held-out gain " << heldout_gain;
     }
   }
 }
