@@ -2,7 +2,9 @@
 """Scatter of periodic cells against their size, from the runs of perf/specimen_scatter.sh: per pressure and size,
 the void ratio after consolidation, the mean of q / sigma3 and of eps_v across the specimens at a few strains
 (each read as a mean over +-min(30%, 0.25%) of strain, as the misfit reads a curve) with its standard error, their
-standard deviation, then the exponent a of sd ~ N^-a from the smallest cell to each larger one."""
+standard deviation, then the exponent a of sd ~ N^-a from the smallest cell to each larger one, and the difference
+of the means between successive sizes with its standard error: how the finite-cell bias falls with size (host/
+cell_bias.hpp takes N^-1/2, under which each step of 4 halves the difference)."""
 import glob
 import math
 import os
@@ -21,7 +23,7 @@ def at(eps, values, strain):
 
 
 def main(work):
-    sd, voids = {}, {}
+    sd, voids, means = {}, {}, {}
     for folder in sorted(glob.glob(os.path.join(work, "n*_*_*"))):
         if not os.path.isdir(folder):
             continue
@@ -38,6 +40,7 @@ def main(work):
         for k, name in ((0, "q/s3"), (1, "eps_v %")):
             cols = list(zip(*(r[k] for r in runs)))
             spread[(s3, n, k)] = [statistics.stdev(c) if len(c) > 1 else math.nan for c in cols]
+            means[(s3, n, k)] = ([statistics.fmean(c) for c in cols], [v / math.sqrt(len(runs)) for v in spread[(s3, n, k)]])
             print(f"{s3:4d} kPa {n:5d} balls mean {name:8s}" + "".join(f"{statistics.fmean(c):7.3f}" for c in cols))
             print(f"{s3:4d} kPa {n:5d} balls s.e. {name:8s}" +
                   "".join(f"{v / math.sqrt(len(runs)):7.3f}" for v in spread[(s3, n, k)]))
@@ -51,6 +54,17 @@ def main(work):
         a = [math.log(x / y) / math.log(n / small) if x > 0 and y > 0 else math.nan
              for x, y in zip(spread[(s3, small, k)], spread[(s3, n, k)])]
         print(f"{s3:4d} kPa {small}->{n} {'q/s3' if k == 0 else 'eps_v':6s}" + "".join(f"{v:7.2f}" for v in a))
+
+    print("difference of the means between successive sizes (smaller - larger), and its standard error")
+    for (s3, n, k) in sorted(means):
+        larger = sorted(m for (p, m, j) in means if p == s3 and j == k and m > n)
+        if not larger:
+            continue
+        (a, sa), (b, sb) = means[(s3, n, k)], means[(s3, larger[0], k)]
+        print(f"{s3:4d} kPa {n}-{larger[0]} {'q/s3' if k == 0 else 'eps_v %':7s}" +
+              "".join(f"{x - y:7.3f}" for x, y in zip(a, b)))
+        print(f"{s3:4d} kPa {n}-{larger[0]} {'s.e.':7s}" +
+              "".join(f"{math.hypot(x, y):7.3f}" for x, y in zip(sa, sb)))
 
 
 if __name__ == "__main__":
