@@ -69,13 +69,15 @@ struct Session {
       : data(load_measured(o.data)),
         ref(o.reference.empty() ? ReferenceValues{}
                                 : load_reference(o.reference, [](const std::string& n) { free_param(n); })),
-        free(free_params(base, o.free)), lab(matched(base), true, o.jobs), folder(new_dated_folder(o.output, kind)) {
+        free(free_params(base, o.free)), lab(matched(base, o.jobs), true, o.jobs), folder(new_dated_folder(o.output, kind)) {
     if (o.noise == "data" || o.noise == "lab") noise.mode = o.noise;
     else noise = lab_noise_options(o.noise);
     for (const std::string& n : data.notes) std::printf("%s: note: %s\n", kind.c_str(), n.c_str());
   }
   NoiseOptions noise;
-  Config matched(const Config& base) { return matched_state(base, data.tests, state, true); }
+  Config matched(const Config& base, int jobs) {
+    return matched_state(base, data.tests, state, true, match_plan(base, jobs));
+  }
   /// The report's line on the specimens' state.
   std::string state_text(const Misfit& m, const std::vector<MeasuredTest>& tests) const {
     if (state.tests == 0)
@@ -84,7 +86,7 @@ struct Session {
              "any difference in density.\n";
     std::string s = "The simulator's specimens were prepared to the data's void ratio " + fmt("%.4f", state.target) +
                     " (preparation friction " + fmt("%.4g", state.prep_mu_s) + ", which packs " +
-                    fmt("%.4f", state.reached) +
+                    fmt("%.4f", state.reached) + fmt(" on the mean of its first %.0f", state.specimens) +
                     "). At the start of shear, measured and simulated (mean of the scatter specimens at the base "
                     "model):";
     for (std::size_t k = 0; k < tests.size(); ++k)

@@ -22,11 +22,14 @@ void measure_cell_bias(PeriodicLab& lab, const Model& base, const std::vector<Me
                        const Ensemble& reference, Misfit& misfit) {
   // Prepared as the simulator's specimens are: to the data's void ratio where they give one (on this cell's own
   // preparation friction), else with the same preparation.
+  // The mean matched is the check cells' own (their first kStateMatchSpecimens).
   StateMatch state;
-  const Config cfg = matched_state(larger_cell(lab.config(), kCellCheckFactor), measured, state, false,
-                                   kCellCheckPrepSteps);
-  PeriodicLab check(cfg, false, kCellCheckSpecimens, lab.config().run.seed + kCellCheckSeedOffset,
-                    kCellCheckSpecimens, lab.jobs());
+  MatchPlan plan;
+  plan.first_seed = lab.config().run.seed + kCellCheckSeedOffset;
+  plan.steps = kCellCheckPrepSteps;
+  plan.jobs = lab.jobs();
+  const Config cfg = matched_state(larger_cell(lab.config(), kCellCheckFactor), measured, state, false, plan);
+  PeriodicLab check(cfg, false, kCellCheckSpecimens, plan.first_seed, kCellCheckSpecimens, lab.jobs());
   const Ensemble larger = check.run_ensemble(base, measured, true);
   const Real n = static_cast<Real>(lab.balls()), factor = static_cast<Real>(check.balls()) / n;
   std::vector<std::vector<Real>> sd(measured.size());

@@ -105,27 +105,54 @@ void PeriodicLab::grow_cell(int factor) {
 }
 
 namespace {
-Real prepared_void_ratio(const Config& cfg) {
-  std::vector<BallSpec> balls;
-  std::array<Real, 3> cell{};
-  prepare_periodic_specimen(cfg, balls, cell, false);
-  return void_ratio_of(balls, cell);
+/// The plan's specimens' mean void ratio after their preparation, summed in seed order.
+Real prepared_void_ratio(const Config& cfg, const MatchPlan& plan) {
+  std::vector<Real> e(static_cast<std::size_t>(std::max(plan.specimens, 1)));
+  auto prepare = [&](std::size_t k) {
+    Config c = cfg;
+    c.run.seed = plan.first_seed + static_cast<unsigned>(k);
+    std::vector<BallSpec> balls;
+    std::array<Real, 3> cell{};
+    prepare_periodic_specimen(c, balls, cell, false);
+    e[k] = void_ratio_of(balls, cell);
+  };
+  if (plan.jobs <= 1 || e.size() <= 1) {
+    for (std::size_t k = 0; k < e.size(); ++k) prepare(k);
+  } else {
+    forked_runs(
+        e.size(), plan.jobs,
+        [&](std::size_t k, int fd) {
+          prepare(k);
+          put_bytes(fd, &e[k], sizeof e[k]);
+        },
+        [&](std::size_t k, int fd) { return get_bytes(fd, &e[k], sizeof e[k]); }, "preparation friction");
+  }
+  Real sum = 0;
+  for (Real v : e) sum += v;
+  return sum / static_cast<Real>(e.size());
 }
 }  // namespace
 
-Real prep_friction_for(const Config& base, Real target, Real& reached, bool verbose, int steps) {
+MatchPlan match_plan(const Config& base, int jobs) {
+  MatchPlan p;
+  p.first_seed = base.run.seed;
+  p.jobs = runs_at_once(jobs);
+  return p;
+}
+
+Real prep_friction_for(const Config& base, Real target, Real& reached, bool verbose, const MatchPlan& plan) {
   Config c = base;
   auto at = [&](Real u) {
     c.periodic.prep_mu_s = u * u;
-    return prepared_void_ratio(c);
+    return prepared_void_ratio(c, plan);
   };
   Real lo = 0, hi = 1, e_lo = at(lo), e_hi = at(hi);
   if (verbose)
-    std::printf("triaxdem: preparation friction 0 to 1 packs void ratios %.4f to %.4f; target %.4f\n", e_lo, e_hi,
-                target);
+    std::printf("triaxdem: preparation friction 0 to 1 packs void ratios %.4f to %.4f (mean of %d specimens); "
+                "target %.4f\n", e_lo, e_hi, plan.specimens, target);
   if (target <= e_lo) return reached = e_lo, 0;
   if (target >= e_hi) return reached = e_hi, 1;
-  for (int k = 0; k < steps; ++k) {
+  for (int k = 0; k < plan.steps; ++k) {
     const Real mid = 0.5 * (lo + hi), e = at(mid);
     (e < target ? lo : hi) = mid;
     (e < target ? e_lo : e_hi) = e;
@@ -136,17 +163,19 @@ Real prep_friction_for(const Config& base, Real target, Real& reached, bool verb
 }
 
 Config matched_state(const Config& base, const std::vector<MeasuredTest>& tests, StateMatch& m, bool verbose,
-                     int steps) {
+                     const MatchPlan& plan) {
   Real sum = 0;
   for (const MeasuredTest& t : tests)
     if (std::isfinite(t.void_ratio)) sum += t.void_ratio, ++m.tests;
   if (m.tests == 0) return base;
   m.target = sum / m.tests;
+  m.specimens = plan.specimens;
   Config c = base;
-  c.periodic.prep_mu_s = m.prep_mu_s = prep_friction_for(base, m.target, m.reached, verbose, steps);
+  c.periodic.prep_mu_s = m.prep_mu_s = prep_friction_for(base, m.target, m.reached, verbose, plan);
   if (verbose)
-    std::printf("triaxdem: the data's void ratio %.4f (mean of %d tests): preparation friction %.4g packs %.4f\n",
-                m.target, m.tests, m.prep_mu_s, m.reached);
+    std::printf("triaxdem: the data's void ratio %.4f (mean of %d tests): preparation friction %.4g packs %.4f "
+                "(mean of %d specimens)\n",
+                m.target, m.tests, m.prep_mu_s, m.reached, m.specimens);
   return c;
 }
 
@@ -197,11 +226,12 @@ void prepare_parallel_runs(int jobs) {
 #endif
 }
 
-int PeriodicLab::set_jobs(int jobs) {
+int runs_at_once(int jobs) {
   constexpr bool host = std::is_same<ExecSpace::memory_space, Kokkos::HostSpace>::value;
-  jobs_ = host && ExecSpace().concurrency() == 1 ? std::max(jobs, 1) : 1;
-  return jobs_;
+  return host && ExecSpace().concurrency() == 1 ? std::max(jobs, 1) : 1;
 }
+
+int PeriodicLab::set_jobs(int jobs) { return jobs_ = runs_at_once(jobs); }
 
 namespace {
 

@@ -95,25 +95,47 @@ class PeriodicLab {
   std::vector<MeasuredTest> run_cases(const Model& m, const std::vector<Case>& cases);
 };
 
-/// The preparation friction ([periodic] prep_mu_s) that packs the base config's first specimen to void ratio
-/// `target` after its preparation: bisection on sqrt(prep_mu_s) over [0, 1] (more friction, a looser packing; the
-/// root spreads the steps where the void ratio changes fastest). `reached` receives the void ratio of the
-/// answer; a target beyond what [0, 1] reaches gets the nearest end. `steps` halvings: 8 take sqrt(prep_mu_s) to
-/// 1/256 of its range.
-Real prep_friction_for(const Config& base, Real target, Real& reached, bool verbose, int steps = 8);
+/// Runs at once that `jobs` asks for, where that is safe (PeriodicLab::set_jobs); otherwise 1.
+int runs_at_once(int jobs);
+
+/// Specimens whose mean void ratio the preparation friction is matched on. One specimen of 120 balls scatters by
+/// about 0.011 in void ratio at one friction (perf/specimen_scatter.sh), and a void ratio 0.001 lower adds about
+/// 0.01-0.02 to q/sigma3 (docs/calibration.md): a match on one specimen leaves that scatter as an offset of every
+/// specimen packed with its friction. The mean of two, packed side by side with 2 jobs, costs no more time.
+constexpr int kStateMatchSpecimens = 2;
+
+/// How the preparation friction is looked for: `steps` halvings, each packing the specimens of packing seeds
+/// first_seed, first_seed + 1, ... (`specimens` of them, up to `jobs` at once: the answer is the same for any
+/// jobs).
+struct MatchPlan {
+  unsigned first_seed = 0;
+  int specimens = kStateMatchSpecimens;
+  int steps = 8;
+  int jobs = 1;
+};
+/// The plan for a lab's specimens: its first seeds ([run] seed on), 8 halvings, `jobs` at once.
+MatchPlan match_plan(const Config& base, int jobs);
+
+/// The preparation friction ([periodic] prep_mu_s) with which the plan's specimens of the base config pack to a
+/// mean void ratio of `target` after their preparation: bisection on sqrt(prep_mu_s) over [0, 1] (more friction,
+/// a looser packing; the root spreads the steps where the void ratio changes fastest). `reached` receives their
+/// mean void ratio at the answer; a target beyond what [0, 1] reaches gets the nearest end. 8 halvings take
+/// sqrt(prep_mu_s) to 1/256 of its range.
+Real prep_friction_for(const Config& base, Real target, Real& reached, bool verbose, const MatchPlan& plan);
 
 /// The measured specimens' state and the preparation that packs it (matched_state).
 struct StateMatch {
   int tests = 0;                                            ///< tests that give a void ratio
   Real target = std::numeric_limits<Real>::quiet_NaN();     ///< their mean void ratio
-  Real reached = std::numeric_limits<Real>::quiet_NaN();    ///< the first specimen's after preparation
+  Real reached = std::numeric_limits<Real>::quiet_NaN();    ///< the matched specimens' mean after preparation
+  int specimens = 0;                                        ///< how many were matched
   Real prep_mu_s = std::numeric_limits<Real>::quiet_NaN();
 };
 
 /// The base config with the preparation friction that packs the mean void ratio of the tests that give one
-/// (prep_friction_for, in `steps` halvings); the base config itself when none does.
+/// (prep_friction_for); the base config itself when none does.
 Config matched_state(const Config& base, const std::vector<MeasuredTest>& tests, StateMatch& m, bool verbose,
-                     int steps = 8);
+                     const MatchPlan& plan);
 
 /// Before Kokkos starts, in a program that will run `jobs` > 1 simulator runs at once: sets OpenMP to one
 /// thread (its runtime read OMP_NUM_THREADS when it was loaded, before main, so through its API), as

@@ -112,7 +112,7 @@ int main(int argc, char** argv) {
                             own ? cfg.run.seed : cfg.run.seed + kForeignSeedOffset + 3 * seed, 0, jobs);
       const std::vector<MeasuredTest> data = synthetic_tests(generator, truth, {100e3, 200e3, 300e3}, "hidden", seed, noise);
       StateMatch state;  // the data's void ratio sets the preparation, as triaxdem diagnose does
-      PeriodicLab matched(matched_state(cfg, data, state, false), false, jobs);
+      PeriodicLab matched(matched_state(cfg, data, state, false, match_plan(cfg, jobs)), false, jobs);
       const Diagnosis dg = diagnose(matched, base, free, data, measure_misfit(matched, base, data, NoiseOptions()), false);
       Real true_heldout = dg.base_heldout;
       bool data_show = false;

@@ -242,6 +242,42 @@ TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
   for (int k = 0; k < 3; ++k) EXPECT_EQ(each[k].q, one[k][k % 2].q) << "sigma3 " << like[k].sigma3;
 }
 
+// The preparation friction is matched on the mean void ratio of the lab's first kStateMatchSpecimens specimens
+// (matched_state): the reached value reported is exactly their mean in the lab built from the matched config (one
+// specimen's would leave its own scatter, about 0.01, as an offset of all of them), packing them side by side gives
+// the same friction, and the bisection ends nearer the target than either end of the friction's range.
+TEST(Calibrate, StateIsMatchedOnTheMeanOfTheLabsFirstSpecimens) {
+  const Config cfg = tiny_cell();
+  MatchPlan plan = match_plan(cfg, 1);
+  plan.steps = 4;
+  Real e0 = 0, e1 = 0;
+  EXPECT_EQ(prep_friction_for(cfg, -1, e0, false, plan), 0);
+  EXPECT_EQ(prep_friction_for(cfg, 10, e1, false, plan), 1);
+  ASSERT_LT(e0, e1) << "more friction in the preparation packs looser";
+  std::vector<MeasuredTest> data(2);
+  data[0].void_ratio = e0 + 0.3 * (e1 - e0);
+  data[1].void_ratio = e0 + 0.5 * (e1 - e0);
+  const Real target = e0 + 0.4 * (e1 - e0);
+  StateMatch m;
+  const Config matched = matched_state(cfg, data, m, false, plan);
+  EXPECT_EQ(m.tests, 2);
+  EXPECT_NEAR(m.target, target, 1e-12);
+  EXPECT_EQ(m.specimens, kStateMatchSpecimens);
+  EXPECT_EQ(matched.periodic.prep_mu_s, m.prep_mu_s);
+  EXPECT_LT(std::fabs(m.reached - target), std::min(target - e0, e1 - target));
+  PeriodicLab lab(matched, false, kStateMatchSpecimens, cfg.run.seed);
+  Real sum = 0;
+  for (int k = 0; k < kStateMatchSpecimens; ++k) sum += lab.prepared_void_ratio(k);
+  EXPECT_EQ(m.reached, sum / kStateMatchSpecimens);
+  if (runs_at_once(2) == 2) {
+    StateMatch side;
+    MatchPlan two = plan;
+    two.jobs = 2;
+    EXPECT_EQ(matched_state(cfg, data, side, false, two).periodic.prep_mu_s, m.prep_mu_s);
+    EXPECT_EQ(side.reached, m.reached);
+  }
+}
+
 // The cell an "auto" [calibrate] cell_factor chooses (measure_misfit): where even all the scatter specimens leave the
 // simulator's standard error above half a lab's noise, the cell grows by the factor that makes up the rest, at most
 // kMaxCellFactor, and the scatter is measured again on it. A fixed cell_factor, or a fixed ensemble, keeps the cell.

@@ -59,7 +59,7 @@ TEST_P(HiddenEffect, DiagnosisNamesIt) {
   analyser.run.seed = c.ensemble;
   if (c.auto_ensemble) analyser.calibrate.ensemble = kAutoEnsemble;
   StateMatch state;  // the data's void ratio sets the preparation, as triaxdem diagnose does
-  PeriodicLab lab(matched_state(analyser, data.tests, state, false), false, 2);
+  PeriodicLab lab(matched_state(analyser, data.tests, state, false, match_plan(analyser, 2)), false, 2);
   const Model base = model_of(cfg);
   const Diagnosis dg = diagnose(lab, base, {free_param("mu_s", base), free_param("mu_r", base)}, data.tests,
                                 measure_misfit(lab, base, data.tests, NoiseOptions()), false);
