@@ -33,26 +33,34 @@ double available_memory() {
 }
 
 /// Refuses a byte outside ASCII anywhere but in a string or a comment. Keys, numbers and table names are ASCII
-/// in TOML; the toml++ of Debian 12 (3.3.0) reaches __builtin_unreachable (undefined behaviour) on many such
-/// characters there, e.g. U+0409 or U+FE7F, so they must not get to it (found by tests/fuzz/fuzz_config).
-/// A quote opens a string only where TOML lets a string begin (after '=', '[', ',', '{', a key's '.', or at
-/// the start of a line): toml++ reads a bare value such as 200''''' to its end before it refuses it, so a
-/// quote inside one must not hide what follows from this check.
+/// in TOML; the toml++ of Debian 12 (3.3.0) reaches __builtin_unreachable (undefined behaviour) whenever it asks
+/// whether such a character is whitespace, for all of U+00A1-U+0499, U+2FCE-U+33C7 and U+FB26-U+FEFE but a few
+/// (is_non_ascii_horizontal_whitespace), so they must not get to it outside strings (found by tests/fuzz/fuzz_config).
+/// Where strings are is decided as toml++ reads the text: a quote opens one only where a string may begin (at
+/// the start of a line, after '=', ',', '{', an opening '[', or a dotted key's '.'), and a bare value (a
+/// number, a boolean, a date, or junk such as 200''[''' followed by more) runs to a blank, ',', ']', '}', '#' or
+/// the line's end, quotes and brackets included, because toml++ reads it so before it refuses it.
 void check_ascii_outside_strings(const std::string& text, const std::string& path) {
   long line = 1, col = 0;
-  char before = '\n';  // the last character outside strings and comments, blanks skipped
-  bool in_key = true;  // no '=' yet on this line: a '.' joins the parts of a dotted key
+  bool may_begin = true;  // a string, a value or a key may begin here
+  bool in_key = true;     // a key is being read: a '.' joins the parts of a dotted key, and no value is bare
+  bool bare = false;      // inside a bare value
+  std::string open;       // the arrays ('[') and inline tables ('{') open here, innermost last
   for (std::size_t k = 0; k < text.size(); ++k, ++col) {
     const char c = text[k];
-    const bool string_may_begin = before == '\n' || before == '=' || before == '[' || before == ',' ||
-                                  before == '{' || (before == '.' && in_key);
     if (c == '\n') {
-      ++line, col = -1, before = '\n', in_key = true;
+      ++line, col = -1, may_begin = true, in_key = open.empty(), bare = false;
     } else if (c == ' ' || c == '\t' || c == '\r') {
-      continue;
+      bare = false;
     } else if (c == '#') {  // a comment, to the end of the line
       while (k + 1 < text.size() && text[k + 1] != '\n') ++k, ++col;
-    } else if ((c == '"' || c == '\'') && string_may_begin) {
+    } else if (static_cast<unsigned char>(c) >= 0x80) {
+      throw ConfigError(path + ":" + std::to_string(line) + ":" + std::to_string(col + 1) +
+                        ": a non-ASCII character outside a string or a comment (keys, numbers and table names are "
+                        "ASCII: write sigma3_kPa, not \u03c3)");
+    } else if (bare && c != ',' && c != ']' && c != '}') {
+      continue;
+    } else if ((c == '"' || c == '\'') && may_begin) {
       const bool multi = text.compare(k, 3, std::string(3, c)) == 0;
       const std::string close = multi ? std::string(3, c) : std::string(1, c);
       k += close.size(), col += static_cast<long>(close.size());
@@ -64,17 +72,29 @@ void check_ascii_outside_strings(const std::string& text, const std::string& pat
         }
       }
       if (k < text.size() && text[k] != '\n') {
-        k += close.size() - 1, col += static_cast<long>(close.size()) - 1, before = c;
+        k += close.size() - 1, col += static_cast<long>(close.size()) - 1, may_begin = false;
       } else if (k < text.size()) {
-        ++line, col = -1, before = '\n', in_key = true;
+        ++line, col = -1, may_begin = true, in_key = open.empty();
       }
-    } else if (static_cast<unsigned char>(c) >= 0x80) {
-      throw ConfigError(path + ":" + std::to_string(line) + ":" + std::to_string(col + 1) +
-                        ": a non-ASCII character outside a string or a comment (keys, numbers and table names are "
-                        "ASCII: write sigma3_kPa, not \u03c3)");
     } else {
-      if (c == '=') in_key = false;
-      before = c;
+      bare = false;
+      const bool value_begins = !in_key && may_begin;
+      if (c == '=') {
+        in_key = false, may_begin = true;
+      } else if (c == ',') {
+        in_key = !open.empty() && open.back() == '{', may_begin = true;  // an inline table's next key
+      } else if (c == '{' && value_begins) {
+        open += c, in_key = true;
+      } else if (c == '[') {
+        if (value_begins) open += c;  // where a value begins, an array; at a line's start, a table's name
+      } else if (c == '.' && in_key) {
+        may_begin = true;
+      } else if ((c == ']' || c == '}') && !open.empty() && open.back() == (c == ']' ? '[' : '{')) {
+        open.pop_back(), may_begin = false;
+      } else {
+        bare = value_begins && c != ']' && c != '}';  // a value that is not a string, an array or a table
+        may_begin = false;
+      }
     }
   }
 }

@@ -73,9 +73,17 @@ TEST(Config, NonAsciiOutsideStringsAndCommentsRefused) {
   // A quote that cannot begin a string does not hide what follows (fuzz_config: U+FE7F after 200''''').
   e = error_of("[particles]\ncount = 200'''''\ufe7f \n");
   EXPECT_NE(e.find("bad.toml:2:17: a non-ASCII character"), std::string::npos) << e;
+  // ... nor does a bracket inside a bare value (fuzz_config: U+FE7F after 200''['''): toml++ reads it to a blank.
+  e = error_of("[particles]\ncount = 200''['''\ufe7f \n");
+  EXPECT_NE(e.find("bad.toml:2:18: a non-ASCII character"), std::string::npos) << e;
   // Strings at the start of an array's line and after ',' are strings (the document parses; only the type is wrong).
   e = error_of("[run]\noutput = 'a#\u03c3'  # \u03c3\nname = [\n  '\u03bc', \"\u03c3\"]\n");
   EXPECT_NE(e.find("[run] name: expected a string"), std::string::npos) << e;
+  // An inline table's keys are keys, however close their '=' and quotes are set; a value line of an array is not.
+  e = error_of("[run]\nname = {a='\u03c3',b=\"\u03bc\"}\n");
+  EXPECT_NE(e.find("[run] name: expected a string"), std::string::npos) << e;
+  e = error_of("[run]\nname = [\n  1.'\u03c3']\n");
+  EXPECT_NE(e.find("bad.toml:3:6: a non-ASCII character"), std::string::npos) << e;
 }
 
 TEST(Config, TimeStepAboveCriticalRefused) {
