@@ -32,6 +32,25 @@ double available_memory() {
   return 0;
 }
 
+namespace {
+/// toml++ asks whether what follows a backslash in a basic string is whitespace (a multi-line string's
+/// line-ending backslash), and then of each character up to the next that is not: the first of those must be
+/// ASCII, for the same undefined behaviour as outside strings. TOML never needs one there: a backslash escapes
+/// only ASCII letters, quotes and itself, and a line-ending backslash trims spaces, tabs and line breaks.
+void check_after_backslash(const std::string& text, std::size_t k, bool multi, const std::string& path) {
+  std::size_t j = k + 1;
+  while (j < text.size() &&
+         (text[j] == ' ' || text[j] == '\t' || (multi && (text[j] == '\r' || text[j] == '\n'))))
+    ++j;
+  if (j >= text.size() || static_cast<unsigned char>(text[j]) < 0x80) return;
+  long line = 1, col = 1;
+  for (std::size_t i = 0; i < j; ++i) text[i] == '\n' ? (++line, col = 1) : ++col;
+  throw ConfigError(path + ":" + std::to_string(line) + ":" + std::to_string(col) +
+                    ": a non-ASCII character after a backslash in a string (escape it as \\uXXXX, or begin the "
+                    "line after a line-ending backslash with an ASCII character)");
+}
+}  // namespace
+
 /// Refuses a byte outside ASCII anywhere but in a string or a comment. Keys, numbers and table names are ASCII
 /// in TOML; the toml++ of Debian 12 (3.3.0) reaches __builtin_unreachable (undefined behaviour) whenever it asks
 /// whether such a character is whitespace, for all of U+00A1-U+0499, U+2FCE-U+33C7 and U+FB26-U+FEFE but a few
@@ -65,7 +84,10 @@ void check_ascii_outside_strings(const std::string& text, const std::string& pat
       const std::string close = multi ? std::string(3, c) : std::string(1, c);
       k += close.size(), col += static_cast<long>(close.size());
       for (; k < text.size() && text.compare(k, close.size(), close) != 0; ++k, ++col) {
-        if (c == '"' && text[k] == '\\') ++k, ++col;  // an escape: the next character is not the end
+        if (c == '"' && text[k] == '\\') {
+          check_after_backslash(text, k, multi, path);
+          ++k, ++col;  // an escape: the next character is not the end
+        }
         if (k < text.size() && text[k] == '\n') {
           if (!multi) break;  // an unterminated string: toml++ reports it
           ++line, col = -1;

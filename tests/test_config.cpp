@@ -84,6 +84,13 @@ TEST(Config, NonAsciiOutsideStringsAndCommentsRefused) {
   EXPECT_NE(e.find("[run] name: expected a string"), std::string::npos) << e;
   e = error_of("[run]\nname = [\n  1.'\u03c3']\n");
   EXPECT_NE(e.find("bad.toml:3:6: a non-ASCII character"), std::string::npos) << e;
+  // After a backslash in a basic string toml++ asks whether the next character is whitespace (fuzz_config:
+  // U+FEF7 after a backslash in a multi-line string), and after a line-ending backslash, the next non-blank one.
+  e = error_of("[run]\nname = \"\"\"a\\\ufef7\"\"\"\n");
+  EXPECT_NE(e.find("bad.toml:2:13: a non-ASCII character after a backslash"), std::string::npos) << e;
+  e = error_of("[run]\nname = \"\"\"a \\  \n\n   \u03c3\"\"\"\n");
+  EXPECT_NE(e.find("bad.toml:4:4: a non-ASCII character after a backslash"), std::string::npos) << e;
+  EXPECT_EQ(error_of("[run]\nname = \"\"\"a \\\n   b\u03c3 \\u03c3\"\"\"\n"), "");
 }
 
 TEST(Config, TimeStepAboveCriticalRefused) {
