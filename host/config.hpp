@@ -86,7 +86,8 @@ struct TriaxialConfig {
   Real membrane_thickness = 0.5e-3;  ///< m (file: membrane_thickness_mm)
   Real membrane_density = 930;    ///< kg/m^3
   /// Local damping during shear about the platens' axial flow (v_z = v_top z / h) instead of the absolute
-  /// velocity; false is PFC's (and the paper's) way, whose drag the top platen reads (README).
+  /// velocity; false is PFC's (and the paper's) way, whose drag the top platen reads (docs/performance.md, The
+  /// triaxial test).
   bool damping_about_flow = false;
 };
 

@@ -362,7 +362,7 @@ void write_measured_curves(const std::string& path, const std::vector<MeasuredTe
   }
   if (is_hdf5_path(path)) return write_measured_h5(path, columns, rows, comment);
   std::ostringstream f;
-  f << "# " << comment << "\n# triaxdem measured-data format (curves): see host/measured.hpp and the README.\n";
+  f << "# " << comment << "\n# triaxdem measured-data format (curves): see host/measured.hpp and docs/calibration.md.\n";
   f << "material";
   for (const std::string& c : columns) f << "," << c;
   f << "\n";

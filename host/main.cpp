@@ -67,7 +67,7 @@ int main(int argc, char** argv) {
   study->add_flag("--resume", study_opt.resume,
                   "keep the cases that finished (summary.csv), continue the triaxial cases from their checkpoints");
   study->add_option("--compare", study_opt.compare,
-                    "measured data (README: measured-data format) whose q_peak goes beside each case's, matched by "
+                    "measured data (docs/calibration.md: Measured data) whose q_peak goes beside each case's, matched by "
                     "[run] material and sigma3; repeat for several files")
       ->allow_extra_args(false)
       ->check(CLI::ExistingFile);
@@ -85,7 +85,7 @@ int main(int argc, char** argv) {
   dem::CalibrationOptions cal;
   std::string free_list;
   auto add_calibration = [&](CLI::App* c) {
-    c->add_option("data", cal.data, "measured-data CSV (README: measured-data format)")->required()
+    c->add_option("data", cal.data, "measured-data CSV (docs/calibration.md: Measured data)")->required()
         ->check(CLI::ExistingFile);
     c->add_option("--config", config_path, "base config: a periodic cell ([box], [periodic], [material])")
         ->required()->check(CLI::ExistingFile);

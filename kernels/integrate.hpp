@@ -18,7 +18,8 @@ struct IntegrateParams {
   bool measure = true;    ///< fill StepStats::unbalanced and ::kinetic (skipped on unmeasured steps)
   /// With about_flow, local damping acts on v - flow_rate (x - flow_origin), component by component: the
   /// velocity about the test's imposed mean flow. On the absolute velocity (PFC, the default) a steady flow
-  /// turns the damping of the balls' fluctuating forces into a net drag against it (README: The triaxial test).
+  /// turns the damping of the balls' fluctuating forces into a net drag against it (docs/performance.md: The
+  /// triaxial test).
   bool about_flow = false;
   Vec3 flow_rate;         ///< 1/s, diagonal of the mean flow's velocity gradient
   Vec3 flow_origin;       ///< m, where the mean flow is at rest

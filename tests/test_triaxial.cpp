@@ -218,7 +218,7 @@ TEST_F(Triaxial, StoppedInEachStageAndResumedMatchesTheUnstoppedRun) {
 }
 
 // Local damping on the absolute velocity drags the axial flow: the top platen pushes that drag as well as the
-// specimen, the bottom one does not feel it (about alpha x the sum of the balls' unbalanced |F_z|; README). Taken
+// specimen, the bottom one does not feel it (about alpha x the sum of the balls' unbalanced |F_z|; docs/performance.md). Taken
 // about the platens' flow (damping_about_flow) the drag is gone and the two platens come together. The
 // bound is loose, half the gap, because other paths may part the platens a little (the membrane's friction,
 // the damping of the radial flow, which stays absolute): a fourth of the gap remained in the 3,662-ball S-3

@@ -90,7 +90,7 @@ def main():
         ax_q.plot(peak[1], peak[0], "o", ms=4, color=line.get_color())
         if "sigma1_bottom_kPa" in s and "sigma3_kPa" in s:
             # q is read at the top platen, which drives the test; the bottom platen shows what reaches the far
-            # end (they differ by what the balls' local damping takes out of the axial flow: README).
+            # end (they differ by what the balls' local damping takes out of the axial flow: docs/performance.md).
             ax_q.plot(ea, s["sigma1_bottom_kPa"] - s["sigma3_kPa"], lw=0.8, ls="--", color=line.get_color(),
                       label=f"{name}: bottom platen")
         ax_v.plot(ea, ev, lw=1.4, color=line.get_color(), label=name)
