@@ -105,31 +105,14 @@ void PeriodicLab::grow_cell(int factor) {
 }
 
 namespace {
-/// The plan's specimens' mean void ratio after their preparation, summed in seed order.
+/// The plan's specimens' mean void ratio after their preparation, summed in seed order: packed as a lab packs
+/// its specimens, so that the mean matched is the mean of a lab's first specimens, bit for bit.
 Real prepared_void_ratio(const Config& cfg, const MatchPlan& plan) {
-  std::vector<Real> e(static_cast<std::size_t>(std::max(plan.specimens, 1)));
-  auto prepare = [&](std::size_t k) {
-    Config c = cfg;
-    c.run.seed = plan.first_seed + static_cast<unsigned>(k);
-    std::vector<BallSpec> balls;
-    std::array<Real, 3> cell{};
-    prepare_periodic_specimen(c, balls, cell, false);
-    e[k] = void_ratio_of(balls, cell);
-  };
-  if (plan.jobs <= 1 || e.size() <= 1) {
-    for (std::size_t k = 0; k < e.size(); ++k) prepare(k);
-  } else {
-    forked_runs(
-        e.size(), plan.jobs,
-        [&](std::size_t k, int fd) {
-          prepare(k);
-          put_bytes(fd, &e[k], sizeof e[k]);
-        },
-        [&](std::size_t k, int fd) { return get_bytes(fd, &e[k], sizeof e[k]); }, "preparation friction");
-  }
+  const int n = std::max(plan.specimens, 1);
+  const PeriodicLab lab(cfg, false, n, plan.first_seed, n, plan.jobs);
   Real sum = 0;
-  for (Real v : e) sum += v;
-  return sum / static_cast<Real>(e.size());
+  for (int k = 0; k < n; ++k) sum += lab.prepared_void_ratio(k);
+  return sum / static_cast<Real>(n);
 }
 }  // namespace
 
