@@ -51,12 +51,12 @@ class CellServo {
   /// servo[d]: axis d is servoed to target[d] (Pa); otherwise its rate is fixed[d] (1/s, extension positive).
   void update(Simulation& sim, const bool servo[3], const Real fixed[3], const Real target[3]) {
     if (calls_++ % prm_.stiffness_every == 0) k_ = cell_stiffness(sim);
-    stress_ = sim.contact_stress(sim.domain().volume());
+    stress_ = sim.contact_stress_diagonal(sim.domain().volume());
     const Real dt = sim.params().integ.dt;
     Real rate[3];
     for (int d = 0; d < 3; ++d) {
       if (!servo[d]) { rate[d] = fixed[d]; continue; }
-      const Real err = stress_[4 * d] - target[d];
+      const Real err = stress_[d] - target[d];
       // gain = alpha sigma3 / (K dt); with no contacts (K = 0) the clamp decides.
       const Real r = k_[d] > 0 ? prm_.servo_alpha * err / (k_[d] * dt)
                                : (err > 0 ? max_rate_ : (err < 0 ? -max_rate_ : Real(0)));
@@ -70,7 +70,7 @@ class CellServo {
   Real max_rate_;
   long calls_ = 0;
   std::array<Real, 3> k_{};
-  std::array<Real, 9> stress_{};
+  std::array<Real, 3> stress_{};
 };
 
 /// Lateral confinement per axis: sigma3 plus the membrane's, from the cell's lateral strains since L0.

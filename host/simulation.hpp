@@ -94,6 +94,8 @@ class Simulation {
   /// Love-Weber stress of the ball-ball contacts over `volume` (m^3), compression positive, row-major
   /// 3 x 3 (Pa): sigma = -(1/V) sum fc (x) (x2 - x1). Boundary (wall, facet) contacts are not included.
   std::array<Real, 9> contact_stress(Real volume) const;
+  /// Its diagonal (xx, yy, zz) alone, bit for bit the same values, at a third of the sums: a servo's every step.
+  std::array<Real, 3> contact_stress_diagonal(Real volume) const;
 
   /// Rigid wall velocity (m/s) and position (m) control.
   void set_wall_velocity(int w, const Vec3& v);

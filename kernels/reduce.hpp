@@ -37,7 +37,9 @@ template <int NSUM, int NMAX, int W, class F>
 void deterministic_reduce_lanes(const char* label, int n, const F& f, Real (&out)[NSUM + NMAX]) {
   constexpr int NV = NSUM + NMAX;
   const int nblock = (n + kReduceBlock - 1) / kReduceBlock;
-  Kokkos::View<Real**, Layout, MemSpace> part(std::string(label), nblock, NV);
+  // Every entry is written by its block: no zero-fill kernel ahead of the reduction, which runs every step.
+  Kokkos::View<Real**, Layout, MemSpace> part(Kokkos::view_alloc(Kokkos::WithoutInitializing, std::string(label)),
+                                              nblock, NV);
   Kokkos::parallel_for(label, RangePolicy(0, nblock),
                        KOKKOS_LAMBDA(const int b) { reduce_block<NSUM, NMAX, W>(b, n, f, part); });
   auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), part);

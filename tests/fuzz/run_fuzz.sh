@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Fuzzes every file triaxdem reads (config, measured CSV and HDF5, checkpoints, snapshots, study summaries,
-# reference values, the specimen cache) for a bounded time each (default 60 s), with AddressSanitizer and
-# UndefinedBehaviorSanitizer, starting from files of each kind. Prints the executions per
+# reference values, the specimen cache) for a bounded time each (default 60 s), one harness per core at a time
+# (TRIAXDEM_FUZZ_JOBS), with AddressSanitizer and UndefinedBehaviorSanitizer, starting from files of each kind. Prints the executions per
 # target; a finding stops the target, leaves crash-* in the build folder and makes this script fail.
 #   tests/fuzz/run_fuzz.sh [SECONDS [TARGET...]]   (clang from Debian: apt-get install clang libomp-dev)
 set -euo pipefail
@@ -69,16 +69,29 @@ seed_files() {
 # first run, all in H5C_protect: tests/fuzz/regressions). An allocation of ours that fails throws bad_alloc,
 # which the harnesses do not catch: still a finding.
 export ASAN_OPTIONS="allocator_may_return_null=1:detect_leaks=0:${ASAN_OPTIONS:-}"
-for t in $run_targets; do
-  t="${t#fuzz_}"
-  corpus="$build/corpus_$t"
-  rm -rf "$corpus" && mkdir -p "$corpus"  # every run from the seeds alone, as CI's fresh clone does
-  i=0  # numbered: several folders hold files of the same name
-  for f in $(seed_files "$t"); do cp "$f" "$corpus/seed$i-$(basename "$f")"; i=$((i + 1)); done
-  echo "fuzz_$t: ${secs} s"
+# One harness: a fresh corpus from the seeds (as CI's fresh clone has), its run, then its summary lines at once, so
+# that harnesses running side by side do not interleave them; its status goes to a file for the end.
+run_one() {
+  local t="${1#fuzz_}" i=0 f rc=0
+  local corpus="$build/corpus_$t"
+  rm -rf "$corpus" && mkdir -p "$corpus"
+  for f in $(seed_files "$t"); do cp "$f" "$corpus/seed$i-$(basename "$f")"; i=$((i + 1)); done  # numbered: names repeat
   (cd "$build" && ./tests/fuzz/fuzz_$t -max_total_time="$secs" -max_len=65536 -print_final_stats=1 \
-      -timeout=10 -rss_limit_mb=4096 "$corpus" > "fuzz_$t.log" 2>&1) || status=1
-  grep -E "stat::number_of_executed_units|stat::new_units_added|ERROR|SUMMARY" "$build/fuzz_$t.log" || true
+      -timeout=10 -rss_limit_mb=4096 "$corpus" > "fuzz_$t.log" 2>&1) || rc=1
+  { echo "fuzz_$t: ${secs} s"; grep -E "stat::number_of_executed_units|stat::new_units_added|ERROR|SUMMARY" \
+      "$build/fuzz_$t.log" || true; }
+  echo "$rc" > "$build/fuzz_$t.status"
+}
+# A harness is one process on one core: as many run at once as there are cores, each for its full time.
+at_once="${TRIAXDEM_FUZZ_JOBS:-$(nproc)}"
+for t in $run_targets; do
+  rm -f "$build/${t}.status"
+  while [ "$(jobs -rp | wc -l)" -ge "$at_once" ]; do wait -n || true; done
+  run_one "$t" &
+done
+wait
+for t in $run_targets; do
+  [ "$(cat "$build/${t}.status" 2>/dev/null || echo 1)" = 0 ] || status=1
 done
 [ "$status" -eq 0 ] && echo "fuzz: no findings" || echo "fuzz: FINDINGS, see $build/fuzz_*.log and $build/crash-*"
 exit "$status"
