@@ -96,7 +96,7 @@ int run_job(const Config& cfg, bool resume, long stop_at_step) {
   };
   Progress progress(cfg.run.name, cfg.run.steps, sim->step_count());
   CheckpointPlan plan{ckpt, CheckpointClock(cfg.run.checkpoint_every, cfg.run.checkpoint_minutes), nullptr,
-                      stop_at_step};
+                      stop_at_step, cfg.fingerprint};
   StopSignals signals;
   try {
     for (long s = sim->step_count() + 1; s <= cfg.run.steps; ++s) {
