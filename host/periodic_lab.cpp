@@ -109,7 +109,7 @@ namespace {
 /// its specimens, so that the mean matched is the mean of a lab's first specimens, bit for bit.
 Real prepared_void_ratio(const Config& cfg, const MatchPlan& plan) {
   const int n = std::max(plan.specimens, 1);
-  const PeriodicLab lab(cfg, false, n, plan.first_seed, n, plan.jobs);
+  const PeriodicLab lab(larger_cell(cfg, plan.cell_factor), false, n, plan.first_seed, n, plan.jobs);
   Real sum = 0;
   for (int k = 0; k < n; ++k) sum += lab.prepared_void_ratio(k);
   return sum / static_cast<Real>(n);
@@ -119,6 +119,7 @@ Real prepared_void_ratio(const Config& cfg, const MatchPlan& plan) {
 MatchPlan match_plan(const Config& base, int jobs) {
   MatchPlan p;
   p.first_seed = base.run.seed;
+  p.cell_factor = fixed_cell_factor(base);
   p.jobs = runs_at_once(jobs);
   return p;
 }

@@ -112,8 +112,10 @@ struct MatchPlan {
   int specimens = kStateMatchSpecimens;
   int steps = 8;
   int jobs = 1;
+  int cell_factor = 1;  ///< the specimens are packed in cells of this many times the base config's balls
 };
-/// The plan for a lab's specimens: its first seeds ([run] seed on), 8 halvings, `jobs` at once.
+/// The plan for a lab's specimens: its first seeds ([run] seed on), in the cell it runs ([calibrate] cell_factor,
+/// the config's own where "auto"), 8 halvings, `jobs` at once.
 MatchPlan match_plan(const Config& base, int jobs);
 
 /// The preparation friction ([periodic] prep_mu_s) with which the plan's specimens of the base config pack to a

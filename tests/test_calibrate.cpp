@@ -245,7 +245,8 @@ TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
 // The preparation friction is matched on the mean void ratio of the lab's first kStateMatchSpecimens specimens
 // (matched_state): the reached value reported is exactly their mean in the lab built from the matched config (one
 // specimen's would leave its own scatter, about 0.01, as an offset of all of them), packing them side by side gives
-// the same friction, and the bisection ends nearer the target than either end of the friction's range.
+// the same friction, and the bisection ends nearer the target than either end of the friction's range; a lab of a
+// fixed larger cell is matched on its own cells.
 TEST(Calibrate, StateIsMatchedOnTheMeanOfTheLabsFirstSpecimens) {
   const Config cfg = tiny_cell();
   MatchPlan plan = match_plan(cfg, 1);
@@ -276,6 +277,18 @@ TEST(Calibrate, StateIsMatchedOnTheMeanOfTheLabsFirstSpecimens) {
     EXPECT_EQ(matched_state(cfg, data, side, false, two).periodic.prep_mu_s, m.prep_mu_s);
     EXPECT_EQ(side.reached, m.reached);
   }
+  // With a fixed [calibrate] cell_factor the specimens matched are those of the larger cell the lab runs.
+  Config big = cfg;
+  big.calibrate.cell_factor = 2;
+  big.calibrate.ensemble = big.calibrate.scatter_specimens = kStateMatchSpecimens;
+  MatchPlan big_plan = match_plan(big, 1);
+  big_plan.steps = 2;
+  StateMatch big_match;
+  const PeriodicLab big_lab(matched_state(big, data, big_match, false, big_plan), false);
+  ASSERT_EQ(big_lab.cell_factor(), 2);
+  Real big_sum = 0;
+  for (int k = 0; k < kStateMatchSpecimens; ++k) big_sum += big_lab.prepared_void_ratio(k);
+  EXPECT_EQ(big_match.reached, big_sum / kStateMatchSpecimens);
 }
 
 // The cell an "auto" [calibrate] cell_factor chooses (measure_misfit): where even all the scatter specimens leave the
