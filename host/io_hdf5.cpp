@@ -1,6 +1,7 @@
 #include "host/io_hdf5.hpp"
 
 #include "host/h5_file.hpp"
+#include "host/xdmf.hpp"
 
 #include <hdf5.h>
 
@@ -166,68 +167,6 @@ void write_snapshot_h5(const std::string& path, const Snapshot& s, const Surface
   });
 }
 
-std::string xml_escape(const std::string& text) {
-  std::string out;
-  for (const char c : text)
-    out += c == '&' ? "&amp;" : c == '<' ? "&lt;" : c == '>' ? "&gt;" : c == '"' ? "&quot;" : std::string(1, c);
-  return out;
-}
-
-/// NumberType/Precision pair of an XDMF DataItem.
-constexpr const char* kF64 = "NumberType=\"Float\" Precision=\"8\"";
-constexpr const char* kU32 = "NumberType=\"UInt\" Precision=\"4\"";
-constexpr const char* kI32 = "NumberType=\"Int\" Precision=\"4\"";
-
-/// The file name is relative, so the output folder can be moved or copied as a whole.
-std::string data_item(const std::string& file, const std::string& dataset, long rows, int cols, const char* type) {
-  const std::string dims = std::to_string(rows) + (cols > 1 ? " " + std::to_string(cols) : "");
-  return "<DataItem Format=\"HDF\" Dimensions=\"" + dims + "\" " + type + ">" + xml_escape(file + ":/" + dataset) +
-         "</DataItem>";
-}
-
-std::string node_attribute(const std::string& name, const std::string& item, bool vector) {
-  return "      <Attribute Name=\"" + xml_escape(name) + "\" AttributeType=\"" + (vector ? "Vector" : "Scalar") +
-         "\" Center=\"Node\">" + item + "</Attribute>\n";
-}
-
-/// Opens a time step's grid. Time is the shortest text that reads back as the same double.
-std::string grid_head(long step, double time, const std::string& topology, long cells, const std::string& conn,
-                      const std::string& nodes) {
-  char value[32];
-  char* end = std::to_chars(value, value + sizeof value, time).ptr;
-  return "    <Grid Name=\"step_" + std::to_string(step) + "\" GridType=\"Uniform\">\n      <Time Value=\"" +
-         std::string(value, end) + "\"/>\n      <Topology " + topology + " NumberOfElements=\"" +
-         std::to_string(cells) + "\">" + conn + "</Topology>\n      <Geometry GeometryType=\"XYZ\">" + nodes +
-         "</Geometry>\n";
-}
-
-std::string particle_grid(const std::string& file, long step, double time, long n,
-                          const std::vector<std::string>& scalars) {
-  std::string grid = grid_head(step, time, "TopologyType=\"Polyvertex\" NodesPerElement=\"1\"", n,
-                               data_item(file, "cells", n, 1, kI32), data_item(file, "x", n, 3, kF64)) +
-                     node_attribute("radius", data_item(file, "radius", n, 1, kF64), false) +
-                     node_attribute("v", data_item(file, "v", n, 3, kF64), true) +
-                     node_attribute("w", data_item(file, "w", n, 3, kF64), true) +
-                     node_attribute("gid", data_item(file, "gid", n, 1, kU32), false) +
-                     node_attribute("specimen", data_item(file, "specimen", n, 1, kI32), false);
-  for (const std::string& name : scalars)
-    grid += node_attribute(name, data_item(file, dataset_name(name), n, 1, kF64), false);
-  return grid + "    </Grid>\n";
-}
-
-std::string surface_grid(const std::string& file, long step, double time, long nodes, long triangles) {
-  return grid_head(step, time, "TopologyType=\"Triangle\"", triangles,
-                   data_item(file, "surface/triangles", triangles, 3, kI32),
-                   data_item(file, "surface/nodes", nodes, 3, kF64)) +
-         "    </Grid>\n";
-}
-
-std::string temporal_collection(const char* name, const std::string& grids) {
-  if (grids.empty()) return "";
-  return std::string("  <Grid Name=\"") + name + "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n" + grids +
-         "  </Grid>\n";
-}
-
 }  // namespace
 
 namespace {
@@ -362,16 +301,13 @@ void Output::resume(const std::vector<double>& rows, const std::string& snapshot
 }
 
 void Output::write_xdmf() const {
-  std::string particles, surface;
-  // Empty grids are left out: the XDMF readers of ParaView fail on a zero-sized DataItem.
+  std::vector<XdmfStep> steps;
   for (const Entry& e : snaps_) {
-    if (e.n > 0) particles += particle_grid(e.file, e.step, e.time, e.n, e.scalars);
-    if (e.nsurf_tris > 0) surface += surface_grid(e.file, e.step, e.time, e.nsurf_nodes, e.nsurf_tris);
+    XdmfStep x{e.file, e.step, e.time, e.n, e.nsurf_nodes, e.nsurf_tris, {}};
+    for (const std::string& name : e.scalars) x.scalars.emplace_back(name, dataset_name(name));
+    steps.push_back(std::move(x));
   }
-  write_text_atomic(in_folder(folder_, "snapshots.xdmf"),
-                    "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n<Domain>\n" +
-                        temporal_collection("particles", particles) + temporal_collection("surface", surface) +
-                        "</Domain>\n</Xdmf>\n");
+  write_text_atomic(in_folder(folder_, "snapshots.xdmf"), xdmf_document(steps));
 }
 
 void claim_output_folder(const std::string& folder, bool resume, bool overwrite) {
@@ -409,7 +345,8 @@ void write_text_atomic(const std::string& path, const std::string& text) {
 
 
 namespace {
-void check_finite(const std::string& path, const std::string& name, const std::vector<double>& v, bool positive = false) {
+void check_finite(const std::string& path, const std::string& name, const std::vector<double>& v,
+                  bool positive = false) {
   for (std::size_t k = 0; k < v.size(); ++k)
     if (!std::isfinite(v[k]) || (positive && !(v[k] > 0)))
       throw std::runtime_error(path + ": " + name + ", value " + std::to_string(k) + ": " + std::to_string(v[k]) +
