@@ -98,7 +98,7 @@ struct Session {
   Misfit misfit_of(const Config& base, const std::string& material, const std::vector<MeasuredTest>& tests) {
     std::printf("%s: %s: measuring the simulator's scatter: %d specimens of %zu balls at the base model\n",
                 folder.c_str(), material.c_str(), lab.specimens(), lab.balls());
-    Misfit m = measure_misfit(lab, model_of(base), tests, noise);
+    Misfit m = measure_misfit(lab, model_of(base), tests, noise, true, &state);
     for (const std::string& n : m.notes()) std::printf("  noise: %s\n", n.c_str());
     const Real ratio = m.ensemble_ratio();
     const bool chosen = base.calibrate.ensemble == kAutoEnsemble;

@@ -216,7 +216,7 @@ int Misfit::members_for(Real target) const {
 }
 
 Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<MeasuredTest>& measured,
-                      const NoiseOptions& noise, bool cell_bias) {
+                      const NoiseOptions& noise, bool cell_bias, StateMatch* state) {
   Ensemble scatter = lab.run_ensemble(base, measured, true);
   auto misfit = [&] {
     return Misfit(measured, noise, scatter, lab.members(), lab.config().periodic.triax.target_strain,
@@ -228,7 +228,7 @@ Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<Mea
     // The cap is on the cell, not on one step: a lab shared by several materials may have grown for an earlier one.
     const int room = kMaxCellFactor / lab.cell_factor();
     if (wanted > lab.specimens() && room > 1 && lab.config().calibrate.cell_factor == kAutoCell) {
-      lab.grow_cell(std::min(room, (wanted + lab.specimens() - 1) / lab.specimens()));
+      lab.grow_cell(std::min(room, (wanted + lab.specimens() - 1) / lab.specimens()), state);
       scatter = lab.run_ensemble(base, measured, true);
     }
     lab.set_members(std::min(misfit().members_for(kEnsembleRatioGoal), lab.specimens()));

@@ -152,9 +152,10 @@ class Misfit {
 /// specimens (at most all the scatter specimens) whose mean's standard error is below kEnsembleRatioGoal of the
 /// data's noise. Where all of them fall short and the cell is "auto" too ([calibrate] cell_factor), the cell grows
 /// by the factor that makes up the rest (at most kMaxCellFactor; the mean of K specimens of N balls scatters as
-/// 1 / sqrt(K N)) and the scatter is measured again on it. Then the cell's bias is measured and counted
-/// (measure_cell_bias) unless `cell_bias` is false.
+/// 1 / sqrt(K N)) and the scatter is measured again on it; where `state` holds the lab's match to the data's void
+/// ratio, the grown cell is matched again (PeriodicLab::grow_cell) and `state` says what it reaches. Then the cell's
+/// bias is measured and counted (measure_cell_bias) unless `cell_bias` is false.
 Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<MeasuredTest>& measured,
-                      const NoiseOptions& noise, bool cell_bias = true);
+                      const NoiseOptions& noise, bool cell_bias = true, StateMatch* state = nullptr);
 
 }  // namespace dem

@@ -97,10 +97,18 @@ void PeriodicLab::pack(int count, bool verbose) {
       "specimen preparation");
 }
 
-void PeriodicLab::grow_cell(int factor) {
+void PeriodicLab::grow_cell(int factor, StateMatch* state) {
   if (factor < 1) throw std::invalid_argument("cell factor " + std::to_string(factor) + " (allowed: 1 or more)");
   cfg_ = larger_cell(cfg_, factor);
   cell_factor_ *= factor;
+  // The friction that packs the data's void ratio in a small cell packs a larger one to another.
+  if (state && state->tests > 0) {
+    MatchPlan plan;
+    plan.first_seed = first_seed_;
+    plan.specimens = state->specimens;
+    plan.jobs = jobs_;
+    cfg_.periodic.prep_mu_s = state->prep_mu_s = prep_friction_for(cfg_, state->target, state->reached, false, plan);
+  }
   pack(specimens(), false);
 }
 
@@ -148,6 +156,7 @@ Real prep_friction_for(const Config& base, Real target, Real& reached, bool verb
 
 Config matched_state(const Config& base, const std::vector<MeasuredTest>& tests, StateMatch& m, bool verbose,
                      const MatchPlan& plan) {
+  m = StateMatch{};
   Real sum = 0;
   for (const MeasuredTest& t : tests)
     if (std::isfinite(t.void_ratio)) sum += t.void_ratio, ++m.tests;

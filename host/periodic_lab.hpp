@@ -34,6 +34,8 @@ constexpr unsigned kForeignSeedOffset = 100000;
 /// The base config with `factor` times the balls in a box as many times larger (same packing density).
 Config larger_cell(const Config& base, int factor);
 
+struct StateMatch;
+
 class PeriodicLab {
  public:
   /// `specimens` specimens with packing seeds first_seed, first_seed + 1, ..., of which the first `members`
@@ -59,7 +61,9 @@ class PeriodicLab {
   /// Makes the first k specimens the ensemble (1 <= k <= specimens()).
   void set_members(int k);
   /// Packs every specimen again (same seeds) in a cell of `factor` times the balls (larger_cell), jobs() at once.
-  void grow_cell(int factor);
+  /// Where `state` holds a match to the data's void ratio, the preparation friction is matched again, on the larger
+  /// cell's first specimens (prep_friction_for), and `state` gets what it reaches.
+  void grow_cell(int factor, StateMatch* state = nullptr);
   /// The cell's balls as a multiple of the config's.
   int cell_factor() const { return cell_factor_; }
   int specimens() const { return static_cast<int>(specimens_.size()); }

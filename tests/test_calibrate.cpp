@@ -293,7 +293,8 @@ TEST(Calibrate, StateIsMatchedOnTheMeanOfTheLabsFirstSpecimens) {
 
 // The cell an "auto" [calibrate] cell_factor chooses (measure_misfit): where even all the scatter specimens leave the
 // simulator's standard error above half a lab's noise, the cell grows by the factor that makes up the rest, at most
-// kMaxCellFactor, and the scatter is measured again on it. A fixed cell_factor, or a fixed ensemble, keeps the cell.
+// kMaxCellFactor, and the scatter is measured again on it; a lab matched to the data's void ratio is matched again on
+// the grown cell. A fixed cell_factor, or a fixed ensemble, keeps the cell.
 // Whether the grown cell then reaches the goal is not asserted: a variance from two specimens has one degree of
 // freedom (here 0.7 of the noise on 100 balls came out 1.2 on 200), which is why the default measures it on 16.
 // The cell's bias, which measure_misfit measures next on cells of four times the balls, is left out: it does not
@@ -323,11 +324,21 @@ TEST(Calibrate, AutoCellGrowsWhereAllScatterSpecimensFallShort) {
 
   cfg.calibrate.cell_factor = kAutoCell;
   PeriodicLab grown(cfg, false);
-  const Misfit large = measure_misfit(grown, m, data, noise, false);
+  // The lab's specimens as if matched to the data's void ratio: the grown cell is matched again, on its own.
+  StateMatch state;
+  state.tests = 1;
+  state.target = data[0].void_ratio;
+  state.specimens = kStateMatchSpecimens;
+  state.prep_mu_s = cfg.periodic.prep_mu_s;
+  const Misfit large = measure_misfit(grown, m, data, noise, false, &state);
   const int factor = std::min(kMaxCellFactor, (wanted + 1) / 2);
   EXPECT_EQ(grown.cell_factor(), factor);
   EXPECT_EQ(grown.balls(), 100u * static_cast<unsigned>(factor));
   EXPECT_EQ(large.sim_balls(), 100.0 * factor) << "the scatter is measured again, on the grown cell";
+  EXPECT_EQ(grown.config().periodic.prep_mu_s, state.prep_mu_s);
+  Real sum = 0;
+  for (int k = 0; k < kStateMatchSpecimens; ++k) sum += grown.prepared_void_ratio(k);
+  EXPECT_EQ(state.reached, sum / kStateMatchSpecimens) << "what the report gives is what the grown cell packs";
 
   cfg.calibrate.ensemble = 2;
   PeriodicLab fixed_ensemble(cfg, false);
