@@ -256,42 +256,31 @@ void Simulation::set_strain_rate(const Vec3& rate) {
 }
 
 namespace {
-/// One ball-ball contact's Love-Weber term: its force on particle 1 and the branch from particle 1 to 2 (the
-/// shift worked out once per launch, as the pair loops do).
-struct LoveWeberTerm {
-  ContactList c;
-  Vec3View x;
-  MinImage image;
-  KOKKOS_INLINE_FUNCTION void operator()(const int k, Vec3& f, Vec3& l) const {
-    f = load(c.fc, k);
-    l = image(load(x, c.j(k)) - load(x, c.i(k)));
-  }
-};
+/// The Love-Weber sums of the ball-ball contacts over `volume`: all nine components (N = 9, row-major) or the
+/// diagonal alone (N = 3). Each component is summed in the same order either way, so it has the same bits.
+template <int N>
+std::array<Real, N> love_weber_stress(const char* label, const ContactList& c, const Vec3View& x, const Domain& dom,
+                                      Real volume) {
+  static_assert(N == 9 || N == 3, "the whole tensor or its diagonal");
+  Real s[N];
+  const MinImage image(dom);  // worked out once per launch, as the pair loops do
+  deterministic_reduce<N, 0>(label, c.n, KOKKOS_LAMBDA(const int k, Real* v) {
+    const Vec3 f = load(c.fc, k);
+    const Vec3 l = image(load(x, c.j(k)) - load(x, c.i(k)));
+    for (int q = 0; q < N; ++q) v[q] = -f[N == 9 ? q / 3 : q] * l[N == 9 ? q % 3 : q];
+  }, s);
+  std::array<Real, N> out;
+  for (int q = 0; q < N; ++q) out[q] = s[q] / volume;
+  return out;
+}
 }  // namespace
 
 std::array<Real, 9> Simulation::contact_stress(Real volume) const {
-  Real s[9];
-  const LoveWeberTerm term{balls_, p_.x, MinImage(prm_.domain)};
-  deterministic_reduce<9, 0>("dem::sim::contact_stress", balls_.n, KOKKOS_LAMBDA(const int k, Real* v) {
-    Vec3 f, l;
-    term(k, f, l);
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) v[3 * a + b] = -f[a] * l[b];
-  }, s);
-  std::array<Real, 9> out;
-  for (int q = 0; q < 9; ++q) out[q] = s[q] / volume;
-  return out;
+  return love_weber_stress<9>("dem::sim::contact_stress", balls_, p_.x, prm_.domain, volume);
 }
 
 std::array<Real, 3> Simulation::contact_stress_diagonal(Real volume) const {
-  Real s[3];
-  const LoveWeberTerm term{balls_, p_.x, MinImage(prm_.domain)};
-  deterministic_reduce<3, 0>("dem::sim::contact_stress_diagonal", balls_.n, KOKKOS_LAMBDA(const int k, Real* v) {
-    Vec3 f, l;
-    term(k, f, l);
-    for (int a = 0; a < 3; ++a) v[a] = -f[a] * l[a];
-  }, s);
-  return {s[0] / volume, s[1] / volume, s[2] / volume};
+  return love_weber_stress<3>("dem::sim::contact_stress_diagonal", balls_, p_.x, prm_.domain, volume);
 }
 
 void Simulation::set_wall_velocity(int w, const Vec3& v) {
