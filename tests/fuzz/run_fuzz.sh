@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Fuzzes every file triaxdem reads (config, measured CSV and HDF5, checkpoints, snapshots, study summaries,
 # reference values, the specimen cache) for a bounded time each (default 60 s), one harness per core at a time
-# (TRIAXDEM_FUZZ_JOBS), with AddressSanitizer and UndefinedBehaviorSanitizer, starting from files of each kind. Prints the executions per
-# target; a finding stops the target, leaves crash-* in the build folder and makes this script fail.
+# (TRIAXDEM_FUZZ_JOBS), with AddressSanitizer and UndefinedBehaviorSanitizer, starting from files of each kind.
+# Prints the executions per target; a finding stops the target, leaves crash-* in the build folder and makes this
+# script fail.
 #   tests/fuzz/run_fuzz.sh [SECONDS [TARGET...]]   (clang from Debian: apt-get install clang libomp-dev)
 set -euo pipefail
 secs="${1:-60}"
@@ -80,7 +81,7 @@ run_one() {
       -timeout=10 -rss_limit_mb=4096 "$corpus" > "fuzz_$t.log" 2>&1) || rc=1
   { echo "fuzz_$t: ${secs} s"; grep -E "stat::number_of_executed_units|stat::new_units_added|ERROR|SUMMARY" \
       "$build/fuzz_$t.log" || true; }
-  echo "$rc" > "$build/fuzz_$t.status"
+  echo "$rc" > "$build/fuzz_$t.status"  # fuzz_<name>.status, as the loops below name it
 }
 # A harness is one process on one core: as many run at once as there are cores, each for its full time.
 at_once="${TRIAXDEM_FUZZ_JOBS:-$(nproc)}"
