@@ -32,8 +32,9 @@ const std::map<std::string, const std::map<std::string, Real>*> kQuantities = {
     {"sigma3", &kStressUnits}, {"q", &kStressUnits},         {"q_peak", &kStressUnits}, {"q_end", &kStressUnits}, {"e_ini", &kStressUnits},
     {"q_1pct", &kStressUnits}, {"q_3pct", &kStressUnits},
     {"eps_a", &kStrainUnits},  {"eps_v", &kStrainUnits}, {"eps_a_peak", &kStrainUnits}};
-const std::set<std::string> kUnitless = {"material",   "test",          "max_dilatancy", "max_dilatancy_sd",
-                                         "void_ratio", "void_ratio_sd", "porosity",      "porosity_sd", "specimen_balls"};
+const std::set<std::string> kUnitless = {"material",       "test",       "max_dilatancy", "max_dilatancy_sd",
+                                         "void_ratio",     "void_ratio_sd", "porosity",   "porosity_sd",
+                                         "specimen_balls", "q_measure"};
 /// The quantities whose standard deviation a file can give: a curve's rows are q and eps_v; a summary row is
 /// its values (sigma3 is the test's key, not a measurement).
 const std::vector<std::string> kCurveSd = {"q", "eps_v"};
@@ -90,7 +91,8 @@ ColumnSpec parse_header(const std::string& at, const std::string& name) {
   fail(at, name,
        "unknown column (allowed: material, test, sigma3_<unit>, eps_a_<unit>, q_<unit>, eps_v_<unit>, q_peak_<unit>, "
        "eps_a_peak_<unit>, q_end_<unit>, max_dilatancy, e_ini_<unit>, q_1pct_<unit>, q_3pct_<unit>, "
-       "<quantity>_sd_<unit>, max_dilatancy_sd, void_ratio or porosity, void_ratio_sd, porosity_sd, specimen_balls)");
+       "<quantity>_sd_<unit>, max_dilatancy_sd, void_ratio or porosity, void_ratio_sd, porosity_sd, specimen_balls, "
+       "q_measure)");
 }
 
 /// The header: each column's quantity and scale, and the column of each quantity.
@@ -281,6 +283,25 @@ void read_summary_row(const RowReader& r, MeasuredTest& t) {
     if (r.has(q + "_sd")) t.summary_sd[q] = r.sd(q);
 }
 
+/// The file's q measure: one name, the same on every row.
+void read_q_measure(const RowReader& r, MeasuredData& d, bool first) {
+  if (!r.has("q_measure")) return;
+  const std::string& v = r.cell("q_measure");
+  QMeasure m = QMeasure::kFixedArea;
+  bool known = false;
+  std::string allowed;
+  for (int k = 0; k < kQMeasures; ++k) {
+    allowed += (k ? ", " : "") + std::string(kQMeasureNames[k]);
+    if (v == kQMeasureNames[k]) m = static_cast<QMeasure>(k), known = true;
+  }
+  if (!known) r.refuse("q_measure", "'" + v + "' is not a q measure (allowed: " + allowed + ")");
+  if (!first && m != d.q_measure)
+    r.refuse("q_measure", "'" + v + "' differs from the first row's '" + name_of(d.q_measure) +
+                              "' (one measure per file)");
+  d.q_measure = m;
+  d.q_measure_given = true;
+}
+
 /// Near-equal pressures of one material are taken as one (a lab's 100 kPa is logged as 99.6 or 101.2), which
 /// the user should hear of: they may have been meant as a series.
 void note_replicates(MeasuredData& d) {
@@ -355,6 +376,7 @@ MeasuredData load_measured(const std::string& path) {
       fail(row.at, "", "has " + std::to_string(row.cells.size()) + " cells, the header " +
                            std::to_string(cols.names.size()));
     const RowReader r{cols, row};
+    read_q_measure(r, d, &row == &table.rows.front());
     MeasuredTest& t = test_of(r, d, tests);
     if (d.curves)
       read_curve_row(r, t);
@@ -365,6 +387,9 @@ MeasuredData load_measured(const std::string& path) {
   if (d.curves)
     for (MeasuredTest& t : d.tests) summarise(t);
   note_replicates(d);
+  if (!d.q_measure_given)
+    d.notes.push_back(path + ": no q_measure column: q taken as fixed_area (platen force over the cross-section "
+                             "after consolidation, as Tang et al. 2025 report it)");
   return d;
 }
 

@@ -19,6 +19,9 @@
 ///     specimen_balls         particles in the specimen (DEM data), one value per test, >= 1
 ///     test                   a label that tells replicates apart: tests of one material and sigma3 with
 ///                            different labels are replicates (the scatter between them is measured noise)
+///     q_measure              which deviator the lab reported, the same on every row (QMeasure: fixed_area,
+///                            area_corrected, parabolic, membrane_corrected); without it fixed_area is taken
+///                            and MeasuredData::notes says so. In HDF5: a string attribute q_measure on '/'.
 /// A file is a curve file when it has an eps_a column, a summary file when it has q_peak. Within a curve
 /// the axial strain must increase; a material, pressure and test label appear once in a summary file.
 /// Implausible values are refused: |q| above kMaxStressRatio sigma3, a strain beyond kMaxStrain.
@@ -37,6 +40,15 @@ namespace dem {
 struct DataError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+
+/// Which deviator q a lab reports (docs/running.md, "Which q"): the platen force over the cross-section after
+/// consolidation (the paper's), over the right-cylinder area A0 (1 - eps_v) / (1 - eps_a), over the mid-height
+/// area of a parabolic barrel, or the right-cylinder value less what the membrane adds.
+enum class QMeasure : int { kFixedArea = 0, kAreaCorrected, kParabolic, kMembraneCorrected };
+constexpr int kQMeasures = 4;
+/// Names in files and reports, by QMeasure.
+constexpr const char* kQMeasureNames[kQMeasures] = {"fixed_area", "area_corrected", "parabolic", "membrane_corrected"};
+inline const char* name_of(QMeasure m) { return kQMeasureNames[static_cast<int>(m)]; }
 
 /// One test (material, sigma3). Curve vectors are empty in a summary file; NaN marks a summary value the
 /// file does not give.
@@ -61,6 +73,8 @@ struct MeasuredData {
   std::string path;
   bool curves = false;                      ///< curve file (else summary)
   std::vector<MeasuredTest> tests;          ///< in file order of first appearance
+  QMeasure q_measure = QMeasure::kFixedArea;  ///< which q the file's q columns are
+  bool q_measure_given = false;             ///< false: the file did not say (fixed_area taken, with a note)
   std::vector<std::string> notes;           ///< what the reader accepted but a user should know (near-equal pressures)
 };
 
@@ -101,10 +115,11 @@ MeasuredTextTable read_csv_table(const std::string& path);
 MeasuredTextTable read_measured_h5(const std::string& path);
 
 /// Writes measured data in the HDF5 form, atomically: `columns` after material (units in the names) and, per
-/// material, its rows of numbers in those columns. Throws DataError naming the path.
+/// material, its rows of numbers in those columns; `q_measure` (a kQMeasureNames entry) when not empty. Throws
+/// DataError naming the path.
 void write_measured_h5(const std::string& path, const std::vector<std::string>& columns,
                        const std::map<std::string, std::vector<std::vector<double>>>& rows,
-                       const std::string& comment);
+                       const std::string& comment, const std::string& q_measure = "");
 
 /// Strain windows of summarise: curves are smoothed by a moving mean over +-0.25% axial strain, q at the end
 /// is the mean over the last 1%, the initial stiffness is fitted over the first 0.2% (the elastic range of

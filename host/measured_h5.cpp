@@ -52,6 +52,12 @@ MeasuredTextTable read_measured_h5(const std::string& path) {
       }
     }
     if (t.header_at.empty()) throw DataError(path + ": no material groups");
+    // A text value has no place in the table of numbers: the file says it once, and every row carries it.
+    const std::string measure = f.string_attribute("/", "q_measure");
+    if (!measure.empty()) {
+      t.header.push_back("q_measure");
+      for (MeasuredTextTable::Row& r : t.rows) r.cells.push_back(measure);
+    }
     return t;
   } catch (const DataError&) {
     throw;
@@ -62,13 +68,14 @@ MeasuredTextTable read_measured_h5(const std::string& path) {
 
 void write_measured_h5(const std::string& path, const std::vector<std::string>& columns,
                        const std::map<std::string, std::vector<std::vector<double>>>& rows,
-                       const std::string& comment) {
+                       const std::string& comment, const std::string& q_measure) {
   std::string names;
   for (const std::string& c : columns) names += (names.empty() ? "" : ",") + c;
   try {
     io::h5::replace_atomically(path, [&](const std::string& tmp) {
       io::h5::H5Writer f(tmp, path);
       f.string_attribute("/", "comment", comment);
+      if (!q_measure.empty()) f.string_attribute("/", "q_measure", q_measure);
       for (const auto& [material, table] : rows) {
         if (material.empty() || material.find('/') != std::string::npos || material == ".")
           throw DataError(path + ": material '" + material + "' cannot name an HDF5 group");

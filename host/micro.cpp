@@ -228,6 +228,16 @@ Tensor love_weber(const ContactSet& s, Real volume, bool include_boundary) {
   return t;
 }
 
+Tensor boundary_stress(const ContactSet& s, Real volume) {
+  Tensor t{};
+  for (const ContactRecord& c : s.contacts) {
+    if (c.boundary == Boundary::kNone || !c.in_volume) continue;
+    const Tensor o = outer(c.point, c.fn * c.normal + c.ft);
+    for (int q = 0; q < 9; ++q) t[q] += o[q] / volume;
+  }
+  return t;
+}
+
 Real axial_deviator(const Tensor& t) { return t[8] - (t[0] + t[4]) / 2; }
 
 Real stress_ratio(const Tensor& s) {

@@ -143,6 +143,8 @@ int run_periodic_job(const Config& cfg) {
     su.balls = static_cast<long>(balls.size());
     su.void_ratio0 = r.void_ratio0;
     su.q_peak = r.q_peak;
+    // The cell has no boundary: its one q is every measure's.
+    su.q_peak_area = su.q_peak_parabolic = su.q_peak_membrane = su.q_peak_lw = r.q_peak;
     su.phi_peak_deg = r.phi_peak_deg;
     su.eps_a_peak = r.eps_a_peak;
     su.q_end = r.q_end;

@@ -14,6 +14,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
@@ -34,7 +35,8 @@ constexpr Real kNaN = std::numeric_limits<Real>::quiet_NaN();
 struct Column {
   const char* name;
   Real TestSummary::*field;
-  double scale;  ///< file value = SI value x scale
+  double scale;           ///< file value = SI value x scale
+  bool optional = false;  ///< NaN when a summary.csv lacks it (written before the column existed)
 };
 const Column kColumns[] = {
     {"sigma3_kPa", &TestSummary::sigma3, 1e-3},       {"mu_s", &TestSummary::mu_s, 1},
@@ -43,7 +45,16 @@ const Column kColumns[] = {
     {"eps_a_peak_pct", &TestSummary::eps_a_peak, 100}, {"q_end_kPa", &TestSummary::q_end, 1e-3},
     {"eps_a_end_pct", &TestSummary::eps_a_end, 100},  {"max_dilatancy", &TestSummary::max_dilatancy, 1},
     {"inertial_number", &TestSummary::inertial_number, 1},
+    {"q_peak_area_kPa", &TestSummary::q_peak_area, 1e-3, true},
+    {"q_peak_parabolic_kPa", &TestSummary::q_peak_parabolic, 1e-3, true},
+    {"q_peak_membrane_kPa", &TestSummary::q_peak_membrane, 1e-3, true},
+    {"q_peak_lw_kPa", &TestSummary::q_peak_lw, 1e-3, true},
 };
+/// The series column of each measure's q whose peak a summary holds (beside q_kPa's, q_peak).
+const std::pair<const char*, Real TestSummary::*> kMeasurePeaks[] = {{"q_area_kPa", &TestSummary::q_peak_area},
+                                                                     {"q_parabolic_kPa", &TestSummary::q_peak_parabolic},
+                                                                     {"q_membrane_kPa", &TestSummary::q_peak_membrane},
+                                                                     {"q_lw_kPa", &TestSummary::q_peak_lw}};
 
 std::vector<std::string> split_csv(const std::string& line) {
   std::vector<std::string> out;
@@ -139,8 +150,20 @@ TestSummary read_summary(const std::string& path) {
   s.kind = get("kind");
   s.balls = std::stol(get("balls"));
   s.wall_seconds = std::stod(get("wall_s"));
-  for (const Column& c : kColumns) s.*(c.field) = std::stod(get(c.name)) / c.scale;
+  for (const Column& c : kColumns)
+    s.*(c.field) = c.optional && !m.count(c.name) ? kNaN : std::stod(get(c.name)) / c.scale;
   return s;
+}
+
+Real q_peak_as(const TestSummary& s, QMeasure m) {
+  if (s.kind == "periodic") return s.q_peak;  // no boundary: its one q is every measure's
+  switch (m) {
+    case QMeasure::kFixedArea: return s.q_peak;
+    case QMeasure::kAreaCorrected: return s.q_peak_area;
+    case QMeasure::kParabolic: return s.q_peak_parabolic;
+    case QMeasure::kMembraneCorrected: return s.q_peak_membrane;
+  }
+  return kNaN;
 }
 
 bool summarise_series(const std::string& folder, TestSummary& s) {
@@ -148,24 +171,34 @@ bool summarise_series(const std::string& folder, TestSummary& s) {
   if (!fs::exists(path)) return false;
   const MeasuredTextTable t = read_csv_table(path);
   const auto& h = t.header;
-  const auto ke = std::find(h.begin(), h.end(), "eps_a_pct") - h.begin();
-  const auto kq = std::find(h.begin(), h.end(), "q_kPa") - h.begin();
-  const auto kv = std::find(h.begin(), h.end(), "eps_v_pct") - h.begin();
   const auto n = static_cast<std::ptrdiff_t>(h.size());
+  auto column = [&](const char* name) { return std::find(h.begin(), h.end(), name) - h.begin(); };
+  const auto ke = column("eps_a_pct"), kq = column("q_kPa"), kv = column("eps_v_pct");
   if (ke == n || kq == n || kv == n || t.rows.empty()) return false;
   struct Row {
     Real eps_a, q, eps_v;
   };
-  std::vector<Row> rows;
-  for (const MeasuredTextTable::Row& r : t.rows) {
-    if (static_cast<std::ptrdiff_t>(r.cells.size()) != n) return false;
-    try {
-      rows.push_back({std::stod(r.cells[ke]) / 100, std::stod(r.cells[kq]) * 1e3, std::stod(r.cells[kv]) / 100});
-    } catch (const std::exception&) {
-      return false;
+  // The rows with q from column kq, or nothing when a row does not read.
+  auto rows_of = [&](std::ptrdiff_t kq_col) -> std::optional<std::vector<Row>> {
+    std::vector<Row> rows;
+    for (const MeasuredTextTable::Row& r : t.rows) {
+      if (static_cast<std::ptrdiff_t>(r.cells.size()) != n) return std::nullopt;
+      try {
+        rows.push_back({std::stod(r.cells[ke]) / 100, std::stod(r.cells[kq_col]) * 1e3, std::stod(r.cells[kv]) / 100});
+      } catch (const std::exception&) {
+        return std::nullopt;
+      }
     }
+    return rows;
+  };
+  const auto rows = rows_of(kq);
+  if (!rows) return false;
+  take_curve_values(s, summarised(*rows, s.sigma3));
+  for (const auto& [name, field] : kMeasurePeaks) {
+    const auto k = column(name);
+    const auto measured = k == n ? std::nullopt : rows_of(k);
+    if (measured) s.*field = summarised(*measured, s.sigma3).q_peak;
   }
-  take_curve_values(s, summarised(rows, s.sigma3));
   return true;
 }
 
@@ -206,6 +239,7 @@ PeakComparison compare_peaks(const MeasuredData& data, const std::vector<StudyCa
                              const std::vector<TestSummary>& summaries) {
   PeakComparison c;
   c.source = data.path;
+  c.measure = data.q_measure;
   c.measured.assign(cases.size(), kNaN);
   c.error.assign(cases.size(), kNaN);
   Real sum = 0;
@@ -213,8 +247,9 @@ PeakComparison compare_peaks(const MeasuredData& data, const std::vector<StudyCa
     for (const MeasuredTest& t : data.tests)
       if (t.material == cases[k].material && std::fabs(t.sigma3 - summaries[k].sigma3) <= 1e-6 * t.sigma3)
         c.measured[k] = t.q_peak;
-    if (!(std::isfinite(c.measured[k]) && std::isfinite(summaries[k].q_peak))) continue;
-    c.error[k] = (summaries[k].q_peak - c.measured[k]) / c.measured[k];
+    const Real simulated = q_peak_as(summaries[k], c.measure);
+    if (!(std::isfinite(c.measured[k]) && std::isfinite(simulated))) continue;
+    c.error[k] = (simulated - c.measured[k]) / c.measured[k];
     sum += std::fabs(c.error[k]);
     if (c.matched == 0 || std::fabs(c.error[k]) > c.max_abs_error) c.max_abs_error = std::fabs(c.error[k]), c.worst = k;
     ++c.matched;
@@ -348,9 +383,9 @@ int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, c
                   p.source.c_str());
       continue;
     }
-    std::printf("ref %zu, %s: %d of %zu cases matched; q_peak off by %.1f%% on average (|error|), %.1f%% at most "
-                "(%s)\n", j + 1, p.source.c_str(), p.matched, cases.size(), 100 * p.mean_abs_error,
-                100 * p.max_abs_error, cases[p.worst].name.c_str());
+    std::printf("ref %zu, %s (q %s): %d of %zu cases matched; q_peak off by %.1f%% on average (|error|), %.1f%% "
+                "at most (%s)\n", j + 1, p.source.c_str(), name_of(p.measure), p.matched, cases.size(),
+                100 * p.mean_abs_error, 100 * p.max_abs_error, cases[p.worst].name.c_str());
   }
   io::write_text_atomic(opt.output + "/study_summary.csv", table.csv);
   std::printf("\nstudy: summary in %s/study_summary.csv\n", opt.output.c_str());

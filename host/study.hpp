@@ -18,6 +18,9 @@ struct TestSummary {
   long balls = 0;
   Real void_ratio0 = 0;         ///< at the start of shear
   Real q_peak = 0;              ///< Pa, peak of the moving mean of q (summarise, host/measured.hpp)
+  /// Pa, the same peak of the other measures of q (TriaxialRecord; docs/running.md, "Which q"): equal to q_peak
+  /// in a periodic cell, which has no boundary; NaN in a summary written before they were recorded.
+  Real q_peak_area = 0, q_peak_parabolic = 0, q_peak_membrane = 0, q_peak_lw = 0;
   Real phi_peak_deg = 0;        ///< asin(q / (q + 2 sigma3)) at the peak
   Real eps_a_peak = 0;          ///< axial strain at the peak
   Real q_end = 0;               ///< Pa, mean q over the last 1% of strain
@@ -27,14 +30,19 @@ struct TestSummary {
   double wall_seconds = 0;
 };
 
+/// The peak of the q a lab reports as `m`, so that a measured peak is compared like with like; a periodic
+/// cell's q_peak whatever m is.
+Real q_peak_as(const TestSummary& s, QMeasure m);
+
 /// Writes folder/summary.csv atomically (a header line and one row).
 void write_summary(const std::string& folder, const TestSummary& s);
 /// Reads it back; throws std::runtime_error naming the file and the missing column.
 TestSummary read_summary(const std::string& path);
 
-/// Recomputes the curve values of s (q_peak, its strain and friction angle, q_end, max dilatancy) from
-/// folder/series.csv as summarise does (s.sigma3 must be set). False, s unchanged, when the file is missing or
-/// lacks the eps_a_pct, q_kPa and eps_v_pct columns.
+/// Recomputes the curve values of s (q_peak, its strain and friction angle, q_end, max dilatancy, and the
+/// peaks of the other measures of q where the series has them) from folder/series.csv as summarise does
+/// (s.sigma3 must be set). False, s unchanged, when the file is missing or lacks the eps_a_pct, q_kPa and
+/// eps_v_pct columns.
 bool summarise_series(const std::string& folder, TestSummary& s);
 
 /// One case of a study: the config, which job runs it, and where its output goes.
@@ -60,6 +68,7 @@ struct StudyOptions {
 /// The cases' peaks beside one measured-data file's: a case is matched by its [run] material and sigma3.
 struct PeakComparison {
   std::string source;                ///< the file
+  QMeasure measure = QMeasure::kFixedArea;  ///< the file's q, which the cases' q_peak_as matches
   std::vector<Real> measured;        ///< Pa, per case; NaN where the file has no such test or the case failed
   std::vector<Real> error;           ///< (simulated - measured) / measured, per case; NaN where unmatched
   int matched = 0;

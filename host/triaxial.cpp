@@ -97,6 +97,35 @@ std::pair<Real, Real> platen_stresses(const Cell& c, const std::vector<Vec3>& f)
 
 Real specimen_volume(const Cell& c) { return enclosed_volume(c.membrane, 0, c.sim->wall_point(kTopPlaten).z); }
 
+/// The record's deviators as labs report them and the specimen's mean stress over the enclosed `volume`, from
+/// the platen force (r.sigma1, r.sigma3_balls and the strains set) and the contacts. `a0`: the cross-section
+/// after consolidation, V0 / h0.
+void measure_stresses(const Cell& c, const TriaxialConfig& tc, const ContactSet& cs, Real volume, Real a0,
+                      TriaxialRecord& r) {
+  const Real force = r.sigma1 * c.area;
+  r.q_area = force / right_cylinder_area(a0, r.eps_a, r.eps_v) - tc.sigma3;
+  r.q_parabolic = force / parabolic_mid_area(a0, r.eps_a, r.eps_v) - tc.sigma3;
+  r.q_membrane = r.q_area + tc.sigma3 - r.sigma3_balls;
+  r.sigma3_hoop = tc.sigma3 + membrane_hoop_stress(tc.membrane_modulus, tc.membrane_thickness,
+                                                   std::sqrt(4 * a0 / M_PI), r.eps_a, r.eps_v);
+  const Tensor lw = love_weber(cs, volume, true), b = boundary_stress(cs, volume);
+  r.q_lw = axial_deviator(lw);
+  r.p_lw = (lw[0] + lw[4] + lw[8]) / 3;
+  r.q_boundary = axial_deviator(b);
+  r.p_boundary = (b[0] + b[4] + b[8]) / 3;
+  const Tensor net = net_force_stress(*c.sim, volume);
+  r.q_net = axial_deviator(net);
+  r.p_net = (net[0] + net[4] + net[8]) / 3;
+}
+
+/// The peak of one measure of q over the records, summarised as q_peak is.
+Real peak_of(const TriaxialResult& r, Real TriaxialRecord::*q, Real sigma3) {
+  if (r.records.empty()) return 0;
+  std::vector<TriaxialRecord> rows = r.records;
+  for (TriaxialRecord& x : rows) x.q = x.*q;
+  return summarised(rows, sigma3).q_peak;
+}
+
 }  // namespace
 
 TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* out, bool verbose,
@@ -111,7 +140,10 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
   std::vector<std::string> columns = {"eps_a_pct",        "eps_v_pct",          "q_kPa",
                                       "sigma1_kPa",       "sigma1_bottom_kPa",  "sigma3_kPa",
                                       "sigma3_balls_kPa", "eps_v_envelope_pct", "unbalanced_ratio",
-                                      "kinetic_energy_J"};
+                                      "kinetic_energy_J", "q_area_kPa",         "q_parabolic_kPa",
+                                      "q_membrane_kPa",   "sigma3_hoop_kPa",    "q_lw_kPa",
+                                      "p_lw_kPa",         "q_boundary_kPa",     "p_boundary_kPa",
+                                      "q_net_kPa",        "p_net_kPa"};
   if (mc.enabled)
     for (const std::string& prefix : {std::string(), std::string("rve_")})
       for (const std::string& c : micro_columns(prefix)) columns.push_back(c);
@@ -229,10 +261,14 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
         r.eps_v_envelope = (v0_envelope - envelope_volume(sim, top_z, cell.mean_radius, env_slabs)) / v0_envelope;
         r.unbalanced = sim.unbalanced_ratio();
         r.kinetic = sim.stats().kinetic;
+        measure_stresses(cell, tc, contacts_now(), volume, v0 / h0, r);
         res.records.push_back(r);
         std::vector<double> row = {100 * r.eps_a,        100 * r.eps_v,          r.q / 1e3,    r.sigma1 / 1e3,
                                    r.sigma1_bottom / 1e3, tc.sigma3 / 1e3,        r.sigma3_balls / 1e3,
                                    100 * r.eps_v_envelope, r.unbalanced,          r.kinetic};
+        for (Real v : {r.q_area, r.q_parabolic, r.q_membrane, r.sigma3_hoop, r.q_lw, r.p_lw, r.q_boundary,
+                       r.p_boundary, r.q_net, r.p_net})
+          row.push_back(v / 1e3);
         const int next_snap = static_cast<int>(st.next_snap);
         if (mc.enabled) {
           const ContactSet& cs = contacts_now();
@@ -354,6 +390,10 @@ int triaxial_job(const Config& cfg, bool resume, long stop_at_step) {
     s.balls = static_cast<long>(sp.balls.size());
     s.void_ratio0 = r.void_ratio_consolidated;
     s.q_peak = r.q_peak;
+    s.q_peak_area = peak_of(r, &TriaxialRecord::q_area, cfg.triaxial.sigma3);
+    s.q_peak_parabolic = peak_of(r, &TriaxialRecord::q_parabolic, cfg.triaxial.sigma3);
+    s.q_peak_membrane = peak_of(r, &TriaxialRecord::q_membrane, cfg.triaxial.sigma3);
+    s.q_peak_lw = peak_of(r, &TriaxialRecord::q_lw, cfg.triaxial.sigma3);
     s.phi_peak_deg = r.phi_peak_deg;
     s.eps_a_peak = r.eps_a_peak;
     s.q_end = r.q_end;

@@ -25,6 +25,17 @@ struct TriaxialRecord {
   Real eps_v_envelope = 0; ///< (V0 - V) / V0 of the balls' envelope (a check of eps_v without the membrane)
   Real unbalanced = 0;
   Real kinetic = 0;     ///< J
+  // The deviator as labs report it (docs/running.md, "Which q"): the top platen force over another area.
+  Real q_area = 0;      ///< Pa, over the right-cylinder area A0 (1 - eps_v) / (1 - eps_a) = V / h
+  Real q_parabolic = 0; ///< Pa, over the mid-height area of a parabolic barrel
+  Real q_membrane = 0;  ///< Pa, q_area less what the membrane adds: sigma3_balls, not the cell pressure
+  Real sigma3_hoop = 0; ///< Pa, cell pressure + a lab's thin-shell estimate of the membrane's hoop stress
+  // The specimen's mean stress, over the enclosed volume V.
+  Real q_lw = 0, p_lw = 0;              ///< Pa, Love-Weber stress of every contact (platens, membrane included)
+  Real q_boundary = 0, p_boundary = 0;  ///< Pa, from the boundary contacts alone (micro.hpp: boundary_stress)
+  /// Pa, (1/V) sum_p x_p (x) F_p of the balls' net contact forces F_p (what inertia, damping and weight leave
+  /// unbalanced), by which the average-stress theorem has the Love-Weber stress exceed the boundary's.
+  Real q_net = 0, p_net = 0;
 };
 
 struct TriaxialResult {

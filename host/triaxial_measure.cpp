@@ -58,6 +58,31 @@ bool ray_crosses(const Vec3& x, const Vec3& dir, const Vec3& a, const Vec3& b, c
 
 }  // namespace
 
+Real right_cylinder_area(Real a0, Real eps_a, Real eps_v) { return a0 * (1 - eps_v) / (1 - eps_a); }
+
+Real parabolic_mid_area(Real a0, Real eps_a, Real eps_v) {
+  // The volume of the parabolic barrel, pi h (8 r_m^2 + 4 r_m r0 + 3 r0^2) / 15, set equal to k pi r0^2 h.
+  const Real k = (1 - eps_v) / (1 - eps_a);
+  const Real ratio = (std::sqrt(30 * k - 5) - 1) / 4;
+  return a0 * ratio * ratio;
+}
+
+Real membrane_hoop_stress(Real young, Real thickness, Real d0, Real eps_a, Real eps_v) {
+  const Real hoop = std::sqrt((1 - eps_v) / (1 - eps_a)) - 1;
+  return hoop > 0 ? 2 * young * thickness * hoop / d0 : 0;
+}
+
+Tensor net_force_stress(Simulation& sim, Real volume) {
+  const Particles& p = sim.particles();
+  auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), p.x);
+  auto f = Kokkos::create_mirror_view_and_copy(HostSpace(), p.f);
+  Tensor t{};
+  for (int i = 0; i < p.n; ++i)
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) t[3 * a + b] += x(i, a) * f(i, b) / volume;
+  return t;
+}
+
 io::SurfaceSnapshot membrane_surface(const Membrane& m) {
   auto nx = Kokkos::create_mirror_view_and_copy(HostSpace(), m.mesh.node_x);
   auto tri = Kokkos::create_mirror_view_and_copy(HostSpace(), m.mesh.tri);

@@ -1,5 +1,6 @@
 #include "triaxial_state.hpp"
 
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
@@ -40,12 +41,18 @@ Stage stage_of(const std::vector<double>& v, const std::string& path) {
   return Stage{v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9]};
 }
 
-constexpr int kRecordValues = 9;
-std::vector<double> record_numbers(const std::vector<TriaxialRecord>& rs) {
+/// A record's fields in the file's order: one list for the writer and the reader.
+constexpr int kRecordValues = 19;
+std::array<Real*, kRecordValues> record_fields(TriaxialRecord& r) {
+  return {&r.eps_a,        &r.eps_v,      &r.sigma1,      &r.sigma1_bottom, &r.q,           &r.sigma3_balls,
+          &r.eps_v_envelope, &r.unbalanced, &r.kinetic,   &r.q_area,        &r.q_parabolic, &r.q_membrane,
+          &r.sigma3_hoop,  &r.q_lw,       &r.p_lw,        &r.q_boundary,    &r.p_boundary,  &r.q_net,
+          &r.p_net};
+}
+std::vector<double> record_numbers(std::vector<TriaxialRecord> rs) {
   std::vector<double> v;
-  for (const TriaxialRecord& r : rs)
-    v.insert(v.end(), {r.eps_a, r.eps_v, r.sigma1, r.sigma1_bottom, r.q, r.sigma3_balls, r.eps_v_envelope,
-                       r.unbalanced, r.kinetic});
+  for (TriaxialRecord& r : rs)
+    for (Real* x : record_fields(r)) v.push_back(*x);
   return v;
 }
 std::vector<TriaxialRecord> records_of(const std::vector<double>& v, const std::string& path) {
@@ -56,10 +63,9 @@ std::vector<TriaxialRecord> records_of(const std::vector<double>& v, const std::
     if (!std::isfinite(v[k]))
       throw std::runtime_error(path + ": number_records, value " + std::to_string(k) + " is not a finite number");
   std::vector<TriaxialRecord> rs(v.size() / kRecordValues);
-  for (std::size_t i = 0; i < rs.size(); ++i) {
-    const double* x = &v[kRecordValues * i];
-    rs[i] = TriaxialRecord{x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], x[8]};
-  }
+  std::size_t at = 0;
+  for (TriaxialRecord& r : rs)
+    for (Real* x : record_fields(r)) *x = v[at++];
   return rs;
 }
 }  // namespace

@@ -324,7 +324,9 @@ TEST(Measured, TestLabelsTellReplicatesApart) {
   EXPECT_EQ(c.tests[0].q, (std::vector<Real>{0, 100e3, 120e3}));
   EXPECT_EQ(c.tests[1].q, (std::vector<Real>{0, 110e3}));
   EXPECT_EQ(replicate_groups(c.tests), (std::vector<std::vector<std::size_t>>{{0, 1}}));
-  EXPECT_TRUE(c.notes.empty());  // the same pressure: nothing to tell
+  // The same pressure: nothing to tell but the q measure the file did not name.
+  ASSERT_EQ(c.notes.size(), 1u);
+  EXPECT_NE(c.notes[0].find("no q_measure column: q taken as fixed_area"), std::string::npos) << c.notes[0];
   const MeasuredData s = load_measured(write("replicates_summary.csv", "material,sigma3_kPa,test,q_peak_kPa\n"
                                                                         "A,100,1,300\nA,100,2,310\n"));
   ASSERT_EQ(s.tests.size(), 2u);
@@ -389,7 +391,7 @@ TEST(Measured, NearEqualPressuresAreGroupedAsReplicates) {
   const MeasuredData d = load_measured(write("near.csv", "material,sigma3_kPa,q_peak_kPa\n"
                                                          "A,100,300\nA,101,305\nA,200,500\nB,100,310\nB,300,700\n"));
   ASSERT_EQ(d.tests.size(), 5u);
-  ASSERT_EQ(d.notes.size(), 1u);
+  ASSERT_EQ(d.notes.size(), 2u);  // and the q measure taken
   EXPECT_NE(d.notes[0].find("near.csv: material A: tests at 100 and 101 kPa differ by less than 2%: taken as "
                             "replicates of one pressure"),
             std::string::npos) << d.notes[0];
@@ -423,6 +425,40 @@ TEST(Measured, Hdf5FormCarriesTheOptionalColumns) {
   } catch (const DataError& e) {
     EXPECT_NE(std::string(e.what()).find("optional.h5:/A/table row 2:q_sd_kPa: standard deviation must be > 0"),
               std::string::npos) << e.what();
+  }
+}
+
+// Which q the lab reported: a column with one name for the whole file (an attribute in HDF5), fixed_area with a
+// note when the file does not say; an unknown name or a second one is refused with line and column.
+TEST(Measured, TheFileSaysWhichQTheLabReported) {
+  const MeasuredData a = load_measured(write("measure.csv", "material,sigma3_kPa,q_peak_kPa,q_measure\n"
+                                                            "A,100,300,area_corrected\nA,200,500,area_corrected\n"));
+  EXPECT_TRUE(a.q_measure_given);
+  EXPECT_EQ(a.q_measure, QMeasure::kAreaCorrected);
+  EXPECT_TRUE(a.notes.empty());
+  const MeasuredData b = load_measured(write("no_measure.csv", "material,sigma3_kPa,q_peak_kPa\nA,100,300\n"));
+  EXPECT_FALSE(b.q_measure_given);
+  EXPECT_EQ(b.q_measure, QMeasure::kFixedArea);
+  ASSERT_EQ(b.notes.size(), 1u);
+  EXPECT_NE(b.notes[0].find("no_measure.csv: no q_measure column: q taken as fixed_area"), std::string::npos);
+  std::string e = error_of("material,sigma3_kPa,q_peak_kPa,q_measure\nA,100,300,corrected\n");
+  EXPECT_NE(e.find("bad.csv:2:q_measure: 'corrected' is not a q measure (allowed: fixed_area, area_corrected, "
+                   "parabolic, membrane_corrected)"),
+            std::string::npos) << e;
+  e = error_of("material,sigma3_kPa,q_peak_kPa,q_measure\nA,100,300,parabolic\nA,200,500,fixed_area\n");
+  EXPECT_NE(e.find("bad.csv:3:q_measure: 'fixed_area' differs from the first row's 'parabolic'"), std::string::npos)
+      << e;
+  const std::string h5 = write("measure.h5", "");
+  write_measured_h5(h5, {"sigma3_kPa", "q_peak_kPa"}, {{"A", {{100, 300}}}}, "test", "membrane_corrected");
+  const MeasuredData c = load_measured(h5);
+  EXPECT_EQ(c.q_measure, QMeasure::kMembraneCorrected);
+  write_measured_h5(h5, {"sigma3_kPa", "q_peak_kPa"}, {{"A", {{100, 300}}}}, "test", "wrong");
+  try {
+    load_measured(h5);
+    ADD_FAILURE() << "accepted an unknown q measure";
+  } catch (const DataError& x) {
+    EXPECT_NE(std::string(x.what()).find("measure.h5:/A/table row 1:q_measure: 'wrong' is not a q measure"),
+              std::string::npos) << x.what();
   }
 }
 

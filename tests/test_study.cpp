@@ -174,6 +174,41 @@ TEST(Study, PeaksAreComparedByMaterialAndPressure) {
   EXPECT_EQ(c.worst, 1u);
 }
 
+// Like with like: a file that says its q is area-corrected is compared with the cases' area-corrected peak;
+// a periodic cell's one q stands for every measure (it has no boundary), also in a summary read back; a
+// membrane summary written before the measures were recorded has none to compare.
+TEST(Study, PeaksAreComparedInTheMeasureTheDataReport) {
+  const auto dir = dem::test::scratch_dir("study_measure");
+  MeasuredData d;
+  d.path = "lab.csv";
+  d.q_measure = QMeasure::kAreaCorrected;
+  MeasuredTest t;
+  t.material = "S-1";
+  t.sigma3 = 100e3;
+  t.q_peak = 120e3;
+  d.tests.push_back(t);
+  std::vector<StudyCase> cases(3);
+  for (StudyCase& c : cases) c.material = "S-1";
+  std::vector<TestSummary> s(3);
+  for (TestSummary& x : s) x.sigma3 = 100e3;
+  s[0].kind = "membrane";
+  s[0].q_peak = 150e3;       // the platen force over the area after consolidation
+  s[0].q_peak_area = 126e3;  // over the right cylinder's: +5% against the lab's 120
+  s[1].kind = "periodic";
+  s[1].q_peak = 90e3;
+  write_summary(dir.string(), s[1]);
+  s[1] = read_summary((dir / "summary.csv").string());
+  s[2].kind = "membrane";
+  s[2].q_peak = 150e3;
+  s[2].q_peak_area = kNaNForTest;
+  const PeakComparison c = compare_peaks(d, cases, s);
+  EXPECT_EQ(c.measure, QMeasure::kAreaCorrected);
+  EXPECT_NEAR(c.error[0], 0.05, 1e-12);
+  EXPECT_NEAR(c.error[1], -0.25, 1e-6);  // 90 against 120
+  EXPECT_TRUE(std::isnan(c.error[2]));
+  EXPECT_EQ(c.matched, 2);
+}
+
 // A kept case's curve values come from its series.csv through the same summary as measured curves: rows that
 // alternate by +-8 kPa about 100 kPa have a raw maximum of 108 kPa, but a moving-mean peak within 2 kPa of 100.
 TEST(Study, KeptCasesAreSummarisedAfreshFromTheirSeries) {

@@ -331,7 +331,7 @@ TEST_F(Untrusted, EditedSnapshotsAreRefusedBeforeMicroUsesThem) {
 }
 
 // A triaxial checkpoint's stage values drive its loops: a snapshot index past the four snapshots indexed an array
-// past its end, a step of -1e15 started an almost endless loop, and records not a multiple of nine were cut.
+// past its end, a step of -1e15 started an almost endless loop, and records not a multiple of their count were cut.
 TEST_F(Untrusted, TriaxialStageValuesAreCheckedBeforeTheRunChanges) {
   sim_ = settled_box();
   Stage st;
@@ -364,14 +364,14 @@ TEST_F(Untrusted, TriaxialStageValuesAreCheckedBeforeTheRunChanges) {
     }
   }
   save_triaxial(path, *sim_, nullptr, st, res);
-  edit_sealed(path, [](Checkpoint& k) { k.numbers.at("records").resize(26); });
+  edit_sealed(path, [](Checkpoint& k) { k.numbers.at("records").resize(3 * 19 - 1); });
   Stage got;
   TriaxialResult out;
   try {
     restore_triaxial(read_checkpoint(path), path, *sim_, nullptr, got, out);
-    ADD_FAILURE() << "accepted 26 record values";
+    ADD_FAILURE() << "accepted 56 record values";
   } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("number_records has 26 values (allowed: 9 per record)"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("number_records has 56 values (allowed: 19 per record)"), std::string::npos)
         << e.what();
   }
 }
