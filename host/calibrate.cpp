@@ -69,6 +69,8 @@ void set_param(Model& m, const std::string& name, Real v) {
   else m.membrane = v;
 }
 
+bool is_contact_param(const std::string& name) { return spec(name).field != nullptr; }
+
 Real get_param(const Model& m, const std::string& name) {
   const ParamSpec& s = spec(name);
   return s.field ? m.law.*s.field : m.membrane;

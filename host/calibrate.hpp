@@ -63,6 +63,8 @@ FreeParam free_param(const std::string& name);
 /// either way (log), mu_r over [0, max(4 x value, 0.05)]. A 3 x 3 design then lands near a sensible answer.
 FreeParam free_param(const std::string& name, const Model& base);
 void set_param(Model& m, const std::string& name, Real v);
+/// True for a parameter of the contact law (every test has it); false for the periodic cell's membrane extension.
+bool is_contact_param(const std::string& name);
 Real get_param(const Model& m, const std::string& name);
 
 /// A quadratic response surface in unit coordinates: value(u) = c . basis(u), fitted by weighted least squares.

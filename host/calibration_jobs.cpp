@@ -6,11 +6,13 @@
 #include <ctime>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "calibrate.hpp"
 #include "host/io_hdf5.hpp"
 #include "diagnose.hpp"
+#include "prediction.hpp"
 #include "progress.hpp"
 #include "calibration_report.hpp"
 #include "text_format.hpp"
@@ -57,19 +59,41 @@ std::map<std::string, std::vector<MeasuredTest>> by_material(const MeasuredData&
   return out;
 }
 
+/// The membrane test a calibration ends with: --predict's config, else the base config's [calibrate] predict
+/// (relative to the base config's folder); none for "none" or where neither names one. Checked before any run.
+std::optional<Config> prediction_template(const Config& base, const std::string& cli) {
+  if (cli == "none" || (cli.empty() && base.calibrate.predict.empty())) return std::nullopt;
+  const std::string key = cli.empty() ? base.path + ": [calibrate] predict" : "--predict";
+  const std::string path =
+      cli.empty() ? (fs::path(base.path).parent_path() / base.calibrate.predict).lexically_normal().string() : cli;
+  if (!fs::exists(path)) throw ConfigError(key + ": " + path + " does not exist (a membrane test's config)");
+  Config c = load_config(path);
+  check_prediction_template(c, key);
+  return c;
+}
+
+/// A material's calibration as the prediction needs it: its tests, the model, and the periodic cell's tests at it.
+struct Calibrated {
+  std::vector<MeasuredTest> tests;
+  Model model;
+  std::vector<MeasuredTest> sim;  ///< in the order of tests
+};
+
 /// What calibrate and diagnose share: the data, the free parameters, the simulator and a new result folder.
 struct Session {
   MeasuredData data;
   ReferenceValues ref;
   std::vector<FreeParam> free;
   StateMatch state;  ///< the data's void ratio and the preparation that packs it
+  std::optional<Config> predict_template;
   PeriodicLab lab;
-  std::string folder;
+  std::string folder, output;
   Session(const Config& base, const CalibrationOptions& o, const std::string& kind)
       : data(load_measured(o.data)),
         ref(o.reference.empty() ? ReferenceValues{}
                                 : load_reference(o.reference, [](const std::string& n) { free_param(n); })),
-        free(free_params(base, o.free)), lab(matched(base, o.jobs), true, o.jobs), folder(new_dated_folder(o.output, kind)) {
+        free(free_params(base, o.free)), predict_template(prediction_template(base, o.predict)),
+        lab(matched(base, o.jobs), true, o.jobs), folder(new_dated_folder(o.output, kind)), output(o.output) {
     if (o.noise == "data" || o.noise == "lab") noise.mode = o.noise;
     else noise = lab_noise_options(o.noise);
     for (const std::string& n : data.notes) std::printf("%s: note: %s\n", kind.c_str(), n.c_str());
@@ -134,6 +158,49 @@ struct Session {
     auto v = m->second.find(name);
     return v == m->second.end() ? std::nan("") : v->second;
   }
+  /// The membrane test at each material's calibrated model (`models`, by material), beside the data: writes
+  /// prediction.csv, prediction_curves.csv and prediction.png, prints the table, and returns it as Markdown ("" when
+  /// there is no template).
+  std::string predict_membrane(const Config& base, const std::map<std::string, Calibrated>& models) const {
+    if (!predict_template) {
+      std::printf("%s: no membrane prediction ([calibrate] predict or --predict names a membrane test)\n",
+                  folder.c_str());
+      return "";
+    }
+    const Config& t = *predict_template;
+    std::vector<std::string> names;
+    for (const FreeParam& f : free) names.push_back(f.name);
+    std::vector<Prediction> all;
+    std::vector<MeasuredTest> curves;
+    for (const auto& [material, cal] : models) {
+      const std::vector<MeasuredTest>& tests = cal.tests;
+      std::printf("%s: %s: predicting the membrane test (%s) at the calibrated parameters: %zu pressures x %ld "
+                  "specimens\n", folder.c_str(), material.c_str(), t.path.c_str(), tests.size(),
+                  base.calibrate.predict_specimens);
+      std::vector<Prediction> p = predict(t, cal.model, names, tests, data.q_measure,
+                                          static_cast<int>(base.calibrate.predict_specimens), output + "/.specimens",
+                                          true);
+      for (std::size_t k = 0; k < p.size() && k < cal.sim.size(); ++k) p[k].periodic_q_peak = cal.sim[k].q_peak;
+      for (Prediction& x : p) {
+        curves.insert(curves.end(), x.members.begin(), x.members.end());
+        all.push_back(std::move(x));
+      }
+    }
+    const std::string md = prediction_markdown(all, data.q_measure);
+    io::write_text_atomic(folder + "/prediction.csv", prediction_csv(all, data.q_measure));
+    write_measured_curves(folder + "/prediction_curves.csv", curves,
+                          "membrane tests predicted at the calibrated parameters, " + t.path,
+                          name_of(data.q_measure));
+    std::printf("\nprediction (%s, the membrane test at the calibrated parameters):\n%s", t.path.c_str(), md.c_str());
+    run_plot_script("plot_prediction.py", {folder});
+    return "## Prediction: the membrane test\n\nThe calibration's periodic cell measures the grains inside a "
+           "specimen, free of any boundary; the lab measured a membrane-confined cylinder at its platens (q as " +
+           std::string(name_of(data.q_measure)) + "). The membrane test of " + t.path + " (" +
+           std::to_string(t.particles.diameter > 0 ? static_cast<long>(t.specimen.diameter / t.particles.diameter) : 0) +
+           " particle diameters across) run at each material's calibrated parameters and each pressure of the data, "
+           "on " + std::to_string(base.calibrate.predict_specimens) + " specimens (prediction.csv, "
+           "prediction_curves.csv):\n\n" + md + "\n![predicted membrane tests beside the data](prediction.png)\n";
+  }
   /// The errors table, the curves in the measured-data format and the figure.
   void finish(const std::vector<MeasuredTest>& meas, const std::vector<MeasuredTest>& sim,
               const std::string& what) const {
@@ -162,6 +229,7 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
   std::ostringstream table;
   table << "material,parameter,value,low95,high95,reference,chi2,data,runs\n";
   std::vector<MeasuredTest> all_meas, all_sim;
+  std::map<std::string, Calibrated> models;
   for (const auto& [material, tests] : by_material(ss.data, o.material)) {
     std::printf("calibrate: %s, %zu tests, free %zu parameters, %zu balls in the periodic cell\n", material.c_str(),
                 tests.size(), ss.free.size(), ss.lab.balls());
@@ -195,12 +263,15 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
                 ss.lab.runs() - runs0);
     all_meas.insert(all_meas.end(), tests.begin(), tests.end());
     all_sim.insert(all_sim.end(), r.best.sim.begin(), r.best.sim.end());
+    models[material] = Calibrated{tests, r.model, r.best.sim};
   }
   print_errors(all_meas, all_sim);
   io::write_text_atomic(ss.folder + "/calibrated.csv", table.str());
   std::printf("calibrate: %ld runs in %s; results in %s (calibrated.csv, errors.csv, simulated_curves.csv)\n",
               ss.lab.runs(), format_duration(ss.lab.seconds()).c_str(), ss.folder.c_str());
   ss.finish(all_meas, all_sim, "the calibrated parameters");
+  const std::string prediction = ss.predict_membrane(base, models);
+  if (!prediction.empty()) io::write_text_atomic(ss.folder + "/prediction.md", prediction);
   return 0;
 }
 
@@ -224,6 +295,7 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
   for (const std::string& n : ss.data.notes) md << "Note on the data: " << n << "\n\n";
   csv << "material,model,parameter,value,chi2,bic,heldout_chi2,runs\n";
   std::vector<MeasuredTest> all_meas, all_sim, all_ext;
+  std::map<std::string, Calibrated> models;
   for (const auto& [material, tests] : by_material(ss.data, o.material)) {
     const Misfit misfit = ss.misfit_of(base, material, tests);
     const Diagnosis dg = diagnose(ss.lab, model_of(base), ss.free, tests, misfit, true);
@@ -294,6 +366,7 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
     md << "\n";
     all_meas.insert(all_meas.end(), tests.begin(), tests.end());
     all_sim.insert(all_sim.end(), dg.base.best.sim.begin(), dg.base.best.sim.end());
+    models[material] = Calibrated{tests, dg.base.model, dg.base.best.sim};
   }
   md << "![measured and simulated: the base model in full lines, the extended one dashed](calibration.png)\n";
   if (all_ext.size() == all_meas.size())
@@ -303,6 +376,9 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
   std::printf("diagnose: %ld runs in %s; report in %s/diagnosis.md\n", ss.lab.runs(),
               format_duration(ss.lab.seconds()).c_str(), ss.folder.c_str());
   ss.finish(all_meas, all_sim, "the calibrated base model");
+  // The report stands before the membrane tests run; their section is added when they end.
+  const std::string prediction = ss.predict_membrane(base, models);
+  if (!prediction.empty()) io::write_text_atomic(ss.folder + "/diagnosis.md", md.str() + "\n" + prediction);
   return 0;
 }
 

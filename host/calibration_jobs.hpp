@@ -16,6 +16,9 @@ struct CalibrationOptions {
   int jobs = 1;                           ///< simulator runs at once (PeriodicLab::set_jobs)
   std::string reference;                  ///< optional reference values (load_reference) to set beside the fit
   std::string noise = "data";             ///< the data's noise: data, lab or a lab noise file
+  /// The membrane test to predict with (host/prediction.hpp): a config path, "none" for no prediction, or ""
+  /// for the base config's [calibrate] predict.
+  std::string predict;
 };
 
 /// Calibrates each material of the data; writes calibrate_<date>/ under options.output. Returns 0.

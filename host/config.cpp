@@ -227,6 +227,8 @@ Config parse_config(const std::string& text, const std::string& path) {
   cal.integer("scatter_specimens", c.calibrate.scatter_specimens, 1, 64);
   if (!cal.word("cell_factor", "auto", c.calibrate.cell_factor, kAutoCell))
     cal.integer("cell_factor", c.calibrate.cell_factor, 1, 16);
+  cal.string("predict", c.calibrate.predict);
+  cal.integer("predict_specimens", c.calibrate.predict_specimens, 1, 16);
   cal.finish();
 
   for (int d = 0; d < 3; ++d)

@@ -139,6 +139,11 @@ struct CalibrateConfig {
   /// file's "auto"): the config's cell, grown (host/misfit.hpp, measure_misfit) only where an "auto" ensemble of
   /// all the scatter specimens still misses half the data's noise.
   long cell_factor = kAutoCell;
+  /// The membrane test that `calibrate` and `diagnose` end with, at the calibrated parameters and the data's
+  /// pressures (host/prediction.hpp): a config with [specimen] and [triaxial], its path as the file gives it
+  /// (relative to that file's folder); "" for none. `predict_specimens`: specimens (packing seeds) per pressure.
+  std::string predict;
+  long predict_specimens = 2;
 };
 
 /// The [periodic] table: the periodic-cell triaxial test (host/periodic_triaxial.hpp).

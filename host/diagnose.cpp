@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <map>
 #include <random>
@@ -339,13 +340,25 @@ std::vector<MeasuredTest> synthetic_tests(PeriodicLab& lab, const Model& truth, 
 }
 
 void write_measured_curves(const std::string& path, const std::vector<MeasuredTest>& tests,
-                           const std::string& comment) {
+                           const std::string& comment, const std::string& q_measure) {
   const bool volume = std::all_of(tests.begin(), tests.end(), [](const MeasuredTest& t) { return !t.eps_v.empty(); });
   auto all = [&](Real MeasuredTest::*m) {
     return std::all_of(tests.begin(), tests.end(), [&](const MeasuredTest& t) { return std::isfinite(t.*m); });
   };
   const bool state = all(&MeasuredTest::void_ratio), size = all(&MeasuredTest::specimen_balls);
-  std::vector<std::string> columns{"sigma3_kPa", "eps_a_pct", "q_kPa"};
+  // The HDF5 form's table holds numbers: labels are written where each is one (member numbers, seeds).
+  auto label_of = [](const MeasuredTest& t, double& v) {
+    char* end = nullptr;
+    v = std::strtod(t.replicate.c_str(), &end);
+    return !t.replicate.empty() && *end == '\0';
+  };
+  double unused = 0;
+  const bool labels = !tests.empty() && std::all_of(tests.begin(), tests.end(), [&](const MeasuredTest& t) {
+    return label_of(t, unused);
+  });
+  std::vector<std::string> columns{"sigma3_kPa"};
+  if (labels) columns.push_back("test");
+  for (const char* c : {"eps_a_pct", "q_kPa"}) columns.push_back(c);
   if (volume) columns.push_back("eps_v_pct");
   if (state) columns.push_back("void_ratio");
   if (size) columns.push_back("specimen_balls");
@@ -353,19 +366,23 @@ void write_measured_curves(const std::string& path, const std::vector<MeasuredTe
   std::vector<std::string> order;                                 // materials in file order
   for (const MeasuredTest& t : tests) {
     if (!rows.count(t.material)) order.push_back(t.material);
+    double label = 0;
+    if (labels) label_of(t, label);
     for (std::size_t i = 0; i < t.q.size(); ++i) {
-      rows[t.material].push_back({1e-3 * t.sigma3, 100 * t.eps_a[i], 1e-3 * t.q[i]});
+      rows[t.material].push_back({1e-3 * t.sigma3});
+      if (labels) rows[t.material].back().push_back(label);
+      for (double v : {100 * t.eps_a[i], 1e-3 * t.q[i]}) rows[t.material].back().push_back(v);
       if (volume) rows[t.material].back().push_back(100 * t.eps_v[i]);
       if (state) rows[t.material].back().push_back(t.void_ratio);
       if (size) rows[t.material].back().push_back(t.specimen_balls);
     }
   }
-  if (is_hdf5_path(path)) return write_measured_h5(path, columns, rows, comment);
+  if (is_hdf5_path(path)) return write_measured_h5(path, columns, rows, comment, q_measure);
   std::ostringstream f;
   f << "# " << comment << "\n# triaxdem measured-data format (curves): see host/measured.hpp and docs/calibration.md.\n";
   f << "material";
   for (const std::string& c : columns) f << "," << c;
-  f << "\n";
+  f << (q_measure.empty() ? "" : ",q_measure") << "\n";
   char cell[32];
   for (const std::string& m : order)
     for (const std::vector<double>& r : rows[m]) {
@@ -374,7 +391,7 @@ void write_measured_curves(const std::string& path, const std::vector<MeasuredTe
         std::snprintf(cell, sizeof cell, ",%.6g", v);
         f << cell;
       }
-      f << "\n";
+      f << (q_measure.empty() ? "" : "," + q_measure) << "\n";
     }
   io::write_text_atomic(path, f.str());
 }

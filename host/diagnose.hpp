@@ -85,8 +85,9 @@ std::vector<MeasuredTest> synthetic_tests(PeriodicLab& lab, const Model& truth, 
 constexpr int kGeneratorCellFactor = 4;
 
 /// Writes tests as a measured-data curve file (kPa, pct; eps_v, void_ratio and specimen_balls when every test has
-/// them): CSV, or HDF5 when the path ends in .h5 or .hdf5; through a temporary file and a rename.
+/// them, the test labels when every test has one that is a number, and q_measure when given): CSV, or HDF5 when
+/// the path ends in .h5 or .hdf5; through a temporary file and a rename.
 void write_measured_curves(const std::string& path, const std::vector<MeasuredTest>& tests,
-                           const std::string& comment);
+                           const std::string& comment, const std::string& q_measure = "");
 
 }  // namespace dem

@@ -100,6 +100,9 @@ int main(int argc, char** argv) {
                   "curves' own scatter), lab (a lab's fixed scatter) or a lab noise file like "
                   "configs/calibration/lab_noise.toml; default data")
         ->check(CLI::IsMember({"data", "lab"}) | CLI::ExistingFile);
+    c->add_option("--predict", cal.predict, "the membrane test to end with at the calibrated parameters: a config "
+                  "with [specimen] and [triaxial] (configs/small/ by default through [calibrate] predict; "
+                  "configs/paper/ for full scale), or none");
   };
   auto* calibrate = app.add_subcommand("calibrate", "fit the free parameters to measured triaxial data");
   add_calibration(calibrate);

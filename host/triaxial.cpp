@@ -118,15 +118,23 @@ void measure_stresses(const Cell& c, const TriaxialConfig& tc, const ContactSet&
   r.p_net = (net[0] + net[4] + net[8]) / 3;
 }
 
-/// The peak of one measure of q over the records, summarised as q_peak is.
-Real peak_of(const TriaxialResult& r, Real TriaxialRecord::*q, Real sigma3) {
-  if (r.records.empty()) return 0;
-  std::vector<TriaxialRecord> rows = r.records;
-  for (TriaxialRecord& x : rows) x.q = x.*q;
-  return summarised(rows, sigma3).q_peak;
+}  // namespace
+
+Real TriaxialRecord::*q_field(QMeasure m) {
+  switch (m) {
+    case QMeasure::kAreaCorrected: return &TriaxialRecord::q_area;
+    case QMeasure::kParabolic: return &TriaxialRecord::q_parabolic;
+    case QMeasure::kMembraneCorrected: return &TriaxialRecord::q_membrane;
+    case QMeasure::kFixedArea: break;
+  }
+  return &TriaxialRecord::q;
 }
 
-}  // namespace
+MeasuredTest curves_of(const TriaxialResult& r, Real TriaxialRecord::*q, Real sigma3) {
+  std::vector<TriaxialRecord> rows = r.records;
+  for (TriaxialRecord& x : rows) x.q = x.*q;
+  return summarised(rows, sigma3);
+}
 
 TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* out, bool verbose,
                             CheckpointPlan* plan) {
@@ -390,10 +398,12 @@ int triaxial_job(const Config& cfg, bool resume, long stop_at_step) {
     s.balls = static_cast<long>(sp.balls.size());
     s.void_ratio0 = r.void_ratio_consolidated;
     s.q_peak = r.q_peak;
-    s.q_peak_area = peak_of(r, &TriaxialRecord::q_area, cfg.triaxial.sigma3);
-    s.q_peak_parabolic = peak_of(r, &TriaxialRecord::q_parabolic, cfg.triaxial.sigma3);
-    s.q_peak_membrane = peak_of(r, &TriaxialRecord::q_membrane, cfg.triaxial.sigma3);
-    s.q_peak_lw = peak_of(r, &TriaxialRecord::q_lw, cfg.triaxial.sigma3);
+    if (!r.records.empty()) {
+      s.q_peak_area = curves_of(r, q_field(QMeasure::kAreaCorrected), s.sigma3).q_peak;
+      s.q_peak_parabolic = curves_of(r, q_field(QMeasure::kParabolic), s.sigma3).q_peak;
+      s.q_peak_membrane = curves_of(r, q_field(QMeasure::kMembraneCorrected), s.sigma3).q_peak;
+      s.q_peak_lw = curves_of(r, &TriaxialRecord::q_lw, s.sigma3).q_peak;
+    }
     s.phi_peak_deg = r.phi_peak_deg;
     s.eps_a_peak = r.eps_a_peak;
     s.q_end = r.q_end;

@@ -10,6 +10,7 @@
 #include "host/micro_report.hpp"
 #include "host/specimen.hpp"
 #include "io_hdf5.hpp"
+#include "measured.hpp"
 #include "simulation.hpp"
 
 namespace dem {
@@ -56,6 +57,13 @@ struct TriaxialResult {
   long steps = 0;              ///< time steps of consolidation and shear
   long balls = 0;
 };
+
+/// The record's field that holds q as a lab reporting `m` computes it.
+Real TriaxialRecord::*q_field(QMeasure m);
+
+/// The shear's curves with q from the records' field `q` (q_field(m), or q_lw), eps_v from the membrane,
+/// summarised like measured curves.
+MeasuredTest curves_of(const TriaxialResult& r, Real TriaxialRecord::*q, Real sigma3);
 
 /// Runs consolidation and shear on `specimen`; writes series and snapshots to `out` when given. With a
 /// `plan`: checkpoints (the simulation, the stage, the records and the output so far) as it says, continues

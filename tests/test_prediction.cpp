@@ -1,0 +1,117 @@
+// The loop closed (host/prediction.hpp): the membrane test at calibrated parameters beside the data, on the tiny
+// membrane specimen of test_triaxial.cpp (16 mm, 452 beads, seconds a run).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include "host/calibrate.hpp"
+#include "host/diagnose.hpp"
+#include "host/io_hdf5.hpp"
+#include "host/prediction.hpp"
+#include "host/triaxial.hpp"
+#include "test_util.hpp"
+
+using namespace dem;
+
+namespace {
+
+std::string refusal(const Config& c, const std::string& key) {
+  try {
+    check_prediction_template(c, key);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+// The template gets the calibrated contact parameters, on the balls and on the walls where it gives them no
+// law of their own, the data's pressure and the member's packing seed; the periodic cell's membrane extension
+// is no parameter of the membrane test and is left out.
+TEST(Prediction, TheTemplateTakesTheCalibratedContactParameters) {
+  Config t = test::tiny_triaxial_config(0.15, 0.015);
+  t.path = "tiny.toml";
+  t.wall.mu_r = 0.1;  // the walls' own rolling resistance
+  Model m{t.ball, 0};
+  set_param(m, "mu_s", 0.3);
+  set_param(m, "mu_r", 0.04);
+  set_param(m, "membrane_kPa", 50e3);
+  const Config c = prediction_config(t, m, {"mu_s", "mu_r", "membrane_kPa"}, 200e3, 2);
+  EXPECT_EQ(c.ball.mu_s, 0.3);
+  EXPECT_EQ(c.ball.mu_r, 0.04);
+  EXPECT_EQ(c.wall.mu_s, 0.3);   // followed the balls, as the template's wall did
+  EXPECT_EQ(c.wall.mu_r, 0.1);   // its own value kept
+  EXPECT_EQ(c.triaxial.sigma3, 200e3);
+  EXPECT_EQ(c.run.seed, t.run.seed + 2);
+  EXPECT_EQ(c.ball.emod, t.ball.emod);  // not free: the template's
+}
+
+// A periodic config is no membrane test, and a specimen under 8 diameters across is refused with the key and
+// the smallest size; the tiny specimen (8 across) passes.
+TEST(Prediction, ATemplateThatCannotHoldTheSpecimenIsRefused) {
+  Config t = test::tiny_triaxial_config(0.15, 0.015);
+  t.path = "tiny.toml";
+  EXPECT_EQ(refusal(t, "--predict"), "");
+  t.specimen.diameter = 12e-3;
+  const std::string e = refusal(t, "--predict");
+  EXPECT_NE(e.find("tiny.toml: [specimen] diameter_mm: 12 mm is 6.0 particle diameters across; a membrane test "
+                   "for --predict needs at least 8 (16 mm)"),
+            std::string::npos) << e;
+  t.has_specimen = false;
+  EXPECT_NE(refusal(t, "[calibrate] predict").find("not a membrane test"), std::string::npos);
+}
+
+// Each prediction is the membrane test itself at the calibrated parameters (the same run, bit for bit), its q in
+// the data's measure; the error is against the data's peak; a stronger friction predicts a stronger specimen.
+TEST(Prediction, EachPressureIsTheMembraneTestAtTheCalibratedParameters) {
+  const auto dir = test::scratch_dir("prediction");
+  const Config t = test::tiny_triaxial_config(0.15, 0.015);
+  Model m{t.ball, 0};
+  set_param(m, "mu_s", 0.3);
+  std::vector<MeasuredTest> data(2);
+  data[0].material = data[1].material = "S-x";
+  data[0].sigma3 = 100e3;
+  data[1].sigma3 = 200e3;
+  data[0].q_peak = 150e3;
+  data[1].q_peak = 300e3;
+  const std::vector<Prediction> p =
+      predict(t, m, {"mu_s"}, data, QMeasure::kAreaCorrected, 1, (dir / "specimens").string(), false);
+  ASSERT_EQ(p.size(), 2u);
+  for (std::size_t j = 0; j < 2; ++j) {
+    ASSERT_EQ(p[j].members.size(), 1u);
+    EXPECT_EQ(p[j].q_peak_mean, p[j].members[0].q_peak);
+    EXPECT_EQ(p[j].q_peak_sd, 0.0);
+    EXPECT_NEAR(p[j].error, (p[j].q_peak_mean - data[j].q_peak) / data[j].q_peak, 1e-15);
+  }
+  {  // the first pressure run again by hand
+    const std::size_t j = 0;
+    const Config c = prediction_config(t, m, {"mu_s"}, data[j].sigma3, 0);
+    const TriaxialResult r = run_triaxial(c, build_specimen(c, false), nullptr, false);
+    EXPECT_EQ(p[j].members[0].q_peak, curves_of(r, &TriaxialRecord::q_area, data[j].sigma3).q_peak);
+    EXPECT_NE(p[j].members[0].q_peak, r.q_peak);  // the fixed-area q is another number
+  }
+  EXPECT_GT(p[1].q_peak_mean, p[0].q_peak_mean);  // the higher pressure
+  set_param(m, "mu_s", 0.05);
+  const std::vector<Prediction> weak =
+      predict(t, m, {"mu_s"}, {data[0]}, QMeasure::kAreaCorrected, 1, (dir / "specimens").string(), false);
+  EXPECT_LT(weak[0].q_peak_mean, 0.9 * p[0].q_peak_mean);
+  const std::string md = prediction_markdown(p, QMeasure::kAreaCorrected);
+  EXPECT_NE(md.find("q as the data report it: area_corrected"), std::string::npos) << md;
+  // The files a calibration writes, and the figure tools/plot_prediction.py draws from them.
+  io::write_text_atomic((dir / "prediction.csv").string(), prediction_csv(p, QMeasure::kAreaCorrected));
+  std::vector<MeasuredTest> curves;
+  for (const Prediction& x : p) curves.insert(curves.end(), x.members.begin(), x.members.end());
+  write_measured_curves((dir / "prediction_curves.csv").string(), curves, "test", "area_corrected");
+  const MeasuredData back = load_measured((dir / "prediction_curves.csv").string());
+  EXPECT_EQ(back.q_measure, QMeasure::kAreaCorrected);
+  ASSERT_EQ(back.tests.size(), 2u);
+  EXPECT_EQ(back.tests[0].replicate, "1");
+  const std::string cmd = std::string("/usr/bin/python3 " TRIAXDEM_SOURCE_DIR "/tools/plot_prediction.py ") +
+                          dir.string() + " > /dev/null";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  EXPECT_TRUE(std::filesystem::exists(dir / "prediction.png"));
+}
