@@ -19,6 +19,8 @@ struct CalibrationOptions {
   /// The membrane test to predict with (host/prediction.hpp): a config path, "none" for no prediction, or ""
   /// for the base config's [calibrate] predict.
   std::string predict;
+  /// The reference test: "periodic", "two_fidelity", or "" for the base config's [calibrate] reference_test.
+  std::string reference_test;
 };
 
 /// Calibrates each material of the data; writes calibrate_<date>/ under options.output. Returns 0.

@@ -229,6 +229,7 @@ Config parse_config(const std::string& text, const std::string& path) {
     cal.integer("cell_factor", c.calibrate.cell_factor, 1, 16);
   cal.string("predict", c.calibrate.predict);
   cal.integer("predict_specimens", c.calibrate.predict_specimens, 1, 16);
+  cal.string("reference_test", c.calibrate.reference_test, {"periodic", "two_fidelity"});
   cal.finish();
 
   for (int d = 0; d < 3; ++d)

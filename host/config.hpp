@@ -144,6 +144,10 @@ struct CalibrateConfig {
   /// (relative to that file's folder); "" for none. `predict_specimens`: specimens (packing seeds) per pressure.
   std::string predict;
   long predict_specimens = 2;
+  /// The test the calibration fits (host/two_fidelity.hpp): "periodic" (the cell alone: it measures the grains
+  /// inside a specimen, not the lab's boundary) or "two_fidelity" (the cell corrected by the `predict` membrane
+  /// test at its optimum, then calibrated again).
+  std::string reference_test = "periodic";
 };
 
 /// The [periodic] table: the periodic-cell triaxial test (host/periodic_triaxial.hpp).

@@ -103,6 +103,9 @@ int main(int argc, char** argv) {
     c->add_option("--predict", cal.predict, "the membrane test to end with at the calibrated parameters: a config "
                   "with [specimen] and [triaxial] (configs/small/ by default through [calibrate] predict; "
                   "configs/paper/ for full scale), or none");
+    c->add_option("--reference-test", cal.reference_test, "what the calibration fits: periodic (the cell) or "
+                  "two_fidelity (the cell corrected by the --predict membrane test); default: [calibrate] "
+                  "reference_test")->check(CLI::IsMember({"periodic", "two_fidelity"}));
   };
   auto* calibrate = app.add_subcommand("calibrate", "fit the free parameters to measured triaxial data");
   add_calibration(calibrate);

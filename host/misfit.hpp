@@ -89,6 +89,8 @@ struct Feature {
   Real measured = 0;
   Real data_sd = 0, specimen_sd = 0, ensemble_sd = 0;  ///< ensemble_sd: one member's; the mean's is / sqrt(K)
   Real cell_sd = 0;  ///< the simulator's finite-cell bias against the data's specimen (host/cell_bias.hpp)
+  /// The uncertainty of the measured discrepancy between the reference test and this simulator (add_discrepancy).
+  Real discrepancy_sd = 0;
   /// The data side's noise: the measured curve's and the measured specimen's, what the simulator's parts are set
   /// against.
   Real data_noise() const { return std::hypot(data_sd, specimen_sd); }
@@ -128,6 +130,11 @@ class Misfit {
   /// Sigma_cell: adds the simulator's finite-cell bias, sd[test][feature] (host/cell_bias.hpp), correlated along
   /// strain as the ensemble's scatter is (a bias moves a curve smoothly); `note` says how it was measured.
   void add_cell_bias(const std::vector<std::vector<Real>>& sd, const std::string& note);
+  /// Two fidelities (host/two_fidelity.hpp): the data are what the reference test measures, which exceeds what this
+  /// simulator gives at the same parameters by delta[test][feature]; the simulator is then compared with the data
+  /// less delta, and delta's uncertainty sd[test][feature] is counted, correlated along strain as a bias is.
+  void add_discrepancy(const std::vector<std::vector<Real>>& delta, const std::vector<std::vector<Real>>& sd,
+                       const std::string& note);
   /// The scatter specimens' mean void ratio at the start of shear of test k, at the base model.
   Real reached_void_ratio(std::size_t k) const { return void_ratio_[k]; }
 
@@ -137,6 +144,8 @@ class Misfit {
   void build_curve_noise(const std::vector<MeasuredTest>& measured, const NoiseOptions& noise, const Ensemble& ref,
                          Real sim_balls);
   void build_summary_noise(const std::vector<MeasuredTest>& measured, const NoiseOptions& noise, const Ensemble& ref);
+  /// Sets each feature's `field` to sd[test][feature] and adds it to Sigma, correlated along strain.
+  void add_correlated(const std::vector<std::vector<Real>>& sd, Real Feature::*field, const std::string& what);
   std::vector<std::vector<Feature>> features_;
   std::vector<std::vector<Real>> cov_;   ///< per test, Sigma (n x n, row-major)
   std::vector<std::string> notes_;

@@ -237,17 +237,32 @@ void Misfit::build_curve_noise(const std::vector<MeasuredTest>& measured, const 
                      fmt(", eps_v %.3g%%", 100 * noise.lab.ev_rel) + fmt(" or %.3g%%)", 100 * noise.lab.ev_abs));
 }
 
-void Misfit::add_cell_bias(const std::vector<std::vector<Real>>& sd, const std::string& note) {
-  if (sd.size() != features_.size()) throw std::logic_error("misfit: a cell bias for other tests");
+void Misfit::add_correlated(const std::vector<std::vector<Real>>& sd, Real Feature::*field, const std::string& what) {
+  if (sd.size() != features_.size()) throw std::logic_error("misfit: a " + what + " for other tests");
   for (std::size_t k = 0; k < features_.size(); ++k) {
     std::vector<Feature>& fs = features_[k];
     const int n = static_cast<int>(fs.size());
-    if (static_cast<int>(sd[k].size()) != n) throw std::logic_error("misfit: a cell bias for other data");
-    for (int i = 0; i < n; ++i) fs[i].cell_sd = sd[k][i];
+    if (static_cast<int>(sd[k].size()) != n) throw std::logic_error("misfit: a " + what + " for other data");
+    for (int i = 0; i < n; ++i) fs[i].*field = sd[k][i];
     for_each_pair(fs, length_, curves_, [&](int i, int j, Real rho) {
-      cov_[k][static_cast<std::size_t>(i) * n + j] += rho * fs[i].cell_sd * fs[j].cell_sd;
+      cov_[k][static_cast<std::size_t>(i) * n + j] += rho * fs[i].*field * fs[j].*field;
     });
   }
+}
+
+void Misfit::add_cell_bias(const std::vector<std::vector<Real>>& sd, const std::string& note) {
+  add_correlated(sd, &Feature::cell_sd, "cell bias");
+  notes_.push_back(note);
+}
+
+void Misfit::add_discrepancy(const std::vector<std::vector<Real>>& delta, const std::vector<std::vector<Real>>& sd,
+                             const std::string& note) {
+  if (delta.size() != features_.size()) throw std::logic_error("misfit: a discrepancy for other tests");
+  for (std::size_t k = 0; k < features_.size(); ++k)
+    if (delta[k].size() != features_[k].size()) throw std::logic_error("misfit: a discrepancy for other data");
+  add_correlated(sd, &Feature::discrepancy_sd, "discrepancy");
+  for (std::size_t k = 0; k < features_.size(); ++k)
+    for (std::size_t i = 0; i < delta[k].size(); ++i) features_[k][i].measured -= delta[k][i];
   notes_.push_back(note);
 }
 

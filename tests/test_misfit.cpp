@@ -10,6 +10,7 @@
 #include "host/cell_bias.hpp"
 #include "host/config.hpp"
 #include "host/misfit.hpp"
+#include "host/two_fidelity.hpp"
 #include "test_util.hpp"
 
 using namespace dem;
@@ -294,4 +295,41 @@ TEST(CellBias, ACountedBiasTakesUpTheShiftItMeasuredAndNothingElse) {
   EXPECT_NEAR(chi2(m.test_residuals(0, {contracts})), volume_before, 1e-6 * volume_before);
   for (const Feature& f : m.features(0))
     if (f.quantity == 0) EXPECT_NEAR(f.cell_sd, 0.1 * f.measured, 1e-6 * f.measured) << f.name;
+}
+
+// Two fidelities (host/two_fidelity.hpp): the lab's test reads q 30% above what the periodic cell gives at the same
+// parameters. Compared with the data as they are, the cell at the true parameters is far outside the noise; with
+// the discrepancy measured (membrane specimens against periodic ones at those parameters) and taken off the data,
+// it fits, and the discrepancy's standard error is what its two sets of specimens scatter by: two membrane
+// specimens at +-2% of q, four periodic ones at +-1%, so sqrt((1.3 x 2%)^2 + 1%^2 / 3) of the cell's q.
+TEST(TwoFidelity, TheDataLessTheMeasuredExcessFitAndItsErrorIsCounted) {
+  const MeasuredTest lab = smooth_test(100e3);
+  MeasuredTest cell = lab;
+  for (Real& q : cell.q) q /= 1.3;
+  summarise(cell);
+  Misfit m({lab}, NoiseOptions(), Ensemble{members_of(cell, 8, 0.01)}, 8, 0.1);
+  const Ensemble periodic{members_of(cell, 4, 0.01)};
+  Prediction membrane;
+  membrane.members = members_of(lab, 2, 0.02);
+  const Real before = chi2(m.test_residuals(0, periodic[0]));
+  ASSERT_GT(before, 50);
+  const Discrepancy d = measure_discrepancy(m, {membrane}, periodic);
+  const std::vector<Feature>& fs = m.features(0);
+  for (std::size_t i = 0; i < fs.size(); ++i) {
+    const Real cell_value = m.mean_values(0, periodic[0])[i];
+    if (fs[i].quantity == 0) {
+      EXPECT_NEAR(d.delta[0][i], 0.3 * cell_value, 1e-6 * cell_value) << fs[i].name;
+      EXPECT_NEAR(d.sd[0][i], std::sqrt(std::pow(1.3 * 0.02, 2) + 1e-4 / 3) * cell_value, 1e-6 * cell_value)
+          << fs[i].name;
+    } else {
+      EXPECT_NEAR(d.delta[0][i], 0, 1e-12) << fs[i].name;  // eps_v: the two read the same
+    }
+  }
+  m.add_discrepancy(d.delta, d.sd, "test");
+  EXPECT_LT(chi2(m.test_residuals(0, periodic[0])), 1);
+  for (const Feature& f : m.features(0))
+    if (f.quantity == 0) EXPECT_GT(f.discrepancy_sd, 0) << f.name;
+  Prediction alone;
+  alone.members = {lab};
+  EXPECT_THROW(measure_discrepancy(m, {alone}, periodic), std::invalid_argument);  // one specimen: no scatter
 }

@@ -1,0 +1,72 @@
+#include "two_fidelity.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "text_format.hpp"
+
+namespace dem {
+
+namespace {
+
+/// Per feature: the sample variance of the members' values about their mean, over the members that have one.
+std::vector<Real> sample_variance(const Misfit& misfit, std::size_t k, const std::vector<MeasuredTest>& members,
+                                  const std::vector<Real>& mean) {
+  std::vector<Real> sum(mean.size(), 0);
+  std::vector<int> n(mean.size(), 0);
+  for (const MeasuredTest& t : members) {
+    const std::vector<Real> v = misfit.mean_values(k, {t});
+    for (std::size_t f = 0; f < v.size(); ++f)
+      if (std::isfinite(v[f])) sum[f] += (v[f] - mean[f]) * (v[f] - mean[f]), ++n[f];
+  }
+  for (std::size_t f = 0; f < sum.size(); ++f) sum[f] = n[f] > 1 ? sum[f] / (n[f] - 1) : 0;
+  return sum;
+}
+
+}  // namespace
+
+Discrepancy measure_discrepancy(const Misfit& misfit, const std::vector<Prediction>& membrane,
+                                const Ensemble& periodic) {
+  if (membrane.size() != misfit.tests() || periodic.size() != misfit.tests())
+    throw std::logic_error("two-fidelity: runs for other tests than the misfit's");
+  Discrepancy d;
+  for (std::size_t k = 0; k < misfit.tests(); ++k) {
+    const std::vector<MeasuredTest>& mem = membrane[k].members;
+    if (mem.size() < 2 || periodic[k].size() < 2)
+      throw std::invalid_argument("two-fidelity: the discrepancy's scatter needs at least 2 specimens of each test "
+                                  "([calibrate] predict_specimens and the ensemble)");
+    const std::vector<Real> m = misfit.mean_values(k, mem), p = misfit.mean_values(k, periodic[k]);
+    const std::vector<Real> vm = sample_variance(misfit, k, mem, m), vp = sample_variance(misfit, k, periodic[k], p);
+    std::vector<Real> delta(m.size()), sd(m.size());
+    for (std::size_t f = 0; f < m.size(); ++f) {
+      // A feature one of the tests does not reach (a strain beyond its curve) is left uncorrected, uncounted.
+      const bool both = std::isfinite(m[f]) && std::isfinite(p[f]);
+      delta[f] = both ? m[f] - p[f] : 0;
+      sd[f] = both ? std::sqrt(vm[f] / static_cast<Real>(mem.size()) + vp[f] / static_cast<Real>(periodic[k].size()))
+                   : 0;
+    }
+    d.delta.push_back(delta);
+    d.sd.push_back(sd);
+  }
+  return d;
+}
+
+std::string discrepancy_text(const Misfit& misfit, const Discrepancy& d, const std::vector<MeasuredTest>& tests) {
+  std::string s;
+  for (std::size_t k = 0; k < d.delta.size(); ++k) {
+    Real delta = 0, sd = 0;
+    int n = 0;
+    const std::vector<Feature>& fs = misfit.features(k);
+    for (std::size_t f = 0; f < fs.size(); ++f)
+      // q of a curve (quantity 0 at a strain), or a summary stress (q_peak, q_end, q_1pct, q_3pct).
+      if (fs[f].strain > 0 ? fs[f].quantity == 0 : fs[f].name.rfind("q_", 0) == 0)
+        delta += d.delta[k][f], sd += d.sd[k][f], ++n;
+    if (n == 0) continue;
+    s += tests[k].material + fmt(" at %g kPa: the membrane test reads ", 1e-3 * tests[k].sigma3) +
+         fmt("%+.1f kPa", 1e-3 * delta / n) + fmt(" (+- %.1f) in q over the periodic cell", 1e-3 * sd / n) +
+         fmt(" (mean over %d compared q values)\n", n);
+  }
+  return s;
+}
+
+}  // namespace dem

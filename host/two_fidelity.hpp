@@ -1,0 +1,32 @@
+#pragma once
+/// The two-fidelity calibration (issue 39): the periodic cell drives the search, and the membrane test, the test
+/// the lab ran, corrects it. At the periodic optimum both run at every pressure of the data; their difference in
+/// each compared feature (the membrane test's specimens against the periodic ensemble, in the q the data report)
+/// is the discrepancy the boundary makes. The periodic cell is then calibrated again against the data less that
+/// discrepancy, its uncertainty counted in the misfit (Misfit::add_discrepancy), so that it reaches the
+/// intervals. The discrepancy is taken as constant near the optimum; the prediction at the new optimum
+/// (host/prediction.hpp) shows how far that holds. Kennedy & O'Hagan (2000) call the idea autoregressive
+/// co-kriging; here the correction is a measured offset per feature, not a fitted process
+/// (shared/notes/triaxial_measures.md, section 4).
+#include <string>
+#include <vector>
+
+#include "misfit.hpp"
+#include "prediction.hpp"
+
+namespace dem {
+
+/// The membrane test's excess over the periodic cell in each feature of the misfit, with its standard error.
+struct Discrepancy {
+  std::vector<std::vector<Real>> delta, sd;  ///< [test][feature], the feature's unit (Pa for q)
+};
+
+/// delta = mean over the membrane test's specimens - mean over the periodic ensemble, per feature of `misfit`;
+/// sd = sqrt(s_m^2 / K_m + s_p^2 / K_p) from the two sets' sample scatter (K_m, K_p >= 2; a set of one gives no
+/// scatter and is refused). `membrane[k].members` and `periodic[k]` run test k of the misfit.
+Discrepancy measure_discrepancy(const Misfit& misfit, const std::vector<Prediction>& membrane, const Ensemble& periodic);
+
+/// The discrepancy in words for the report: per test, delta and sd of the features' q (kPa), mean over them.
+std::string discrepancy_text(const Misfit& misfit, const Discrepancy& d, const std::vector<MeasuredTest>& tests);
+
+}  // namespace dem
