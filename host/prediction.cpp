@@ -50,8 +50,10 @@ std::vector<Prediction> predict(const Config& membrane, const Model& calibrated,
   long done = 0;
   for (int k = 0; k < specimens; ++k) {
     // Friction and pressure do not change the specimen: one packing per member serves every test.
+    if (verbose) std::printf("prediction: specimen %d of %d (packed once, then cached in %s)\n", k + 1, specimens,
+                             cache.c_str());
     const Specimen sp = cached_specimen(prediction_config(membrane, calibrated, free, membrane.triaxial.sigma3, k),
-                                        cache, false);
+                                        cache, verbose);
     for (std::size_t j = 0; j < tests.size(); ++j) {
       const Config c = prediction_config(membrane, calibrated, free, tests[j].sigma3, k);
       const TriaxialResult r = run_triaxial(c, sp, nullptr, false);

@@ -55,7 +55,8 @@ def main():
     if not materials:
         sys.exit(f"plot_prediction: {args.folder}/prediction_curves.csv holds no curves")
     measure = table[0]["q_measure"] if table else "fixed_area"
-    fig, ax = plt.subplots(2, len(materials), figsize=(4.2 * len(materials), 6.6), squeeze=False, sharex=True)
+    fig, ax = plt.subplots(2, len(materials), figsize=(max(6.0, 4.2 * len(materials)), 6.6), squeeze=False,
+                           sharex=True)
     for c, m in enumerate(materials):
         pressures = sorted({k[1] for k in pred if k[0] == m})
         for i, s3 in enumerate(pressures):
@@ -81,7 +82,7 @@ def main():
     ax[1][0].set_ylabel("volumetric strain eps_v (%, contraction +)")
     for a in ax[0]:
         a.legend(fontsize=7)
-    fig.suptitle("membrane test at the calibrated parameters (lines) against the data", fontsize=10)
+    fig.suptitle("membrane test at the calibrated parameters (lines), the data (marks)", fontsize=9)
     fig.tight_layout()
     out = args.output or os.path.join(args.folder, "prediction.png")
     fig.savefig(out, dpi=130)
