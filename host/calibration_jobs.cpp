@@ -255,7 +255,10 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
   table << "material,parameter,value,low95,high95,reference,chi2,data,runs\n";
   std::vector<MeasuredTest> all_meas, all_sim;
   std::map<std::string, Calibrated> models;
-  for (const auto& [material, tests] : by_material(ss.data, o.material)) {
+  for (const auto& by : by_material(ss.data, o.material)) {
+    // Named, not structured, bindings: a lambda below captures them (C++17 cannot capture a structured binding).
+    const std::string& material = by.first;
+    const std::vector<MeasuredTest>& tests = by.second;
     std::printf("calibrate: %s, %zu tests, free %zu parameters, %zu balls in the periodic cell\n", material.c_str(),
                 tests.size(), ss.free.size(), ss.lab.balls());
     const long runs0 = ss.lab.runs();

@@ -25,6 +25,11 @@ std::vector<Real> sample_variance(const Misfit& misfit, std::size_t k, const std
 
 }  // namespace
 
+bool scales_with_stress(const Feature& f) {
+  if (f.strain > 0) return f.quantity == 0;  // a curve's q (eps_v is quantity 1)
+  return f.quantity != kStrainAtPeak && f.quantity != kDilatancy;
+}
+
 Discrepancy measure_discrepancy(const Misfit& misfit, const std::vector<Prediction>& membrane,
                                 const Ensemble& periodic) {
   if (membrane.size() != misfit.tests() || periodic.size() != misfit.tests())
@@ -37,13 +42,21 @@ Discrepancy measure_discrepancy(const Misfit& misfit, const std::vector<Predicti
                                   "([calibrate] predict_specimens and the ensemble)");
     const std::vector<Real> m = misfit.mean_values(k, mem), p = misfit.mean_values(k, periodic[k]);
     const std::vector<Real> vm = sample_variance(misfit, k, mem, m), vp = sample_variance(misfit, k, periodic[k], p);
-    std::vector<Real> delta(m.size()), sd(m.size());
+    const Real km = static_cast<Real>(mem.size()), kp = static_cast<Real>(periodic[k].size());
+    const std::vector<Feature>& fs = misfit.features(k);
+    std::vector<Real> delta(m.size(), 0), sd(m.size(), 0);
     for (std::size_t f = 0; f < m.size(); ++f) {
       // A feature one of the tests does not reach (a strain beyond its curve) is left uncorrected, uncounted.
-      const bool both = std::isfinite(m[f]) && std::isfinite(p[f]);
-      delta[f] = both ? m[f] - p[f] : 0;
-      sd[f] = both ? std::sqrt(vm[f] / static_cast<Real>(mem.size()) + vp[f] / static_cast<Real>(periodic[k].size()))
-                   : 0;
+      if (!(std::isfinite(m[f]) && std::isfinite(p[f]))) continue;
+      if (scales_with_stress(fs[f]) && m[f] > 0 && p[f] > 0) {
+        // The cell reads rho = p / m of the membrane test: the data's value y becomes rho y, delta = (1 - rho) y.
+        const Real rho = p[f] / m[f], y = fs[f].measured;
+        delta[f] = (1 - rho) * y;
+        sd[f] = std::fabs(rho * y) * std::sqrt(vm[f] / (km * m[f] * m[f]) + vp[f] / (kp * p[f] * p[f]));
+      } else {
+        delta[f] = m[f] - p[f];
+        sd[f] = std::sqrt(vm[f] / km + vp[f] / kp);
+      }
     }
     d.delta.push_back(delta);
     d.sd.push_back(sd);
@@ -58,8 +71,7 @@ std::string discrepancy_text(const Misfit& misfit, const Discrepancy& d, const s
     int n = 0;
     const std::vector<Feature>& fs = misfit.features(k);
     for (std::size_t f = 0; f < fs.size(); ++f)
-      // q of a curve (quantity 0 at a strain), or a summary stress (q_peak, q_end, q_1pct, q_3pct).
-      if (fs[f].strain > 0 ? fs[f].quantity == 0 : fs[f].name.rfind("q_", 0) == 0)
+      if (scales_with_stress(fs[f]) && (fs[f].strain > 0 || fs[f].quantity != kInitialStiffness))
         delta += d.delta[k][f], sd += d.sd[k][f], ++n;
     if (n == 0) continue;
     s += tests[k].material + fmt(" at %g kPa: the membrane test reads ", 1e-3 * tests[k].sigma3) +

@@ -21,9 +21,16 @@ struct Discrepancy {
   std::vector<std::vector<Real>> delta, sd;  ///< [test][feature], the feature's unit (Pa for q)
 };
 
-/// delta = mean over the membrane test's specimens - mean over the periodic ensemble, per feature of `misfit`;
-/// sd = sqrt(s_m^2 / K_m + s_p^2 / K_p) from the two sets' sample scatter (K_m, K_p >= 2; a set of one gives no
-/// scatter and is refused). `membrane[k].members` and `periodic[k]` run test k of the misfit.
+/// Whether a feature is a stress (q at a strain; E_ini, q_1pct, q_3pct, q_peak, q_end): the boundary scales it
+/// (the bulge's area, the walls' layer), so the discrepancy is taken as a ratio; strains (eps_v, eps_a at the peak,
+/// dilatancy) take it as a difference.
+bool scales_with_stress(const Feature& f);
+
+/// Per feature of `misfit`, with m and p the means over the membrane test's specimens and the periodic ensemble:
+/// for a stress, the cell reads rho = p / m of the membrane test, and the datum y is corrected by
+/// delta = (1 - rho) y; for a strain, delta = m - p. sd from the two sets' sample scatter s_m, s_p over K_m, K_p
+/// specimens: |rho y| sqrt(s_m^2 / (K_m m^2) + s_p^2 / (K_p p^2)) or sqrt(s_m^2 / K_m + s_p^2 / K_p) (K_m, K_p >= 2;
+/// a set of one gives no scatter and is refused). `membrane[k].members` and `periodic[k]` run test k of the misfit.
 Discrepancy measure_discrepancy(const Misfit& misfit, const std::vector<Prediction>& membrane, const Ensemble& periodic);
 
 /// The discrepancy in words for the report: per test, delta and sd of the features' q (kPa), mean over them.

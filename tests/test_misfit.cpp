@@ -301,7 +301,8 @@ TEST(CellBias, ACountedBiasTakesUpTheShiftItMeasuredAndNothingElse) {
 // parameters. Compared with the data as they are, the cell at the true parameters is far outside the noise; with
 // the discrepancy measured (membrane specimens against periodic ones at those parameters) and taken off the data,
 // it fits, and the discrepancy's standard error is what its two sets of specimens scatter by: two membrane
-// specimens at +-2% of q, four periodic ones at +-1%, so sqrt((1.3 x 2%)^2 + 1%^2 / 3) of the cell's q.
+// specimens at +-2% of q, four periodic ones at +-1%: the ratio's relative error is sqrt(2%^2 + 1%^2 / 3), and
+// delta = (1 - 1/1.3) of the datum, which is 0.3 of the cell's value, with that relative error on the cell's value.
 TEST(TwoFidelity, TheDataLessTheMeasuredExcessFitAndItsErrorIsCounted) {
   const MeasuredTest lab = smooth_test(100e3);
   MeasuredTest cell = lab;
@@ -319,7 +320,7 @@ TEST(TwoFidelity, TheDataLessTheMeasuredExcessFitAndItsErrorIsCounted) {
     const Real cell_value = m.mean_values(0, periodic[0])[i];
     if (fs[i].quantity == 0) {
       EXPECT_NEAR(d.delta[0][i], 0.3 * cell_value, 1e-6 * cell_value) << fs[i].name;
-      EXPECT_NEAR(d.sd[0][i], std::sqrt(std::pow(1.3 * 0.02, 2) + 1e-4 / 3) * cell_value, 1e-6 * cell_value)
+      EXPECT_NEAR(d.sd[0][i], std::sqrt(0.02 * 0.02 + 1e-4 / 3) * cell_value, 1e-6 * cell_value)
           << fs[i].name;
     } else {
       EXPECT_NEAR(d.delta[0][i], 0, 1e-12) << fs[i].name;  // eps_v: the two read the same
