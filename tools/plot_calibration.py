@@ -29,15 +29,16 @@ def read_rows(path):
         sys.exit(f"plot_calibration: cannot read {path}: {e.strerror}")
 
 
-def curves(path):
-    """{(material, sigma3_kPa): (eps_a, q, eps_v)} in %, kPa, %."""
+def curves(path, by_test=False):
+    """{(material, sigma3_kPa): (eps_a, q, eps_v)} in %, kPa, % (eps_v NaN where the file has none); with
+    by_test, keyed (material, sigma3_kPa, test label) so that replicates stay apart."""
     out = {}
     for r in read_rows(path):
-        key = (r["material"], float(r["sigma3_kPa"]))
+        key = (r["material"], float(r["sigma3_kPa"])) + ((r.get("test", ""),) if by_test else ())
         e, q, v = out.setdefault(key, ([], [], []))
         e.append(float(r["eps_a_pct"]))
         q.append(float(r["q_kPa"]))
-        v.append(float(r["eps_v_pct"]))
+        v.append(float(r["eps_v_pct"]) if r.get("eps_v_pct") not in (None, "") else float("nan"))
     return out
 
 

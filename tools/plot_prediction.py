@@ -12,7 +12,6 @@ Reads FOLDER/prediction_curves.csv, FOLDER/prediction.csv and, when the data had
 Needs Debian's python3-matplotlib.
 """
 import argparse
-import csv
 import os
 import sys
 
@@ -21,25 +20,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-
-def read_rows(path):
-    try:
-        with open(path, newline="") as f:
-            return list(csv.DictReader(line for line in f if not line.startswith("#")))
-    except OSError as e:
-        sys.exit(f"plot_prediction: cannot read {path}: {e.strerror}")
-
-
-def curves(path):
-    """{(material, sigma3_kPa, test): (eps_a, q, eps_v)} in %, kPa, %."""
-    out = {}
-    for r in read_rows(path):
-        key = (r["material"], float(r["sigma3_kPa"]), r.get("test", ""))
-        e, q, v = out.setdefault(key, ([], [], []))
-        e.append(float(r["eps_a_pct"]))
-        q.append(float(r["q_kPa"]))
-        v.append(float(r["eps_v_pct"]) if r.get("eps_v_pct") not in (None, "") else float("nan"))
-    return out
+from plot_calibration import curves, read_rows  # noqa: E402  (beside this script)
 
 
 def main():
@@ -47,10 +28,10 @@ def main():
     ap.add_argument("folder", help="result folder of triaxdem calibrate or diagnose")
     ap.add_argument("-o", "--output", help="PNG file (default: FOLDER/prediction.png)")
     args = ap.parse_args()
-    pred = curves(os.path.join(args.folder, "prediction_curves.csv"))
+    pred = curves(os.path.join(args.folder, "prediction_curves.csv"), by_test=True)
     table = read_rows(os.path.join(args.folder, "prediction.csv"))
     measured_path = os.path.join(args.folder, "measured_curves.csv")
-    meas = curves(measured_path) if os.path.exists(measured_path) else {}
+    meas = curves(measured_path, by_test=True) if os.path.exists(measured_path) else {}
     materials = sorted({k[0] for k in pred})
     if not materials:
         sys.exit(f"plot_prediction: {args.folder}/prediction_curves.csv holds no curves")
