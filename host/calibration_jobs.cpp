@@ -41,6 +41,11 @@ namespace {
 std::vector<FreeParam> free_params(const Config& cfg, const std::vector<std::string>& cli) {
   std::vector<FreeParam> out;
   for (const std::string& n : cli.empty() ? cfg.calibrate.free : cli) {
+    // A parameter twice would be two coordinates of one value: a singular fit.
+    for (const FreeParam& f : out)
+      if (f.name == n)
+        throw ConfigError((cli.empty() ? cfg.path + ": [calibrate] free" : std::string("--free")) + ": " + n +
+                          " given twice (each free parameter once)");
     try {
       out.push_back(free_param(n, model_of(cfg)));
     } catch (const std::invalid_argument& e) {
@@ -438,10 +443,21 @@ int synth_job(const Config& base, const SynthOptions& o) {
   Model truth = model_of(base);
   std::string comment = "synthetic data from " + base.path + ", seed " + std::to_string(o.seed) + ", extension " +
                         o.extension;
+  // The output is refused before any run: never the config itself, another file only with --overwrite.
+  std::error_code ec;
+  if (fs::exists(o.output) && fs::equivalent(o.output, base.path, ec))
+    throw std::invalid_argument("synth -o " + o.output + ": that is the config (--config); name another file");
+  if (fs::exists(o.output) && !o.overwrite)
+    throw std::invalid_argument("synth -o " + o.output + ": the file exists (--overwrite replaces it)");
   if (o.extension != "none") {
     const Extension& e = extension(o.extension);
-    const Real v = o.strength >= 0 ? o.strength / free_param(e.param).shown  // given in the key's unit
-                                   : draw_strength(e, o.seed);
+    const FreeParam range = free_param(e.param);
+    if (!std::isnan(o.strength) && !(o.strength >= range.shown * range.lo && o.strength <= range.shown * range.hi))
+      throw std::invalid_argument("synth --strength " + fmt("%g", o.strength) + ": out of the range of " + e.param +
+                                  " (allowed: [" + fmt("%g", range.shown * range.lo) + ", " +
+                                  fmt("%g", range.shown * range.hi) + "])");
+    const Real v = !std::isnan(o.strength) ? o.strength / range.shown  // given in the key's unit
+                                           : draw_strength(e, o.seed);
     set_param(truth, e.param, v);
     comment += " (" + e.param + " = " + fmt("%.4g", free_param(e.param).shown * v) + ")";
   }

@@ -1,6 +1,7 @@
 #pragma once
 /// The command-line jobs of calibration and diagnosis (issue 5): `triaxdem calibrate`, `triaxdem diagnose` and
 /// `triaxdem synth` (synthetic measured data with a hidden effect, for tests and studies).
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -32,7 +33,9 @@ int diagnose_job(const Config& base, const CalibrationOptions& o);
 struct SynthOptions {
   std::string output;                     ///< CSV to write
   std::string extension = "none";         ///< hertz, roughness, wear, membrane or none
-  Real strength = -1;                     ///< extension parameter; < 0: drawn from the seed within its range
+  /// The extension parameter in its key's unit, within its range (free_param); NaN: drawn from the seed.
+  Real strength = std::numeric_limits<Real>::quiet_NaN();
+  bool overwrite = false;                 ///< replace an existing output file (never the config)
   unsigned seed = 1;
   long specimen_seed = -1;                ///< packing seed; < 0: the config's seed + kForeignSeedOffset
   std::vector<Real> sigma3{100e3, 200e3, 300e3};  ///< Pa

@@ -121,6 +121,8 @@ struct PeriodicTriaxialParams {
   bool verbose = true;               ///< progress lines and the summary on stdout
 };
 
+/// Records a test's curve must have to its end strain ([triaxial] record_every_pct, [periodic] record_strain_pct).
+inline constexpr long kMinRecords = 20;
 inline constexpr long kAutoEnsemble = 0;
 inline constexpr long kAutoCell = 0;
 

@@ -116,6 +116,7 @@ int main(int argc, char** argv) {
   auto* synth = app.add_subcommand("synth", "synthetic measured curves with a hidden model extension");
   synth->add_option("--config", config_path, "base config (periodic cell)")->required()->check(CLI::ExistingFile);
   synth->add_option("-o,--output", syn.output, "CSV to write")->required();
+  synth->add_flag("--overwrite", syn.overwrite, "replace an existing output file (never the config)");
   synth->add_option("--extension", syn.extension, "hertz, roughness, wear, membrane or none");
   synth->add_option("--strength", syn.strength, "the extension's parameter in its config unit (default: drawn from the seed)");
   synth->add_option("--seed", syn.seed, "noise and strength seed");

@@ -346,3 +346,15 @@ TEST(Config, FingerprintFollowsTheSettingsNotTheirSpelling) {
   EXPECT_EQ(fp("[material]\nmu_s = 0.3\nmu_r = 0.05\nemod_Pa = 100000000\n"),
             fp("[material]\nmu_s = 0.3\nmu_r = 0.05\nemod_Pa = 1.0e8\n"));
 }
+
+// A record interval too coarse for the end strain gave two rows and a "peak" at the last (record_strain_pct = 50
+// with a 10% target): refused with both keys and the largest interval allowed (kMinRecords rows).
+TEST(Config, RecordIntervalMustGiveTheCurveRows) {
+  std::string e = error_of("[periodic]\nrecord_strain_pct = 50.0\ntarget_axial_strain_pct = 10.0\n");
+  EXPECT_NE(e.find("[periodic] record_strain_pct: 50% leaves 0 records to the end at 10% (allowed: at most "
+                   "target_axial_strain_pct / 20 = 0.5%)"),
+            std::string::npos) << e;
+  e = error_of("[triaxial]\nrecord_every_pct = 1.0\naxial_strain_end_pct = 15.0\n");
+  EXPECT_NE(e.find("[triaxial] record_every_pct: 1% leaves 15 records"), std::string::npos) << e;
+  EXPECT_EQ(error_of("[triaxial]\nrecord_every_pct = 0.75\naxial_strain_end_pct = 15.0\n"), "");
+}
