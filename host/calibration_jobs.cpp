@@ -276,7 +276,7 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
       CalibrationResult r = calibrate(ss.lab, model_of(base), ss.free, tests, m, 4, [&](long done, long, Real chi2) {
         char extra[64];
         std::snprintf(extra, sizeof extra, "runs, best chi2 %.1f", chi2);
-        progress.update(std::min(done - start, planned), extra);
+        progress.update(done - start, extra);
       });
       progress.finish("");
       return r;

@@ -29,6 +29,12 @@ void Progress::update(long done, const std::string& extra) {
   last_ = now;
   last_decile_ = decile;
   const double elapsed = std::chrono::duration<double>(now - start_).count();
+  if (done > total_) {  // past the plan (a search that widens its range): no ETA to give, but the line goes on
+    std::printf("%s%s %ld, beyond the %ld planned; elapsed %s %s%s", tty_ ? "\r" : "", what_.c_str(), done, total_,
+                format_duration(elapsed).c_str(), extra.c_str(), tty_ ? "   " : "\n");
+    std::fflush(stdout);
+    return;
+  }
   const long run = done - first_;  // done by this run, at the elapsed time's rate
   const double eta = run > 0 ? elapsed * static_cast<double>(total_ - done) / run : 0;
   std::printf("%s%s %ld/%ld (%3.0f%%) elapsed %s ETA %s %s%s", tty_ ? "\r" : "", what_.c_str(), done, total_,

@@ -10,7 +10,8 @@ class Progress {
  public:
   /// `first`: work already done before this run (a resumed run), left out of the rate behind the ETA.
   Progress(std::string what, long total, long first = 0);
-  /// Reports `done` of `total`; `extra` is appended (e.g. current unbalanced-force ratio).
+  /// Reports `done` of `total`; `extra` is appended (e.g. current unbalanced-force ratio). Past `total` the line
+  /// says so, without an ETA.
   void update(long done, const std::string& extra = "");
   void finish(const std::string& extra = "");
 

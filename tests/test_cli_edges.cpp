@@ -8,6 +8,7 @@
 #include <iterator>
 #include <string>
 
+#include "host/progress.hpp"
 #include "test_util.hpp"
 
 namespace fs = std::filesystem;
@@ -72,4 +73,16 @@ TEST(CliEdges, SynthNeverWritesOverItsConfigNorOutOfRange) {
     EXPECT_NE(o.output.find("out of the range of wear (allowed: [0, 0.9])"), std::string::npos) << o.output;
     EXPECT_FALSE(fs::exists(dir / "new.csv"));
   }
+}
+
+// A calibration that widens its search ran past its planned runs and printed "840/840 (100%) ETA 0m00s" for many
+// silent minutes: past the plan the line says so, and keeps coming (a log gets one per tenth, or every 30 s).
+TEST(CliEdges, ProgressPastItsPlanSaysSo) {
+  testing::internal::CaptureStdout();
+  dem::Progress p("calibrate S-1", 10);
+  p.update(5);
+  p.update(12, "runs");
+  const std::string out = testing::internal::GetCapturedStdout();
+  EXPECT_NE(out.find("calibrate S-1 12, beyond the 10 planned; elapsed"), std::string::npos) << out;
+  EXPECT_EQ(out.find("12/10"), std::string::npos) << out;
 }
