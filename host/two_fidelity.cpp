@@ -67,16 +67,21 @@ Discrepancy measure_discrepancy(const Misfit& misfit, const std::vector<Predicti
 std::string discrepancy_text(const Misfit& misfit, const Discrepancy& d, const std::vector<MeasuredTest>& tests) {
   std::string s;
   for (std::size_t k = 0; k < d.delta.size(); ++k) {
-    Real delta = 0, sd = 0;
+    Real delta = 0, sd = 0, ratio = 0;
     int n = 0;
     const std::vector<Feature>& fs = misfit.features(k);
     for (std::size_t f = 0; f < fs.size(); ++f)
-      if (scales_with_stress(fs[f]) && (fs[f].strain > 0 || fs[f].quantity != kInitialStiffness))
-        delta += d.delta[k][f], sd += d.sd[k][f], ++n;
+      if (scales_with_stress(fs[f]) && (fs[f].strain > 0 || fs[f].quantity != kInitialStiffness) &&
+          fs[f].measured != 0) {
+        delta += d.delta[k][f];
+        sd += d.sd[k][f];
+        ratio += 1 - d.delta[k][f] / fs[f].measured;
+        ++n;
+      }
     if (n == 0) continue;
-    s += tests[k].material + fmt(" at %g kPa: the membrane test reads ", 1e-3 * tests[k].sigma3) +
-         fmt("%+.1f kPa", 1e-3 * delta / n) + fmt(" (+- %.1f) in q over the periodic cell", 1e-3 * sd / n) +
-         fmt(" (mean over %d compared q values)\n", n);
+    s += tests[k].material + fmt(" at %g kPa: the periodic cell reads ", 1e-3 * tests[k].sigma3) +
+         fmt("%.3f of the membrane test's q", ratio / n) + fmt("; the data's q taken down by %.1f", 1e-3 * delta / n) +
+         fmt(" +- %.1f kPa (mean over ", 1e-3 * sd / n) + std::to_string(n) + " compared q values)\n";
   }
   return s;
 }

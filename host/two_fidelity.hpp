@@ -33,7 +33,8 @@ bool scales_with_stress(const Feature& f);
 /// a set of one gives no scatter and is refused). `membrane[k].members` and `periodic[k]` run test k of the misfit.
 Discrepancy measure_discrepancy(const Misfit& misfit, const std::vector<Prediction>& membrane, const Ensemble& periodic);
 
-/// The discrepancy in words for the report: per test, delta and sd of the features' q (kPa), mean over them.
+/// The discrepancy in words for the report: per test, the cell's ratio to the membrane test and the correction of the
+/// data's q with its sd (kPa), means over the compared stresses (E_ini left out).
 std::string discrepancy_text(const Misfit& misfit, const Discrepancy& d, const std::vector<MeasuredTest>& tests);
 
 }  // namespace dem

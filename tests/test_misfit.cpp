@@ -326,6 +326,9 @@ TEST(TwoFidelity, TheDataLessTheMeasuredExcessFitAndItsErrorIsCounted) {
       EXPECT_NEAR(d.delta[0][i], 0, 1e-12) << fs[i].name;  // eps_v: the two read the same
     }
   }
+  const std::string text = discrepancy_text(m, d, {lab});
+  EXPECT_NE(text.find("A at 100 kPa: the periodic cell reads 0.769 of the membrane test's q"), std::string::npos)
+      << text;
   m.add_discrepancy(d.delta, d.sd, "test");
   EXPECT_LT(chi2(m.test_residuals(0, periodic[0])), 1);
   for (const Feature& f : m.features(0))
