@@ -319,6 +319,10 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
     all_sim.insert(all_sim.end(), r.best.sim.begin(), r.best.sim.end());
     models[material] = Calibrated{tests, r.model, r.best.sim};
   }
+  if (ss.two_fidelity)
+    std::printf("calibrate: two fidelities: the table sets the periodic cell against the data as measured; it was "
+                "fitted to them less the boundary's discrepancy, and the membrane prediction below is the test "
+                "that compares with the lab\n");
   print_errors(all_meas, all_sim);
   io::write_text_atomic(ss.folder + "/calibrated.csv", table.str());
   std::printf("calibrate: %ld runs in %s; results in %s (calibrated.csv, errors.csv, simulated_curves.csv)\n",
