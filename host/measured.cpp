@@ -4,6 +4,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <limits>
@@ -321,11 +322,16 @@ void note_replicates(MeasuredData& d) {
 }  // namespace
 
 MeasuredTextTable read_csv_table(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+    throw DataError(path + ": not a regular file (measured data are a CSV or HDF5 file)");
   std::ifstream f(path);
   if (!f) throw DataError(path + ": cannot be read");
   MeasuredTextTable t;
   std::string line;
   for (long n = 1; std::getline(f, line); ++n) {
+    // A spreadsheet's UTF-8 byte order mark is no part of the first column's name.
+    if (n == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
     const std::string s = trim(line);
     if (s.empty() || s[0] == '#') continue;
     if (t.header.empty() && t.header_at.empty()) {

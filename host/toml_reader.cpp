@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 
 #include "config_checks.hpp"
@@ -38,11 +39,19 @@ void canonical_text(const toml::node& n, std::string& out) {
 }
 
 std::string file_text(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+    throw ConfigError(path + ": not a regular file (a config is a text file)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ConfigError(path + ": cannot be read");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
+  // Read at most one byte past the cap: a device or a huge file (/dev/zero) is refused, not read into memory.
+  std::string text(kMaxConfigBytes + 1, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.size() > kMaxConfigBytes)
+    throw ConfigError(path + ": larger than " + std::to_string(kMaxConfigBytes / 1024) +
+                      " KiB (allowed: a config or noise file of at most that size)");
+  return text;
 }
 
 toml::table parse_tables(const std::string& text, const std::string& path, const std::vector<std::string>& tables) {

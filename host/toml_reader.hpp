@@ -160,7 +160,10 @@ class TableReader {
   }
 };
 
-/// The whole file, as bytes; ConfigError if it cannot be read.
+/// The largest config or lab noise file read: the shipped ones are under 5 KiB.
+constexpr std::size_t kMaxConfigBytes = 1 << 20;
+
+/// The whole file, as bytes; ConfigError if it cannot be read or is larger than kMaxConfigBytes.
 std::string file_text(const std::string& path);
 
 /// The TOML document of `text`, whose top-level entries must be tables named in `tables`.

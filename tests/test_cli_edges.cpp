@@ -86,3 +86,20 @@ TEST(CliEdges, ProgressPastItsPlanSaysSo) {
   EXPECT_NE(out.find("calibrate S-1 12, beyond the 10 planned; elapsed"), std::string::npos) << out;
   EXPECT_EQ(out.find("12/10"), std::string::npos) << out;
 }
+
+// `triaxdem check /dev/zero` read without end (9.7 GB after 16 s): a device is refused by name, and so is a
+// config over the size cap, with the cap, before it is held in memory.
+TEST(CliEdges, ADeviceOrAHugeFileIsNoConfig) {
+  const fs::path dir = dem::test::scratch_dir("cli_big");
+  Outcome o = triaxdem("check /dev/zero", dir);
+  EXPECT_EQ(o.code, 1);
+  EXPECT_NE(o.output.find("/dev/zero: not a regular file"), std::string::npos) << o.output;
+  const fs::path big = dir / "big.toml";
+  {
+    std::ofstream f(big);
+    f << "# " << std::string(2 << 20, 'x') << "\n";
+  }
+  o = triaxdem("check " + big.string(), dir);
+  EXPECT_EQ(o.code, 1);
+  EXPECT_NE(o.output.find("larger than 1024 KiB"), std::string::npos) << o.output;
+}

@@ -462,6 +462,20 @@ TEST(Measured, TheFileSaysWhichQTheLabReported) {
   }
 }
 
+// A spreadsheet's CSV starts with a UTF-8 byte order mark, which made the first column "unknown column material";
+// a device is refused by name instead of read without end.
+TEST(Measured, AByteOrderMarkIsNoPartOfTheHeaderAndADeviceIsNoData) {
+  const MeasuredData d = load_measured(write("bom.csv", "\xEF\xBB\xBFmaterial,sigma3_kPa,q_peak_kPa\nA,100,300\n"));
+  ASSERT_EQ(d.tests.size(), 1u);
+  EXPECT_EQ(d.tests[0].material, "A");
+  try {
+    load_measured("/dev/zero");
+    ADD_FAILURE() << "read a device";
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("/dev/zero: not a regular file"), std::string::npos) << e.what();
+  }
+}
+
 // The Mohr-Coulomb friction angle of a drained triaxial test, sin(phi) = (sigma1 - sigma3) / (sigma1 + sigma3):
 // q = 2 sigma3 gives sigma1 = 3 sigma3 and sin(phi) = 1/2, 30 degrees; q = 0 none; q = 8 sigma3 gives 4/5
 // (53.13 degrees). The study's tables rest on this function.
