@@ -65,39 +65,12 @@ std::map<std::string, std::vector<MeasuredTest>> by_material(const MeasuredData&
   return out;
 }
 
-/// The membrane test a calibration ends with: --predict's config, else the base config's [calibrate] predict
-/// (relative to the base config's folder); none for "none" or where neither names one. Checked before any run.
-std::optional<Config> prediction_template(const Config& base, const std::string& cli) {
-  if (cli == "none" || (cli.empty() && base.calibrate.predict.empty())) return std::nullopt;
-  const std::string key = cli.empty() ? base.path + ": [calibrate] predict" : "--predict";
-  const std::string path =
-      cli.empty() ? (fs::path(base.path).parent_path() / base.calibrate.predict).lexically_normal().string() : cli;
-  if (!fs::exists(path)) throw ConfigError(key + ": " + path + " does not exist (a membrane test's config)");
-  Config c = load_config(path);
-  check_prediction_template(c, key);
-  return c;
-}
-
 /// A material's calibration as the prediction needs it: its tests, the model, and the periodic cell's tests at it.
 struct Calibrated {
   std::vector<MeasuredTest> tests;
   Model model;
   std::vector<MeasuredTest> sim;  ///< in the order of tests
 };
-
-/// Whether the calibration fits two fidelities (--reference-test, else [calibrate] reference_test); they need a
-/// membrane test to predict with on at least 2 specimens, checked before any run.
-bool two_fidelity_of(const Config& base, const CalibrationOptions& o, const std::optional<Config>& membrane) {
-  const std::string which = o.reference_test.empty() ? base.calibrate.reference_test : o.reference_test;
-  if (which != "two_fidelity") return false;
-  const std::string key = o.reference_test.empty() ? base.path + ": [calibrate] reference_test" : "--reference-test";
-  if (!membrane)
-    throw ConfigError(key + ": two_fidelity needs a membrane test: [calibrate] predict or --predict");
-  if (base.calibrate.predict_specimens < 2)
-    throw ConfigError(base.path + ": [calibrate] predict_specimens: two_fidelity measures the discrepancy's scatter "
-                      "on the membrane specimens (allowed: 2-16)");
-  return true;
-}
 
 /// What calibrate and diagnose share: the data, the free parameters, the simulator and a new result folder.
 struct Session {
@@ -115,7 +88,7 @@ struct Session {
         ref(o.reference.empty() ? ReferenceValues{}
                                 : load_reference(o.reference, [](const std::string& n) { free_param(n); })),
         free(free_params(base, o.free)), predict_template(prediction_template(base, o.predict)),
-        two_fidelity(two_fidelity_of(base, o, predict_template)),
+        two_fidelity(two_fidelity_wanted(base, o.reference_test, predict_template.has_value())),
         lab(matched(base, o.jobs), true, o.jobs), folder(new_dated_folder(o.output, kind)), output(o.output) {
     if (o.noise == "data" || o.noise == "lab") noise.mode = o.noise;
     else noise = lab_noise_options(o.noise);
@@ -126,6 +99,11 @@ struct Session {
     std::vector<std::string> names;
     for (const FreeParam& f : free) names.push_back(f.name);
     return names;
+  }
+  /// The membrane test at `model` on every test of `tests`, q in the data's measure (a template must be set).
+  std::vector<Prediction> predict_at(const Config& base, const Model& model, const std::vector<MeasuredTest>& tests) const {
+    return predict(*predict_template, model, free_names(), tests, data.q_measure,
+                   static_cast<int>(base.calibrate.predict_specimens), output + "/.specimens", true);
   }
   Config matched(const Config& base, int jobs) {
     return matched_state(base, data.tests, state, true, match_plan(base, jobs));
@@ -196,7 +174,6 @@ struct Session {
       return "";
     }
     const Config& t = *predict_template;
-    const std::vector<std::string> names = free_names();
     std::vector<Prediction> all;
     std::vector<MeasuredTest> curves;
     for (const auto& [material, cal] : models) {
@@ -204,9 +181,7 @@ struct Session {
       std::printf("%s: %s: predicting the membrane test (%s) at the calibrated parameters: %zu pressures x %ld "
                   "specimens\n", folder.c_str(), material.c_str(), t.path.c_str(), tests.size(),
                   base.calibrate.predict_specimens);
-      std::vector<Prediction> p = predict(t, cal.model, names, tests, data.q_measure,
-                                          static_cast<int>(base.calibrate.predict_specimens), output + "/.specimens",
-                                          true);
+      std::vector<Prediction> p = predict_at(base, cal.model, tests);
       for (std::size_t k = 0; k < p.size() && k < cal.sim.size(); ++k) p[k].periodic_q_peak = cal.sim[k].q_peak;
       for (Prediction& x : p) {
         curves.insert(curves.end(), x.members.begin(), x.members.end());
@@ -220,16 +195,7 @@ struct Session {
                           name_of(data.q_measure));
     std::printf("\nprediction (%s, the membrane test at the calibrated parameters):\n%s", t.path.c_str(), md.c_str());
     run_plot_script("plot_prediction.py", {folder});
-    return "## Prediction: the membrane test\n\nThe calibration's periodic cell measures the grains inside a "
-           "specimen, free of any boundary; the lab measured a membrane-confined cylinder at its platens (q as " +
-           std::string(name_of(data.q_measure)) + "). The membrane test of " + t.path + " (" +
-           std::to_string(t.particles.diameter > 0 ? static_cast<long>(t.specimen.diameter / t.particles.diameter) : 0) +
-           " particle diameters across) run at each material's calibrated parameters and each pressure of the data, "
-           "on " + std::to_string(base.calibrate.predict_specimens) + " specimens (prediction.csv, "
-           "prediction_curves.csv):\n\n" + md +
-           (discrepancy.empty() ? "" : "\nTwo fidelities: the periodic cell was calibrated again to the data less the "
-                                       "membrane test's excess over it at the first optimum:\n\n" + discrepancy) +
-           "\n![predicted membrane tests beside the data](prediction.png)\n";
+    return prediction_section(t, base.calibrate.predict_specimens, data.q_measure, md, discrepancy);
   }
   /// The errors table, the curves in the measured-data format and the figure.
   void finish(const std::vector<MeasuredTest>& meas, const std::vector<MeasuredTest>& sim,
@@ -286,9 +252,7 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
       // The boundary's discrepancy at the periodic optimum, then the cell calibrated to the data less it.
       std::printf("calibrate: %s: two fidelities: the membrane test and every periodic specimen at the periodic "
                   "optimum\n", material.c_str());
-      const std::vector<Prediction> mem =
-          predict(*ss.predict_template, r.model, ss.free_names(), tests, ss.data.q_measure,
-                  static_cast<int>(base.calibrate.predict_specimens), ss.output + "/.specimens", true);
+      const std::vector<Prediction> mem = ss.predict_at(base, r.model, tests);
       const Discrepancy d = measure_discrepancy(misfit, mem, ss.lab.run_ensemble(r.model, tests, true));
       const std::string text = discrepancy_text(misfit, d, tests);
       std::printf("%s", text.c_str());
@@ -440,39 +404,6 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
   // The report stands before the membrane tests run; their section is added when they end.
   const std::string prediction = ss.predict_membrane(base, models);
   if (!prediction.empty()) io::write_text_atomic(ss.folder + "/diagnosis.md", md.str() + "\n" + prediction);
-  return 0;
-}
-
-int synth_job(const Config& base, const SynthOptions& o) {
-  Model truth = model_of(base);
-  std::string comment = "synthetic data from " + base.path + ", seed " + std::to_string(o.seed) + ", extension " +
-                        o.extension;
-  // The output is refused before any run: never the config itself, another file only with --overwrite.
-  std::error_code ec;
-  if (fs::exists(o.output) && fs::equivalent(o.output, base.path, ec))
-    throw std::invalid_argument("synth -o " + o.output + ": that is the config (--config); name another file");
-  if (fs::exists(o.output) && !o.overwrite)
-    throw std::invalid_argument("synth -o " + o.output + ": the file exists (--overwrite replaces it)");
-  if (o.extension != "none") {
-    const Extension& e = extension(o.extension);
-    const FreeParam range = free_param(e.param);
-    if (!std::isnan(o.strength) && !(o.strength >= range.shown * range.lo && o.strength <= range.shown * range.hi))
-      throw std::invalid_argument("synth --strength " + fmt("%g", o.strength) + ": out of the range of " + e.param +
-                                  " (allowed: [" + fmt("%g", range.shown * range.lo) + ", " +
-                                  fmt("%g", range.shown * range.hi) + "])");
-    const Real v = !std::isnan(o.strength) ? o.strength / range.shown  // given in the key's unit
-                                           : draw_strength(e, o.seed);
-    set_param(truth, e.param, v);
-    comment += " (" + e.param + " = " + fmt("%.4g", free_param(e.param).shown * v) + ")";
-  }
-  const unsigned specimen = o.specimen_seed >= 0 ? static_cast<unsigned>(o.specimen_seed)
-                                                 : base.run.seed + kForeignSeedOffset;
-  comment += ", a specimen per test (packing seeds from " + std::to_string(specimen) + ", " +
-             std::to_string(kGeneratorCellFactor) + " times the config's balls)";
-  PeriodicLab lab(larger_cell(base, kGeneratorCellFactor), false, static_cast<int>(o.sigma3.size()), specimen);
-  const std::vector<MeasuredTest> tests = synthetic_tests(lab, truth, o.sigma3, o.material, o.seed);
-  write_measured_curves(o.output, tests, comment);
-  std::printf("synth: %s -> %s\n", comment.c_str(), o.output.c_str());
   return 0;
 }
 

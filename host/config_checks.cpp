@@ -6,6 +6,7 @@
 
 #include "config.hpp"
 #include "config_checks.hpp"
+#include "text_format.hpp"
 
 namespace dem {
 
@@ -119,6 +120,15 @@ void check_ascii_outside_strings(const std::string& text, const std::string& pat
       }
     }
   }
+}
+
+void check_records(const std::string& path, const char* table, const char* key, double every, const char* end_key,
+                   double end) {
+  if (every <= end / kMinRecords) return;
+  throw ConfigError(path + ": [" + table + "] " + key + ": " + fmt("%g", 100 * every) + "% leaves " +
+                    std::to_string(static_cast<long>(end / every)) + " records to the end at " + fmt("%g", 100 * end) +
+                    "% (allowed: at most " + end_key + " / " + std::to_string(kMinRecords) + " = " +
+                    fmt("%g", 100 * end / kMinRecords) + "%)");
 }
 
 }  // namespace dem

@@ -347,15 +347,13 @@ void write_measured_curves(const std::string& path, const std::vector<MeasuredTe
   };
   const bool state = all(&MeasuredTest::void_ratio), size = all(&MeasuredTest::specimen_balls);
   // The HDF5 form's table holds numbers: labels are written where each is one (member numbers, seeds).
-  auto label_of = [](const MeasuredTest& t, double& v) {
+  std::vector<double> label(tests.size());
+  bool labels = !tests.empty();
+  for (std::size_t k = 0; k < tests.size() && labels; ++k) {
     char* end = nullptr;
-    v = std::strtod(t.replicate.c_str(), &end);
-    return !t.replicate.empty() && *end == '\0';
-  };
-  double unused = 0;
-  const bool labels = !tests.empty() && std::all_of(tests.begin(), tests.end(), [&](const MeasuredTest& t) {
-    return label_of(t, unused);
-  });
+    label[k] = std::strtod(tests[k].replicate.c_str(), &end);
+    labels = !tests[k].replicate.empty() && *end == '\0';
+  }
   std::vector<std::string> columns{"sigma3_kPa"};
   if (labels) columns.push_back("test");
   for (const char* c : {"eps_a_pct", "q_kPa"}) columns.push_back(c);
@@ -364,13 +362,12 @@ void write_measured_curves(const std::string& path, const std::vector<MeasuredTe
   if (size) columns.push_back("specimen_balls");
   std::map<std::string, std::vector<std::vector<double>>> rows;  // by material
   std::vector<std::string> order;                                 // materials in file order
-  for (const MeasuredTest& t : tests) {
+  for (std::size_t k = 0; k < tests.size(); ++k) {
+    const MeasuredTest& t = tests[k];
     if (!rows.count(t.material)) order.push_back(t.material);
-    double label = 0;
-    if (labels) label_of(t, label);
     for (std::size_t i = 0; i < t.q.size(); ++i) {
       rows[t.material].push_back({1e-3 * t.sigma3});
-      if (labels) rows[t.material].back().push_back(label);
+      if (labels) rows[t.material].back().push_back(label[k]);
       for (double v : {100 * t.eps_a[i], 1e-3 * t.q[i]}) rows[t.material].back().push_back(v);
       if (volume) rows[t.material].back().push_back(100 * t.eps_v[i]);
       if (state) rows[t.material].back().push_back(t.void_ratio);

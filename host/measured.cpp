@@ -285,7 +285,7 @@ void read_summary_row(const RowReader& r, MeasuredTest& t) {
 }
 
 /// The file's q measure: one name, the same on every row.
-void read_q_measure(const RowReader& r, MeasuredData& d, bool first) {
+void read_q_measure(const RowReader& r, MeasuredData& d) {
   if (!r.has("q_measure")) return;
   const std::string& v = r.cell("q_measure");
   QMeasure m = QMeasure::kFixedArea;
@@ -296,7 +296,7 @@ void read_q_measure(const RowReader& r, MeasuredData& d, bool first) {
     if (v == kQMeasureNames[k]) m = static_cast<QMeasure>(k), known = true;
   }
   if (!known) r.refuse("q_measure", "'" + v + "' is not a q measure (allowed: " + allowed + ")");
-  if (!first && m != d.q_measure)
+  if (d.q_measure_given && m != d.q_measure)
     r.refuse("q_measure", "'" + v + "' differs from the first row's '" + name_of(d.q_measure) +
                               "' (one measure per file)");
   d.q_measure = m;
@@ -382,7 +382,7 @@ MeasuredData load_measured(const std::string& path) {
       fail(row.at, "", "has " + std::to_string(row.cells.size()) + " cells, the header " +
                            std::to_string(cols.names.size()));
     const RowReader r{cols, row};
-    read_q_measure(r, d, &row == &table.rows.front());
+    read_q_measure(r, d);
     MeasuredTest& t = test_of(r, d, tests);
     if (d.curves)
       read_curve_row(r, t);

@@ -240,8 +240,10 @@ Tensor boundary_stress(const ContactSet& s, Real volume) {
 
 Real axial_deviator(const Tensor& t) { return t[8] - (t[0] + t[4]) / 2; }
 
+Real mean_stress(const Tensor& t) { return (t[0] + t[4] + t[8]) / 3; }
+
 Real stress_ratio(const Tensor& s) {
-  const Real p = (s[0] + s[4] + s[8]) / 3;
+  const Real p = mean_stress(s);
   return p > 0 ? axial_deviator(s) / p : 0;
 }
 

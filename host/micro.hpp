@@ -108,6 +108,8 @@ Tensor boundary_stress(const ContactSet& s, Real volume);
 
 /// Axial deviator t_zz - (t_xx + t_yy)/2 of a tensor, z the specimen's axis: q of a stress.
 Real axial_deviator(const Tensor& t);
+/// Mean of the diagonal, tr / 3: p of a stress.
+Real mean_stress(const Tensor& t);
 /// Triaxial stress ratio q/p of a stress tensor (p = tr/3); zero when p <= 0.
 Real stress_ratio(const Tensor& s);
 /// q/p of the stress-force-fabric relation, sigma / p = I + (2/5)(a^c + a^n + 3/2 a^t), taken with the

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 
 #include "calibrate.hpp"
 #include "progress.hpp"
@@ -22,6 +23,19 @@ void check_prediction_template(const Config& membrane, const std::string& key) {
                       " mm is " + fmt("%.1f", membrane.specimen.diameter / membrane.particles.diameter) +
                       " particle diameters across; a membrane test for " + key + " needs at least " +
                       fmt("%g", kMinDiametersAcross) + " (" + fmt("%g", 1e3 * least) + " mm)");
+}
+
+std::optional<Config> prediction_template(const Config& base, const std::string& cli) {
+  if (cli == "none" || (cli.empty() && base.calibrate.predict.empty())) return std::nullopt;
+  const std::string key = cli.empty() ? base.path + ": [calibrate] predict" : "--predict";
+  const std::string path = cli.empty() ? (std::filesystem::path(base.path).parent_path() / base.calibrate.predict)
+                                             .lexically_normal()
+                                             .string()
+                                       : cli;
+  if (!std::filesystem::exists(path)) throw ConfigError(key + ": " + path + " does not exist (a membrane test's config)");
+  Config c = load_config(path);
+  check_prediction_template(c, key);
+  return c;
 }
 
 Config prediction_config(const Config& membrane, const Model& calibrated, const std::vector<std::string>& free,
@@ -46,6 +60,7 @@ std::vector<Prediction> predict(const Config& membrane, const Model& calibrated,
                                 const std::vector<MeasuredTest>& tests, QMeasure measure, int specimens,
                                 const std::string& cache, bool verbose) {
   std::vector<Prediction> out(tests.size());
+  for (std::size_t j = 0; j < tests.size(); ++j) out[j].measured = tests[j];
   Progress progress("prediction: membrane tests", static_cast<long>(tests.size() * specimens));
   long done = 0;
   for (int k = 0; k < specimens; ++k) {
@@ -62,7 +77,6 @@ std::vector<Prediction> predict(const Config& membrane, const Model& calibrated,
       t.replicate = std::to_string(k + 1);
       t.void_ratio = r.void_ratio_consolidated;
       t.specimen_balls = static_cast<Real>(sp.balls.size());
-      out[j].measured = tests[j];
       out[j].members.push_back(t);
       if (verbose)
         progress.update(++done, t.material + " at " + fmt("%g kPa", 1e-3 * t.sigma3) + ", specimen " + t.replicate +
@@ -94,10 +108,10 @@ std::pair<Real, Real> error_summary(const std::vector<Prediction>& p) {
   return {p.empty() ? 0 : sum / static_cast<Real>(p.size()), most};
 }
 
-}  // namespace
-
 /// The boundary's share of the predicted q: (membrane test - periodic cell) / membrane test; NaN without a cell.
 Real boundary_share(const Prediction& x) { return (x.q_peak_mean - x.periodic_q_peak) / x.q_peak_mean; }
+
+}  // namespace
 
 std::string prediction_markdown(const std::vector<Prediction>& p, QMeasure measure) {
   std::string md = std::string("| material | sigma3 kPa | measured q_peak kPa | predicted kPa (mean +- sd of ") +
@@ -128,6 +142,19 @@ std::string prediction_csv(const std::vector<Prediction>& p, QMeasure measure) {
            (cell ? fmt("%.3f", 100 * boundary_share(x)) : "") + "\n";
   }
   return csv;
+}
+
+std::string prediction_section(const Config& membrane, long specimens, QMeasure measure, const std::string& markdown,
+                               const std::string& discrepancy) {
+  const long across = static_cast<long>(membrane.specimen.diameter / membrane.particles.diameter);
+  return "## Prediction: the membrane test\n\nThe calibration's periodic cell measures the grains inside a specimen, "
+         "free of any boundary; the lab measured a membrane-confined cylinder at its platens (q as " +
+         std::string(name_of(measure)) + "). The membrane test of " + membrane.path + " (" + std::to_string(across) +
+         " particle diameters across) run at each material's calibrated parameters and each pressure of the data, on " +
+         std::to_string(specimens) + " specimens (prediction.csv, prediction_curves.csv):\n\n" + markdown +
+         (discrepancy.empty() ? "" : "\nTwo fidelities: the periodic cell was calibrated again to the data less the "
+                                     "membrane test's excess over it at the first optimum:\n\n" + discrepancy) +
+         "\n![predicted membrane tests beside the data](prediction.png)\n";
 }
 
 }  // namespace dem

@@ -4,6 +4,7 @@
 /// periodic cell says what the grains do inside a specimen; this says what the lab's test would have measured
 /// with those grains, membrane, platens and bulge included.
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,11 @@ constexpr Real kMinDiametersAcross = 8;
 /// membrane test at least kMinDiametersAcross particles across. `key` names where it came from in messages.
 /// Throws ConfigError naming the file, the key and the smallest allowed size.
 void check_prediction_template(const Config& membrane, const std::string& key);
+
+/// The membrane test a calibration ends with: `cli` (--predict's config), else the base config's [calibrate]
+/// predict (relative to the base config's folder); none for "none" or where neither names one. Loaded and checked
+/// (check_prediction_template) before any run; ConfigError names the key.
+std::optional<Config> prediction_template(const Config& base, const std::string& cli);
 
 /// The template with the calibrated contact parameters (`free` names, values from `calibrated`), the pressure
 /// sigma3 (Pa) and packing seed [run] seed + member. Free parameters of the periodic cell alone (its membrane
@@ -50,5 +56,11 @@ std::vector<Prediction> predict(const Config& membrane, const Model& calibrated,
 /// the mean and largest |error|, and as CSV rows with a header.
 std::string prediction_markdown(const std::vector<Prediction>& p, QMeasure measure);
 std::string prediction_csv(const std::vector<Prediction>& p, QMeasure measure);
+
+/// The report's section: what was run (`membrane` on `specimens` specimens, q as `measure`), the table
+/// `markdown` (prediction_markdown), the two-fidelity correction in words when `discrepancy` is not empty, and
+/// prediction.png.
+std::string prediction_section(const Config& membrane, long specimens, QMeasure measure, const std::string& markdown,
+                               const std::string& discrepancy);
 
 }  // namespace dem

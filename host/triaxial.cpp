@@ -97,6 +97,20 @@ std::pair<Real, Real> platen_stresses(const Cell& c, const std::vector<Vec3>& f)
 
 Real specimen_volume(const Cell& c) { return enclosed_volume(c.membrane, 0, c.sim->wall_point(kTopPlaten).z); }
 
+/// series.csv's columns before the micro ones, and a record's values in them (series_row): one order for both.
+const std::vector<std::string> kSeriesColumns = {
+    "eps_a_pct",        "eps_v_pct",          "q_kPa",            "sigma1_kPa",      "sigma1_bottom_kPa",
+    "sigma3_kPa",       "sigma3_balls_kPa",   "eps_v_envelope_pct", "unbalanced_ratio", "kinetic_energy_J",
+    "q_area_kPa",       "q_parabolic_kPa",    "q_membrane_kPa",   "sigma3_hoop_kPa", "q_lw_kPa",
+    "p_lw_kPa",         "q_boundary_kPa",     "p_boundary_kPa",   "q_net_kPa",       "p_net_kPa"};
+
+std::vector<double> series_row(const TriaxialRecord& r, Real sigma3) {
+  return {100 * r.eps_a,         100 * r.eps_v,        r.q / 1e3,           r.sigma1 / 1e3,     r.sigma1_bottom / 1e3,
+          sigma3 / 1e3,          r.sigma3_balls / 1e3, 100 * r.eps_v_envelope, r.unbalanced,     r.kinetic,
+          r.q_area / 1e3,        r.q_parabolic / 1e3,  r.q_membrane / 1e3,  r.sigma3_hoop / 1e3, r.q_lw / 1e3,
+          r.p_lw / 1e3,          r.q_boundary / 1e3,   r.p_boundary / 1e3,  r.q_net / 1e3,      r.p_net / 1e3};
+}
+
 /// The record's deviators as labs report them and the specimen's mean stress over the enclosed `volume`, from
 /// the platen force (r.sigma1, r.sigma3_balls and the strains set) and the contacts. `a0`: the cross-section
 /// after consolidation, V0 / h0.
@@ -109,13 +123,13 @@ void measure_stresses(const Cell& c, const TriaxialConfig& tc, const ContactSet&
   r.sigma3_hoop = tc.sigma3 + membrane_hoop_stress(tc.membrane_modulus, tc.membrane_thickness,
                                                    std::sqrt(4 * a0 / M_PI), r.eps_a, r.eps_v);
   const Tensor lw = love_weber(cs, volume, true), b = boundary_stress(cs, volume);
-  r.q_lw = axial_deviator(lw);
-  r.p_lw = (lw[0] + lw[4] + lw[8]) / 3;
-  r.q_boundary = axial_deviator(b);
-  r.p_boundary = (b[0] + b[4] + b[8]) / 3;
   const Tensor net = net_force_stress(*c.sim, volume);
+  r.q_lw = axial_deviator(lw);
+  r.p_lw = mean_stress(lw);
+  r.q_boundary = axial_deviator(b);
+  r.p_boundary = mean_stress(b);
   r.q_net = axial_deviator(net);
-  r.p_net = (net[0] + net[4] + net[8]) / 3;
+  r.p_net = mean_stress(net);
 }
 
 }  // namespace
@@ -145,13 +159,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
   const Real dt = sim.params().integ.dt;
   TriaxialResult res;
   const MicroConfig& mc = cfg.micro;
-  std::vector<std::string> columns = {"eps_a_pct",        "eps_v_pct",          "q_kPa",
-                                      "sigma1_kPa",       "sigma1_bottom_kPa",  "sigma3_kPa",
-                                      "sigma3_balls_kPa", "eps_v_envelope_pct", "unbalanced_ratio",
-                                      "kinetic_energy_J", "q_area_kPa",         "q_parabolic_kPa",
-                                      "q_membrane_kPa",   "sigma3_hoop_kPa",    "q_lw_kPa",
-                                      "p_lw_kPa",         "q_boundary_kPa",     "p_boundary_kPa",
-                                      "q_net_kPa",        "p_net_kPa"};
+  std::vector<std::string> columns = kSeriesColumns;
   if (mc.enabled)
     for (const std::string& prefix : {std::string(), std::string("rve_")})
       for (const std::string& c : micro_columns(prefix)) columns.push_back(c);
@@ -271,12 +279,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
         r.kinetic = sim.stats().kinetic;
         measure_stresses(cell, tc, contacts_now(), volume, v0 / h0, r);
         res.records.push_back(r);
-        std::vector<double> row = {100 * r.eps_a,        100 * r.eps_v,          r.q / 1e3,    r.sigma1 / 1e3,
-                                   r.sigma1_bottom / 1e3, tc.sigma3 / 1e3,        r.sigma3_balls / 1e3,
-                                   100 * r.eps_v_envelope, r.unbalanced,          r.kinetic};
-        for (Real v : {r.q_area, r.q_parabolic, r.q_membrane, r.sigma3_hoop, r.q_lw, r.p_lw, r.q_boundary,
-                       r.p_boundary, r.q_net, r.p_net})
-          row.push_back(v / 1e3);
+        std::vector<double> row = series_row(r, tc.sigma3);
         const int next_snap = static_cast<int>(st.next_snap);
         if (mc.enabled) {
           const ContactSet& cs = contacts_now();

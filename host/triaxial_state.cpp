@@ -3,6 +3,7 @@
 #include <array>
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 #include "micro_report.hpp"
 
@@ -41,18 +42,19 @@ Stage stage_of(const std::vector<double>& v, const std::string& path) {
   return Stage{v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9]};
 }
 
-/// A record's fields in the file's order: one list for the writer and the reader.
+/// A record's fields in the file's order: one list for the writer (const records) and the reader.
 constexpr int kRecordValues = 19;
-std::array<Real*, kRecordValues> record_fields(TriaxialRecord& r) {
+template <class Record>
+std::array<decltype(&std::declval<Record&>().eps_a), kRecordValues> record_fields(Record& r) {
   return {&r.eps_a,        &r.eps_v,      &r.sigma1,      &r.sigma1_bottom, &r.q,           &r.sigma3_balls,
           &r.eps_v_envelope, &r.unbalanced, &r.kinetic,   &r.q_area,        &r.q_parabolic, &r.q_membrane,
           &r.sigma3_hoop,  &r.q_lw,       &r.p_lw,        &r.q_boundary,    &r.p_boundary,  &r.q_net,
           &r.p_net};
 }
-std::vector<double> record_numbers(std::vector<TriaxialRecord> rs) {
+std::vector<double> record_numbers(const std::vector<TriaxialRecord>& rs) {
   std::vector<double> v;
-  for (TriaxialRecord& r : rs)
-    for (Real* x : record_fields(r)) v.push_back(*x);
+  for (const TriaxialRecord& r : rs)
+    for (const Real* x : record_fields(r)) v.push_back(*x);
   return v;
 }
 std::vector<TriaxialRecord> records_of(const std::vector<double>& v, const std::string& path) {

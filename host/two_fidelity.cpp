@@ -25,6 +25,16 @@ std::vector<Real> sample_variance(const Misfit& misfit, std::size_t k, const std
 
 }  // namespace
 
+bool two_fidelity_wanted(const Config& base, const std::string& cli, bool membrane) {
+  if ((cli.empty() ? base.calibrate.reference_test : cli) != "two_fidelity") return false;
+  const std::string key = cli.empty() ? base.path + ": [calibrate] reference_test" : "--reference-test";
+  if (!membrane) throw ConfigError(key + ": two_fidelity needs a membrane test: [calibrate] predict or --predict");
+  if (base.calibrate.predict_specimens < 2)
+    throw ConfigError(base.path + ": [calibrate] predict_specimens: two_fidelity measures the discrepancy's scatter "
+                      "on the membrane specimens (allowed: 2-16)");
+  return true;
+}
+
 bool scales_with_stress(const Feature& f) {
   if (f.strain > 0) return f.quantity == 0;  // a curve's q (eps_v is quantity 1)
   return f.quantity != kStrainAtPeak && f.quantity != kDilatancy;

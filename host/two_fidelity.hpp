@@ -21,6 +21,11 @@ struct Discrepancy {
   std::vector<std::vector<Real>> delta, sd;  ///< [test][feature], the feature's unit (Pa for q)
 };
 
+/// Whether the calibration fits two fidelities: `cli` (--reference-test), else the base config's [calibrate]
+/// reference_test. Two fidelities need a membrane test to predict with (`membrane`) on at least 2 specimens;
+/// ConfigError names the key before any run.
+bool two_fidelity_wanted(const Config& base, const std::string& cli, bool membrane);
+
 /// Whether a feature is a stress (q at a strain; E_ini, q_1pct, q_3pct, q_peak, q_end): the boundary scales it
 /// (the bulge's area, the walls' layer), so the discrepancy is taken as a ratio; strains (eps_v, eps_a at the peak,
 /// dilatancy) take it as a difference.
