@@ -16,7 +16,7 @@ for k in $sizes; do
   cfg="$work/k$k.toml"
   sed -e "s/^count = .*/count = $n/" -e "s/^size_mm = .*/size_mm = [$edge, $edge, $edge]/" \
       -e "s|^output = .*|output = \"$work/out_k$k\"|" "$root/perf/configs/periodic_54k.toml" > "$cfg"
-  /usr/bin/time -f "%M" -o "$work/rss_k$k" "$build/triaxdem" run "$cfg" -n "$steps" > "$work/log_k$k" 2>&1
+  /usr/bin/time -f "%M" -o "$work/rss_k$k" "$build/triaxdem" run "$cfg" -n "$steps" --overwrite > "$work/log_k$k" 2>&1
   line=$(grep "^time loop:" "$work/log_k$k")
   rate=$(sed -n 's/.*; \([0-9.e+]*\) particle-steps\/s.*/\1/p' <<< "$line")
   stage() { sed -n "s/.*$1 \([0-9.]*\) s.*/\1/p" <<< "$line"; }

@@ -2,16 +2,19 @@
 # Builds Kokkos 3.4.01 with CUDA (+ Serial on the host) from Debian bookworm's trilinos source, for a machine with
 # the CUDA toolkit (nvcc on PATH or in /usr/local/cuda). Then configure triaxdem against it:
 #   scripts/build_kokkos_cuda.sh                       # ARCH=AMPERE80 PREFIX=/opt/kokkos-3.4.01-cuda
+#   SM=90 scripts/build_kokkos_cuda.sh                 # Hopper machine code: PREFIX=/opt/kokkos-3.4.01-cuda-sm90
 #   cmake -S . -B build-cuda -DKokkos_ROOT=/opt/kokkos-3.4.01-cuda \
 #         -DCMAKE_CXX_COMPILER=/opt/kokkos-3.4.01-cuda/bin/nvcc_wrapper && cmake --build build-cuda -j
 # Kokkos 3.4 knows GPUs up to Ampere (AMPERE80, AMPERE86); its sm_80 code carries PTX, which the driver compiles for
-# an H100 (sm_90) when the program starts. Native sm_90 code needs Kokkos >= 4.0 (-DKokkos_ARCH_HOPPER90=ON), which
-# Debian 12 does not ship; triaxdem compiles against 3.4 and 4.x alike (kernels/vec3.hpp).
+# an H100 (sm_90) when the program starts, every time on a fresh machine. Kokkos >= 4.0 knows Hopper
+# (-DKokkos_ARCH_HOPPER90=ON), and Debian 12 does not ship it; SM=90 keeps 3.4's AMPERE80 settings (a subset of
+# what Hopper has) and emits sm_90 machine code instead of sm_80's, so that nothing is compiled at start.
 # Two patches make 3.4.01 build with CUDA 13 (both are upstream fixes of later Kokkos releases, applied here with
 # sed so that the source stays Debian's): the half-precision type, which no triaxdem kernel uses, is left out (CUDA 13
 # dropped the conversions it relies on), and cudaMemPrefetchAsync takes a cudaMemLocation since CUDA 13.
 set -euo pipefail
-PREFIX="${PREFIX:-/opt/kokkos-3.4.01-cuda}"
+SM="${SM:-}"
+PREFIX="${PREFIX:-/opt/kokkos-3.4.01-cuda${SM:+-sm$SM}}"
 ARCH="${ARCH:-AMPERE80}"
 CFG_H="$PREFIX/include/KokkosCore_config.h"
 if [ -f "$PREFIX/lib/cmake/Kokkos/KokkosConfig.cmake" ] && grep -q '^#define KOKKOS_ENABLE_CUDA$' "$CFG_H" 2>/dev/null; then
@@ -53,9 +56,14 @@ new = """#if CUDA_VERSION >= 13000
 assert old in s, "kokkos-cuda: Kokkos_CudaSpace.cpp is not 3.4.01's"
 open(p, "w").write(s.replace(old, new))
 PY
+if [ -n "$SM" ]; then
+  grep -q "CHECK_CUDA_ARCH($ARCH *sm_" kokkos/cmake/kokkos_arch.cmake ||
+    { echo "kokkos-cuda: no CHECK_CUDA_ARCH($ARCH ...) in kokkos_arch.cmake" >&2; exit 1; }
+  sed -i "s/CHECK_CUDA_ARCH($ARCH *sm_[0-9]*)/CHECK_CUDA_ARCH($ARCH sm_$SM)/" kokkos/cmake/kokkos_arch.cmake
+fi
 cmake -S kokkos -B build -DCMAKE_BUILD_TYPE=Release -DCMAKE_INSTALL_PREFIX="$PREFIX" -DCMAKE_CXX_STANDARD=17 \
   -DCMAKE_CXX_COMPILER="$PWD/kokkos/bin/nvcc_wrapper" -DKokkos_ENABLE_CUDA=ON -DKokkos_ENABLE_CUDA_LAMBDA=ON \
   -DKokkos_ENABLE_SERIAL=ON -DKokkos_ARCH_"$ARCH"=ON >/dev/null
 cmake --build build -j"$(nproc)" >/dev/null
 $SUDO cmake --install build >/dev/null
-echo "kokkos-cuda: installed Kokkos 3.4.01 (CUDA $ARCH + Serial) to $PREFIX"
+echo "kokkos-cuda: installed Kokkos 3.4.01 (CUDA $ARCH${SM:+ as sm_$SM} + Serial) to $PREFIX"

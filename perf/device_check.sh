@@ -1,0 +1,93 @@
+#!/usr/bin/env bash
+# The GPU check (docs/performance.md, "GPU"): everything a lent GPU's few minutes should answer, prepared on the
+# CPU machine and run as one script there.
+#   perf/device_check.sh prepare REF       # CPU build: the reference runs the device's are compared with
+#   perf/device_check.sh run REF OUT       # any build: particle-steps/s, launch overhead, CPU-GPU agreement, tests
+# BUILD: the build whose binaries run (default build); CPU_BUILD: the one that prepares (default build).
+# TINY=1: a few hundred balls and steps and no membrane specimen, for CI on any build.
+# Each stage has its own time limit, so that a slow stage costs its limit and not the rest.
+set -uo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+mode="${1:-}"; ref="$(realpath -m "${2:-}")"
+[ "$mode" = prepare ] || [ "$mode" = run ] && [ -n "${2:-}" ] ||
+  { echo "usage: perf/device_check.sh prepare REF | run REF OUT" >&2; exit 2; }
+tiny="${TINY:-0}"
+small_cfg="$root/configs/small/S1_100kPa.toml"
+# The membrane comparison: from a checkpoint inside consolidation to a few records into the shear.
+small_start=2000; small_stop=10000
+
+if [ "$mode" = prepare ]; then
+  bin="$(realpath "${CPU_BUILD:-$root/build}")/triaxdem"
+  mkdir -p "$ref"
+  # The periodic cell of the calibration, sheared to 0.5% only (the whole path from the gas, about 20,000 steps).
+  sed -e 's/^target_axial_strain_pct = .*/target_axial_strain_pct = 0.5/' -e 's/^record_strain_pct = .*/record_strain_pct = 0.025/' \
+      -e 's/^snapshot_strains_pct = .*/snapshot_strains_pct = [0.5]/' "$root/configs/periodic/periodic_S1_100kPa.toml" \
+      > "$ref/periodic.toml"
+  [ "$tiny" = 1 ] && sed -i -e 's/^count = .*/count = 200/' -e 's/^size_mm = .*/size_mm = [18.0, 18.0, 18.0]/' "$ref/periodic.toml"
+  "$bin" periodic "$ref/periodic.toml" -o "$ref/periodic_cpu" --overwrite > "$ref/periodic_cpu.log" 2>&1 ||
+    { tail -n 5 "$ref/periodic_cpu.log"; exit 1; }
+  if [ "$tiny" != 1 ]; then
+    "$bin" triaxial "$small_cfg" -o "$ref/small_start" --overwrite --stop-at-step "$small_start" > "$ref/small_start.log" 2>&1
+    [ $? -eq 3 ] || { tail -n 5 "$ref/small_start.log"; exit 1; }
+    rm -rf "$ref/small_cpu"; cp -r "$ref/small_start" "$ref/small_cpu"
+    "$bin" triaxial "$small_cfg" -o "$ref/small_cpu" --resume --stop-at-step "$small_stop" > "$ref/small_cpu.log" 2>&1
+    [ $? -eq 3 ] || { tail -n 5 "$ref/small_cpu.log"; exit 1; }
+  fi
+  echo "device_check: references in $ref"
+  exit 0
+fi
+
+out="$(realpath -m "${3:?usage: perf/device_check.sh run REF OUT}")"
+build="$(realpath "${BUILD:-$root/build}")"; bin="$build/triaxdem"
+mkdir -p "$out"
+stage() { echo; echo "== $1 ($(date +%T))"; }
+
+stage "device and build"
+command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,memory.total,driver_version,clocks.max.sm --format=csv
+"$bin" info || { echo "device_check: $bin does not start" >&2; exit 1; }
+
+# Launch overhead: 64 balls, where a step's time is its launches and waits. Then the benchmark packing's sizes.
+if [ "$tiny" = 1 ]; then overhead_steps=200; sizes="6 10"; steps=50; else overhead_steps=3000; sizes="38 100 215"; steps=200; fi
+stage "launch overhead (64 balls, $overhead_steps steps)"
+BUILD="$build" WORK="$out/scaling" K=4 STEPS="$overhead_steps" timeout 60 bash "$root/perf/scaling.sh"
+for k in $sizes; do
+  stage "particle-steps/s at $((k * k * k)) balls ($steps steps)"
+  BUILD="$build" WORK="$out/scaling" K="$k" STEPS="$steps" timeout "$([ "$k" -gt 150 ] && echo 120 || echo 100)" bash "$root/perf/scaling.sh" | tail -n +2
+  rm -f "$out/scaling/out_k$k"/*.h5  # the snapshots of 10^7 balls are gigabytes
+done
+
+stage "periodic cell against the CPU's"
+timeout 60 "$bin" periodic "$ref/periodic.toml" -o "$out/periodic" --overwrite > "$out/periodic.log" 2>&1
+grep "^time loop" "$out/periodic.log"
+python3 "$root/tools/compare_runs.py" "$ref/periodic_cpu" "$out/periodic"
+
+if [ "$tiny" != 1 ]; then
+  stage "membrane triaxial test against the CPU's (steps $small_start-$small_stop)"
+  rm -rf "$out/small"; cp -r "$ref/small_start" "$out/small"
+  timeout 60 "$bin" triaxial "$small_cfg" -o "$out/small" --resume --stop-at-step "$small_stop" > "$out/small.log" 2>&1
+  grep "^time loop" "$out/small.log"
+  python3 "$root/tools/compare_runs.py" "$ref/small_cpu" "$out/small"
+fi
+
+tests="$build/tests/triaxdem_tests"
+if [ -x "$tests" ]; then
+  kernels='ContactLaw.*:Detection.*:Dynamics.*:BlowUp.*:Membrane*:Stress.*:Micro.*:SimdLanes.*:Reference.*:PeriodicCell.*:IoHdf5.*:Checkpoint.*:Determinism.*:TriaxialMeasures.*'
+  limit=90; [ "$tiny" = 1 ] && limit=60
+  for part in kernels other; do
+    filter="$kernels"; [ "$part" = other ] && filter="-$kernels"
+    stage "the suite's $part tests (at most $limit s)"
+    timeout "$limit" "$tests" --gtest_filter="$filter" > "$out/tests_$part.log" 2>&1; echo "exit status $? (124: stopped at the limit)"
+    echo "passed $(grep -c '^\[       OK \]' "$out/tests_$part.log"), failed $(grep -c '^\[  FAILED  \].*ms)$' "$out/tests_$part.log")"
+    grep -E '^\[  FAILED  \].*ms\)$|^\[  SKIPPED \]' "$out/tests_$part.log"
+    echo "slowest:"; sed -n 's/^\[       OK \] \(.*\) (\([0-9]*\) ms)$/\2 ms \1/p' "$out/tests_$part.log" | sort -rn | head -n 5
+  done
+fi
+
+if [ "$tiny" != 1 ]; then
+  stage "full scale: the paper's S-1 specimen (53,704 beads), as far as 60 s go"
+  timeout 60 "$bin" specimen "$root/configs/paper/S1_100kPa.toml" -o "$out/full" > "$out/full.log" 2>&1
+  echo "exit status $? (124: stopped at the limit)"
+  tr '\r' '\n' < "$out/full.log" | grep -E "layer|time loop" | awk 'NR % 20 == 1' | tail -n 12
+  tr '\r' '\n' < "$out/full.log" | grep -E "layer" | tail -n 1
+fi
+stage "done"
