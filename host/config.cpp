@@ -120,6 +120,7 @@ Config parse_config(const std::string& text, const std::string& path) {
   sp.number("platen_speed_mm_s", c.specimen.platen_speed, 0, 1e4, 1e-3, true);
   sp.number("stop_ratio", c.specimen.stop_ratio, 0, 1, 1, true);
   sp.integer("max_steps_per_layer", c.specimen.max_steps_per_layer, 1, 1000000000L);
+  sp.boolean("accept_unsettled", c.specimen.accept_unsettled);
   sp.finish();
   if (c.specimen.ball_count > 0) {
     // The count decides; the target e is the one it gives in the nominal cylinder.

@@ -68,6 +68,9 @@ struct SpecimenConfig {
   Real platen_speed = 0.05;      ///< m/s, top platen speed while compacting a layer (file: platen_speed_mm_s)
   Real stop_ratio = 1e-3;        ///< unbalanced-force ratio that ends a layer
   long max_steps_per_layer = 200000;
+  /// A layer that reaches max_steps_per_layer before stop_ratio is not at rest: the specimen is refused (and
+  /// cached, so that a rerun that accepts it starts at once) unless this is set.
+  bool accept_unsettled = false;
 };
 
 /// Drained triaxial test on the [specimen]: membrane, isotropic consolidation, shear (Sec. 3.3).

@@ -310,8 +310,9 @@ void Output::write_xdmf() const {
   write_text_atomic(in_folder(folder_, "snapshots.xdmf"), xdmf_document(steps));
 }
 
-void claim_output_folder(const std::string& folder, bool resume, bool overwrite) {
-  if (resume || !fs::is_directory(folder)) return;
+FolderLock claim_output_folder(const std::string& folder, bool resume, bool overwrite) {
+  FolderLock lock(folder);
+  if (resume) return lock;
   // What marks a folder as a run's (every run writes these), and what else a run leaves there: the triaxial
   // job's tables and micro files, and a crashed writer's temporaries and series marker, which the next Output
   // of the folder would otherwise roll forward into the new run's series.
@@ -323,11 +324,11 @@ void claim_output_folder(const std::string& folder, bool resume, bool overwrite)
         (starts(name, "snap_") && ext == ".h5"))
       outputs.push_back(e.path());
     else if (name == kSeriesMarker || name.find(".tmp.") != std::string::npos || name == "summary.csv" ||
-             name == "layers.csv" || name == "porosity_profile.csv" || (starts(name, "micro_") && ext == ".csv") ||
+             name == "layers.csv" || name == "specimen.csv" || name == "porosity_profile.csv" || (starts(name, "micro_") && ext == ".csv") ||
              (starts(name, "force_chains_") && ext == ".vtk"))
       leftovers.push_back(e.path());
   }
-  if (outputs.empty()) return;
+  if (outputs.empty()) return lock;
   if (!overwrite) {
     std::sort(outputs.begin(), outputs.end());
     throw std::runtime_error("output folder '" + folder + "' holds another run's outputs (" +
@@ -337,6 +338,7 @@ void claim_output_folder(const std::string& folder, bool resume, bool overwrite)
   }
   for (const fs::path& p : outputs) fs::remove(p);
   for (const fs::path& p : leftovers) fs::remove(p);
+  return lock;
 }
 
 void write_text_atomic(const std::string& path, const std::string& text) {

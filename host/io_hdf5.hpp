@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "folder_lock.hpp"
+
 namespace dem::io {
 
 /// One particle snapshot on the host, structure of arrays; vectors are interleaved (x0,y0,z0,x1,...).
@@ -88,11 +90,11 @@ class Output {
   void write_xdmf() const;
 };
 
-/// Makes `folder` the output of a new run (resume: the continuation of the run there). A folder that holds
-/// another run's outputs (checkpoint, series, snapshots) is refused, so that a later --resume cannot mix two runs,
-/// unless `overwrite`: then those files are removed first. Throws std::runtime_error naming the folder and what
-/// it holds.
-void claim_output_folder(const std::string& folder, bool resume, bool overwrite);
+/// Makes `folder` the output of a new run (resume: the continuation of the run there), locked for as long as the
+/// returned lock lives (FolderLock: a second run into it is refused). A folder that holds another run's outputs
+/// (checkpoint, series, snapshots) is refused, so that a later --resume cannot mix two runs, unless `overwrite`:
+/// then those files are removed first. Throws std::runtime_error naming the folder and what holds it.
+[[nodiscard]] FolderLock claim_output_folder(const std::string& folder, bool resume, bool overwrite);
 
 /// Writes text to path atomically (a temporary file of this process, flushed, then renamed). Throws
 /// std::runtime_error naming the path.

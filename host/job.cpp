@@ -172,11 +172,15 @@ int specimen_job(const Config& cfg) {
               specimen_ball_count(cfg), cfg.particles.diameter * 1e3, cfg.specimen.void_ratio,
               cfg.specimen.diameter * 1e3, cfg.specimen.height * 1e3, cfg.specimen.layers);
   Specimen sp;
+  StopSignals signals;
   try {
     sp = build_specimen(cfg, true);
   } catch (const BlowUp& e) {
     std::fprintf(stderr, "triaxdem: %s\n", e.what());
     return 2;
+  } catch (const RunStopped& e) {
+    std::fprintf(stderr, "\ntriaxdem: %s\n", e.what());
+    return e.code;
   }
   write_specimen_report(out.folder(), cfg, sp);
   io::Snapshot snap;
@@ -199,6 +203,7 @@ int specimen_job(const Config& cfg) {
     std::printf("specimen: WARNING: the top platen stopped above the target height: the void ratio %.3f is not "
                 "reachable in this mould with these beads without squeezing them (try a larger e)\n",
                 cfg.specimen.void_ratio);
+  require_settled(cfg, sp);
   return 0;
 }
 

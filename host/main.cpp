@@ -2,10 +2,13 @@
 #include <CLI/CLI.hpp>
 #include <Kokkos_Core.hpp>
 
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <sstream>
+#include <string>
 #include <thread>
 
 #include "host/calibrate.hpp"
@@ -18,6 +21,46 @@
 #include "host/periodic_triaxial.hpp"
 #include "host/study.hpp"
 #include "host/triaxial.hpp"
+
+namespace {
+
+// Threads and processes beyond a few per core only slow a run down, and tens of thousands crash the OpenMP
+// runtime (signal 11, no message): counts are refused above this many per core.
+constexpr int kMaxPerCore = 8;
+
+int machine_cores() { return static_cast<int>(std::max(1u, std::thread::hardware_concurrency())); }
+
+std::string count_range(int lowest) {
+  const int cores = machine_cores();
+  return "allowed: " + std::string(lowest == 0 ? "0 for the default, " : "") + "1 to " +
+         std::to_string(kMaxPerCore * cores) + ", " + std::to_string(kMaxPerCore) + " x this machine's " +
+         std::to_string(cores) + " cores";
+}
+
+/// A thread or process count: an integer from `lowest` (0: the default) to kMaxPerCore x the cores.
+CLI::Validator count_on_this_machine(int lowest) {
+  return CLI::Validator(
+      [lowest](std::string& s) -> std::string {
+        char* end = nullptr;
+        const long v = std::strtol(s.c_str(), &end, 10);
+        if (end == s.c_str() || *end != '\0' || v < lowest || v > kMaxPerCore * machine_cores())
+          return s + " is no count for this machine (" + count_range(lowest) + ")";
+        return "";
+      },
+      "COUNT");
+}
+
+/// OMP_NUM_THREADS as the OpenMP runtime would take it, checked before the runtime starts. Empty: fine.
+std::string omp_threads_problem() {
+  const char* env = std::getenv("OMP_NUM_THREADS");
+  if (!env || !*env) return "";
+  char* end = nullptr;
+  const long v = std::strtol(env, &end, 10);
+  if (end != env && (*end == '\0' || *end == ',') && v >= 1 && v <= kMaxPerCore * machine_cores()) return "";
+  return "OMP_NUM_THREADS=" + std::string(env) + " is no thread count for this machine (" + count_range(1) + ")";
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"triaxdem: DEM laboratory for triaxial tests on granular materials"};
@@ -41,6 +84,7 @@ int main(int argc, char** argv) {
   auto* specimen = app.add_subcommand("specimen", "build the [specimen] of a config by multilayer compaction");
   specimen->add_option("config", config_path, "TOML config file")->required()->check(CLI::ExistingFile);
   specimen->add_option("-o,--output", output, "output folder (overrides [run] output)");
+  specimen->add_flag("--overwrite", overwrite, overwrite_help);
 
   auto* triaxial = app.add_subcommand("triaxial", "specimen, membrane, consolidation and shear (drained triaxial test)");
   triaxial->add_option("config", config_path, "TOML config file")->required()->check(CLI::ExistingFile);
@@ -61,9 +105,9 @@ int main(int argc, char** argv) {
   study->add_option("configs", study_inputs, "config folders (every *.toml) or files")->required();
   study->add_option("-o,--output", study_opt.output, "output folder: summary, figure, one subfolder per case");
   study->add_option("-j,--jobs", study_opt.jobs, "cases run at once (default: one per two cores)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(count_on_this_machine(0));
   study->add_option("-t,--threads", study_opt.threads, "OpenMP threads per case (default: the cores shared out)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(count_on_this_machine(0));
   study->add_flag("--resume", study_opt.resume,
                   "keep the cases that finished (summary.csv), continue the triaxial cases from their checkpoints");
   study->add_option("--compare", study_opt.compare,
@@ -95,7 +139,7 @@ int main(int argc, char** argv) {
                   "to set beside the calibrated ones")->check(CLI::ExistingFile);
     c->add_option("-o,--output", cal.output, "parent folder of the dated result folder (default out)");
     c->add_option("-j,--jobs", cal.jobs, "simulator runs at once, one thread each (default: one per core)")
-        ->check(CLI::PositiveNumber);
+        ->check(count_on_this_machine(1));
     c->add_option("--noise", cal.noise, "the data's noise: data (its standard-deviation columns, replicates, or its "
                   "curves' own scatter), lab (a lab's fixed scatter) or a lab noise file like "
                   "configs/calibration/lab_noise.toml; default data")
@@ -130,13 +174,18 @@ int main(int argc, char** argv) {
 
   auto* info = app.add_subcommand("info", "print the Kokkos build in use");
 
-  cal.jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  cal.jobs = machine_cores();
   CLI11_PARSE(app, argc, argv);
+  if (const std::string problem = omp_threads_problem(); !problem.empty()) {
+    std::fprintf(stderr, "triaxdem: %s\n", problem.c_str());
+    return 1;
+  }
   // Parallel calibration runs are child processes of one thread each (PeriodicLab::set_jobs).
   if (calibrate->parsed() || diagnose->parsed()) dem::prepare_parallel_runs(cal.jobs);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // progress reaches a log file as it happens
   if (study->parsed()) {  // the study only starts child processes: no Kokkos of its own
     try {
+      const dem::io::FolderLock lock(study_opt.output);  // two studies into one folder would mix their cases
       return dem::study_job(study_inputs, study_opt, "/proc/self/exe");
     } catch (const std::exception& e) {
       std::fprintf(stderr, "triaxdem: %s\n", e.what());
@@ -164,9 +213,11 @@ int main(int argc, char** argv) {
       std::printf("%s: OK\n", config_path.c_str());
       return 0;
     }
+    // Held until the job returns: a second run into the folder is refused while this one writes there.
+    dem::io::FolderLock lock;
+    if (run->parsed() || triaxial->parsed() || periodic->parsed() || specimen->parsed())
+      lock = dem::io::claim_output_folder(cfg.run.output, resume, overwrite);
     if (specimen->parsed()) return dem::specimen_job(cfg);
-    if (run->parsed() || triaxial->parsed() || periodic->parsed())
-      dem::io::claim_output_folder(cfg.run.output, resume, overwrite);
     if (triaxial->parsed()) return dem::triaxial_job(cfg, resume, stop_at);
     if (periodic->parsed()) return dem::run_periodic_job(cfg);
     if (calibrate->parsed() || diagnose->parsed()) {

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <string>
 
+#include "checkpoint.hpp"
 #include "io_hdf5.hpp"
 #include "packing.hpp"
 #include "progress.hpp"
@@ -69,6 +70,10 @@ std::pair<long, Real> compact(Simulation& sim, Real z_target, const SpecimenConf
     sim.step(measure);
     ++s;
     if (measure) {
+      // A stop asked for here has no checkpoint to write: a half-built specimen is no state to resume.
+      if (StopSignals::requested())
+        throw RunStopped(std::string(StopSignals::name()) + " during the specimen build: nothing was stored, and "
+                         "the next run builds the specimen again", 128 + StopSignals::signal());
       ratio = sim.unbalanced_ratio();
       if (progress) {
         char extra[80];
@@ -166,11 +171,6 @@ Specimen build_specimen(const Config& cfg, bool verbose) {
     out.balls = all;
     LayerReport rep{z0, z1, sim.wall_point(kTop).z, slab_void_ratio(out.balls, R, z0, z1), steps, ratio};
     out.layers.push_back(rep);
-    if (steps >= sc.max_steps_per_layer && ratio >= sc.stop_ratio)
-      std::fprintf(stderr, "specimen: WARNING: layer %ld/%ld stopped at [specimen] max_steps_per_layer = %ld with "
-                   "the unbalanced ratio at %.1e, above stop_ratio = %.0e: it is not at rest (raise "
-                   "max_steps_per_layer, or accept it)\n", k + 1, sc.layers, sc.max_steps_per_layer, ratio,
-                   sc.stop_ratio);
     if (verbose)
       std::printf("specimen: layer %ld/%ld: %ld balls, platen at %.3f mm (target %.3f), unbalanced ratio %.1e; time "
                   "loop: %s\n", k + 1, sc.layers, pc.count, rep.z_platen * 1e3, z1 * 1e3, ratio,
@@ -263,23 +263,44 @@ bool load_specimen(const std::string& path, const std::string& key, Specimen& sp
   return true;
 }
 
-Specimen cached_specimen(const Config& cfg, const std::string& cache, bool verbose) {
+Specimen cached_specimen(const Config& cfg, const std::string& cache, bool verbose, const std::string& own) {
   const std::string key = specimen_key(cfg);
   char name[32];
   std::snprintf(name, sizeof name, "%016zx.csv", std::hash<std::string>{}(key));
   const std::string path = (std::filesystem::path(cache) / name).string();
   Specimen sp;
-  if (load_specimen(path, key, sp)) {
+  const bool from_own = !own.empty() && load_specimen(own, key, sp);
+  if (from_own) {
+    if (verbose) std::printf("specimen: the run's own, %s (%zu balls, e = %.4f)\n", own.c_str(), sp.balls.size(),
+                             sp.void_ratio);
+  } else if (load_specimen(path, key, sp)) {
     if (verbose)
       std::printf("specimen: reusing %s (%zu balls, e = %.4f; same beads, mould, seed and compaction)\n", path.c_str(),
                   sp.balls.size(), sp.void_ratio);
-    return sp;
+  } else {
+    sp = build_specimen(cfg, verbose);
+    std::filesystem::create_directories(cache);
+    save_specimen(path, sp, key);
+    if (verbose) std::printf("specimen: stored in %s for later runs\n", path.c_str());
   }
-  sp = build_specimen(cfg, verbose);
-  std::filesystem::create_directories(cache);
-  save_specimen(path, sp, key);
-  if (verbose) std::printf("specimen: stored in %s for later runs\n", path.c_str());
+  if (!own.empty() && !from_own) save_specimen(own, sp, key);
+  require_settled(cfg, sp);
   return sp;
+}
+
+void require_settled(const Config& cfg, const Specimen& sp) {
+  const SpecimenConfig& sc = cfg.specimen;
+  if (sc.accept_unsettled) return;
+  for (std::size_t k = 0; k < sp.layers.size(); ++k) {
+    const LayerReport& l = sp.layers[k];
+    if (l.steps < sc.max_steps_per_layer || l.unbalanced < sc.stop_ratio) continue;
+    char msg[400];
+    std::snprintf(msg, sizeof msg, "[specimen] layer %zu/%zu stopped at max_steps_per_layer = %ld with the unbalanced "
+                  "ratio at %.1e, above stop_ratio = %.0e: it is not at rest. Raise max_steps_per_layer, or set "
+                  "accept_unsettled = true to go on with it (the specimen is kept: a rerun does not build it again)",
+                  k + 1, sp.layers.size(), sc.max_steps_per_layer, l.unbalanced, sc.stop_ratio);
+    throw ConfigError(cfg.path + ": " + msg);
+  }
 }
 
 }  // namespace dem

@@ -46,8 +46,14 @@ void save_specimen(const std::string& path, const Specimen& sp, const std::strin
 bool load_specimen(const std::string& path, const std::string& key, Specimen& sp);
 
 /// build_specimen through a cache folder: reuses cache/<hash of the key>.csv when it holds this key,
-/// otherwise builds the specimen and stores it there.
-Specimen cached_specimen(const Config& cfg, const std::string& cache, bool verbose);
+/// otherwise builds the specimen and stores it there. With `own` (a run folder's specimen.csv), that file is
+/// looked at first and written when it does not hold the specimen: a run resumed elsewhere, or after the cache
+/// was cleared, does not build it again. Then require_settled: an unsettled specimen is kept and refused.
+Specimen cached_specimen(const Config& cfg, const std::string& cache, bool verbose, const std::string& own = "");
+
+/// Throws ConfigError naming the first layer that max_steps_per_layer stopped above stop_ratio, the keys to
+/// change, and accept_unsettled, unless [specimen] accept_unsettled.
+void require_settled(const Config& cfg, const Specimen& sp);
 
 /// Exact volume of the part of a sphere (centre height zc, radius r) between the planes z0 < z1 (m^3).
 Real sphere_slab_volume(Real zc, Real r, Real z0, Real z1);

@@ -365,9 +365,10 @@ int triaxial_job(const Config& cfg, bool resume, long stop_at_step) {
   }
   StopSignals signals;
   try {
-    // Specimens are shared through a cache beside the output folder (the nine paper cases build one).
-    const Specimen sp =
-        cached_specimen(cfg, (std::filesystem::path(out.folder()).parent_path() / ".specimens").string(), true);
+    // Specimens are shared through a cache beside the output folder (the nine paper cases build one), and each run
+    // keeps its own copy, which a resume reads first.
+    const Specimen sp = cached_specimen(cfg, (std::filesystem::path(out.folder()).parent_path() / ".specimens").string(),
+                                        true, out.folder() + "/specimen.csv");
     std::printf("specimen: %zu balls, e = %.4f, height %.3f mm (layers.csv, porosity_profile.csv)\n",
                 sp.balls.size(), sp.void_ratio, sp.height * 1e3);
     write_specimen_report(out.folder(), cfg, sp);

@@ -2,12 +2,17 @@
 // program itself, run as a user runs it, on the shipped configs.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
 
+#include "host/folder_lock.hpp"
 #include "host/progress.hpp"
 #include "test_util.hpp"
 
@@ -20,10 +25,11 @@ struct Outcome {
   std::string output;
 };
 
-/// `triaxdem ARGS`, its exit code and what it printed (stdout and stderr).
-Outcome triaxdem(const std::string& args, const fs::path& dir) {
+/// `triaxdem ARGS` (after `prefix`: the environment, or a command that runs it), its exit code and what it
+/// printed (stdout and stderr).
+Outcome triaxdem(const std::string& args, const fs::path& dir, const std::string& prefix = "OMP_NUM_THREADS=1") {
   const fs::path log = dir / "log.txt";
-  const std::string cmd = "cd " + std::string(TRIAXDEM_SOURCE_DIR) + " && OMP_NUM_THREADS=1 " TRIAXDEM_BINARY " " +
+  const std::string cmd = "cd " + std::string(TRIAXDEM_SOURCE_DIR) + " && " + prefix + " " TRIAXDEM_BINARY " " +
                           args + " > " + log.string() + " 2>&1";
   const int status = std::system(cmd.c_str());
   std::ifstream in(log);
@@ -33,7 +39,107 @@ Outcome triaxdem(const std::string& args, const fs::path& dir) {
   return o;
 }
 
+std::string text_of(const fs::path& p) {
+  std::ifstream in(p);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+/// The shipped small S-1 config made the tiny triaxial test of the job tests (16 x 16 mm, 3 layers, about 450
+/// beads, inertial number 1e-2, a 24 x 8 membrane: seconds), with `specimen_extra` added to [specimen].
+fs::path tiny_triaxial_file(const fs::path& dir, const std::string& specimen_extra) {
+  std::string t = text_of(fs::path(TRIAXDEM_SOURCE_DIR) / "configs/small/S1_100kPa.toml");
+  const std::pair<const char*, const char*> edits[] = {
+      {"diameter_mm = 25.0", "diameter_mm = 16.0"}, {"height_mm = 50.0", "height_mm = 16.0"},
+      {"void_ratio = 0.60", "void_ratio = 0.70"},   {"layers = 5", "layers = 3\n" },
+      {"stop_ratio = 1e-3", "stop_ratio = 1e-2"},   {"inertial_number = 1e-3", "inertial_number = 1e-2"},
+      {"membrane_nodes_around = 81", "membrane_nodes_around = 24"},
+      {"membrane_segments = 20", "membrane_segments = 8"}, {"rve_edge_mm = 12.0", "rve_edge_mm = 8.0"}};
+  for (const auto& [from, to] : edits) {
+    const std::size_t at = t.find(from);
+    EXPECT_NE(at, std::string::npos) << from << ": the shipped config changed; update this test";
+    if (at != std::string::npos) t.replace(at, std::string(from).size(), to);
+  }
+  const std::size_t layers = t.find("layers = 3\n");
+  t.insert(layers + 11, specimen_extra);
+  const fs::path file = dir / "tiny.toml";
+  std::ofstream(file) << t;
+  return file;
+}
+
 }  // namespace
+
+// Two runs started at once into one folder both went on and left a mixture of their files: a run locks its folder
+// before it writes, and a second is refused naming the first; the lock goes with the run.
+TEST(CliEdges, ASecondRunIntoARunningRunsFolderIsRefused) {
+  const fs::path dir = dem::test::scratch_dir("cli_lock");
+  const fs::path out = dir / "out";
+  {
+    const dem::io::FolderLock held(out.string());
+    const Outcome o = triaxdem("run configs/default.toml -n 5 -o " + out.string(), dir);
+    EXPECT_EQ(o.code, 1) << o.output;
+    EXPECT_NE(o.output.find("is in use by another run (pid " + std::to_string(getpid())), std::string::npos) << o.output;
+    EXPECT_FALSE(fs::exists(out / "series.csv")) << "the refused run wrote";
+  }
+  const Outcome o = triaxdem("run configs/default.toml -n 5 -o " + out.string(), dir);
+  EXPECT_EQ(o.code, 0) << o.output;
+  EXPECT_TRUE(fs::exists(out / "series.csv"));
+  EXPECT_FALSE(fs::exists(out / ".triaxdem.lock")) << "the run left its lock behind";
+}
+
+// `study -t 100000` and OMP_NUM_THREADS=100000 crashed every case with signal 11 and an empty log: counts beyond
+// the machine are refused, naming the option or variable and the allowed range.
+TEST(CliEdges, ThreadAndJobCountsBeyondTheMachineAreRefused) {
+  const fs::path dir = dem::test::scratch_dir("cli_threads");
+  Outcome o = triaxdem("study configs/small -t 100000 -o " + (dir / "s").string(), dir);
+  EXPECT_NE(o.code, 0) << o.output;
+  EXPECT_NE(o.output.find("--threads: 100000 is no count for this machine (allowed: 0 for the default, 1 to "),
+            std::string::npos) << o.output;
+  o = triaxdem("calibrate data/tang2025_table6_peak.csv --config configs/calibration/base.toml -j 0", dir);
+  EXPECT_NE(o.output.find("--jobs: 0 is no count for this machine (allowed: 1 to "), std::string::npos) << o.output;
+  o = triaxdem("info", dir, "OMP_NUM_THREADS=100000");
+  EXPECT_EQ(o.code, 1) << o.output;
+  EXPECT_NE(o.output.find("OMP_NUM_THREADS=100000 is no thread count for this machine (allowed: 1 to "),
+            std::string::npos) << o.output;
+  EXPECT_EQ(triaxdem("info", dir, "OMP_NUM_THREADS=1").code, 0);
+}
+
+// A specimen whose layer the step cap stopped before it came to rest warned and went on (exit 0): it is refused,
+// naming the keys, unless accepted; the refused specimen is kept, so the rerun that accepts it does not build it
+// again; and a resume reads the run's own copy, so clearing the shared cache costs nothing.
+TEST(CliEdges, AnUnsettledSpecimenIsRefusedUnlessAcceptedAndKeptForTheRerun) {
+  const fs::path dir = dem::test::scratch_dir("cli_unsettled");
+  const std::string out = " -o " + (dir / "run").string();
+  Outcome o = triaxdem("triaxial " + tiny_triaxial_file(dir, "max_steps_per_layer = 300\n").string() + out, dir);
+  EXPECT_EQ(o.code, 1) << o.output;
+  EXPECT_NE(o.output.find("[specimen] layer 1/3 stopped at max_steps_per_layer = 300 with the unbalanced ratio at"),
+            std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("set accept_unsettled = true"), std::string::npos) << o.output;
+  const std::string accepted =
+      tiny_triaxial_file(dir, "max_steps_per_layer = 300\naccept_unsettled = true\n").string();
+  o = triaxdem("triaxial " + accepted + out + " --overwrite --stop-at-step 2", dir);
+  EXPECT_EQ(o.code, 3) << o.output;
+  EXPECT_EQ(o.output.find("specimen layer"), std::string::npos) << "built again:\n" << o.output;
+  fs::remove_all(dir / ".specimens");
+  o = triaxdem("triaxial " + accepted + out + " --resume --stop-at-step 4", dir);
+  EXPECT_EQ(o.code, 3) << o.output;
+  EXPECT_NE(o.output.find("specimen: the run's own"), std::string::npos) << o.output;
+  EXPECT_EQ(o.output.find("specimen layer"), std::string::npos) << "built again on resume:\n" << o.output;
+}
+
+// A SIGTERM (or Ctrl-C) while the specimen was being built was held until the whole build had ended (minutes to
+// an hour at full scale): it now stops the build, saying that nothing was stored.
+TEST(CliEdges, AStopSignalEndsTheSpecimenBuild) {
+  const fs::path dir = dem::test::scratch_dir("cli_term");
+  const auto start = std::chrono::steady_clock::now();
+  // The shipped small specimen takes about two minutes on one thread: the signal comes in its first layer.
+  const Outcome o = triaxdem("triaxial configs/small/S1_100kPa.toml -o " + (dir / "run").string(), dir,
+                             "OMP_NUM_THREADS=1 timeout --preserve-status -s TERM 2");
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(o.code, 128 + SIGTERM) << o.output;
+  EXPECT_NE(o.output.find("SIGTERM during the specimen build: nothing was stored"), std::string::npos) << o.output;
+  EXPECT_LT(seconds, 30) << "the build went on after the signal";
+  EXPECT_FALSE(fs::exists(dir / ".specimens")) << "a half-built specimen was stored";
+}
 
 // `--free mu_s,mu_s` was taken as two parameters (a singular fit): refused with the option, and no result folder
 // is left behind.

@@ -236,9 +236,35 @@ TEST_F(IoHdf5, InterruptedSeriesCommitIsFinishedAndOverwriteClearsWhatARunLeaves
   put("series.csv.tmp.2.0", "a crashed run's");
   for (const char* name : {"summary.csv", "micro_A.csv", "force_chains_A.vtk", "layers.csv", "notes.txt"})
     put(name, "x");
-  dem::io::claim_output_folder(dir_.string(), false, true);
+  const dem::io::FolderLock lock = dem::io::claim_output_folder(dir_.string(), false, true);
   for (const char* gone : {"series.csv", "checkpoint.h5.tmp.1.1", ".series_commit", "series.csv.tmp.2.0",
                            "summary.csv", "micro_A.csv", "force_chains_A.vtk", "layers.csv"})
     EXPECT_FALSE(fs::exists(path(gone))) << gone;
   EXPECT_TRUE(fs::exists(path("notes.txt")));
+}
+
+// One run per folder: a second lock on a locked folder is refused naming the holder, whether in this process or
+// another; the lock goes with its holder, file and all; a lock file left by a killed run (the kernel dropped its
+// lock) is taken over, not waited for; a moved lock still releases once.
+TEST_F(IoHdf5, FolderLockAdmitsOneRunAtATime) {
+  const std::string folder = (dir_ / "locked").string();
+  {
+    dem::io::FolderLock first(folder);
+    EXPECT_TRUE(first.held());
+    try {
+      dem::io::FolderLock second(folder);
+      FAIL() << "a second lock was granted";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("is in use by another run (pid " + std::to_string(getpid()) + " on "),
+                std::string::npos) << e.what();
+    }
+    dem::io::FolderLock moved(std::move(first));
+    EXPECT_FALSE(first.held());
+    EXPECT_TRUE(moved.held());
+    EXPECT_THROW(dem::io::FolderLock again(folder), std::runtime_error);
+  }
+  EXPECT_FALSE(fs::exists(fs::path(folder) / ".triaxdem.lock"));
+  std::ofstream(fs::path(folder) / ".triaxdem.lock") << "pid 1 on a machine that crashed\n";
+  const dem::io::FolderLock after_crash(folder);
+  EXPECT_TRUE(after_crash.held());
 }
