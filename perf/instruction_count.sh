@@ -5,12 +5,13 @@
 # start; the difference over (N2 - N1) x balls leaves out reading the packing and setting up (no neighbour
 # rebuild happens in between: the logs are checked). Needs perf/peer_benchmark.sh run first (its packing
 # and inputs) and valgrind. About 15 minutes.
-#   perf/instruction_count.sh                 # N1=20 N2=40 BUILD=build WORK=runs/peer_benchmark
+#   perf/instruction_count.sh                 # N1=20 N2=40 BUILD=build WORK=runs/peer_benchmark PEERS="liggghts lammps"
+# PEERS and CONFIG as perf/peer_benchmark.sh was run with (PEERS="": triaxdem alone).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-n1="${N1:-20}"; n2="${N2:-40}"
+n1="${N1:-20}"; n2="${N2:-40}"; peers="${PEERS-liggghts lammps}"
 build="$(realpath "${BUILD:-$root/build}")"; work="$(realpath -m "${WORK:-$root/runs/peer_benchmark}")"
-for f in packing.data in.liggghts in.lammps; do
+for f in packing.data $(for code in $peers; do echo "in.$code"; done); do
   [ -f "$work/$f" ] || { echo "instruction_count: $work/$f missing: run perf/peer_benchmark.sh first"; exit 1; }
 done
 command -v valgrind >/dev/null || { echo "instruction_count: valgrind is needed (Debian package valgrind)"; exit 1; }
@@ -22,18 +23,27 @@ balls=$(sed -n 's/^\([0-9]*\) atoms$/\1/p' packing.data)
 count() {  # code steps -> instructions collected
   local code=$1 n=$2
   case $code in
-    triaxdem) cmd=("$build/triaxdem" run "$root/perf/configs/periodic_54k.toml" -o "$out/triaxdem_$n" -n "$n") ;;
+    triaxdem) cmd=("$build/triaxdem" run "$(realpath "${CONFIG:-$root/perf/configs/periodic_54k.toml}")" -o "$out/triaxdem_$n"
+                    -n "$n" --overwrite) ;;
     liggghts) sed "s/^run .*/run $n/" "$work/in.liggghts" > "in.liggghts_$n"; cmd=(liggghts -in "in.liggghts_$n" -log none) ;;
     lammps) sed "s/^run .*/run $n/" "$work/in.lammps" > "in.lammps_$n"; cmd=(lmp -in "in.lammps_$n" -log none) ;;
   esac
-  OMP_NUM_THREADS=1 valgrind --tool=callgrind --callgrind-out-file="callgrind.$code.$n" "${cmd[@]}" > "$code.$n.log" 2>&1
+  OMP_NUM_THREADS=1 valgrind --tool=callgrind --callgrind-out-file="callgrind.$code.$n" "${cmd[@]}" > "$code.$n.log" 2>&1 ||
+    true
+  if grep -q "unhandled instruction bytes: 0x62" "$code.$n.log"; then
+    echo "instruction_count: valgrind cannot run $code's AVX-512 code (EVEX): count a build configured with" \
+         "-DTRIAXDEM_X86_64=v3 (BUILD=...)" >&2; exit 1
+  fi
+  if [ "$code" = triaxdem ] && ! grep -q "^time loop:" "$code.$n.log"; then
+    echo "instruction_count: $code did not run to its end under valgrind ($out/$code.$n.log)" >&2; exit 1
+  fi
   if grep -q "^Neighbor list builds = [1-9]" "$code.$n.log" || grep -q "([2-9][0-9]* rebuilds)" "$code.$n.log"; then
     echo "instruction_count: $code rebuilt its neighbour list within $n steps; use fewer steps" >&2; exit 1
   fi
   sed -n 's/^==[0-9]*== Collected : \([0-9]*\)$/\1/p' "$code.$n.log"
 }
 echo "instructions per particle-step, $balls balls, steps $n1 -> $n2, one core (callgrind)"
-for code in triaxdem liggghts lammps; do
+for code in triaxdem $peers; do
   a=$(count $code "$n1"); b=$(count $code "$n2")
   awk -v c="$code" -v a="$a" -v b="$b" -v s=$((n2 - n1)) -v n="$balls" 'BEGIN { printf "  %-9s %6.0f\n", c, (b - a) / (s * n) }'
 done

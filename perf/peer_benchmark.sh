@@ -2,7 +2,8 @@
 # Side-by-side throughput on one packing: triaxdem (OpenMP threads) against LIGGGHTS and LAMMPS (Debian
 # packages, MPI ranks), each on all cores, run one after the other in this one script so that the ratios
 # are taken on the same machine in the same state. Installs the peers from Debian when they are missing.
-#   perf/peer_benchmark.sh                    # STEPS=2000 REPS=3 NP=$(nproc) BUILD=build
+#   perf/peer_benchmark.sh                    # STEPS=2000 REPS=3 NP=$(nproc) BUILD=build PEERS="liggghts lammps"
+# CONFIG: another packing config (default perf/configs/periodic_54k.toml); PEERS="": triaxdem alone (the CI's check).
 # The packing: perf/configs/periodic_54k.toml (54,872 balls of 2 mm, a jittered cubic array at a pitch of
 # 0.995 d, periodic), written by triaxdem and read by the peers. The contact laws, as close as each code has:
 #   triaxdem  rrlinear: kn = pi r^2 E / (2 r), ks = kn / 1.5, Coulomb mu_s 0.3, rolling spring ks R^2 capped
@@ -15,20 +16,25 @@ set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 steps="${STEPS:-2000}"; reps="${REPS:-3}"; np="${NP:-$(nproc)}"
 build="$(realpath "${BUILD:-$root/build}")"; work="$(realpath -m "${WORK:-$root/runs/peer_benchmark}")"
+peers="${PEERS-liggghts lammps}"
 tdem="$build/triaxdem"
 [ -x "$tdem" ] || { echo "peer_benchmark: build triaxdem first ($tdem)"; exit 1; }
-if ! command -v liggghts >/dev/null || ! command -v lmp >/dev/null || ! command -v mpirun >/dev/null; then
+declare -A package=([liggghts]=liggghts [lammps]=lammps) command_of=([liggghts]=liggghts [lammps]=lmp)
+missing=""
+for code in $peers; do command -v "${command_of[$code]}" >/dev/null || missing+=" ${package[$code]}"; done
+[ -z "$peers" ] || command -v mpirun >/dev/null || missing+=" openmpi-bin"
+if [ -n "$missing" ]; then
   SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"
-  $SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends liggghts lammps openmpi-bin
+  $SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $missing
 fi
 # Debian's interpreter first: python3-h5py is installed for it, not for a python3 earlier on PATH.
 py=python3; [ -x /usr/bin/python3 ] && py=/usr/bin/python3
 mkdir -p "$work"
 cd "$work"
-cfg="$root/perf/configs/periodic_54k.toml"
+cfg="$(realpath "${CONFIG:-$root/perf/configs/periodic_54k.toml}")"
 export OMP_PROC_BIND=spread OMP_PLACES=threads
 # The packing and the time step, from triaxdem itself.
-OMP_NUM_THREADS="$np" "$tdem" run "$cfg" -o "$work/packing" -n 0 > packing.log 2>&1
+OMP_NUM_THREADS="$np" "$tdem" run "$cfg" -o "$work/packing" -n 0 --overwrite > packing.log 2>&1
 dt=$(sed -n 's/.*, dt \([0-9.e+-]*\) s.*/\1/p' packing.log | head -1)
 "$py" - "$work/packing/snap_000000000.h5" "$cfg" <<'PY'
 import sys, h5py, tomllib
@@ -94,20 +100,21 @@ mpi="mpirun -np $np --bind-to core"
 [ "$(id -u)" -ne 0 ] || mpi="$mpi --allow-run-as-root"
 declare -A rates
 for rep in $(seq "$reps"); do
-  OMP_NUM_THREADS="$np" "$tdem" run "$cfg" -o "$work/triaxdem_run" -n "$steps" > triaxdem.log 2>&1
+  OMP_NUM_THREADS="$np" "$tdem" run "$cfg" -o "$work/triaxdem_run" -n "$steps" --overwrite > triaxdem.log 2>&1
   rates[triaxdem]+="$(sed -n 's/.*; \([0-9.e+]*\) particle-steps\/s.*/\1/p' triaxdem.log | tail -1) "
-  OMP_NUM_THREADS=1 $mpi liggghts -in in.liggghts -log none > liggghts.log 2>&1
-  rates[liggghts]+="$(rate_of_loop liggghts.log) "
-  OMP_NUM_THREADS=1 $mpi lmp -in in.lammps -log none > lammps.log 2>&1
-  rates[lammps]+="$(rate_of_loop lammps.log) "
+  for code in $peers; do
+    OMP_NUM_THREADS=1 $mpi "${command_of[$code]}" -in "in.$code" -log none > "$code.log" 2>&1
+    rates[$code]+="$(rate_of_loop "$code.log") "
+  done
 done
 median() { tr ' ' '\n' | grep . | sort -g | awk '{ a[NR] = $1 } END { print a[int((NR + 1) / 2)] }'; }
-echo "peer benchmark: 54,872 balls, $steps steps, dt $dt s, $np cores (triaxdem: $np OpenMP threads; peers: $np MPI ranks), median of $reps"
+balls=$(sed -n 's/^\([0-9]*\) atoms$/\1/p' packing.data)
+echo "peer benchmark: $balls balls, $steps steps, dt $dt s, $np cores (triaxdem: $np OpenMP threads; peers: $np MPI ranks), median of $reps"
 best=0
-for code in triaxdem liggghts lammps; do
+for code in triaxdem $peers; do
   m=$(echo "${rates[$code]}" | median)
   printf "  %-9s %8.3g particle-steps/s   (runs: %s)\n" "$code" "$m" "${rates[$code]}"
   [ "$code" = triaxdem ] && mine=$m
   [ "$code" != triaxdem ] && best=$("$py" -c "print(max($best, $m))")
 done
-"$py" -c "print(f'  triaxdem / faster peer: {$mine / $best:.2f}')"
+[ -z "$peers" ] || "$py" -c "print(f'  triaxdem / faster peer: {$mine / $best:.2f}')"

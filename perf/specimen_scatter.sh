@@ -6,14 +6,14 @@
 # (tools/specimen_scatter.py). SMALL_PREP_MU_S prepares the 120-ball cells with that friction instead of the
 # config's, to set them at the larger cells' void ratio as diagnose matches a specimen's state (0.012 for 0.03).
 # About 10 minutes on 2 cores.
-#   bash perf/specimen_scatter.sh              # SEEDS=12 BUILD=build WORK=runs/specimen_scatter SMALL_PREP_MU_S=
+#   bash perf/specimen_scatter.sh              # SEEDS=12 FACTORS="1 4 16" BUILD=build WORK=runs/specimen_scatter SMALL_PREP_MU_S=
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="$(realpath "${BUILD:-$root/build}")"; work="$(realpath -m "${WORK:-$root/runs/specimen_scatter}")"
-seeds="${SEEDS:-12}"
+seeds="${SEEDS:-12}"; factors="${FACTORS:-1 4 16}"
 mkdir -p "$work"
 for s3 in 100 300; do
-  for factor in 1 4 16; do
+  for factor in $factors; do
     n=$((120 * factor)); edge=$(awk -v f="$factor" 'BEGIN { printf "%.4f", 14.5 * f ^ (1 / 3) }')
     for ((seed = 1; seed <= seeds; ++seed)); do
       cfg="$work/n${n}_${s3}_$seed.toml"
