@@ -100,7 +100,7 @@ Config parse_config(const std::string& text, const std::string& path) {
   TableReader sv = table("solver");
   sv.number("damping", c.solver.damping, 0, 0.99);
   sv.number_triple("gravity", c.solver.gravity, -1e4, 1e4);
-  sv.number("dt_safety", c.solver.dt_safety, 0, 1, 1, true);
+  sv.number("dt_safety", c.solver.dt_safety, kMinDtFraction, 1);
   sv.number("dt_s", c.solver.dt, 0, 1);
   sv.number("mass_scale", c.solver.mass_scale, 1, 1e12);
   sv.number("skin", c.solver.skin, 0, 2, 1, true);

@@ -187,8 +187,12 @@ struct Config {
   CalibrateConfig calibrate;
 };
 
+/// The smallest time step a run takes, as a fraction of the critical step: quasi-static DEM runs at 0.1-0.3 of it,
+/// and a step a thousand times smaller only multiplies the cost (dt_s = 1e-300 ran, and would never end).
+constexpr Real kMinDtFraction = 1e-3;
+
 /// The time step of a run: [solver] dt_s when set, else dt_safety x `critical` (s). Throws ConfigError naming
-/// `path`, the key and the allowed range when dt_s is above the critical step.
+/// `path`, the key and the allowed range when dt_s is above the critical step or below kMinDtFraction of it.
 Real time_step(const SolverConfig& solver, Real critical, const std::string& path);
 
 /// Memory a run of `balls` balls needs at its peak (bytes): 667 bytes per ball in steady state

@@ -11,11 +11,11 @@
 namespace dem {
 
 Real time_step(const SolverConfig& solver, Real critical, const std::string& path) {
-  if (solver.dt > critical) {
+  if (solver.dt > critical || (solver.dt > 0 && solver.dt < kMinDtFraction * critical)) {
     std::ostringstream m;
-    m << path << ": [solver] dt_s: " << solver.dt << " s is above the critical time step " << critical
-      << " s of these balls and contact laws (allowed: (0, " << critical
-      << "]; leave dt_s out to use dt_safety x critical)";
+    m << path << ": [solver] dt_s: " << solver.dt << " s is " << (solver.dt > critical ? "above" : "far below")
+      << " the critical time step " << critical << " s of these balls and contact laws (allowed: ["
+      << kMinDtFraction * critical << ", " << critical << "]; leave dt_s out to use dt_safety x critical)";
     throw ConfigError(m.str());
   }
   return solver.dt > 0 ? solver.dt : solver.dt_safety * critical;

@@ -19,6 +19,7 @@
 #include "host/job.hpp"
 #include "host/micro_report.hpp"
 #include "host/periodic_triaxial.hpp"
+#include "host/provenance.hpp"
 #include "host/study.hpp"
 #include "host/triaxial.hpp"
 
@@ -64,6 +65,7 @@ std::string omp_threads_problem() {
 
 int main(int argc, char** argv) {
   CLI::App app{"triaxdem: DEM laboratory for triaxial tests on granular materials"};
+  app.set_version_flag("--version", dem::version_line());
   app.require_subcommand(1);
   std::string config_path, output;
   long steps = -1;

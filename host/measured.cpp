@@ -20,6 +20,9 @@ namespace {
 constexpr Real kNaN = std::numeric_limits<Real>::quiet_NaN();
 /// Sands stay below e ~ 1.2 and soft clays below ~ 4: a larger value is something else (a porosity in percent).
 constexpr Real kMaxVoidRatio = 5;
+// A curve of one or two rows has no shape: its peak, stiffness and dilatancy would be read off single points (a file
+// with one point per test started a calibration). Three rows are the fewest with a peak between them.
+constexpr std::size_t kMinCurveRows = 3;
 
 /// A column's quantity and the factor that turns the file's unit into SI.
 struct ColumnSpec {
@@ -391,7 +394,14 @@ MeasuredData load_measured(const std::string& path) {
   }
   if (d.tests.empty()) throw DataError(path + ": no data rows");
   if (d.curves)
-    for (MeasuredTest& t : d.tests) summarise(t);
+    for (MeasuredTest& t : d.tests) {
+      if (t.eps_a.size() < kMinCurveRows)
+        throw DataError(path + ": " + describe(t) + ": " + std::to_string(t.eps_a.size()) + " row" +
+                        (t.eps_a.size() == 1 ? "" : "s") + " (allowed: at least " + std::to_string(kMinCurveRows) +
+                        " rows of eps_a and q per test: a curve; give one row per test in a summary file, with "
+                        "q_peak_<unit> and no eps_a column)");
+      summarise(t);
+    }
   note_replicates(d);
   if (!d.q_measure_given)
     d.notes.push_back(path + ": no q_measure column: q taken as fixed_area (platen force over the cross-section "

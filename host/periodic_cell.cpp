@@ -152,6 +152,7 @@ int run_periodic_job(const Config& cfg) {
     su.max_dilatancy = r.max_dilatancy;
     su.inertial_number = r.inertial;
     su.wall_seconds = r.wall_seconds;
+    su.provenance = provenance_of(cfg);
     write_summary(out.folder(), su);
   } catch (const BlowUp& e) {
     out.flush_series();

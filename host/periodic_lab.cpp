@@ -142,6 +142,15 @@ Real prep_friction_for(const Config& base, Real target, Real& reached, bool verb
   if (verbose)
     std::printf("triaxdem: preparation friction 0 to 1 packs void ratios %.4f to %.4f (mean of %d specimens); "
                 "target %.4f\n", e_lo, e_hi, plan.specimens, target);
+  // A state far outside what the cell packs is another material state, not a calibration target (a data void
+  // ratio of 4.5 was matched by the loosest packing, 0.87, and calibrated on).
+  if (target < e_lo - kMaxStateGap || target > e_hi + kMaxStateGap) {
+    char msg[360];
+    std::snprintf(msg, sizeof msg, "the data's void ratio %.4f is beyond this cell's reach: preparation friction 0 to "
+                  "1 packs it at %.4f to %.4f, and a state more than %.2f outside that range cannot be matched (check "
+                  "the data's void_ratio or porosity column)", target, e_lo, e_hi, kMaxStateGap);
+    throw DataError(msg);
+  }
   if (target <= e_lo) return reached = e_lo, 0;
   if (target >= e_hi) return reached = e_hi, 1;
   for (int k = 0; k < plan.steps; ++k) {

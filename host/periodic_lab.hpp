@@ -122,11 +122,17 @@ struct MatchPlan {
 /// the config's own where "auto"), 8 halvings, `jobs` at once.
 MatchPlan match_plan(const Config& base, int jobs);
 
+/// How far (in void ratio) a data state may lie outside what a cell's preparation reaches and still be matched
+/// by the nearest end. Table 6's glass beads (e 0.60-0.61) lie 0.01-0.02 from the densest packing of the shipped
+/// cells (0.589 for 120 balls), which the nearest end serves; a gap of a tenth is as large as the whole range the
+/// preparation friction spans (0.59-0.87), another state, and is refused.
+constexpr Real kMaxStateGap = 0.05;
+
 /// The preparation friction ([periodic] prep_mu_s) with which the plan's specimens of the base config pack to a
 /// mean void ratio of `target` after their preparation: bisection on sqrt(prep_mu_s) over [0, 1] (more friction,
 /// a looser packing; the root spreads the steps where the void ratio changes fastest). `reached` receives their
-/// mean void ratio at the answer; a target beyond what [0, 1] reaches gets the nearest end. 8 halvings take
-/// sqrt(prep_mu_s) to 1/256 of its range.
+/// mean void ratio at the answer; a target beyond what [0, 1] reaches gets the nearest end, and one more than
+/// kMaxStateGap beyond it throws DataError. 8 halvings take sqrt(prep_mu_s) to 1/256 of its range.
 Real prep_friction_for(const Config& base, Real target, Real& reached, bool verbose, const MatchPlan& plan);
 
 /// The measured specimens' state and the preparation that packs it (matched_state).

@@ -64,10 +64,16 @@ std::vector<std::string> split_csv(const std::string& line) {
   return out;
 }
 
+// Provenance, after the numbers: text columns, optional for the reader (older summaries lack them).
+const std::pair<const char*, std::string Provenance::*> kProvenanceColumns[] = {
+    {"version", &Provenance::version}, {"backend", &Provenance::backend}, {"config", &Provenance::config},
+    {"config_hash", &Provenance::config_hash}};
+
 std::string summary_header() {
   std::string h = "kind,balls,wall_s";
   for (const Column& c : kColumns) h += std::string(",") + c.name;
-  return h;
+  for (const auto& [name, field] : kProvenanceColumns) h += std::string(",") + name;
+  return h + ",seed";
 }
 
 std::string summary_values(const TestSummary& s) {
@@ -78,7 +84,12 @@ std::string summary_values(const TestSummary& s) {
     std::snprintf(b, sizeof b, ",%.6g", s.*(c.field) * c.scale);
     row += b;
   }
-  return row;
+  for (const auto& [name, field] : kProvenanceColumns) {
+    std::string text = s.provenance.*field;
+    std::replace(text.begin(), text.end(), ',', ';');  // one cell, for this file's plain comma splitting
+    row += "," + text;
+  }
+  return row + "," + std::to_string(s.provenance.seed);
 }
 
 /// Where tools/<script> is: beside the executable's folder (build tree or install prefix), else the sources.
@@ -152,6 +163,9 @@ TestSummary read_summary(const std::string& path) {
   s.wall_seconds = std::stod(get("wall_s"));
   for (const Column& c : kColumns)
     s.*(c.field) = c.optional && !m.count(c.name) ? kNaN : std::stod(get(c.name)) / c.scale;
+  for (const auto& [name, field] : kProvenanceColumns)
+    if (m.count(name)) s.provenance.*field = m[name];
+  if (m.count("seed")) s.provenance.seed = std::stol(m["seed"]);
   return s;
 }
 

@@ -7,6 +7,7 @@
 
 #include "config.hpp"
 #include "measured.hpp"
+#include "provenance.hpp"
 
 namespace dem {
 
@@ -28,6 +29,7 @@ struct TestSummary {
   Real max_dilatancy = 0;       ///< max of -d eps_v / d eps_a
   Real inertial_number = 0;
   double wall_seconds = 0;
+  Provenance provenance;        ///< empty in a summary written before it was recorded
 };
 
 /// The peak of the q a lab reports as `m`, so that a measured peak is compared like with like; a periodic

@@ -102,13 +102,17 @@ const std::vector<std::string> kSeriesColumns = {
     "eps_a_pct",        "eps_v_pct",          "q_kPa",            "sigma1_kPa",      "sigma1_bottom_kPa",
     "sigma3_kPa",       "sigma3_balls_kPa",   "eps_v_envelope_pct", "unbalanced_ratio", "kinetic_energy_J",
     "q_area_kPa",       "q_parabolic_kPa",    "q_membrane_kPa",   "sigma3_hoop_kPa", "q_lw_kPa",
-    "p_lw_kPa",         "q_boundary_kPa",     "p_boundary_kPa",   "q_net_kPa",       "p_net_kPa"};
+    "p_lw_kPa",         "q_boundary_kPa",     "p_boundary_kPa",   "q_net_kPa",       "p_net_kPa",
+    "p_kPa",            "void_ratio",         "phi_mob_deg"};
 
-std::vector<double> series_row(const TriaxialRecord& r, Real sigma3) {
+/// `e0`: the void ratio after consolidation, from which eps_v counts. p and phi_mob are the lab's, of the q the
+/// paper reports (q_kPa) and the cell pressure: p = sigma3 + q / 3, as the periodic series has them.
+std::vector<double> series_row(const TriaxialRecord& r, Real sigma3, Real e0) {
   return {100 * r.eps_a,         100 * r.eps_v,        r.q / 1e3,           r.sigma1 / 1e3,     r.sigma1_bottom / 1e3,
           sigma3 / 1e3,          r.sigma3_balls / 1e3, 100 * r.eps_v_envelope, r.unbalanced,     r.kinetic,
           r.q_area / 1e3,        r.q_parabolic / 1e3,  r.q_membrane / 1e3,  r.sigma3_hoop / 1e3, r.q_lw / 1e3,
-          r.p_lw / 1e3,          r.q_boundary / 1e3,   r.p_boundary / 1e3,  r.q_net / 1e3,      r.p_net / 1e3};
+          r.p_lw / 1e3,          r.q_boundary / 1e3,   r.p_boundary / 1e3,  r.q_net / 1e3,      r.p_net / 1e3,
+          (sigma3 + r.q / 3) / 1e3, (1 + e0) * (1 - r.eps_v) - 1, friction_angle_deg(r.q, sigma3)};
 }
 
 /// The record's deviators as labs report them and the specimen's mean stress over the enclosed `volume`, from
@@ -279,7 +283,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
         r.kinetic = sim.stats().kinetic;
         measure_stresses(cell, tc, contacts_now(), volume, v0 / h0, r);
         res.records.push_back(r);
-        std::vector<double> row = series_row(r, tc.sigma3);
+        std::vector<double> row = series_row(r, tc.sigma3, st.void_ratio);
         const int next_snap = static_cast<int>(st.next_snap);
         if (mc.enabled) {
           const ContactSet& cs = contacts_now();
@@ -415,6 +419,7 @@ int triaxial_job(const Config& cfg, bool resume, long stop_at_step) {
     s.max_dilatancy = r.max_dilatancy;
     s.inertial_number = r.inertial_number;
     s.wall_seconds = r.wall_seconds;
+    s.provenance = provenance_of(cfg);
     write_summary(out.folder(), s);
     std::printf("output: %s/series.csv, summary.csv, snapshots.xdmf (ParaView: balls and membrane)\n",
                 out.folder().c_str());

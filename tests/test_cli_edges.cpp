@@ -5,12 +5,16 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "host/folder_lock.hpp"
 #include "host/progress.hpp"
@@ -44,25 +48,26 @@ std::string text_of(const fs::path& p) {
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
-/// The shipped small S-1 config made the tiny triaxial test of the job tests (16 x 16 mm, 3 layers, about 450
-/// beads, inertial number 1e-2, a 24 x 8 membrane: seconds), with `specimen_extra` added to [specimen].
-fs::path tiny_triaxial_file(const fs::path& dir, const std::string& specimen_extra) {
-  std::string t = text_of(fs::path(TRIAXDEM_SOURCE_DIR) / "configs/small/S1_100kPa.toml");
-  const std::pair<const char*, const char*> edits[] = {
-      {"diameter_mm = 25.0", "diameter_mm = 16.0"}, {"height_mm = 50.0", "height_mm = 16.0"},
-      {"void_ratio = 0.60", "void_ratio = 0.70"},   {"layers = 5", "layers = 3\n" },
-      {"stop_ratio = 1e-3", "stop_ratio = 1e-2"},   {"inertial_number = 1e-3", "inertial_number = 1e-2"},
-      {"membrane_nodes_around = 81", "membrane_nodes_around = 24"},
-      {"membrane_segments = 20", "membrane_segments = 8"}, {"rve_edge_mm = 12.0", "rve_edge_mm = 8.0"}};
-  for (const auto& [from, to] : edits) {
-    const std::size_t at = t.find(from);
-    EXPECT_NE(at, std::string::npos) << from << ": the shipped config changed; update this test";
-    if (at != std::string::npos) t.replace(at, std::string(from).size(), to);
+/// The numeric cells of a CSV file's last row, by column name.
+std::map<std::string, double> last_row(const fs::path& file) {
+  std::ifstream in(file);
+  std::string header, line, last;
+  std::getline(in, header);
+  while (std::getline(in, line)) last = line;
+  std::stringstream h(header), v(last);
+  std::map<std::string, double> row;
+  for (std::string name, cell; std::getline(h, name, ',') && std::getline(v, cell, ',');) {
+    char* end = nullptr;
+    const double x = std::strtod(cell.c_str(), &end);
+    if (end != cell.c_str() && *end == '\0') row[name] = x;
   }
-  const std::size_t layers = t.find("layers = 3\n");
-  t.insert(layers + 11, specimen_extra);
+  return row;
+}
+
+/// tests/data/tiny_triaxial.toml (450 beads: seconds) with `specimen_extra` added to its last table, [specimen].
+fs::path tiny_triaxial_file(const fs::path& dir, const std::string& specimen_extra) {
   const fs::path file = dir / "tiny.toml";
-  std::ofstream(file) << t;
+  std::ofstream(file) << text_of(fs::path(TRIAXDEM_SOURCE_DIR) / "tests/data/tiny_triaxial.toml") << specimen_extra;
   return file;
 }
 
@@ -139,6 +144,45 @@ TEST(CliEdges, AStopSignalEndsTheSpecimenBuild) {
   EXPECT_NE(o.output.find("SIGTERM during the specimen build: nothing was stored"), std::string::npos) << o.output;
   EXPECT_LT(seconds, 30) << "the build went on after the signal";
   EXPECT_FALSE(fs::exists(dir / ".specimens")) << "a half-built specimen was stored";
+}
+
+// A data void ratio of 4.5 was matched by the loosest packing the cell reaches (0.87) and calibrated on: a state
+// beyond the preparation's reach by more than kMaxStateGap is refused, with both ends of that reach.
+TEST(CliEdges, ADataStateBeyondTheCellsReachIsRefused) {
+  const fs::path dir = dem::test::scratch_dir("cli_state");
+  std::ofstream(dir / "loose.csv") << "material,sigma3_kPa,eps_a_pct,q_kPa,eps_v_pct,void_ratio\n"
+                                      "A,100,0,0,0,4.5\nA,100,1,60,0.1,4.5\nA,100,2,70,-0.1,4.5\nA,100,3,65,-0.3,4.5\n";
+  const Outcome o = triaxdem("calibrate " + (dir / "loose.csv").string() + " --config tests/data/hidden_effects.toml "
+                             "--predict none -j 1 -o " + (dir / "out").string(), dir);
+  EXPECT_EQ(o.code, 1) << o.output;
+  EXPECT_NE(o.output.find("the data's void ratio 4.5000 is beyond this cell's reach: preparation friction 0 to 1 "
+                          "packs it at 0."), std::string::npos) << o.output;
+}
+
+// The README writes `triaxdem ...` and nothing said which build a result came from: --version names the version,
+// the commit and the Kokkos backend, and every summary.csv carries them with the config's path, hash and seed.
+TEST(CliEdges, VersionAndProvenance) {
+  const fs::path dir = dem::test::scratch_dir("cli_version");
+  Outcome o = triaxdem("--version", dir);
+  EXPECT_EQ(o.code, 0) << o.output;
+  EXPECT_EQ(o.output.rfind("triaxdem " TRIAXDEM_VERSION "+", 0), 0u) << o.output;
+  EXPECT_NE(o.output.find("(Kokkos "), std::string::npos) << o.output;
+  o = triaxdem("triaxial tests/data/tiny_triaxial.toml -o " + (dir / "run").string(), dir);
+  ASSERT_EQ(o.code, 0) << o.output;
+  const std::string summary = text_of(dir / "run" / "summary.csv");
+  EXPECT_NE(summary.find(",version,backend,config,config_hash,seed\n"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("," TRIAXDEM_VERSION "+"), std::string::npos) << summary;
+  EXPECT_NE(summary.find(",tests/data/tiny_triaxial.toml,"), std::string::npos) << summary;
+  // The membrane series has p, the void ratio and the mobilised friction angle, as the periodic one has; e from
+  // eps_v and the consolidated e0 of summary.csv (6 digits there).
+  const auto row = last_row(dir / "run" / "series.csv");
+  for (const char* name : {"q_kPa", "sigma3_kPa", "eps_v_pct", "p_kPa", "void_ratio", "phi_mob_deg"})
+    ASSERT_TRUE(row.count(name)) << name << " missing from series.csv";
+  const double q = row.at("q_kPa"), s3 = row.at("sigma3_kPa");
+  EXPECT_NEAR(row.at("p_kPa"), s3 + q / 3, 1e-6 * s3);
+  EXPECT_NEAR(std::sin(row.at("phi_mob_deg") * M_PI / 180), q / (q + 2 * s3), 1e-6);
+  const double e0 = last_row(dir / "run" / "summary.csv").at("void_ratio0");
+  EXPECT_NEAR(row.at("void_ratio"), (1 + e0) * (1 - row.at("eps_v_pct") / 100) - 1, 1e-5);
 }
 
 // `--free mu_s,mu_s` was taken as two parameters (a singular fit): refused with the option, and no result folder

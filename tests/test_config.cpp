@@ -103,18 +103,24 @@ TEST(Config, TimeStepAboveCriticalRefused) {
   }
 }
 
-// The same rule for every job (run, specimen, triaxial, periodic): dt_s above the critical step is refused
-// with the key and the allowed range; without dt_s the step is dt_safety x critical.
+// The same rule for every job (run, specimen, triaxial, periodic): dt_s above the critical step, or so far below
+// it that the run would never end (1e-300 ran), is refused with the key and the allowed range; without dt_s the
+// step is dt_safety x critical.
 TEST(Config, TimeStepRuleNamesKeyAndRange) {
   dem::SolverConfig s;
-  s.dt = 2e-6;
-  try {
-    dem::time_step(s, 1e-6, "x.toml");
-    FAIL() << "2 us above a critical 1 us";
-  } catch (const dem::ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("x.toml: [solver] dt_s: 2e-06 s"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("allowed: (0, 1e-06]"), std::string::npos) << e.what();
+  for (const double dt : {2e-6, 1e-300}) {
+    s.dt = dt;
+    try {
+      dem::time_step(s, 1e-6, "x.toml");
+      FAIL() << dt << " s against a critical 1 us";
+    } catch (const dem::ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("x.toml: [solver] dt_s: " + std::string(dt > 1e-6 ? "2e-06" : "1e-300")),
+                std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("allowed: [1e-09, 1e-06]"), std::string::npos) << e.what();
+    }
   }
+  s.dt = 2e-9;
+  EXPECT_EQ(dem::time_step(s, 1e-6, "x.toml"), 2e-9);
   s.dt = 0;
   s.dt_safety = 0.25;
   EXPECT_EQ(dem::time_step(s, 1e-6, "x.toml"), 0.25e-6);

@@ -271,7 +271,8 @@ TEST(Measured, BadStandardDeviationsAreRefusedWithLineAndColumn) {
 TEST(Measured, VoidRatioOrPorosityIsOnePerTest) {
   const MeasuredData c = load_measured(write("curve_e.csv",
                                              "material,sigma3_kPa,eps_a_pct,q_kPa,void_ratio,void_ratio_sd\n"
-                                             "A,100,0,0,0.65,0.02\nA,100,1,100,0.65,0.02\nB,100,0,0,0.7,0.01\n"));
+                                             "A,100,0,0,0.65,0.02\nA,100,1,100,0.65,0.02\nA,100,2,90,0.65,0.02\n"
+                                             "B,100,0,0,0.7,0.01\nB,100,1,80,0.7,0.01\nB,100,2,85,0.7,0.01\n"));
   ASSERT_EQ(c.tests.size(), 2u);
   EXPECT_DOUBLE_EQ(c.tests[0].void_ratio, 0.65);
   EXPECT_DOUBLE_EQ(c.tests[0].void_ratio_sd, 0.02);
@@ -317,12 +318,12 @@ TEST(Measured, TestLabelsTellReplicatesApart) {
   const MeasuredData c = load_measured(write("replicates.csv",
                                              "material,sigma3_kPa,test,eps_a_pct,q_kPa\n"
                                              "A,100,r1,0,0\nA,100,r1,1,100\nA,100,r2,0,0\nA,100,r2,1,110\n"
-                                             "A,100,r1,2,120\n"));
+                                             "A,100,r1,2,120\nA,100,r2,2,115\n"));
   ASSERT_EQ(c.tests.size(), 2u);
   EXPECT_EQ(c.tests[0].replicate, "r1");
   EXPECT_EQ(c.tests[1].replicate, "r2");
   EXPECT_EQ(c.tests[0].q, (std::vector<Real>{0, 100e3, 120e3}));
-  EXPECT_EQ(c.tests[1].q, (std::vector<Real>{0, 110e3}));
+  EXPECT_EQ(c.tests[1].q, (std::vector<Real>{0, 110e3, 115e3}));
   EXPECT_EQ(replicate_groups(c.tests), (std::vector<std::vector<std::size_t>>{{0, 1}}));
   // The same pressure: nothing to tell but the q measure the file did not name.
   ASSERT_EQ(c.notes.size(), 1u);
@@ -352,7 +353,8 @@ TEST(Measured, ImplausibleValuesAreRefusedWithLineAndColumn) {
   EXPECT_NE(e.find("bad.csv:3:eps_a_pct: 150% is implausible (allowed: |eps_a| <= 100%)"), std::string::npos) << e;
   e = error_of(curve + "A,100,1,50,-101\n");
   EXPECT_NE(e.find("bad.csv:3:eps_v_pct: -101% is implausible (allowed: |eps_v| <= 100%)"), std::string::npos) << e;
-  const MeasuredTest edge = load_measured(write("edge.csv", curve + "A,100,100,10000,-100\n")).tests[0];
+  const MeasuredTest edge =
+      load_measured(write("edge.csv", curve + "A,100,50,5000,-50\nA,100,100,10000,-100\n")).tests[0];
   EXPECT_DOUBLE_EQ(edge.q.back(), 100 * 100e3);
   const std::string summary =
       "material,sigma3_kPa,q_peak_kPa,eps_a_peak_pct,q_end_kPa,e_ini_MPa,q_1pct_kPa,q_3pct_kPa\n";
@@ -410,12 +412,13 @@ TEST(Measured, Hdf5FormCarriesTheOptionalColumns) {
   const std::string h5 = write("optional.h5", "");
   write_measured_h5(h5, {"sigma3_kPa", "test", "eps_a_pct", "q_kPa", "q_sd_kPa", "void_ratio"},
                     {{"A",
-                      {{100, 1, 0, 0, 2, 0.6}, {100, 1, 1, 90, 3, 0.6}, {100, 2, 0, 0, 2, 0.62}, {100, 2, 1, 95, 4, 0.62}}}},
+                      {{100, 1, 0, 0, 2, 0.6}, {100, 1, 1, 90, 3, 0.6}, {100, 1, 2, 92, 3, 0.6},
+                       {100, 2, 0, 0, 2, 0.62}, {100, 2, 1, 95, 4, 0.62}, {100, 2, 2, 97, 5, 0.62}}}},
                     "test");
   const MeasuredData d = load_measured(h5);
   ASSERT_EQ(d.tests.size(), 2u);
   EXPECT_EQ(d.tests[1].replicate, "2");
-  EXPECT_EQ(d.tests[1].q_sd, (std::vector<Real>{2e3, 4e3}));
+  EXPECT_EQ(d.tests[1].q_sd, (std::vector<Real>{2e3, 4e3, 5e3}));
   EXPECT_DOUBLE_EQ(d.tests[1].void_ratio, 0.62);
   write_measured_h5(h5, {"sigma3_kPa", "eps_a_pct", "q_kPa", "q_sd_kPa"}, {{"A", {{100, 0, 0, 2}, {100, 1, 90, 0}}}},
                     "test");
@@ -484,4 +487,15 @@ TEST(Measured, FrictionAngleOfTheTriaxialTestIsMohrCoulombs) {
   EXPECT_NEAR(friction_angle_deg(0, 100e3), 0.0, 1e-12);
   EXPECT_NEAR(friction_angle_deg(800e3, 100e3), std::asin(0.8) * 180 / M_PI, 1e-12);
   EXPECT_NEAR(friction_angle_deg(2, 1), 30.0, 1e-12) << "a ratio: the unit does not matter";
+}
+
+// A file with one point per test started a calibration, its peak and stiffness read off single points: a curve
+// needs three rows per test, and the message says where the one-row form belongs (a summary file).
+TEST(Measured, ACurveOfOneOrTwoRowsIsRefused) {
+  std::string e = error_of("material,sigma3_kPa,eps_a_pct,q_kPa\nA,100,1,50\nA,200,0,0\nA,200,1,80\nA,200,2,90\n");
+  EXPECT_NE(e.find("bad.csv: A at 100 kPa: 1 row (allowed: at least 3 rows of eps_a and q per test: a curve; give "
+                   "one row per test in a summary file"), std::string::npos) << e;
+  e = error_of("material,sigma3_kPa,eps_a_pct,q_kPa\nA,100,0,0\nA,100,1,50\n");
+  EXPECT_NE(e.find(": 2 rows (allowed: at least 3"), std::string::npos) << e;
+  EXPECT_EQ(error_of("material,sigma3_kPa,eps_a_pct,q_kPa\nA,100,0,0\nA,100,1,50\nA,100,2,40\n"), "");
 }

@@ -51,6 +51,8 @@ TEST(Study, SummaryRoundTripsInFileUnits) {
   s.phi_peak_deg = 30.5;
   s.eps_a_peak = 0.042;
   s.max_dilatancy = 0.61;
+  // Where it came from (issue 40: a summary did not say): a comma in a path stays in one cell.
+  s.provenance = {"0.1.0+abc1234-dirty", "OpenMP x2", "configs/a,b.toml", "0123456789abcdef", 17};
   write_summary(dir.string(), s);
   std::ifstream f(dir / "summary.csv");
   std::string header, row;
@@ -63,6 +65,11 @@ TEST(Study, SummaryRoundTripsInFileUnits) {
   EXPECT_EQ(r.balls, 3662);
   EXPECT_NEAR(r.q_peak, 403.71e3, 1e-3);  // 6 significant digits in the file
   EXPECT_NEAR(r.eps_a_peak, 0.042, 1e-9);
+  EXPECT_EQ(r.provenance.version, "0.1.0+abc1234-dirty");
+  EXPECT_EQ(r.provenance.backend, "OpenMP x2");
+  EXPECT_EQ(r.provenance.config, "configs/a;b.toml");
+  EXPECT_EQ(r.provenance.config_hash, "0123456789abcdef");
+  EXPECT_EQ(r.provenance.seed, 17);
   std::ofstream(dir / "broken.csv") << "kind,balls\nmembrane,3\n";
   try {
     read_summary((dir / "broken.csv").string());
