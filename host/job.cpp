@@ -1,12 +1,17 @@
 #include "job.hpp"
 
+#include <algorithm>
+#include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <numeric>
+#include <string>
 
 #include "checkpoint.hpp"
 #include "packing.hpp"
 #include "specimen.hpp"
 #include "progress.hpp"
+#include "triaxial.hpp"
 
 namespace dem {
 
@@ -204,6 +209,92 @@ int specimen_job(const Config& cfg) {
                 "reachable in this mould with these beads without squeezing them (try a larger e)\n",
                 cfg.specimen.void_ratio);
   require_settled(cfg, sp);
+  return 0;
+}
+
+namespace {
+std::string g3(double x) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.3g", x);
+  return b;
+}
+}  // namespace
+
+int check_job(const Config& cfg) {
+  auto box = build_simulation(cfg, false);
+  const Real dt = box->params().integ.dt, critical = box->critical_dt();
+  const std::string dt_text = g3(dt) + " s (" +
+                              (cfg.solver.dt > 0 ? std::string("[solver] dt_s") : g3(cfg.solver.dt_safety) +
+                                                                                      " x the critical " +
+                                                                                      g3(critical) + " s") +
+                              ")";
+  // The speed of these beads here, packed as a test packs them (about 6 contacts each: a cubic array pressed to a
+  // pitch of 0.995 d, periodic; the config's own box may be a gas, ten times faster), after its first rebuilds, and
+  // as many as the job has up to 40^3: 4,096 beads that fit in cache ran 9 times faster than the 53,704 of the
+  // paper's specimen.
+  const long job_balls = cfg.has_specimen ? specimen_ball_count(cfg) : static_cast<long>(box->particles().n);
+  const int side = std::clamp(static_cast<int>(std::lround(std::cbrt(static_cast<double>(job_balls)))), 8, 40);
+  Config dense = cfg;
+  dense.particles.count = side * side * side;
+  dense.particles.diameter_ratio = 1;
+  dense.box.fill = "lattice";
+  dense.box.lattice_spacing = 0.995;
+  dense.box.walls = false;
+  for (int k = 0; k < 3; ++k) {
+    dense.box.periodic[k] = true;
+    dense.box.size[k] = side * dense.box.lattice_spacing * cfg.particles.diameter;
+  }
+  dense.solver.gravity = {0, 0, 0};
+  auto probe = build_simulation(dense, false);
+  probe->run(20);
+  const auto t0 = std::chrono::steady_clock::now();
+  const long probe_steps = 200;
+  probe->run(probe_steps);
+  Kokkos::fence();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double rate = probe->particles().n * static_cast<double>(probe_steps) / std::max(seconds, 1e-9);
+  const std::string speed = g3(rate) + " particle-steps/s measured here on " +
+                            std::to_string(probe->particles().n) + " packed beads of this config, " +
+                            std::to_string(ExecSpace().concurrency()) + " threads";
+  auto estimate = [&](double balls, double steps) { return format_duration(balls * steps / rate); };
+  std::printf("%s: OK\n", cfg.path.c_str());
+  if (cfg.has_specimen) {
+    const SpecimenConfig& sc = cfg.specimen;
+    const TriaxialConfig& tc = cfg.triaxial;
+    const long n = specimen_ball_count(cfg);
+    const ShearPlan shear = shear_plan(cfg, dt);
+    const long records = std::lround(tc.axial_strain_end / tc.record_every);
+    std::printf("a drained triaxial test (triaxdem triaxial):\n"
+                "  specimen: %ld beads of %.3g mm in a %.4g x %.4g mm cylinder (target e %.3f), %ld layers, kept in "
+                "../.specimens beside the output folder\n"
+                "  membrane: %d x %d nodes, %.3g MPa, %.3g mm; cell pressure %.4g kPa\n"
+                "  consolidation: until sigma1 is within %.2g%% of sigma3 and the unbalanced ratio below %.0e (at most "
+                "%ld steps)\n"
+                "  shear: inertial number %.1e (strain rate %.3g 1/s%s) to %.3g%% in %ld steps, a record every %.3g%% "
+                "(%ld records)\n"
+                "  time step: %s of these beads (the membrane can lower it)\n"
+                "  estimate: the shear about %s at %s (no membrane, no measurements: a lower bound); the specimen "
+                "(unless cached) and the consolidation come on top\n",
+                n, cfg.particles.diameter * 1e3, sc.diameter * 1e3, sc.height * 1e3, sc.void_ratio, sc.layers,
+                tc.membrane_around, tc.membrane_segments, tc.membrane_modulus / 1e6, tc.membrane_thickness * 1e3,
+                tc.sigma3 / 1e3, 100 * tc.consolidation_tol, tc.stop_ratio, tc.max_consolidation_steps,
+                tc.inertial_number, shear.rate, cfg.solver.mass_scale != 1 ? ", density scaling" : "",
+                100 * tc.axial_strain_end, shear.steps, 100 * tc.record_every, records, dt_text.c_str(),
+                estimate(static_cast<double>(n), static_cast<double>(shear.steps)).c_str(), speed.c_str());
+  } else if (cfg.has_periodic) {
+    const PeriodicTriaxialParams& p = cfg.periodic.triax;
+    std::printf("a periodic-cell triaxial test (triaxdem periodic):\n"
+                "  cell: %d balls of %.3g mm in %.4g x %.4g x %.4g mm, %s\n"
+                "  consolidation at %.4g kPa, then shear to %.3g%% at inertial number %.1e, a record every %.3g%%\n"
+                "  time step: %s\n  speed: %s\n",
+                box->particles().n, cfg.particles.diameter * 1e3, cfg.box.size[0] * 1e3, cfg.box.size[1] * 1e3,
+                cfg.box.size[2] * 1e3, cfg.box.fill.c_str(), p.sigma3 / 1e3, 100 * p.target_strain,
+                p.target_inertial, 100 * p.record_strain, dt_text.c_str(), speed.c_str());
+  } else {
+    std::printf("a box of balls (triaxdem run): %d balls, %d walls, %ld steps, about %s\n  time step: %s\n",
+                box->particles().n, box->num_walls(), cfg.run.steps,
+                estimate(box->particles().n, static_cast<double>(cfg.run.steps)).c_str(), dt_text.c_str());
+  }
   return 0;
 }
 

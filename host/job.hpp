@@ -28,6 +28,11 @@ io::Snapshot take_snapshot(Simulation& sim, const std::string& label);
 /// stopped by one, 3 at stop_at_step.
 int run_job(const Config& cfg, bool resume = false, long stop_at_step = -1);
 
+/// `triaxdem check`: validates the config and describes the job it is for (a membrane triaxial test when it has
+/// [specimen], a periodic cell when it has [periodic], else the `run` job's box): balls, geometry, stages, the time
+/// step of its beads and laws, steps, and a wall-time estimate from the speed measured on a box of its beads.
+int check_job(const Config& cfg);
+
 /// Writes layers.csv (each layer's void ratio in the finished specimen) and porosity_profile.csv.
 void write_specimen_report(const std::string& folder, const Config& cfg, const Specimen& sp);
 

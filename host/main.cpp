@@ -171,7 +171,7 @@ int main(int argc, char** argv) {
   synth->add_option("--pressures", syn_kpa, "confining pressures, kPa (default 100 200 300)");
   synth->add_option("--material", syn.material, "material name in the file");
 
-  auto* check = app.add_subcommand("check", "validate a config and print the derived time step");
+  auto* check = app.add_subcommand("check", "validate a config and describe its job: balls, stages, time step, steps, a wall-time estimate");
   check->add_option("config", config_path, "TOML config file")->required()->check(CLI::ExistingFile);
 
   auto* info = app.add_subcommand("info", "print the Kokkos build in use");
@@ -210,11 +210,7 @@ int main(int argc, char** argv) {
     dem::Config cfg = dem::load_config(config_path);
     if (!output.empty()) cfg.run.output = output;
     if (steps >= 0) cfg.run.steps = steps;
-    if (check->parsed()) {
-      dem::build_simulation(cfg, true);
-      std::printf("%s: OK\n", config_path.c_str());
-      return 0;
-    }
+    if (check->parsed()) return dem::check_job(cfg);
     // Held until the job returns: a second run into the folder is refused while this one writes there.
     dem::io::FolderLock lock;
     if (run->parsed() || triaxial->parsed() || periodic->parsed() || specimen->parsed())

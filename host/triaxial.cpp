@@ -138,6 +138,22 @@ void measure_stresses(const Cell& c, const TriaxialConfig& tc, const ContactSet&
 
 }  // namespace
 
+ShearPlan shear_plan(const Config& cfg, Real dt) {
+  const TriaxialConfig& tc = cfg.triaxial;
+  // Constant platen speed from the inertial number (density scaling counts in rho).
+  const Real rho = cfg.particles.density * cfg.solver.mass_scale;
+  ShearPlan p;
+  p.rate = tc.inertial_number / (cfg.particles.diameter * std::sqrt(rho / tc.sigma3));
+  // The platen speeds up linearly over the steps of kRampStrain at full rate (the strain lost to the ramp,
+  // half of that, is added at the end). Started at full speed at once, it sends a stress wave that the top
+  // platen reads as a peak before the bottom one feels any load: 160 kPa at 0.1% strain against a
+  // quasi-static plateau of 140 kPa in the full-scale S-1 case at 100 kPa.
+  constexpr Real kRampStrain = 0.005;
+  p.ramp = std::max(1L, std::lround(kRampStrain / (p.rate * dt)));
+  p.steps = static_cast<long>(std::ceil(tc.axial_strain_end / (p.rate * dt))) + p.ramp / 2;
+  return p;
+}
+
 Real TriaxialRecord::*q_field(QMeasure m) {
   switch (m) {
     case QMeasure::kAreaCorrected: return &TriaxialRecord::q_area;
@@ -241,17 +257,10 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
     const Real h0 = st.h0, v0 = st.v0, v0_envelope = st.v0_envelope;
     const int env_slabs = tc.membrane_segments;
 
-    // Shear: constant platen speed from the inertial number (density scaling counts in rho).
-    const Real rho = cfg.particles.density * cfg.solver.mass_scale;
-    res.shear_rate = tc.inertial_number / (cfg.particles.diameter * std::sqrt(rho / tc.sigma3));
+    const ShearPlan plan_of_shear = shear_plan(cfg, dt);
+    res.shear_rate = plan_of_shear.rate;
     res.inertial_number = tc.inertial_number;
-    // The platen speeds up linearly over the steps of kRampStrain at full rate (the strain lost to the ramp,
-    // half of that, is added at the end). Started at full speed at once, it sends a stress wave that the top
-    // platen reads as a peak before the bottom one feels any load: 160 kPa at 0.1% strain against a
-    // quasi-static plateau of 140 kPa in the full-scale S-1 case at 100 kPa.
-    constexpr Real kRampStrain = 0.005;
-    const long ramp = std::max(1L, std::lround(kRampStrain / (res.shear_rate * dt)));
-    const long steps = static_cast<long>(std::ceil(tc.axial_strain_end / (res.shear_rate * dt))) + ramp / 2;
+    const long ramp = plan_of_shear.ramp, steps = plan_of_shear.steps;
     if (verbose && st.step == 0)
       std::printf("shear: strain rate %.3g 1/s (inertial number %.1e%s), %ld steps to %.0f%%\n", res.shear_rate,
                   tc.inertial_number, cfg.solver.mass_scale != 1 ? ", with density scaling" : "", steps,

@@ -72,6 +72,14 @@ MeasuredTest curves_of(const TriaxialResult& r, Real TriaxialRecord::*q, Real si
 TriaxialResult run_triaxial(const Config& cfg, const Specimen& specimen, io::Output* out, bool verbose,
                             CheckpointPlan* plan = nullptr);
 
+/// The shear stage's platen motion: strain rate (1/s) from the inertial number, the steps of its start-up ramp and
+/// the steps to the end strain, at time step `dt`.
+struct ShearPlan {
+  Real rate = 0;
+  long ramp = 0, steps = 0;
+};
+ShearPlan shear_plan(const Config& cfg, Real dt);
+
 /// The `triaxial` CLI job: specimen, then run_triaxial with checkpoints in OUT/checkpoint.h5 ([run]
 /// checkpoint_every, checkpoint_minutes, SIGINT, SIGTERM), outputs and a summary. `resume`: continue from the
 /// checkpoint. Returns 0, 2 on a blow-up, 128 + the signal or 3 (stop_at_step) when stopped with a checkpoint.

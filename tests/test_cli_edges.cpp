@@ -185,6 +185,22 @@ TEST(CliEdges, VersionAndProvenance) {
   EXPECT_NEAR(row.at("void_ratio"), (1 + e0) * (1 - row.at("eps_v_pct") / 100) - 1, 1e-5);
 }
 
+// `check` on a triaxial config reported "2000 balls, 6 walls", the run job's default box: it describes the job the
+// config is for, with its ball count, stages, time step, steps and a wall-time estimate.
+TEST(CliEdges, CheckDescribesTheJobTheConfigIsFor) {
+  const fs::path dir = dem::test::scratch_dir("cli_check");
+  Outcome o = triaxdem("check tests/data/tiny_triaxial.toml", dir);
+  EXPECT_EQ(o.code, 0) << o.output;
+  for (const char* part : {"a drained triaxial test (triaxdem triaxial)", "specimen: 452 beads of 2 mm in a 16 x 16 mm",
+                           "membrane: 24 x 8 nodes", "shear: inertial number 1.0e-02", "(150 records)", "time step: ",
+                           "estimate: the shear about "})
+    EXPECT_NE(o.output.find(part), std::string::npos) << part << " missing:\n" << o.output;
+  EXPECT_EQ(o.output.find("2000 balls"), std::string::npos) << o.output;
+  o = triaxdem("check configs/periodic/periodic_S1_100kPa.toml", dir);
+  EXPECT_NE(o.output.find("a periodic-cell triaxial test (triaxdem periodic):\n  cell: 1000 balls"), std::string::npos)
+      << o.output;
+}
+
 // `--free mu_s,mu_s` was taken as two parameters (a singular fit): refused with the option, and no result folder
 // is left behind.
 TEST(CliEdges, ARepeatedFreeParameterIsRefused) {
