@@ -132,13 +132,23 @@ MatchPlan match_plan(const Config& base, int jobs) {
   return p;
 }
 
-Real prep_friction_for(const Config& base, Real target, Real& reached, bool verbose, const MatchPlan& plan) {
+namespace {
+/// The plan's mean void ratio after preparation with friction u^2.
+Real void_ratio_at(const Config& base, Real u, const MatchPlan& plan) {
   Config c = base;
-  auto at = [&](Real u) {
-    c.periodic.prep_mu_s = u * u;
-    return prepared_void_ratio(c, plan);
-  };
-  Real lo = 0, hi = 1, e_lo = at(lo), e_hi = at(hi);
+  c.periodic.prep_mu_s = u * u;
+  return prepared_void_ratio(c, plan);
+}
+}  // namespace
+
+std::pair<Real, Real> preparation_reach(const Config& base, const MatchPlan& plan) {
+  return {void_ratio_at(base, 0, plan), void_ratio_at(base, 1, plan)};
+}
+
+Real prep_friction_for(const Config& base, Real target, Real& reached, bool verbose, const MatchPlan& plan) {
+  auto at = [&](Real u) { return void_ratio_at(base, u, plan); };
+  Real lo = 0, hi = 1;
+  auto [e_lo, e_hi] = preparation_reach(base, plan);
   if (verbose)
     std::printf("triaxdem: preparation friction 0 to 1 packs void ratios %.4f to %.4f (mean of %d specimens); "
                 "target %.4f\n", e_lo, e_hi, plan.specimens, target);

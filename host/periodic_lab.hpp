@@ -7,6 +7,7 @@
 #include <array>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "config.hpp"
@@ -127,6 +128,10 @@ MatchPlan match_plan(const Config& base, int jobs);
 /// cells (0.589 for 120 balls), which the nearest end serves; a gap of a tenth is as large as the whole range the
 /// preparation friction spans (0.59-0.87), another state, and is refused.
 constexpr Real kMaxStateGap = 0.05;
+
+/// The mean void ratios the plan's specimens of the base config pack to after their preparation with friction 0
+/// (the densest) and 1 (the loosest): the states a calibration can match.
+std::pair<Real, Real> preparation_reach(const Config& base, const MatchPlan& plan);
 
 /// The preparation friction ([periodic] prep_mu_s) with which the plan's specimens of the base config pack to a
 /// mean void ratio of `target` after their preparation: bisection on sqrt(prep_mu_s) over [0, 1] (more friction,

@@ -6,6 +6,7 @@
 /// result is bit for bit the Real one, given that the build fuses no multiply-add (tests/test_simd_lanes.cpp checks it).
 ///
 /// GPUs take one contact per thread (kContactLanes = 1): T is then Real and nothing here is used.
+#include "det_math.hpp"
 #include "types.hpp"
 
 #include <type_traits>
@@ -86,7 +87,7 @@ inline Pack4 sqrt(const Pack4& a) {
 }
 inline Pack4 exp(const Pack4& a) {
   Pack4 r;
-  for (int k = 0; k < 4; ++k) r.set(k, std::exp(a[k]));
+  for (int k = 0; k < 4; ++k) r.set(k, kc::exp(a[k]));
   return r;
 }
 /// |a| by clearing the sign bit, as fabs does (-0 gives +0).

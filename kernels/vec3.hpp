@@ -5,13 +5,14 @@
 #include <cstring>
 #include <type_traits>
 
+#include "det_math.hpp"
 #include "simd.hpp"
 #include "types.hpp"
 
 namespace dem {
 namespace kc {
+// exp is det_math.hpp's: the same bits on every backend.
 #if KOKKOS_VERSION >= 30700
-using Kokkos::exp;
 using Kokkos::fabs;
 using Kokkos::floor;
 using Kokkos::isfinite;
@@ -19,7 +20,6 @@ using Kokkos::max;
 using Kokkos::min;
 using Kokkos::sqrt;
 #else
-using Kokkos::Experimental::exp;
 using Kokkos::Experimental::fabs;
 using Kokkos::Experimental::floor;
 using Kokkos::Experimental::isfinite;

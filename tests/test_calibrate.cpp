@@ -251,10 +251,16 @@ TEST(Calibrate, StateIsMatchedOnTheMeanOfTheLabsFirstSpecimens) {
   const Config cfg = tiny_cell();
   MatchPlan plan = match_plan(cfg, 1);
   plan.steps = 4;
-  Real e0 = 0, e1 = 0;
-  EXPECT_EQ(prep_friction_for(cfg, -1, e0, false, plan), 0);
-  EXPECT_EQ(prep_friction_for(cfg, 10, e1, false, plan), 1);
+  const auto [e0, e1] = preparation_reach(cfg, plan);
   ASSERT_LT(e0, e1) << "more friction in the preparation packs looser";
+  // Just beyond either end: the nearest end; far beyond (a state of another material, or a typo): refused.
+  Real reached = 0;
+  EXPECT_EQ(prep_friction_for(cfg, e0 - 0.5 * kMaxStateGap, reached, false, plan), 0);
+  EXPECT_EQ(reached, e0);
+  EXPECT_EQ(prep_friction_for(cfg, e1 + 0.5 * kMaxStateGap, reached, false, plan), 1);
+  EXPECT_EQ(reached, e1);
+  EXPECT_THROW(prep_friction_for(cfg, -1, reached, false, plan), DataError);
+  EXPECT_THROW(prep_friction_for(cfg, 10, reached, false, plan), DataError);
   std::vector<MeasuredTest> data(2);
   data[0].void_ratio = e0 + 0.3 * (e1 - e0);
   data[1].void_ratio = e0 + 0.5 * (e1 - e0);
