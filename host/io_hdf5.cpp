@@ -324,8 +324,8 @@ FolderLock claim_output_folder(const std::string& folder, bool resume, bool over
         (starts(name, "snap_") && ext == ".h5"))
       outputs.push_back(e.path());
     else if (name == kSeriesMarker || name.find(".tmp.") != std::string::npos || name == "summary.csv" ||
-             name == "layers.csv" || name == "specimen.csv" || name == "porosity_profile.csv" || (starts(name, "micro_") && ext == ".csv") ||
-             (starts(name, "force_chains_") && ext == ".vtk"))
+             name == "layers.csv" || name == "specimen.csv" || name == "porosity_profile.csv" ||
+             (starts(name, "micro_") && ext == ".csv") || (starts(name, "force_chains_") && ext == ".vtk"))
       leftovers.push_back(e.path());
   }
   if (outputs.empty()) return lock;

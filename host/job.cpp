@@ -212,11 +212,42 @@ int specimen_job(const Config& cfg) {
   return 0;
 }
 
+Config packed_lattice(const Config& base, int side, bool periodic) {
+  Config c = base;
+  c.particles.count = static_cast<long>(side) * side * side;
+  c.particles.diameter_ratio = 1;
+  c.box.fill = "lattice";
+  c.box.lattice_spacing = 0.995;
+  const Real pitch = c.box.lattice_spacing * c.particles.diameter;
+  for (int k = 0; k < 3; ++k) {
+    c.box.periodic[k] = periodic;
+    c.box.size[k] = periodic ? side * pitch : (side - 1) * pitch + c.particles.diameter * 1.0005;
+  }
+  c.box.walls = !periodic;
+  c.solver.gravity = {0, 0, 0};
+  return c;
+}
+
 namespace {
 std::string g3(double x) {
   char b[32];
   std::snprintf(b, sizeof b, "%.3g", x);
   return b;
+}
+
+/// Particle-steps per second of the benchmark packing of `cfg`'s beads at about `balls` of them (between 8^3 and
+/// 40^3): 4,096 beads that fit in cache ran 9 times faster than the 53,704 of the paper's specimen. The config's
+/// own box may be a gas, ten times faster than a packing. Timed after the first rebuilds.
+double packed_speed(const Config& cfg, long balls) {
+  const int side = std::clamp(static_cast<int>(std::lround(std::cbrt(static_cast<double>(balls)))), 8, 40);
+  auto probe = build_simulation(packed_lattice(cfg, side, true), false);
+  probe->run(20);
+  const auto t0 = std::chrono::steady_clock::now();
+  const long steps = 200;
+  probe->run(steps);
+  Kokkos::fence();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return probe->particles().n * static_cast<double>(steps) / std::max(seconds, 1e-9);
 }
 }  // namespace
 
@@ -228,40 +259,15 @@ int check_job(const Config& cfg) {
                                                                                       " x the critical " +
                                                                                       g3(critical) + " s") +
                               ")";
-  // The speed of these beads here, packed as a test packs them (about 6 contacts each: a cubic array pressed to a
-  // pitch of 0.995 d, periodic; the config's own box may be a gas, ten times faster), after its first rebuilds, and
-  // as many as the job has up to 40^3: 4,096 beads that fit in cache ran 9 times faster than the 53,704 of the
-  // paper's specimen.
   const long job_balls = cfg.has_specimen ? specimen_ball_count(cfg) : static_cast<long>(box->particles().n);
-  const int side = std::clamp(static_cast<int>(std::lround(std::cbrt(static_cast<double>(job_balls)))), 8, 40);
-  Config dense = cfg;
-  dense.particles.count = side * side * side;
-  dense.particles.diameter_ratio = 1;
-  dense.box.fill = "lattice";
-  dense.box.lattice_spacing = 0.995;
-  dense.box.walls = false;
-  for (int k = 0; k < 3; ++k) {
-    dense.box.periodic[k] = true;
-    dense.box.size[k] = side * dense.box.lattice_spacing * cfg.particles.diameter;
-  }
-  dense.solver.gravity = {0, 0, 0};
-  auto probe = build_simulation(dense, false);
-  probe->run(20);
-  const auto t0 = std::chrono::steady_clock::now();
-  const long probe_steps = 200;
-  probe->run(probe_steps);
-  Kokkos::fence();
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const double rate = probe->particles().n * static_cast<double>(probe_steps) / std::max(seconds, 1e-9);
-  const std::string speed = g3(rate) + " particle-steps/s measured here on " +
-                            std::to_string(probe->particles().n) + " packed beads of this config, " +
+  const double rate = packed_speed(cfg, job_balls);
+  const std::string speed = g3(rate) + " particle-steps/s measured here on packed beads of this config, " +
                             std::to_string(ExecSpace().concurrency()) + " threads";
   auto estimate = [&](double balls, double steps) { return format_duration(balls * steps / rate); };
   std::printf("%s: OK\n", cfg.path.c_str());
   if (cfg.has_specimen) {
     const SpecimenConfig& sc = cfg.specimen;
     const TriaxialConfig& tc = cfg.triaxial;
-    const long n = specimen_ball_count(cfg);
     const ShearPlan shear = shear_plan(cfg, dt);
     const long records = std::lround(tc.axial_strain_end / tc.record_every);
     std::printf("a drained triaxial test (triaxdem triaxial):\n"
@@ -275,12 +281,12 @@ int check_job(const Config& cfg) {
                 "  time step: %s of these beads (the membrane can lower it)\n"
                 "  estimate: the shear about %s at %s (no membrane, no measurements: a lower bound); the specimen "
                 "(unless cached) and the consolidation come on top\n",
-                n, cfg.particles.diameter * 1e3, sc.diameter * 1e3, sc.height * 1e3, sc.void_ratio, sc.layers,
+                job_balls, cfg.particles.diameter * 1e3, sc.diameter * 1e3, sc.height * 1e3, sc.void_ratio, sc.layers,
                 tc.membrane_around, tc.membrane_segments, tc.membrane_modulus / 1e6, tc.membrane_thickness * 1e3,
                 tc.sigma3 / 1e3, 100 * tc.consolidation_tol, tc.stop_ratio, tc.max_consolidation_steps,
                 tc.inertial_number, shear.rate, cfg.solver.mass_scale != 1 ? ", density scaling" : "",
                 100 * tc.axial_strain_end, shear.steps, 100 * tc.record_every, records, dt_text.c_str(),
-                estimate(static_cast<double>(n), static_cast<double>(shear.steps)).c_str(), speed.c_str());
+                estimate(static_cast<double>(job_balls), static_cast<double>(shear.steps)).c_str(), speed.c_str());
   } else if (cfg.has_periodic) {
     const PeriodicTriaxialParams& p = cfg.periodic.triax;
     std::printf("a periodic-cell triaxial test (triaxdem periodic):\n"

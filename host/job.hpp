@@ -28,6 +28,11 @@ io::Snapshot take_snapshot(Simulation& sim, const std::string& label);
 /// stopped by one, 3 at stop_at_step.
 int run_job(const Config& cfg, bool resume = false, long stop_at_step = -1);
 
+/// The benchmark packing of `base`'s beads and contact laws: side^3 balls of the config's diameter in a jittered
+/// cubic array pressed to a pitch of 0.995 d (about 6 contacts each), no gravity; periodic on every axis, or between
+/// six plane walls that touch the outer layers. perf/bench_engine times it, and `check` measures its speed.
+Config packed_lattice(const Config& base, int side, bool periodic);
+
 /// `triaxdem check`: validates the config and describes the job it is for (a membrane triaxial test when it has
 /// [specimen], a periodic cell when it has [periodic], else the `run` job's box): balls, geometry, stages, the time
 /// step of its beads and laws, steps, and a wall-time estimate from the speed measured on a box of its beads.

@@ -38,15 +38,20 @@ std::string count_range(int lowest) {
          std::to_string(cores) + " cores";
 }
 
+/// Whether `text` is an integer from `lowest` to kMaxPerCore x the cores; with `list`, the first of a
+/// comma-separated list (OMP_NUM_THREADS gives one count per nesting level).
+bool count_fits(const std::string& text, int lowest, bool list) {
+  char* end = nullptr;
+  const long v = std::strtol(text.c_str(), &end, 10);
+  return end != text.c_str() && (*end == '\0' || (list && *end == ',')) && v >= lowest &&
+         v <= kMaxPerCore * machine_cores();
+}
+
 /// A thread or process count: an integer from `lowest` (0: the default) to kMaxPerCore x the cores.
 CLI::Validator count_on_this_machine(int lowest) {
   return CLI::Validator(
       [lowest](std::string& s) -> std::string {
-        char* end = nullptr;
-        const long v = std::strtol(s.c_str(), &end, 10);
-        if (end == s.c_str() || *end != '\0' || v < lowest || v > kMaxPerCore * machine_cores())
-          return s + " is no count for this machine (" + count_range(lowest) + ")";
-        return "";
+        return count_fits(s, lowest, false) ? "" : s + " is no count for this machine (" + count_range(lowest) + ")";
       },
       "COUNT");
 }
@@ -54,10 +59,7 @@ CLI::Validator count_on_this_machine(int lowest) {
 /// OMP_NUM_THREADS as the OpenMP runtime would take it, checked before the runtime starts. Empty: fine.
 std::string omp_threads_problem() {
   const char* env = std::getenv("OMP_NUM_THREADS");
-  if (!env || !*env) return "";
-  char* end = nullptr;
-  const long v = std::strtol(env, &end, 10);
-  if (end != env && (*end == '\0' || *end == ',') && v >= 1 && v <= kMaxPerCore * machine_cores()) return "";
+  if (!env || !*env || count_fits(env, 1, true)) return "";
   return "OMP_NUM_THREADS=" + std::string(env) + " is no thread count for this machine (" + count_range(1) + ")";
 }
 

@@ -13,21 +13,11 @@ namespace {
 dem::Config packing_config(int side, bool periodic) {
   dem::Config c;
   c.path = "<bench>";
-  c.particles.count = static_cast<long>(side) * side * side;
   c.particles.diameter = 2e-3;
-  c.box.fill = "lattice";
-  c.box.lattice_spacing = 0.995;
-  const double pitch = c.box.lattice_spacing * c.particles.diameter;
-  for (int k = 0; k < 3; ++k) {
-    c.box.periodic[k] = periodic;
-    c.box.size[k] = periodic ? side * pitch : (side - 1) * pitch + c.particles.diameter * 1.0005;
-  }
-  c.box.walls = !periodic;
   c.ball.mu_s = 0.3;
   c.ball.mu_r = 0.02;
   c.wall = c.ball;
-  c.solver.gravity = {0, 0, 0};
-  return c;
+  return dem::packed_lattice(c, side, periodic);
 }
 
 std::size_t bytes_per_particle(dem::Simulation& sim) {
