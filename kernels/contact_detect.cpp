@@ -1,6 +1,5 @@
 #include "contact_detect.hpp"
 
-#include <Kokkos_Sort.hpp>
 #include <algorithm>
 #include <vector>
 
@@ -119,7 +118,7 @@ PairKeyView run_search(Search s, int n, const char* label) {
   const int total = scan_counts(s.count, s.offset);
   s.keys = PairKeyView("dem::detect::keys", total);
   Kokkos::parallel_for(label, Kokkos::RangePolicy<ExecSpace, typename Search::TagFill>(0, n), s);
-  if (total > 1) Kokkos::sort(s.keys);
+  sort_keys(s.keys);
   return s.keys;
 }
 

@@ -1,53 +1,120 @@
 #pragma once
-/// Reductions whose rounding does not depend on the thread count: fixed-size blocks reduced in order,
-/// then the block results combined in order on the host. Stage decisions (unbalanced-force ratio)
-/// depend on them, so they must be as repeatable as the state.
+/// Reductions whose rounding depends on nothing but the item count: a fixed-shape tree, the same on every backend
+/// and thread count. Stage decisions (unbalanced-force ratio) and the servo (contact stress) depend on them, so
+/// they must be as repeatable as the state.
+///
+/// The tree: items in blocks of kReduceBlock; in a block, value k takes value k + h for h = B/2, B/4, .., 1 (the
+/// halving tree, past-the-end items as zeros); the block results are items of the next level, until one is left.
+/// A GPU reduces a block with a team of B threads in shared memory, a CPU with one thread in a loop: the same
+/// operations on the same operands, so the same bits, and every item is computed by its own thread on a GPU.
+#include "simd.hpp"
 #include "types.hpp"
-
-#include <string>
 
 namespace dem {
 
-constexpr int kReduceBlock = 512;
+constexpr int kReduceBlock = 256;
 
-/// Block b of a reduction over i in [0, n): f(i, count, vals) fills vals[k] for item i + k, k < count <= W (W items
-/// at once, as lanes), and the items' values are taken in order: vals[.][0, NSUM) summed, vals[.][NSUM, NSUM + NMAX)
-/// maximised (from 0, so for non-negative quantities). The block's results go to part(b, .).
-template <int NSUM, int NMAX, int W, class F, class Part>
-KOKKOS_INLINE_FUNCTION void reduce_block(int b, int n, const F& f, const Part& part) {
-  static_assert(kReduceBlock % W == 0, "a group of W items stays in one block");
-  constexpr int NV = NSUM + NMAX;
-  Real acc[NV] = {};
-  const int end = (b + 1) * kReduceBlock < n ? (b + 1) * kReduceBlock : n;
-  for (int i = b * kReduceBlock; i < end; i += W) {
-    const int count = end - i < W ? end - i : W;
-    Real v[W][NV] = {};
-    f(i, count, v);
-    for (int k = 0; k < count; ++k) {
-      for (int q = 0; q < NSUM; ++q) acc[q] += v[k][q];
-      for (int q = NSUM; q < NV; ++q) acc[q] = v[k][q] > acc[q] ? v[k][q] : acc[q];
-    }
+/// Device scratch for the tree's block results, of at least `count` Reals: one buffer, grown and never shrunk,
+/// so that a step allocates nothing. Kernels run in order, so one reduction's use ends before the next begins.
+Kokkos::View<Real*, MemSpace> reduce_scratch(std::size_t count);
+
+namespace detail {
+
+using ReduceTeam = Kokkos::TeamPolicy<ExecSpace>::member_type;
+using TeamScratch = Kokkos::View<Real*, ExecSpace::scratch_memory_space, Kokkos::MemoryUnmanaged>;
+
+/// Level > 0 of the tree: item i's values are block i's results of the level below (value q at in[q * n + i]).
+template <int NV>
+struct LevelItems {
+  const Real* in;
+  int n;
+  KOKKOS_INLINE_FUNCTION void operator()(const int i, int, Real (*vals)[NV]) const {
+    for (int q = 0; q < NV; ++q) vals[0][q] = in[q * n + i];
   }
-  for (int q = 0; q < NV; ++q) part(b, q) = acc[q];
+};
+
+/// One level: team b reduces items [b B, (b + 1) B) of f (W at a time) to out[q * nblock + b].
+template <int NSUM, int NMAX, int W, class F>
+struct TreeLevel {
+  static constexpr int NV = NSUM + NMAX, B = kReduceBlock;
+  static_assert(B % W == 0, "a group of W items stays in one block");
+  F f;
+  int n, nblock;
+  Real* out;
+
+  KOKKOS_INLINE_FUNCTION void operator()(const ReduceTeam& t) const {
+    const TeamScratch s(t.team_scratch(0), NV * B);
+    const int base = t.league_rank() * B;
+    Kokkos::parallel_for(Kokkos::TeamThreadRange(t, B / W), [&](const int g) {
+      const int i = base + g * W;
+      const int count = n - i < W ? (n - i > 0 ? n - i : 0) : W;
+      Real v[W][NV] = {};
+      if (count > 0) f(i, count, v);
+      for (int k = 0; k < W; ++k)
+        for (int q = 0; q < NV; ++q) s(q * B + g * W + k) = v[k][q];
+    });
+    t.team_barrier();
+    for (int h = B / 2; h >= 1; h /= 2) {
+#ifdef TRIAXDEM_HOST_PACKS
+      // One thread per team (tree_level): the same operations, each value's row as one loop the compiler vectorises.
+      Real* r = s.data();
+      for (int q = 0; q < NSUM; ++q)
+        for (int k = 0; k < h; ++k) r[q * B + k] += r[q * B + k + h];
+      for (int q = NSUM; q < NV; ++q)
+        for (int k = 0; k < h; ++k) r[q * B + k] = r[q * B + k + h] > r[q * B + k] ? r[q * B + k + h] : r[q * B + k];
+#else
+      Kokkos::parallel_for(Kokkos::TeamThreadRange(t, h), [&](const int k) {
+        for (int q = 0; q < NSUM; ++q) s(q * B + k) += s(q * B + k + h);
+        for (int q = NSUM; q < NV; ++q) s(q * B + k) = s(q * B + k + h) > s(q * B + k) ? s(q * B + k + h) : s(q * B + k);
+      });
+      t.team_barrier();
+#endif
+    }
+    Kokkos::single(Kokkos::PerTeam(t), [&]() {
+      for (int q = 0; q < NV; ++q) out[q * nblock + t.league_rank()] = s(q * B);
+    });
+  }
+};
+
+template <int NSUM, int NMAX, int W, class F>
+void tree_level(const char* label, int n, const F& f, Real* out) {
+  using Level = TreeLevel<NSUM, NMAX, W, F>;
+  const int nblock = (n + kReduceBlock - 1) / kReduceBlock;
+#ifdef TRIAXDEM_HOST_PACKS
+  const int team = 1;  // a CPU thread walks its block: teams of threads would only add barriers
+#else
+  const int team = kReduceBlock / W;
+#endif
+  const auto policy = Kokkos::TeamPolicy<ExecSpace>(nblock, team)
+                          .set_scratch_size(0, Kokkos::PerTeam(TeamScratch::shmem_size(Level::NV * kReduceBlock)));
+  Kokkos::parallel_for(label, policy, Level{f, n, nblock, out});
 }
 
-/// Reduces the values f(i, count, vals) of items [0, n), W at a time (reduce_block): fixed-size blocks in parallel,
-/// then the block results in block order on the host.
+}  // namespace detail
+
+/// Reduces the values f(i, count, vals) of items [0, n), W at a time: vals[k] gets item i + k's values, k < count
+/// <= W; vals[.][0, NSUM) are summed and vals[.][NSUM, NSUM + NMAX) maximised (from 0: non-negative quantities).
+/// The tree of the header; only the root's NSUM + NMAX values come back to the host.
 template <int NSUM, int NMAX, int W, class F>
 void deterministic_reduce_lanes(const char* label, int n, const F& f, Real (&out)[NSUM + NMAX]) {
   constexpr int NV = NSUM + NMAX;
-  const int nblock = (n + kReduceBlock - 1) / kReduceBlock;
-  // Every entry is written by its block: no zero-fill kernel ahead of the reduction, which runs every step.
-  Kokkos::View<Real**, Layout, MemSpace> part(Kokkos::view_alloc(Kokkos::WithoutInitializing, std::string(label)),
-                                              nblock, NV);
-  Kokkos::parallel_for(label, RangePolicy(0, nblock),
-                       KOKKOS_LAMBDA(const int b) { reduce_block<NSUM, NMAX, W>(b, n, f, part); });
-  auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), part);
   for (int q = 0; q < NV; ++q) out[q] = 0;
-  for (int b = 0; b < nblock; ++b) {
-    for (int q = 0; q < NSUM; ++q) out[q] += h(b, q);
-    for (int q = NSUM; q < NV; ++q) out[q] = h(b, q) > out[q] ? h(b, q) : out[q];
+  if (n <= 0) return;
+  const auto blocks = [](int items) { return (items + kReduceBlock - 1) / kReduceBlock; };
+  std::size_t total = 0;
+  for (int m = blocks(n);; m = blocks(m)) {
+    total += static_cast<std::size_t>(m) * NV;
+    if (m == 1) break;
   }
+  Real* level = reduce_scratch(total).data();
+  detail::tree_level<NSUM, NMAX, W>(label, n, f, level);
+  for (int m = blocks(n); m > 1; m = blocks(m)) {
+    Real* next = level + static_cast<std::size_t>(m) * NV;
+    detail::tree_level<NSUM, NMAX, 1>(label, m, detail::LevelItems<NV>{level, m}, next);
+    level = next;
+  }
+  Kokkos::deep_copy(Kokkos::View<Real*, HostSpace, Kokkos::MemoryUnmanaged>(out, NV),
+                    Kokkos::View<Real*, MemSpace, Kokkos::MemoryUnmanaged>(level, NV));
 }
 
 /// An item function f(i, vals) as one of W = 1 item at a time.

@@ -5,6 +5,7 @@
 #   perf/device_check.sh run REF OUT       # any build: particle-steps/s, launch overhead, CPU-GPU agreement, tests
 # BUILD: the build whose binaries run (default build); CPU_BUILD: the one that prepares (default build).
 # TINY=1: a few hundred balls and steps, no membrane specimen and not the suite's tests, for CI on any build.
+# PARTS: which of the suite's tests run (default "kernels other"; "kernels" when device time is short).
 # Each stage has its own time limit, so that a slow stage costs its limit and not the rest.
 set -uo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -77,7 +78,7 @@ tests="$build/tests/triaxdem_tests"
 if [ -x "$tests" ] && [ "$tiny" != 1 ]; then
   kernels='ContactLaw.*:Detection.*:Dynamics.*:BlowUp.*:Membrane*:Stress.*:Micro.*:SimdLanes.*:Reference.*:PeriodicCell.*:IoHdf5.*:Checkpoint.*:Determinism.*:TriaxialMeasures.*'
   limit=90
-  for part in kernels other; do
+  for part in ${PARTS:-kernels other}; do
     filter="$kernels"; [ "$part" = other ] && filter="-$kernels"
     stage "the suite's $part tests (at most $limit s)"
     timeout -k 5 "$limit" "$tests" --gtest_filter="$filter" > "$out/tests_$part.log" 2>&1; echo "exit status $? (124: stopped at the limit)"

@@ -505,3 +505,41 @@ TEST(Detection, ConcaveFoldGivesTwoContactsConvexRidgeOne) {
     EXPECT_NEAR(r.fn[0], kn * d, 1e-9 * kn * d);
   }
 }
+
+namespace {
+
+/// Keys as a rebuild makes them: ball-ball pairs over many gids, then ball-wall keys of three objects, each over
+/// thousands of gids (a bin sort over the raw key puts each object's keys in one bin), in a scrambled order.
+std::vector<std::uint64_t> scrambled_keys() {
+  std::vector<std::uint64_t> k;
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<std::uint32_t> gid(0, 20000);
+  for (int c = 0; c < 30000; ++c) {
+    const std::uint32_t a = gid(rng), b = gid(rng);
+    if (a != b) k.push_back(pair_key(a, b));
+  }
+  for (int obj = 0; obj < 3; ++obj)
+    for (std::uint32_t g = 0; g < 20000; g += 1 + obj) k.push_back(wall_key(obj, g));
+  std::sort(k.begin(), k.end());
+  k.erase(std::unique(k.begin(), k.end()), k.end());
+  std::shuffle(k.begin(), k.end(), rng);
+  return k;
+}
+
+}  // namespace
+
+TEST(Detection, KeySortsGiveTheOrderOfStdSort) {
+  const std::vector<std::uint64_t> keys = scrambled_keys();
+  std::vector<std::uint64_t> want = keys;
+  std::sort(want.begin(), want.end());
+  for (const bool bins : {false, true}) {
+    PairKeyView d("keys", keys.size());
+    auto h = Kokkos::create_mirror_view(d);
+    for (std::size_t i = 0; i < keys.size(); ++i) h(i) = keys[i];
+    Kokkos::deep_copy(d, h);
+    if (bins) bin_sort_keys(d); else sort_keys(d);
+    Kokkos::deep_copy(h, d);
+    for (std::size_t i = 0; i < keys.size(); ++i)
+      ASSERT_EQ(h(i), want[i]) << (bins ? "bin_sort_keys" : "sort_keys") << ", position " << i << " of " << keys.size();
+  }
+}

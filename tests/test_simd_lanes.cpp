@@ -14,6 +14,7 @@
 #include "kernels/contact_force.hpp"
 #include "kernels/integrate.hpp"
 #include "test_util.hpp"
+#include "tree_sum.hpp"
 
 using namespace dem;
 
@@ -316,6 +317,7 @@ TEST(SimdLanes, LeapfrogLanesGiveTheScalarUpdatesBits) {
   auto x0 = h(p.x), v0 = h(p.v), w0 = h(p.w), xr = h(p.x_ref);
   auto mass = h(p.mass), inertia = h(p.inertia), radius = h(p.radius);
   std::vector<ScalarStep> want(n);
+  std::vector<double> summed[3];
   double sums[5] = {0, 0, 0, 0, 0};
   for (int i = 0; i < n; ++i) {
     ScalarStep& r = want[i];
@@ -338,9 +340,10 @@ TEST(SimdLanes, LeapfrogLanesGiveTheScalarUpdatesBits) {
     const double vals[5] = {std::sqrt(dot(force, force)), 0.5 * (mi * dot(r.v, r.v) + ii * dot(r.w, r.w)), 0,
                             dot(r.x - load(xr, i), r.x - load(xr, i)),
                             dot(r.v, r.v) * (prm.dt * prm.dt) / (radius(i) * radius(i))};
-    for (int q = 0; q < 3; ++q) sums[q] += vals[q];
+    for (int q = 0; q < 3; ++q) summed[q].push_back(vals[q]);
     for (int q = 3; q < 5; ++q) sums[q] = std::max(sums[q], vals[q]);
   }
+  for (int q = 0; q < 3; ++q) sums[q] = test::tree_sum(summed[q]);
   const StepStats st = integrate(p, prm, g);
   auto x1 = h(p.x), v1 = h(p.v), w1 = h(p.w), f1 = h(p.f), m1 = h(p.m);
   for (int i = 0; i < n; ++i) {

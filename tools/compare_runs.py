@@ -5,7 +5,9 @@ For each CSV file the two run folders share (series.csv, summary.csv, ...) it co
 row by row, and for checkpoint.h5 (read with h5py where installed) every numeric dataset. A file is 'identical'
 when every value is equal as written (CSV: the text; HDF5: the bits); otherwise it gives the largest relative
 difference, |a - b| / max(|a|, |b|, floor), with the column and row where it occurs. The floor (default 1e-12)
-keeps values that are zero in one run from dividing by zero. Columns of wall-clock time are left out.
+keeps values that are zero in one run from dividing by zero. What says where and how long a run ran, not what it
+computed, is left out: wall-clock times (wall_s, a checkpoint's stage_times_s) and the build and machine (version,
+backend, config: a CSV column or an HDF5 dataset whose name ends in an ignored name).
 
     tools/compare_runs.py RUN_A RUN_B [--tolerance 1e-9] [--floor 1e-12] [--ignore wall_s,...]
 
@@ -67,7 +69,7 @@ def compare_csv(path_a, path_b, floor, ignore):
     return worst, notes
 
 
-def compare_h5(path_a, path_b, floor):
+def compare_h5(path_a, path_b, floor, ignore):
     import numpy as np
     import h5py
 
@@ -76,6 +78,8 @@ def compare_h5(path_a, path_b, floor):
         names = []
         fa.visititems(lambda n, o: names.append(n) if isinstance(o, h5py.Dataset) else None)
         for n in names:
+            if any(n.endswith(i) for i in ignore):
+                continue
             if n not in fb:
                 notes.append(f"{n} only in the first")
                 continue
@@ -104,8 +108,10 @@ def main():
     ap.add_argument("run_b")
     ap.add_argument("--tolerance", type=float, default=0.0, help="largest relative difference allowed (0: identical)")
     ap.add_argument("--floor", type=float, default=1e-12, help="denominator floor of the relative difference")
-    ap.add_argument("--ignore", default="wall_s", help="columns not compared, comma-separated (default wall_s)")
+    ignored = "wall_s,stage_times_s,version,backend,config"
+    ap.add_argument("--ignore", default=ignored, help=f"columns and datasets not compared, comma-separated (default {ignored})")
     args = ap.parse_args()
+    ignore = set(args.ignore.split(","))
     for run in (args.run_a, args.run_b):
         if not os.path.isdir(run):
             sys.exit(f"compare_runs: {run}: not a folder")
@@ -115,10 +121,10 @@ def main():
     for name in files:
         pa, pb = os.path.join(args.run_a, name), os.path.join(args.run_b, name)
         if name.endswith(".csv"):
-            worst, notes = compare_csv(pa, pb, args.floor, set(args.ignore.split(",")))
+            worst, notes = compare_csv(pa, pb, args.floor, ignore)
         elif name == "checkpoint.h5":
             try:
-                worst, notes = compare_h5(pa, pb, args.floor)
+                worst, notes = compare_h5(pa, pb, args.floor, ignore)
             except ImportError:
                 print(f"| {name} | | | | | not compared: no h5py |")
                 continue
