@@ -72,6 +72,17 @@ struct Calibrated {
   std::vector<MeasuredTest> sim;  ///< in the order of tests
 };
 
+/// Removes a result folder that is still empty when the job ends: a refusal after the folder was made.
+struct EmptyFolderRemover {
+  std::string path;
+  EmptyFolderRemover(const EmptyFolderRemover&) = delete;
+  EmptyFolderRemover& operator=(const EmptyFolderRemover&) = delete;
+  ~EmptyFolderRemover() {
+    std::error_code ec;
+    if (fs::is_directory(path, ec) && fs::is_empty(path, ec)) fs::remove(path, ec);
+  }
+};
+
 /// What calibrate and diagnose share: the data, the free parameters, the simulator and a new result folder.
 struct Session {
   MeasuredData data;
@@ -83,6 +94,7 @@ struct Session {
   std::string discrepancy;    ///< what the two fidelities measured, for the report
   PeriodicLab lab;
   std::string folder, output;
+  EmptyFolderRemover remover{folder};
   Session(const Config& base, const CalibrationOptions& o, const std::string& kind)
       : data(load_measured(o.data)),
         ref(o.reference.empty() ? ReferenceValues{}
@@ -128,7 +140,9 @@ struct Session {
   Misfit misfit_of(const Config& base, const std::string& material, const std::vector<MeasuredTest>& tests) {
     std::printf("%s: %s: measuring the simulator's scatter: %d specimens of %zu balls at the base model\n",
                 folder.c_str(), material.c_str(), lab.specimens(), lab.balls());
+    lab.set_progress("  " + material + ": scatter");
     Misfit m = measure_misfit(lab, model_of(base), tests, noise, true, &state);
+    lab.set_progress("");
     for (const std::string& n : m.notes()) std::printf("  noise: %s\n", n.c_str());
     const Real ratio = m.ensemble_ratio();
     const bool chosen = base.calibrate.ensemble == kAutoEnsemble;

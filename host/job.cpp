@@ -85,6 +85,10 @@ int run_job(const Config& cfg, bool resume, long stop_at_step) {
   const std::string ckpt = checkpoint_path(out.folder());
   if (resume) {
     resume_from(resume_checkpoint(ckpt, "run", cfg.fingerprint), *sim, &out);
+    if (sim->step_count() >= cfg.run.steps)
+      throw std::runtime_error(ckpt + " is at step " + std::to_string(sim->step_count()) + ", the step count is " +
+                               std::to_string(cfg.run.steps) + " ([run] steps or -n): nothing to continue; give -n above " +
+                               std::to_string(sim->step_count()) + " to run on");
     std::printf("triaxdem: resuming %s at step %ld (t = %.6g s)\n", ckpt.c_str(), sim->step_count(), sim->time());
   } else {
     out.write_snapshot(take_snapshot(*sim, "initial"));

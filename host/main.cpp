@@ -3,6 +3,7 @@
 #include <Kokkos_Core.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -61,6 +62,29 @@ std::string omp_threads_problem() {
   const char* env = std::getenv("OMP_NUM_THREADS");
   if (!env || !*env || count_fits(env, 1, true)) return "";
   return "OMP_NUM_THREADS=" + std::string(env) + " is no thread count for this machine (" + count_range(1) + ")";
+}
+
+/// A confining pressure in kPa: a finite number above 0.
+CLI::Validator pressure_kpa() {
+  return CLI::Validator(
+      [](std::string& s) -> std::string {
+        char* end = nullptr;
+        const double v = std::strtod(s.c_str(), &end);
+        return end != s.c_str() && *end == '\0' && std::isfinite(v) && v > 0
+                   ? ""
+                   : s + " is no confining pressure (kPa, a number above 0)";
+      },
+      "KPA");
+}
+
+/// The message for a first argument that names no command, or "" (CLI11 would say only that one is required).
+std::string unknown_command(const CLI::App& app, const std::string& word) {
+  std::string names;
+  for (const CLI::App* c : app.get_subcommands([](const CLI::App*) { return true; })) {
+    if (c->get_name() == word) return "";
+    names += (names.empty() ? "" : ", ") + c->get_name();
+  }
+  return "'" + word + "' is no triaxdem command; the commands: " + names + " (triaxdem COMMAND --help for one)";
 }
 
 }  // namespace
@@ -170,7 +194,7 @@ int main(int argc, char** argv) {
   synth->add_option("--seed", syn.seed, "noise and strength seed");
   synth->add_option("--specimen-seed", syn.specimen_seed, "packing seed of the specimen (default: the config's [run] "
                     "seed + 100000, a specimen no calibration ensemble of that config uses)");
-  synth->add_option("--pressures", syn_kpa, "confining pressures, kPa (default 100 200 300)");
+  synth->add_option("--pressures", syn_kpa, "confining pressures, kPa (default 100 200 300)")->check(pressure_kpa());
   synth->add_option("--material", syn.material, "material name in the file");
 
   auto* check = app.add_subcommand("check", "validate a config and describe its job: balls, stages, time step, steps, a wall-time estimate");
@@ -179,6 +203,12 @@ int main(int argc, char** argv) {
   auto* info = app.add_subcommand("info", "print the Kokkos build in use");
 
   cal.jobs = machine_cores();
+  if (argc > 1 && argv[1][0] != '-') {
+    if (const std::string problem = unknown_command(app, argv[1]); !problem.empty()) {
+      std::fprintf(stderr, "triaxdem: %s\n", problem.c_str());
+      return 1;
+    }
+  }
   CLI11_PARSE(app, argc, argv);
   if (const std::string problem = omp_threads_problem(); !problem.empty()) {
     std::fprintf(stderr, "triaxdem: %s\n", problem.c_str());

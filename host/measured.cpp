@@ -23,6 +23,11 @@ constexpr Real kMaxVoidRatio = 5;
 // A curve of one or two rows has no shape: its peak, stiffness and dilatancy would be read off single points (a file
 // with one point per test started a calibration). Three rows are the fewest with a peak between them.
 constexpr std::size_t kMinCurveRows = 3;
+// The curve's smoothing and noise estimate read a window of rows around each row, so their cost grows with the
+// square of the rows per strain: 10^5 rows of a test take about a second, 10^6 minutes. A curve shows nothing at
+// 10^5 rows that it does not at 10^4. A file beyond the total is refused while it is read, before it fills memory.
+constexpr std::size_t kMaxCurveRows = 100000;
+constexpr std::size_t kMaxFileRows = 2000000;
 
 /// A column's quantity and the factor that turns the file's unit into SI.
 struct ColumnSpec {
@@ -341,6 +346,10 @@ MeasuredTextTable read_csv_table(const std::string& path) {
       t.header = split(s);
       t.header_at = path + ":" + std::to_string(n);
     } else {
+      if (t.rows.size() == kMaxFileRows)
+        throw DataError(path + ":" + std::to_string(n) + ": more than " + std::to_string(kMaxFileRows) +
+                        " data rows (allowed: at most " + std::to_string(kMaxFileRows) + " in a file, " +
+                        std::to_string(kMaxCurveRows) + " per test; thin the curves, e.g. every 10th row)");
       t.rows.push_back({path + ":" + std::to_string(n), split(s)});
     }
   }
@@ -400,6 +409,11 @@ MeasuredData load_measured(const std::string& path) {
                         (t.eps_a.size() == 1 ? "" : "s") + " (allowed: at least " + std::to_string(kMinCurveRows) +
                         " rows of eps_a and q per test: a curve; give one row per test in a summary file, with "
                         "q_peak_<unit> and no eps_a column)");
+      if (t.eps_a.size() > kMaxCurveRows)
+        throw DataError(path + ": " + describe(t) + ": " + std::to_string(t.eps_a.size()) + " rows (allowed: at most " +
+                        std::to_string(kMaxCurveRows) + " per test: a curve shows no more at a million rows than at "
+                        "ten thousand, and costs minutes to read; thin it, e.g. every " +
+                        std::to_string((t.eps_a.size() + kMaxCurveRows - 1) / kMaxCurveRows * 10) + "th row)");
       summarise(t);
     }
   note_replicates(d);

@@ -224,9 +224,13 @@ int micro_job(const std::string& source, double at_pct, double rve_edge_mm, int 
       if (std::isfinite(eps)) have += level;
       if (std::isfinite(eps) && std::fabs(eps - at_pct) < 1e-6) path = file;
     }
+    if (found.empty())
+      throw std::runtime_error(source + ": not a triaxial run's folder (no snap_*.h5 in it); give the -o folder of a "
+                               "'triaxdem triaxial' run, or one snapshot file");
     if (path.empty())
       throw std::runtime_error(source + ": no snapshot at axial strain " + std::to_string(at_pct) +
-                               "% (the run saved states at: " + (have.empty() ? std::string("none") : have) + ")");
+                               "% (the run saved states at: " + (have.empty() ? std::string("none in the shear") : have) +
+                               "; [triaxial] snapshot_strains_pct sets them)");
   } else if (!fs::is_regular_file(source)) {
     throw std::runtime_error(source + ": no such run folder or snapshot file");
   }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <type_traits>
 
@@ -14,6 +15,7 @@
 
 #include "forked_runs.hpp"
 #include "periodic_triaxial.hpp"
+#include "progress.hpp"
 
 namespace dem {
 
@@ -275,8 +277,17 @@ bool receive_curves(int fd, MeasuredTest& t) {
 
 std::vector<MeasuredTest> PeriodicLab::run_cases(const Model& m, const std::vector<Case>& cases) {
   std::vector<MeasuredTest> out(cases.size());
+  std::optional<Progress> progress;
+  if (!progress_label_.empty()) progress.emplace(progress_label_, static_cast<long>(cases.size()));
+  long done = 0;
+  const auto one_done = [&]() {
+    if (progress) progress->update(++done, "runs");
+  };
   if (jobs_ <= 1 || cases.size() <= 1) {
-    for (std::size_t j = 0; j < cases.size(); ++j) out[j] = run(m, cases[j].sigma3, cases[j].material, cases[j].member);
+    for (std::size_t j = 0; j < cases.size(); ++j) {
+      out[j] = run(m, cases[j].sigma3, cases[j].material, cases[j].member);
+      one_done();
+    }
     return out;
   }
   const auto t0 = std::chrono::steady_clock::now();
@@ -286,7 +297,9 @@ std::vector<MeasuredTest> PeriodicLab::run_cases(const Model& m, const std::vect
       [&](std::size_t j, int fd) {
         out[j].material = cases[j].material;
         out[j].sigma3 = cases[j].sigma3;
-        return receive_curves(fd, out[j]);
+        const bool received = receive_curves(fd, out[j]);
+        one_done();
+        return received;
       },
       "calibration");
   runs_ += static_cast<long>(cases.size());

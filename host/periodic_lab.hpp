@@ -69,6 +69,9 @@ class PeriodicLab {
   int cell_factor() const { return cell_factor_; }
   int specimens() const { return static_cast<int>(specimens_.size()); }
   const Config& config() const { return cfg_; }
+  /// Names the runs that follow in a progress line with ETA (each batch of runs counts them); "" for none: a
+  /// calibration's search reports its own progress, the scatter measurement and the state match this way.
+  void set_progress(std::string label) { progress_label_ = std::move(label); }
   long runs() const { return runs_; }
   double seconds() const { return seconds_; }
   std::size_t balls() const { return specimens_.front().balls.size(); }
@@ -85,6 +88,7 @@ class PeriodicLab {
   std::vector<Specimen> specimens_;
   long runs_ = 0;
   double seconds_ = 0;
+  std::string progress_label_;
   int jobs_ = 1;
   int members_ = 1;
   int cell_factor_ = 1;

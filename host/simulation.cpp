@@ -352,13 +352,19 @@ std::array<long, 2> Simulation::touching() const {
 }
 
 std::string describe(const StageTimes& t, long particles, long steps) {
-  char line[320];
+  char line[360];
+  // A membrane's share only where there is one; "boundaries": moving walls, membrane nodes or the periodic
+  // cell's stretch. A GPU's thread count says nothing a user can set.
+  char membrane[48] = "";
+  if (t.membrane > 0) std::snprintf(membrane, sizeof membrane, "membrane %.1f s, ", t.membrane);
+  char threads[32] = "";
+  if (Kokkos::SpaceAccessibility<HostSpace, MemSpace>::accessible)
+    std::snprintf(threads, sizeof threads, " (%d threads)", ExecSpace().concurrency());
   std::snprintf(line, sizeof line,
-                "%ld steps, rebuild %.1f s (%ld rebuilds), forces %.1f s, membrane %.1f s, gather+integrate %.1f s, "
-                "walls %.1f s; %.3g particle-steps/s on %s (%d threads)",
-                steps, t.rebuild, t.rebuilds, t.forces, t.membrane, t.integrate, t.boundaries,
-                particles * static_cast<double>(steps) / std::max(1e-9, t.loop()), ExecSpace::name(),
-                ExecSpace().concurrency());
+                "%ld steps, rebuild %.1f s (%ld rebuilds), forces %.1f s, %sgather+integrate %.1f s, "
+                "boundaries %.1f s; %.3g particle-steps/s on %s%s",
+                steps, t.rebuild, t.rebuilds, t.forces, membrane, t.integrate, t.boundaries,
+                particles * static_cast<double>(steps) / std::max(1e-9, t.loop()), ExecSpace::name(), threads);
   return line;
 }
 

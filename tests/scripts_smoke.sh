@@ -47,6 +47,10 @@ check tools/compare_runs.py "$py" "$root/tools/compare_runs.py" "$work/tiny" "$w
 "$tdem" study "$root/tests/data/tiny_triaxial.toml" -o "$work/study" -j 1 -t 1 > "$work/study.log" 2>&1
 check tools/plot_study.py "$py" "$root/tools/plot_study.py" "$work/study" -o "$work/study.png"
 exists "$work/study.png"
+printf '# doc\n<!-- docs_table tiny -->\nold\n<!-- /docs_table tiny -->\nkept\n' > "$work/doc.md"
+check tools/docs_table.py "$py" "$root/tools/docs_table.py" "$work/study" --doc "$work/doc.md" --block tiny
+grep -q "^| tiny_triaxial | " "$work/doc.md" && grep -q "^kept$" "$work/doc.md" && ! grep -q "^old$" "$work/doc.md" ||
+  { cat "$work/doc.md"; echo "scripts_smoke: docs_table did not replace its block" >&2; exit 1; }
 check tools/plot_calibration.py "$py" "$root/tools/plot_calibration.py" "$cal" -o "$work/calibration.png"
 check tools/plot_prediction.py "$py" "$root/tools/plot_prediction.py" "$cal" -o "$work/prediction.png"
 exists "$work/calibration.png" "$work/prediction.png"

@@ -218,7 +218,13 @@ TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
   for (int k = 0; k < 3; ++k) like[k].sigma3 = 100e3 * (k + 1);
   const Ensemble one = lab.run_ensemble(m, like);
   ASSERT_EQ(lab.set_jobs(2), 2) << "the runs fork only from a one-thread process (ctest runs this test so)";
+  // The scatter measurement printed nothing for minutes: a labelled batch reports its runs as they come back.
+  lab.set_progress("scatter");
+  testing::internal::CaptureStdout();
   const Ensemble par = lab.run_ensemble(m, like);
+  const std::string shown = testing::internal::GetCapturedStdout();
+  EXPECT_NE(shown.find("scatter 6/6 (100%)"), std::string::npos) << shown;
+  lab.set_progress("");
   ASSERT_EQ(par.size(), 3u);
   for (int k = 0; k < 3; ++k) {
     ASSERT_EQ(par[k].size(), 2u);

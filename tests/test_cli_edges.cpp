@@ -269,3 +269,56 @@ TEST(CliEdges, ADeviceOrAHugeFileIsNoConfig) {
   EXPECT_EQ(o.code, 1);
   EXPECT_NE(o.output.find("larger than 1024 KiB"), std::string::npos) << o.output;
 }
+
+// `triaxdem bogus` said only "A subcommand is required": the word is named, with the commands there are.
+TEST(CliEdges, AnUnknownCommandIsNamedWithTheCommandsThereAre) {
+  const fs::path dir = dem::test::scratch_dir("cli_bogus");
+  const Outcome o = triaxdem("bogus", dir);
+  EXPECT_EQ(o.code, 1);
+  EXPECT_NE(o.output.find("'bogus' is no triaxdem command; the commands: run, "), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("calibrate"), std::string::npos) << o.output;
+}
+
+// `synth --pressures 0` failed after 6 s naming sigma3, a key the user never typed: the option is refused at once.
+TEST(CliEdges, AZeroPressureIsRefusedNamingTheOption) {
+  const fs::path dir = dem::test::scratch_dir("cli_pressures");
+  const Outcome o = triaxdem("synth --config configs/calibration/base.toml --pressures 100 0 -o " +
+                             (dir / "s.csv").string(), dir);
+  EXPECT_EQ(o.code, 105) << o.output;  // CLI11's validation failure
+  EXPECT_NE(o.output.find("--pressures"), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("0 is no confining pressure (kPa, a number above 0)"), std::string::npos) << o.output;
+  EXPECT_FALSE(fs::exists(dir / "s.csv"));
+}
+
+// `--resume -n 1000` on a run already past step 1000 did nothing and said nothing.
+TEST(CliEdges, AResumeBehindItsCheckpointSaysSo) {
+  const fs::path dir = dem::test::scratch_dir("cli_resume_behind");
+  const std::string run = "run configs/default.toml -o " + (dir / "out").string();
+  Outcome o = triaxdem(run + " -n 40", dir);
+  ASSERT_EQ(o.code, 0) << o.output;
+  o = triaxdem(run + " -n 20 --resume", dir);
+  EXPECT_EQ(o.code, 1) << o.output;
+  EXPECT_NE(o.output.find("is at step 40, the step count is 20 ([run] steps or -n): nothing to continue; give -n "
+                          "above 40"), std::string::npos) << o.output;
+}
+
+// `micro` on a folder that is not a run said "saved states at: none".
+TEST(CliEdges, MicroOnAFolderThatIsNoRunSaysSo) {
+  const fs::path dir = dem::test::scratch_dir("cli_micro");
+  const Outcome o = triaxdem("micro " + dir.string(), dir);
+  EXPECT_EQ(o.code, 1) << o.output;
+  EXPECT_NE(o.output.find("not a triaxial run's folder (no snap_*.h5 in it)"), std::string::npos) << o.output;
+}
+
+// A calibration refused after it had made its dated result folder left the folder behind, empty.
+TEST(CliEdges, ARefusedCalibrationLeavesNoFolder) {
+  const fs::path dir = dem::test::scratch_dir("cli_refused_folder");
+  std::ofstream(dir / "d.csv") << "material,sigma3_kPa,eps_a_pct,q_kPa,eps_v_pct\n"
+                                  "A,100,0,0,0\nA,100,1,60,0.1\nA,100,2,70,-0.1\nA,100,3,65,-0.3\n";
+  const Outcome o = triaxdem("calibrate " + (dir / "d.csv").string() + " --config tests/data/hidden_effects.toml "
+                             "--predict none --material nosuch -j 1 -o " + (dir / "out").string(), dir);
+  EXPECT_EQ(o.code, 1) << o.output;
+  EXPECT_NE(o.output.find("no tests of material 'nosuch'"), std::string::npos) << o.output;
+  ASSERT_TRUE(fs::is_directory(dir / "out")) << o.output;  // the parent a user named stays
+  EXPECT_TRUE(fs::is_empty(dir / "out")) << "a refused calibration left its dated folder";
+}

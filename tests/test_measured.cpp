@@ -499,3 +499,18 @@ TEST(Measured, ACurveOfOneOrTwoRowsIsRefused) {
   EXPECT_NE(e.find(": 2 rows (allowed: at least 3"), std::string::npos) << e;
   EXPECT_EQ(error_of("material,sigma3_kPa,eps_a_pct,q_kPa\nA,100,0,0\nA,100,1,50\nA,100,2,40\n"), "");
 }
+
+// A measured file of 10^6 rows spent minutes smoothing before any check or message: a test's rows are capped, and
+// the cap names the count, the limit and a thinning that fits.
+TEST(Measured, ACurveOfMoreRowsThanTheCapIsRefused) {
+  const auto curve = [](long rows) {
+    std::string text = "material,sigma3_kPa,eps_a_pct,q_kPa\n";
+    for (long k = 0; k < rows; ++k)
+      text += "A,100," + std::to_string(15.0 * k / rows) + "," + std::to_string(100.0 + (k % 7)) + "\n";
+    return text;
+  };
+  const std::string e = error_of(curve(100001));
+  EXPECT_NE(e.find("bad.csv: A at 100 kPa: 100001 rows (allowed: at most 100000 per test"), std::string::npos) << e;
+  EXPECT_NE(e.find("thin it, e.g. every 20th row"), std::string::npos) << e;
+  EXPECT_EQ(error_of(curve(100000)), "");
+}

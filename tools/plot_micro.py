@@ -19,6 +19,7 @@ import sys
 import matplotlib
 
 matplotlib.use("Agg")
+import matplotlib.lines  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
@@ -93,52 +94,73 @@ def main():
 
     fig = plt.figure(figsize=(12, 7.5), constrained_layout=True)
     gs = fig.add_gridspec(2, 4)
-    ax = fig.add_subplot(gs[0, :2])
-    for key, label in (("a_c", "a_c"), ("a_n", "a_n"), ("a_t", "a_t")):
-        ax.plot(ea, s[key], label=label)
-    ax.set_title("anisotropy, all contacts (Fig. 16)", fontsize=10)
-    ax.set_xlabel("axial strain (%)")
-    ax.legend(fontsize=8)
-    ax.grid(True, lw=0.4, alpha=0.6)
-    ax = fig.add_subplot(gs[0, 2:])
-    for key, style in (("a_c_strong", "-"), ("a_c_weak", "--"), ("a_n_strong", "-"), ("a_n_weak", "--")):
-        ax.plot(ea, s[key], style, label=key)
-    ax.set_title("strong and weak networks (Fig. 17)", fontsize=10)
-    ax.set_xlabel("axial strain (%)")
-    ax.legend(fontsize=8)
-    ax.grid(True, lw=0.4, alpha=0.6)
+    # The series' anisotropies are signed: + when the fabric's major direction is the stress's, - when across it.
+    # A nearly isotropic network (the weak one) flips between the two from record to record, so the curves show
+    # the magnitude and hollow marks the records where the direction lies across the stress.
+    def anisotropy(ax, keys, title):
+        for key, style in keys:
+            a = np.asarray(s[key])
+            line, = ax.plot(ea, np.abs(a), style, label=key)
+            across = a < 0
+            if across.any():
+                ax.plot(ea[across], np.abs(a[across]), "o", mfc="none", ms=4, color=line.get_color())
+        ax.plot([], [], "o", mfc="none", ms=4, color="0.3", label="major direction across the stress")
+        ax.set_title(title, fontsize=10)
+        ax.set_xlabel("axial strain (%)")
+        ax.set_ylabel("anisotropy magnitude sqrt(3/2 a:a) (-)")
+        ax.set_ylim(bottom=0)
+        ax.legend(fontsize=8)
+        ax.grid(True, lw=0.4, alpha=0.6)
+
+    anisotropy(fig.add_subplot(gs[0, :2]), (("a_c", "-"), ("a_n", "-"), ("a_t", "-")),
+               "anisotropy, all contacts (Fig. 16)")
+    anisotropy(fig.add_subplot(gs[0, 2:]), (("a_c_strong", "-"), ("a_c_weak", "--"), ("a_n_strong", "-"),
+                                            ("a_n_weak", "--")), "strong and weak networks (Fig. 17)")
+    roses = {p: read_csv(os.path.join(run, f"micro_rose_{p}.csv")) for p in POINTS
+             if os.path.exists(os.path.join(run, f"micro_rose_{p}.csv"))}
+    quantities = (("density_all", "contact density"), ("fn_all_N", "normal force"),
+                  ("ft_all_N", "tangential force"))
+    # One radial scale for all four roses: each quantity over its largest value at A-D, so that A and D compare.
+    largest = {key: max(max(r[key].max() for r in roses.values()), 1e-300) for key, _ in quantities} if roses else {}
     for k, p in enumerate(POINTS):
-        path = os.path.join(run, f"micro_rose_{p}.csv")
-        if not os.path.exists(path):
+        if p not in roses:
             continue
-        r = read_csv(path)
+        r = roses[p]
         th = np.radians(r["theta_deg"])
         # The rose in a vertical plane: theta from the z axis (up), down one side and back up the mirror side.
         ang = np.concatenate([np.pi / 2 - th, (np.pi / 2 + th)[::-1], [np.pi / 2 - th[0]]])
         pa = fig.add_subplot(gs[1, k], projection="polar")
-        for key, label in (("density_all", "contact density"), ("fn_all_N", "normal force"),
-                           ("ft_all_N", "tangential force")):
-            v = r[key] / max(r[key].max(), 1e-300)
+        for key, label in quantities:
+            v = r[key] / largest[key]
             pa.plot(ang, np.concatenate([v, v[::-1], [v[0]]]), label=label)
         pa.set_title(f"{p}", fontsize=10)
-        pa.set_yticklabels([])
+        pa.set_ylim(0, 1.05)
+        pa.set_yticks([0.5, 1.0])
+        pa.tick_params(labelsize=7)
         if k == 0:
-            pa.legend(fontsize=7, loc="lower left", bbox_to_anchor=(-0.3, -0.35))
+            pa.legend(fontsize=7, loc="lower left", bbox_to_anchor=(-0.3, -0.35),
+                      title="each over its largest at A-D", title_fontsize=7)
     fig.savefig(os.path.join(run, "micro_anisotropy.png"), dpi=120)
 
     chains = [(p, os.path.join(run, f"force_chains_{p}.vtk")) for p in POINTS]
     chains = [(p, f) for p, f in chains if os.path.exists(f)]
     if chains:
-        fig = plt.figure(figsize=(4 * len(chains), 4.4), constrained_layout=True)
-        for k, (p, path) in enumerate(chains):
-            seg, fn, strong = read_chains(path)
+        read = [(p, read_chains(path)) for p, path in chains]
+        fmax = max(max(fn.max() for _, (_, fn, _) in read), 1e-300)
+        scale = 3.0 / fmax  # one width scale for every panel: a chain as thick at A as at D carries as much
+        fig = plt.figure(figsize=(4 * len(chains), 4.8), constrained_layout=True)
+        for k, (p, (seg, fn, strong)) in enumerate(read):
             ax = fig.add_subplot(1, len(chains), k + 1, projection="3d")
-            scale = 3.0 / max(fn.max(), 1e-300)
             for sel, colour in ((strong == 0, "tab:orange"), (strong == 1, "tab:green")):
                 for (a, b), f in zip(seg[sel], fn[sel]):
                     ax.plot(*zip(a * 1e3, b * 1e3), color=colour, lw=0.3 + scale * f)
             ax.set_title(f"{p}: mean force {fn.mean():.2f} N", fontsize=9)
             ax.set_axis_off()
+        handles = [matplotlib.lines.Line2D([], [], color="tab:green", lw=2, label="strong (above the mean force)"),
+                   matplotlib.lines.Line2D([], [], color="tab:orange", lw=1, label="weak"),
+                   matplotlib.lines.Line2D([], [], color="0.3", lw=0.3 + scale * fmax,
+                                           label=f"width: normal force, {fmax:.1f} N widest (all panels)")]
+        fig.legend(handles=handles, loc="lower center", ncol=3, fontsize=8)
         fig.savefig(os.path.join(run, "force_chains.png"), dpi=110)
     print(f"plot_micro: wrote micro_forces.png, micro_coordination.png, micro_anisotropy.png"
           f"{', force_chains.png' if chains else ''} in {run}")
