@@ -37,8 +37,8 @@ def table(study):
     rows = read_rows(os.path.join(study, "study_summary.csv"))
     if not rows:
         sys.exit(f"docs_table: {study}/study_summary.csv has no cases")
-    compared = [c[len("q_peak_"):-len("_kPa")] for c in rows[0] if c.startswith("q_peak_") and c.endswith("_kPa")
-                and c[len("q_peak_"):-len("_kPa")] not in ("area", "parabolic", "membrane", "lw")]
+    # Each compared file has a q_peak_<stem>_kPa and an error_<stem>_pct column.
+    compared = [c[len("error_"):-len("_pct")] for c in rows[0] if c.startswith("error_") and c.endswith("_pct")]
     head = ["case"] + [f"{c} q_peak (kPa)" for c in compared] + ["triaxdem q_peak (kPa), highest record"]
     if compared:
         head.append(f"vs {compared[0]}")
