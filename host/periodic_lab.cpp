@@ -148,9 +148,19 @@ std::pair<Real, Real> preparation_reach(const Config& base, const MatchPlan& pla
 }
 
 Real prep_friction_for(const Config& base, Real target, Real& reached, bool verbose, const MatchPlan& plan) {
-  auto at = [&](Real u) { return void_ratio_at(base, u, plan); };
+  // Each packing of the plan's specimens takes seconds to minutes: the match reports them (the ends, then the
+  // bisection's steps; it may stop early at an end).
+  std::optional<Progress> progress;
+  if (verbose) progress.emplace("triaxdem: matching the void ratio", 2L + plan.steps);
+  long packings = 0;
+  auto at = [&](Real u) {
+    const Real e = void_ratio_at(base, u, plan);
+    if (progress) progress->update(++packings, "packings");
+    return e;
+  };
   Real lo = 0, hi = 1;
   auto [e_lo, e_hi] = preparation_reach(base, plan);
+  if (progress) progress->update(packings = 2, "packings");
   if (verbose)
     std::printf("triaxdem: preparation friction 0 to 1 packs void ratios %.4f to %.4f (mean of %d specimens); "
                 "target %.4f\n", e_lo, e_hi, plan.specimens, target);

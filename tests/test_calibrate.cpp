@@ -272,7 +272,11 @@ TEST(Calibrate, StateIsMatchedOnTheMeanOfTheLabsFirstSpecimens) {
   data[1].void_ratio = e0 + 0.5 * (e1 - e0);
   const Real target = e0 + 0.4 * (e1 - e0);
   StateMatch m;
-  const Config matched = matched_state(cfg, data, m, false, plan);
+  // The match packed for minutes in silence: it reports each packing (the two ends and the 4 halvings).
+  testing::internal::CaptureStdout();
+  const Config matched = matched_state(cfg, data, m, true, plan);
+  const std::string shown = testing::internal::GetCapturedStdout();
+  EXPECT_NE(shown.find("matching the void ratio 6/6 (100%)"), std::string::npos) << shown;
   EXPECT_EQ(m.tests, 2);
   EXPECT_NEAR(m.target, target, 1e-12);
   EXPECT_EQ(m.specimens, kStateMatchSpecimens);
