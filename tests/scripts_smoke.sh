@@ -86,6 +86,7 @@ exists "$work/sweep.csv"
 # Every script and perf program has its line above.
 missing=""
 for f in "$root"/perf/*.sh "$root"/perf/*.cpp "$root"/tools/*.py; do
+  [[ "$(basename "$f")" == _* ]] && continue  # a module the tools import, not a script
   name="$(basename "$(dirname "$f")")/$(basename "$f")"; name="${name%.cpp}"
   [[ " ${ran[*]} " == *" $name "* ]] || missing+=" $name"
 done

@@ -11,18 +11,11 @@ With --doc, the lines between `<!-- docs_table BLOCK -->` and `<!-- /docs_table 
 rest of the file is left as it is; a doc without the markers is refused, not appended to.
 """
 import argparse
-import csv
 import math
 import os
 import sys
 
-
-def read_rows(path):
-    try:
-        with open(path, newline="") as f:
-            return list(csv.DictReader(f))
-    except OSError as e:
-        sys.exit(f"docs_table: cannot read {path}: {e.strerror}")
+from _csv_rows import read_rows
 
 
 def highest_record(study, case):

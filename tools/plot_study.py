@@ -11,7 +11,6 @@ Reads STUDY/study_summary.csv (written by `triaxdem study`) and each case's STUD
 Needs Debian's python3-matplotlib and python3-numpy.
 """
 import argparse
-import csv
 import os
 import sys
 
@@ -21,13 +20,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from _csv_rows import read_rows  # noqa: E402
 
-def read_csv(path):
-    try:
-        with open(path, newline="") as f:
-            return list(csv.DictReader(f))
-    except OSError as e:
-        sys.exit(f"plot_study: cannot read {path}: {e.strerror}")
 
 
 def main():
@@ -35,7 +29,7 @@ def main():
     ap.add_argument("study", help="output folder of `triaxdem study`")
     ap.add_argument("-o", "--output", help="PNG file (default: STUDY/study.png)")
     args = ap.parse_args()
-    cases = [r for r in read_csv(os.path.join(args.study, "study_summary.csv")) if r["status"] == "ok"]
+    cases = [r for r in read_rows(os.path.join(args.study, "study_summary.csv")) if r["status"] == "ok"]
     if not cases:
         sys.exit(f"plot_study: {args.study}/study_summary.csv lists no finished case")
     pressures = sorted({float(r["sigma3_kPa"]) for r in cases})
@@ -45,7 +39,7 @@ def main():
     fig, axes = plt.subplots(2, len(pressures), figsize=(4.2 * len(pressures), 7), squeeze=False,
                              constrained_layout=True)
     for r in cases:
-        rows = read_csv(os.path.join(args.study, r["case"], "series.csv"))
+        rows = read_rows(os.path.join(args.study, r["case"], "series.csv"))
         ea = np.array([float(x["eps_a_pct"]) for x in rows])
         q = np.array([float(x["q_kPa"]) for x in rows])
         ev = np.array([float(x["eps_v_pct"]) for x in rows])
@@ -83,7 +77,7 @@ def figure_10(study, cases, pressures):
     per confining pressure, like the paper's Figure 10 (needs the runs' micro columns)."""
     points = {}
     for r in cases:
-        rows = read_csv(os.path.join(study, r["case"], "series.csv"))
+        rows = read_rows(os.path.join(study, r["case"], "series.csv"))
         if not rows or "fn_ratio_strong_weak" not in rows[0]:
             return
         peak = max(rows, key=lambda x: float(x["q_kPa"]))
