@@ -18,6 +18,7 @@
 
 #include "host/folder_lock.hpp"
 #include "host/progress.hpp"
+#include "host/simulation.hpp"
 #include "test_util.hpp"
 
 namespace fs = std::filesystem;
@@ -321,4 +322,18 @@ TEST(CliEdges, ARefusedCalibrationLeavesNoFolder) {
   EXPECT_NE(o.output.find("no tests of material 'nosuch'"), std::string::npos) << o.output;
   ASSERT_TRUE(fs::is_directory(dir / "out")) << o.output;  // the parent a user named stays
   EXPECT_TRUE(fs::is_empty(dir / "out")) << "a refused calibration left its dated folder";
+}
+
+// The periodic job's time line read "membrane 0.0 s, walls 22.8 s" for a cell with neither: the stage is called
+// boundaries (the cell's stretch, walls or membrane nodes), and the membrane's time shows only where it ran.
+TEST(CliEdges, TheTimeLineNamesOnlyStagesThatRan) {
+  dem::StageTimes t;
+  t.boundaries = 1.25;
+  std::string line = dem::describe(t, 1000, 10);
+  EXPECT_NE(line.find("boundaries 1.2 s"), std::string::npos) << line;
+  EXPECT_EQ(line.find("membrane"), std::string::npos) << line;
+  EXPECT_EQ(line.find("walls"), std::string::npos) << line;
+  t.membrane = 2;
+  line = dem::describe(t, 1000, 10);
+  EXPECT_NE(line.find("membrane 2.0 s"), std::string::npos) << line;
 }
