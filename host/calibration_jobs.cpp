@@ -37,6 +37,27 @@ std::string new_dated_folder(const std::string& parent, const std::string& prefi
 
 namespace {
 
+/// A folder as a path without a trailing separator ("out/calibrate_x/" names calibrate_x).
+fs::path folder_path(const std::string& folder) {
+  fs::path p = fs::path(folder).lexically_normal();
+  return p.has_filename() ? p : p.parent_path();
+}
+
+/// The folder a resumed calibrate or diagnose continues in: one that a run of the same kind made.
+std::string resumed_folder(const std::string& folder, const std::string& kind) {
+  const std::string name = folder_path(folder).filename().string();
+  if (!fs::is_directory(folder) || name.rfind(kind + "_", 0) != 0)
+    throw std::invalid_argument("--resume " + folder + ": not a " + kind + "_<date> folder of an earlier " + kind +
+                                " (it gives the folder to continue in)");
+  return folder_path(folder).string();
+}
+
+/// The parent folder of a resumed folder: where its run left the specimens it shares with others.
+std::string resumed_parent(const std::string& folder) {
+  const fs::path parent = folder_path(folder).parent_path();
+  return parent.empty() ? "." : parent.string();
+}
+
 /// The free parameters: from the command line, else from the config's [calibrate] free.
 std::vector<FreeParam> free_params(const Config& cfg, const std::vector<std::string>& cli) {
   std::vector<FreeParam> out;
@@ -101,12 +122,22 @@ struct Session {
                                 : load_reference(o.reference, [](const std::string& n) { free_param(n); })),
         free(free_params(base, o.free)), predict_template(prediction_template(base, o.predict)),
         two_fidelity(two_fidelity_wanted(base, o.reference_test, predict_template.has_value())),
-        lab(matched(base, o.jobs), true, o.jobs), folder(new_dated_folder(o.output, kind)), output(o.output) {
+        lab(matched(base, o.jobs), true, o.jobs),
+        folder(o.resume.empty() ? new_dated_folder(o.output, kind) : resumed_folder(o.resume, kind)),
+        output(o.resume.empty() ? o.output : resumed_parent(o.resume)) {
+    lab.set_run_store(folder + "/runs");
+    if (!o.resume.empty())
+      std::printf("%s: resuming in %s: the runs stored there are read, not run again\n", kind.c_str(), folder.c_str());
     if (o.noise == "data" || o.noise == "lab") noise.mode = o.noise;
     else noise = lab_noise_options(o.noise);
     for (const std::string& n : data.notes) std::printf("%s: note: %s\n", kind.c_str(), n.c_str());
   }
   NoiseOptions noise;
+  /// "N runs", and how many of them a resumed session read from its store.
+  std::string runs_text() const {
+    const long read = lab.stored_runs_read();
+    return fmt("%ld runs", lab.runs()) + (read > 0 ? fmt(" (%ld of them read from the run store)", read) : "");
+  }
   std::vector<std::string> free_names() const {
     std::vector<std::string> names;
     for (const FreeParam& f : free) names.push_back(f.name);
@@ -303,8 +334,8 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
                 "that compares with the lab\n");
   print_errors(all_meas, all_sim);
   io::write_text_atomic(ss.folder + "/calibrated.csv", table.str());
-  std::printf("calibrate: %ld runs in %s; results in %s (calibrated.csv, errors.csv, simulated_curves.csv)\n",
-              ss.lab.runs(), format_duration(ss.lab.seconds()).c_str(), ss.folder.c_str());
+  std::printf("calibrate: %s in %s; results in %s (calibrated.csv, errors.csv, simulated_curves.csv)\n",
+              ss.runs_text().c_str(), format_duration(ss.lab.seconds()).c_str(), ss.folder.c_str());
   ss.finish(all_meas, all_sim, "the calibrated parameters");
   const std::string prediction = ss.predict_membrane(base, models);
   if (!prediction.empty()) io::write_text_atomic(ss.folder + "/prediction.md", prediction);
@@ -412,7 +443,7 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
     write_measured_curves(ss.folder + "/extended_curves.csv", all_ext, "simulated by the extended model of each material");
   io::write_text_atomic(ss.folder + "/diagnosis.md", md.str());
   io::write_text_atomic(ss.folder + "/models.csv", csv.str());
-  std::printf("diagnose: %ld runs in %s; report in %s/diagnosis.md\n", ss.lab.runs(),
+  std::printf("diagnose: %s in %s; report in %s/diagnosis.md\n", ss.runs_text().c_str(),
               format_duration(ss.lab.seconds()).c_str(), ss.folder.c_str());
   ss.finish(all_meas, all_sim, "the calibrated base model");
   // The report stands before the membrane tests run; their section is added when they end.

@@ -22,6 +22,9 @@ struct CalibrationOptions {
   std::string predict;
   /// The reference test: "periodic", "two_fidelity", or "" for the base config's [calibrate] reference_test.
   std::string reference_test;
+  /// A result folder of an earlier calibrate or diagnose of the same data to continue in: its stored runs
+  /// (PeriodicLab::set_run_store) are read instead of run again. "": a new dated folder.
+  std::string resume;
 };
 
 /// Calibrates each material of the data; writes calibrate_<date>/ under options.output. Returns 0.

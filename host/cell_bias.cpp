@@ -30,6 +30,7 @@ void measure_cell_bias(PeriodicLab& lab, const Model& base, const std::vector<Me
   plan.jobs = lab.jobs();
   const Config cfg = matched_state(larger_cell(lab.config(), kCellCheckFactor), measured, state, false, plan);
   PeriodicLab check(cfg, false, kCellCheckSpecimens, plan.first_seed, kCellCheckSpecimens, lab.jobs());
+  check.set_run_store(lab.run_store());  // its own specimens: their runs have their own names there
   const Ensemble larger = check.run_ensemble(base, measured, true);
   const Real n = static_cast<Real>(lab.balls()), factor = static_cast<Real>(check.balls()) / n;
   std::vector<std::vector<Real>> sd(measured.size());

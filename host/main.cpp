@@ -175,6 +175,8 @@ int main(int argc, char** argv) {
     c->add_option("--predict", cal.predict, "the membrane test to end with at the calibrated parameters: a config "
                   "with [specimen] and [triaxial] (configs/small/ by default through [calibrate] predict; "
                   "configs/paper/ for full scale), or none");
+    c->add_option("--resume", cal.resume, "continue in the result folder of an earlier run of this command on the "
+                  "same data and config: the runs it stored are read, not run again")->check(CLI::ExistingDirectory);
     c->add_option("--reference-test", cal.reference_test, "what the calibration fits: periodic (the cell) or "
                   "two_fidelity (the cell corrected by the --predict membrane test); default: [calibrate] "
                   "reference_test")->check(CLI::IsMember({"periodic", "two_fidelity"}));

@@ -1,8 +1,12 @@
 #include "periodic_lab.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <optional>
 #include <stdexcept>
@@ -13,9 +17,11 @@
 #include <omp.h>
 #endif
 
+#include "fnv1a.hpp"
 #include "forked_runs.hpp"
 #include "periodic_triaxial.hpp"
 #include "progress.hpp"
+#include "provenance.hpp"
 
 namespace dem {
 
@@ -285,6 +291,50 @@ bool receive_curves(int fd, MeasuredTest& t) {
 
 }  // namespace
 
+void PeriodicLab::set_run_store(std::string folder) { store_ = std::move(folder); }
+
+std::string PeriodicLab::stored_path(const Model& m, const Case& c) const {
+  if (store_.empty()) return "";
+  const std::string version = program_version();
+  std::uint64_t h = fnv1a(version.data(), version.size());
+  h = fnv1a(cfg_.fingerprint.data(), cfg_.fingerprint.size(), h);
+  h = fnv1a(&m.law, sizeof m.law, h);  // Reals only: no padding
+  h = fnv1a(&m.membrane, sizeof m.membrane, h);
+  h = fnv1a(&c.sigma3, sizeof c.sigma3, h);
+  const Specimen& sp = specimens_.at(static_cast<std::size_t>(c.member));
+  for (const BallSpec& b : sp.balls) {
+    const Real v[] = {b.x.x, b.x.y, b.x.z, b.v.x, b.v.y, b.v.z, b.w.x, b.w.y, b.w.z, b.radius, b.density};
+    h = fnv1a(v, sizeof v, h);
+    h = fnv1a(&b.material, sizeof b.material, h);
+  }
+  h = fnv1a(sp.cell.data(), sizeof(Real) * sp.cell.size(), h);
+  return store_ + "/" + hex16(h) + ".run";
+}
+
+namespace {
+/// A stored run's curves (send_curves' bytes), or false where there is none or it is cut short.
+bool read_stored(const std::string& path, MeasuredTest& t) {
+  if (path.empty()) return false;
+  const int fd = ::open(path.c_str(), O_RDONLY);
+  if (fd < 0) return false;
+  const bool ok = receive_curves(fd, t);
+  ::close(fd);
+  return ok;
+}
+
+/// Writes a run's curves beside their place and renames them in: a killed calibration leaves whole files only.
+void store_run(const std::string& path, const MeasuredTest& t) {
+  if (path.empty()) return;
+  std::filesystem::create_directories(std::filesystem::path(path).parent_path());  // at the first run
+  const std::string tmp = path + ".tmp";
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  if (fd < 0) throw std::runtime_error(tmp + ": cannot be written (the calibration's run store)");
+  send_curves(fd, t);
+  ::close(fd);
+  std::filesystem::rename(tmp, path);
+}
+}  // namespace
+
 std::vector<MeasuredTest> PeriodicLab::run_cases(const Model& m, const std::vector<Case>& cases) {
   std::vector<MeasuredTest> out(cases.size());
   std::optional<Progress> progress;
@@ -293,26 +343,47 @@ std::vector<MeasuredTest> PeriodicLab::run_cases(const Model& m, const std::vect
   const auto one_done = [&]() {
     if (progress) progress->update(++done, "runs");
   };
-  if (jobs_ <= 1 || cases.size() <= 1) {
-    for (std::size_t j = 0; j < cases.size(); ++j) {
+  std::vector<std::string> paths(cases.size());
+  std::vector<std::size_t> todo;  // the cases not in the store
+  for (std::size_t j = 0; j < cases.size(); ++j) {
+    paths[j] = stored_path(m, cases[j]);
+    out[j].material = cases[j].material;
+    out[j].sigma3 = cases[j].sigma3;
+    if (read_stored(paths[j], out[j])) {
+      ++stored_read_;
+      ++runs_;  // a run of the search, read: the counts a resumed search reports are those it reported
+      one_done();
+    } else {
+      out[j] = MeasuredTest{};
+      todo.push_back(j);
+    }
+  }
+  if (jobs_ <= 1 || todo.size() <= 1) {
+    for (const std::size_t j : todo) {
       out[j] = run(m, cases[j].sigma3, cases[j].material, cases[j].member);
+      store_run(paths[j], out[j]);
       one_done();
     }
     return out;
   }
   const auto t0 = std::chrono::steady_clock::now();
   forked_runs(
-      cases.size(), jobs_,
-      [&](std::size_t j, int fd) { send_curves(fd, run(m, cases[j].sigma3, cases[j].material, cases[j].member)); },
-      [&](std::size_t j, int fd) {
+      todo.size(), jobs_,
+      [&](std::size_t k, int fd) {
+        const Case& c = cases[todo[k]];
+        send_curves(fd, run(m, c.sigma3, c.material, c.member));
+      },
+      [&](std::size_t k, int fd) {
+        const std::size_t j = todo[k];
         out[j].material = cases[j].material;
         out[j].sigma3 = cases[j].sigma3;
         const bool received = receive_curves(fd, out[j]);
+        if (received) store_run(paths[j], out[j]);
         one_done();
         return received;
       },
       "calibration");
-  runs_ += static_cast<long>(cases.size());
+  runs_ += static_cast<long>(todo.size());
   seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }

@@ -69,6 +69,14 @@ class PeriodicLab {
   int cell_factor() const { return cell_factor_; }
   int specimens() const { return static_cast<int>(specimens_.size()); }
   const Config& config() const { return cfg_; }
+  /// Keeps every run's curves in `folder` (one file each, named by a hash of the model, the pressure, the
+  /// specimen's balls, the config and the program's version) as it ends, and reads a run found there instead of
+  /// running it again: a calibration writes what it has as it goes, and one resumed in its folder replays its
+  /// search from the stored runs, bit for bit. "" keeps nothing.
+  void set_run_store(std::string folder);
+  const std::string& run_store() const { return store_; }
+  /// Of runs(), those read from the store instead of run.
+  long stored_runs_read() const { return stored_read_; }
   /// Names the runs that follow in a progress line with ETA (each batch of runs counts them); "" for none: a
   /// calibration's search reports its own progress, the scatter measurement and the state match this way.
   void set_progress(std::string label) { progress_label_ = std::move(label); }
@@ -89,6 +97,8 @@ class PeriodicLab {
   long runs_ = 0;
   double seconds_ = 0;
   std::string progress_label_;
+  std::string store_;
+  long stored_read_ = 0;
   int jobs_ = 1;
   int members_ = 1;
   int cell_factor_ = 1;
@@ -100,8 +110,10 @@ class PeriodicLab {
     Real sigma3;
     int member;
   };
-  /// The cases in order, up to jobs() at once.
+  /// The cases in order, up to jobs() at once; those in the run store are read.
   std::vector<MeasuredTest> run_cases(const Model& m, const std::vector<Case>& cases);
+  /// The run store's file of a case ("" without a store).
+  std::string stored_path(const Model& m, const Case& c) const;
 };
 
 /// Runs at once that `jobs` asks for, where that is safe (PeriodicLab::set_jobs); otherwise 1.

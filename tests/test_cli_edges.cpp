@@ -4,6 +4,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -336,4 +337,51 @@ TEST(CliEdges, TheTimeLineNamesOnlyStagesThatRan) {
   t.membrane = 2;
   line = dem::describe(t, 1000, 10);
   EXPECT_NE(line.find("membrane 2.0 s"), std::string::npos) << line;
+}
+
+// calibrate and diagnose wrote nothing until they ended and could not resume: each run's curves are stored in the
+// result folder as the run ends, and --resume reads them. With half of them gone (a calibration killed part way),
+// the resumed one runs only the missing ones and ends with the same results, to the byte. It runs once (not again
+// at two threads): the program it starts runs at one thread either way.
+TEST(CliEdges, ACalibrationResumesFromItsStoredRuns) {
+  const fs::path dir = dem::test::scratch_dir("cli_resume_calibration");
+  std::string base = text_of(fs::path(TRIAXDEM_SOURCE_DIR) / "tests/data/hidden_effects.toml");
+  for (const auto& [key, value] : {std::pair<std::string, std::string>{"ensemble", "1"}, {"scatter_specimens", "2"},
+                                   {"target_axial_strain_pct", "1.0"}}) {
+    const auto at = base.find("\n" + key + " = ");
+    ASSERT_NE(at, std::string::npos) << key;
+    base.replace(at + 1, base.find('\n', at + 1) - at - 1, key + " = " + value);
+  }
+  std::ofstream(dir / "base.toml") << base;
+  const std::string config = " --config " + (dir / "base.toml").string();
+  Outcome o = triaxdem("synth" + config + " -o " + (dir / "data.csv").string() + " --extension none --seed 1 "
+                       "--pressures 100", dir);
+  ASSERT_EQ(o.code, 0) << o.output;
+  const std::string calibrate = "calibrate " + (dir / "data.csv").string() + config + " --predict none -j 1 ";
+  o = triaxdem(calibrate + "-o " + (dir / "out").string(), dir);
+  ASSERT_EQ(o.code, 0) << o.output;
+  fs::path folder;
+  for (const auto& e : fs::directory_iterator(dir / "out")) folder = e.path();
+  std::vector<fs::path> runs;
+  for (const auto& e : fs::directory_iterator(folder / "runs")) runs.push_back(e.path());
+  ASSERT_GT(runs.size(), 20u) << "each run stored as it ended";
+  std::map<std::string, std::string> first;
+  for (const char* f : {"calibrated.csv", "errors.csv", "simulated_curves.csv"}) first[f] = text_of(folder / f);
+  std::sort(runs.begin(), runs.end());
+  for (std::size_t k = 0; k < runs.size(); k += 2) fs::remove(runs[k]);
+  o = triaxdem(calibrate + "--resume " + folder.string(), dir);
+  ASSERT_EQ(o.code, 0) << o.output;
+  EXPECT_NE(o.output.find("resuming in " + folder.string() + ": the runs stored there are read"), std::string::npos)
+      << o.output;
+  // The store also holds the cell-bias check's runs: of the search's, those left are read, the others run again.
+  EXPECT_NE(o.output.find(" of them read from the run store)"), std::string::npos) << o.output;
+  const auto at = o.output.find("read from the run store)");
+  const long total = std::stol(o.output.substr(o.output.rfind("calibrate: ", at) + 11));
+  const long read = std::stol(o.output.substr(o.output.rfind("runs (", at) + 6));
+  EXPECT_GT(read, 0);
+  EXPECT_LT(read, total) << "only the missing runs run again";
+  for (const auto& [f, text] : first) EXPECT_EQ(text_of(folder / f), text) << f;
+  o = triaxdem(calibrate + "--resume " + (dir / "out").string(), dir);
+  EXPECT_EQ(o.code, 1);
+  EXPECT_NE(o.output.find("not a calibrate_<date> folder of an earlier calibrate"), std::string::npos) << o.output;
 }
