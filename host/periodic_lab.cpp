@@ -159,14 +159,18 @@ Real prep_friction_for(const Config& base, Real target, Real& reached, bool verb
   std::optional<Progress> progress;
   if (verbose) progress.emplace("triaxdem: matching the void ratio", 2L + plan.steps);
   long packings = 0;
+  auto packed = [&](long count) {
+    packings += count;
+    if (progress) progress->update(packings, "packings");
+  };
   auto at = [&](Real u) {
     const Real e = void_ratio_at(base, u, plan);
-    if (progress) progress->update(++packings, "packings");
+    packed(1);
     return e;
   };
   Real lo = 0, hi = 1;
   auto [e_lo, e_hi] = preparation_reach(base, plan);
-  if (progress) progress->update(packings = 2, "packings");
+  packed(2);
   if (verbose)
     std::printf("triaxdem: preparation friction 0 to 1 packs void ratios %.4f to %.4f (mean of %d specimens); "
                 "target %.4f\n", e_lo, e_hi, plan.specimens, target);

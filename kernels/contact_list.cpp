@@ -36,14 +36,14 @@ struct DenseKeyBins {
 void bin_sort_keys(const PairKeyView& keys) {
   const int n = static_cast<int>(keys.extent(0));
   if (n < 2) return;
-  std::uint64_t first = 0, last = 0;
+  Kokkos::MinMaxScalar<std::uint64_t> range;
+  Kokkos::parallel_reduce("dem::contacts::key_range", RangePolicy(0, n),
+      KOKKOS_LAMBDA(const int i, Kokkos::MinMaxScalar<std::uint64_t>& acc) {
+        acc.min_val = keys(i) < acc.min_val ? keys(i) : acc.min_val;
+        acc.max_val = keys(i) > acc.max_val ? keys(i) : acc.max_val;
+      }, Kokkos::MinMax<std::uint64_t>(range));
+  const std::uint64_t first = range.min_val, last = range.max_val;
   std::uint32_t lo_max = 0;
-  Kokkos::parallel_reduce("dem::contacts::key_first", RangePolicy(0, n),
-      KOKKOS_LAMBDA(const int i, std::uint64_t& acc) { acc = keys(i) < acc ? keys(i) : acc; },
-      Kokkos::Min<std::uint64_t>(first));
-  Kokkos::parallel_reduce("dem::contacts::key_last", RangePolicy(0, n),
-      KOKKOS_LAMBDA(const int i, std::uint64_t& acc) { acc = keys(i) > acc ? keys(i) : acc; },
-      Kokkos::Max<std::uint64_t>(last));
   Kokkos::parallel_reduce("dem::contacts::key_lo_max", RangePolicy(0, n),
       KOKKOS_LAMBDA(const int i, std::uint32_t& acc) { acc = key_lo(keys(i)) > acc ? key_lo(keys(i)) : acc; },
       Kokkos::Max<std::uint32_t>(lo_max));
