@@ -122,7 +122,7 @@ struct Session {
                                 : load_reference(o.reference, [](const std::string& n) { free_param(n); })),
         free(free_params(base, o.free)), predict_template(prediction_template(base, o.predict)),
         two_fidelity(two_fidelity_wanted(base, o.reference_test, predict_template.has_value())),
-        lab(matched(base, o.jobs), true, o.jobs),
+        lab(matched(reference_cell(base, o.reference_test), o.jobs), true, o.jobs),
         folder(o.resume.empty() ? new_dated_folder(o.output, kind) : resumed_folder(o.resume, kind)),
         output(o.resume.empty() ? o.output : resumed_parent(o.resume)) {
     lab.set_run_store(folder + "/runs");
@@ -133,6 +133,12 @@ struct Session {
     for (const std::string& n : data.notes) std::printf("%s: note: %s\n", kind.c_str(), n.c_str());
   }
   NoiseOptions noise;
+  /// The reference test's cell, for the report.
+  std::string cell_text() const {
+    return lab.config().periodic.boundary == CellBoundary::walls
+               ? "the cell between six walls (stresses measured at the walls, as a walled test measures them)"
+               : "the periodic cell (stresses from its contacts: the specimen's interior, without a boundary)";
+  }
   /// "N runs", and how many of them a resumed session read from its store.
   std::string runs_text() const {
     const long read = lab.stored_runs_read();
@@ -275,8 +281,8 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
     // Named, not structured, bindings: a lambda below captures them (C++17 cannot capture a structured binding).
     const std::string& material = by.first;
     const std::vector<MeasuredTest>& tests = by.second;
-    std::printf("calibrate: %s, %zu tests, free %zu parameters, %zu balls in the periodic cell\n", material.c_str(),
-                tests.size(), ss.free.size(), ss.lab.balls());
+    std::printf("calibrate: %s, %zu tests, free %zu parameters, %zu balls in %s\n", material.c_str(), tests.size(),
+                ss.free.size(), ss.lab.balls(), ss.cell_text().c_str());
     const long runs0 = ss.lab.runs();
     const Misfit misfit = ss.misfit_of(base, material, tests);  // sets the ensemble ("auto": from the scatter)
     auto fit = [&](const Misfit& m, const std::string& what) {
@@ -349,8 +355,8 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
                 "membrane prediction at the end shows what the boundary adds)\n");
   std::ostringstream md, csv;
   md << "# Diagnosis of " << o.data << "\n\n"
-     << "Simulator: periodic-cell triaxial, an ensemble of " << ss.lab.members() << " specimens of " << ss.lab.balls()
-     << " balls (packing seeds from " << base.run.seed << "), each prepared once; every parameter point runs them all "
+     << "Simulator: the cell triaxial test in " << ss.cell_text() << ", an ensemble of " << ss.lab.members()
+     << " specimens of " << ss.lab.balls() << " balls (packing seeds from " << base.run.seed << "), each prepared once; every parameter point runs them all "
         "and compares their mean. Free base parameters:";
   for (const FreeParam& f : ss.free) md << " " << f.name;
   md << ". Misfit: chi2 over " << (ss.data.curves ? "q and eps_v at fixed axial strains (0.02% to 15%)"
@@ -367,6 +373,8 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
   std::vector<MeasuredTest> all_meas, all_sim, all_ext;
   std::map<std::string, Calibrated> models;
   for (const auto& [material, tests] : by_material(ss.data, o.material)) {
+    std::printf("diagnose: %s, %zu tests, %zu balls in %s\n", material.c_str(), tests.size(), ss.lab.balls(),
+                ss.cell_text().c_str());
     const Misfit misfit = ss.misfit_of(base, material, tests);
     const Diagnosis dg = diagnose(ss.lab, model_of(base), ss.free, tests, misfit, true);
     std::printf("diagnose: %s: verdict: %s\n  %s\n", material.c_str(), dg.verdict.c_str(), dg.explanation.c_str());

@@ -28,6 +28,9 @@ void measure_cell_bias(PeriodicLab& lab, const Model& base, const std::vector<Me
   plan.first_seed = lab.config().run.seed + kCellCheckSeedOffset;
   plan.steps = kCellCheckPrepSteps;
   plan.jobs = lab.jobs();
+  // The lab's cell was matched to the same data: the larger one's friction lies near its own.
+  plan.around = std::sqrt(lab.config().periodic.prep_mu_s);
+  plan.store = lab.run_store();
   const Config cfg = matched_state(larger_cell(lab.config(), kCellCheckFactor), measured, state, false, plan);
   PeriodicLab check(cfg, false, kCellCheckSpecimens, plan.first_seed, kCellCheckSpecimens, lab.jobs());
   check.set_run_store(lab.run_store());  // its own specimens: their runs have their own names there

@@ -22,7 +22,8 @@ constexpr int kCellCheckFactor = 4;
 constexpr int kCellCheckSpecimens = 4;
 /// Halvings of the check cells' preparation friction (prep_friction_for): sqrt(prep_mu_s) to 1/32 of its range, a
 /// void ratio within about 0.003 of the target (the range of 0 to 1 spans about 0.15; the nearer end is taken),
-/// below the 0.01 by which specimens of one friction differ; each halving packs a check cell, about 2 runs' time.
+/// below the 0.01 by which specimens of one friction differ; each packing of a check cell costs about 2 runs' time.
+/// The halvings start from a bracket around the lab's own matched friction (MatchPlan::around): four packings.
 constexpr int kCellCheckPrepSteps = 5;
 /// Packing seeds of the check cells start this far above the config's seed: neither an ensemble member (at most 64)
 /// nor a data specimen (kForeignSeedOffset).

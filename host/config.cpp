@@ -219,6 +219,9 @@ Config parse_config(const std::string& text, const std::string& path) {
   pr.number("prep_mu_s", c.periodic.prep_mu_s, 0, 10);
   pr.number("prep_mu_r", c.periodic.prep_mu_r, 0, 10);
   pr.number("prep_unbalanced_tolerance", c.periodic.prep_unbalanced_tolerance, 0, 1, 1, true);
+  std::string boundary = "periodic";
+  pr.string("boundary", boundary, {"periodic", "walls"});
+  c.periodic.boundary = boundary == "walls" ? CellBoundary::walls : CellBoundary::periodic;
   pr.finish();
 
   check_records(path, "triaxial", "record_every_pct", c.triaxial.record_every, "axial_strain_end_pct",
@@ -234,7 +237,7 @@ Config parse_config(const std::string& text, const std::string& path) {
     cal.integer("cell_factor", c.calibrate.cell_factor, 1, 16);
   cal.string("predict", c.calibrate.predict);
   cal.integer("predict_specimens", c.calibrate.predict_specimens, 1, 16);
-  cal.string("reference_test", c.calibrate.reference_test, {"periodic", "two_fidelity"});
+  cal.string("reference_test", c.calibrate.reference_test, {"periodic", "walls", "two_fidelity"});
   cal.finish();
 
   for (int d = 0; d < 3; ++d)

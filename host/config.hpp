@@ -156,8 +156,12 @@ struct CalibrateConfig {
 };
 
 /// The [periodic] table: the periodic-cell triaxial test (host/periodic_triaxial.hpp).
+/// The cell test's boundary (host/cell_boundary.hpp): the periodic cell, or six rigid frictionless walls.
+enum class CellBoundary { periodic, walls };
+
 struct PeriodicConfig {
   PeriodicTriaxialParams triax;
+  CellBoundary boundary = CellBoundary::periodic;
   /// Friction during a preparatory consolidation (YADE's compaction friction): below the test's mu_s
   /// gives a denser specimen. < 0: the material's value (no preparatory stage).
   Real prep_mu_s = -1, prep_mu_r = -1;

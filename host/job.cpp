@@ -293,10 +293,13 @@ int check_job(const Config& cfg) {
                 estimate(static_cast<double>(job_balls), static_cast<double>(shear.steps)).c_str(), speed.c_str());
   } else if (cfg.has_periodic) {
     const PeriodicTriaxialParams& p = cfg.periodic.triax;
-    std::printf("a periodic-cell triaxial test (triaxdem periodic):\n"
+    std::printf("%s (triaxdem periodic):\n"
                 "  cell: %d balls of %.3g mm in %.4g x %.4g x %.4g mm, %s\n"
                 "  consolidation at %.4g kPa, then shear to %.3g%% at inertial number %.1e, a record every %.3g%%\n"
                 "  time step: %s\n  speed: %s\n",
+                cfg.periodic.boundary == CellBoundary::walls
+                    ? "a cell triaxial test between six servo-controlled walls, measured at the walls"
+                    : "a periodic-cell triaxial test",
                 box->particles().n, cfg.particles.diameter * 1e3, cfg.box.size[0] * 1e3, cfg.box.size[1] * 1e3,
                 cfg.box.size[2] * 1e3, cfg.box.fill.c_str(), p.sigma3 / 1e3, 100 * p.target_strain,
                 p.target_inertial, 100 * p.record_strain, dt_text.c_str(), speed.c_str());

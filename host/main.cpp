@@ -177,9 +177,10 @@ int main(int argc, char** argv) {
                   "configs/paper/ for full scale), or none");
     c->add_option("--resume", cal.resume, "continue in the result folder of an earlier run of this command on the "
                   "same data and config: the runs it stored are read, not run again")->check(CLI::ExistingDirectory);
-    c->add_option("--reference-test", cal.reference_test, "what the calibration fits: periodic (the cell) or "
-                  "two_fidelity (the cell corrected by the --predict membrane test); default: [calibrate] "
-                  "reference_test")->check(CLI::IsMember({"periodic", "two_fidelity"}));
+    c->add_option("--reference-test", cal.reference_test, "what the calibration fits: periodic (the cell), walls "
+                  "(the cell between six servo-controlled walls, measured at the walls) or two_fidelity (the cell "
+                  "corrected by the --predict membrane test); default: [calibrate] reference_test")
+        ->check(CLI::IsMember({"periodic", "walls", "two_fidelity"}));
   };
   auto* calibrate = app.add_subcommand("calibrate", "fit the free parameters to measured triaxial data");
   add_calibration(calibrate);

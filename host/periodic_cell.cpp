@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "cell_boundary.hpp"
 #include "checkpoint.hpp"
 #include "job.hpp"
 #include "packing.hpp"
@@ -13,18 +14,23 @@
 
 namespace dem {
 
+namespace {
+const char* cell_name(CellBoundary b) { return b == CellBoundary::walls ? "a cuboid between six walls" : "a periodic cell"; }
+}  // namespace
+
 std::unique_ptr<Simulation> make_periodic_simulation(const std::vector<BallSpec>& balls,
                                                      const std::array<Real, 3>& cell, const ContactParams& law,
-                                                     const SolverConfig& solver) {
+                                                     const SolverConfig& solver, CellBoundary boundary) {
   if (balls.empty()) throw std::invalid_argument("periodic triaxial: no balls");
   Real dmean = 0;
   for (const BallSpec& b : balls) dmean += 2 * b.radius;
   dmean /= static_cast<Real>(balls.size());
+  const bool walls = boundary == CellBoundary::walls;
   SimParams prm;
   for (int k = 0; k < 3; ++k) {
     prm.domain.lo[k] = 0;
     prm.domain.hi[k] = cell[k];
-    prm.domain.periodic[k] = true;
+    prm.domain.periodic[k] = !walls;
   }
   prm.integ.gravity = Vec3();
   prm.integ.alpha = solver.damping;
@@ -33,8 +39,16 @@ std::unique_ptr<Simulation> make_periodic_simulation(const std::vector<BallSpec>
   prm.overlap_limit = solver.overlap_limit;
   std::vector<BallSpec> b = balls;
   for (BallSpec& s : b) s.material = 0;
-  auto sim = std::make_unique<Simulation>(make_particles(b), WallSet(), FacetMesh(), std::vector<ContactParams>{law},
-                                          1, prm);
+  std::unique_ptr<Simulation> sim;
+  if (walls) {
+    ContactParams smooth = law;  // walls without friction, as a walled test's lubricated or polished walls
+    smooth.mu_s = smooth.mu_r = 0;
+    sim = std::make_unique<Simulation>(make_particles(b), make_walls(cell_walls(cell)), FacetMesh(),
+                                       std::vector<ContactParams>{law, smooth, smooth, smooth}, 2, prm);
+  } else {
+    sim = std::make_unique<Simulation>(make_particles(b), WallSet(), FacetMesh(), std::vector<ContactParams>{law}, 1,
+                                       prm);
+  }
   sim->set_dt(time_step(solver, sim->critical_dt(), "the periodic cell's config"));
   return sim;
 }
@@ -48,6 +62,9 @@ std::vector<BallSpec> extract_balls(Simulation& sim, std::array<Real, 3>& cell) 
   auto spec = Kokkos::create_mirror_view_and_copy(HostSpace(), p.specimen);
   auto mat = Kokkos::create_mirror_view_and_copy(HostSpace(), p.material);
   const Domain& dom = sim.domain();
+  const bool walls = walled(sim);
+  Vec3 corner(dom.lo[0], dom.lo[1], dom.lo[2]);
+  if (walls) corner = Vec3(sim.wall_point(0).x, sim.wall_point(2).y, sim.wall_point(4).z);
   std::vector<BallSpec> out(p.n);
   for (int i = 0; i < p.n; ++i) {
     BallSpec& b = out[gid(i)];
@@ -57,20 +74,22 @@ std::vector<BallSpec> extract_balls(Simulation& sim, std::array<Real, 3>& cell) 
     b.material = mat(i);
   }
   for (int k = 0; k < p.n; ++k) {
-    const Vec3 x = dom.wrap(h.x[k]);
-    out[k].x = Vec3(x.x - dom.lo[0], x.y - dom.lo[1], x.z - dom.lo[2]);
+    out[k].x = (walls ? h.x[k] : dom.wrap(h.x[k])) - corner;
     out[k].v = h.v[k];
     out[k].w = h.w[k];
   }
-  for (int d = 0; d < 3; ++d) cell[d] = dom.length(d);
+  cell = cell_lengths(sim);
   return out;
 }
 
 void check_periodic_config(const Config& cfg) {
-  if (!(cfg.box.periodic[0] && cfg.box.periodic[1] && cfg.box.periodic[2]))
-    throw ConfigError(cfg.path + ": [box] periodic: the periodic triaxial needs [true, true, true]");
+  const bool walls = cfg.periodic.boundary == CellBoundary::walls;
+  if (!walls && !(cfg.box.periodic[0] && cfg.box.periodic[1] && cfg.box.periodic[2]))
+    throw ConfigError(cfg.path + ": [box] periodic: the periodic triaxial needs [true, true, true] (or [periodic] "
+                      "boundary = \"walls\")");
   if (cfg.solver.gravity[0] != 0 || cfg.solver.gravity[1] != 0 || cfg.solver.gravity[2] != 0)
-    throw ConfigError(cfg.path + ": [solver] gravity: must be [0, 0, 0] in a fully periodic cell");
+    throw ConfigError(cfg.path + ": [solver] gravity: must be [0, 0, 0] in the cell test");
+  if (walls) return;  // no minimum image between walls
   // Consolidation shrinks the cell and shear shortens its axis: at random close packing (solid fraction 0.64,
   // the densest a packing of spheres reaches unloaded) and the end strain, each side must still hold 3
   // contact cut-offs, or the minimum image becomes ambiguous and the run stops part way. 5% more for the
@@ -96,17 +115,19 @@ void prepare_periodic_specimen(const Config& cfg, std::vector<BallSpec>& balls, 
                                bool verbose) {
   check_periodic_config(cfg);
   const PeriodicConfig& pc = cfg.periodic;
-  balls = make_packing(cfg);
+  Config inside = cfg;  // between walls every ball starts inside the box
+  if (pc.boundary == CellBoundary::walls) inside.box.periodic = {false, false, false};
+  balls = make_packing(inside);
   cell = cfg.box.size;
   ContactParams prep = cfg.ball.base();
   if (pc.prep_mu_s >= 0) prep.mu_s = pc.prep_mu_s;
   if (pc.prep_mu_r >= 0) prep.mu_r = pc.prep_mu_r;
   if (prep.mu_s == cfg.ball.mu_s && prep.mu_r == cfg.ball.mu_r) return;
-  auto sim = make_periodic_simulation(balls, cell, prep, cfg.solver);
+  auto sim = make_periodic_simulation(balls, cell, prep, cfg.solver, pc.boundary);
   if (verbose)
-    std::printf("triaxdem: preparation: %zu balls in a periodic cell %.2f x %.2f x %.2f mm, consolidated with "
-                "mu_s = %g, mu_r = %g; dt %.3e s\n", balls.size(), 1e3 * cell[0], 1e3 * cell[1], 1e3 * cell[2],
-                prep.mu_s, prep.mu_r, sim->params().integ.dt);
+    std::printf("triaxdem: preparation: %zu balls in %s %.2f x %.2f x %.2f mm, consolidated with "
+                "mu_s = %g, mu_r = %g; dt %.3e s\n", balls.size(), cell_name(pc.boundary), 1e3 * cell[0],
+                1e3 * cell[1], 1e3 * cell[2], prep.mu_s, prep.mu_r, sim->params().integ.dt);
   PeriodicTriaxialParams pp = resolve_periodic_params(*sim, pc.triax);
   pp.name = cfg.run.name + " preparation";
   pp.verbose = verbose;
@@ -124,26 +145,27 @@ int run_periodic_job(const Config& cfg) {
   io::Output out(cfg.run.output);
   std::unique_ptr<Simulation> sim;
   auto announce = [&](const char* what) {
-    std::printf("triaxdem: %s: %zu balls in a periodic cell %.2f x %.2f x %.2f mm; critical dt %.3e s, dt %.3e s\n",
-                what, balls.size(), 1e3 * sim->domain().length(0), 1e3 * sim->domain().length(1),
-                1e3 * sim->domain().length(2), sim->critical_dt(), sim->params().integ.dt);
+    const std::array<Real, 3> l = cell_lengths(*sim);
+    std::printf("triaxdem: %s: %zu balls in %s %.2f x %.2f x %.2f mm; critical dt %.3e s, dt %.3e s\n", what,
+                balls.size(), cell_name(cfg.periodic.boundary), 1e3 * l[0], 1e3 * l[1], 1e3 * l[2],
+                sim->critical_dt(), sim->params().integ.dt);
     if (cfg.solver.mass_scale != 1)
       std::printf("triaxdem: DENSITY SCALING x%g is on: inertia is not physical (quasi-static runs only)\n",
                   cfg.solver.mass_scale);
   };
   try {
-    sim = make_periodic_simulation(balls, cell, cfg.ball, cfg.solver);
+    sim = make_periodic_simulation(balls, cell, cfg.ball, cfg.solver, cfg.periodic.boundary);
     announce("test");
     const PeriodicTriaxialResult r = run_periodic_triaxial(*sim, tp, &out);
     TestSummary su;
-    su.kind = "periodic";
+    su.kind = cfg.periodic.boundary == CellBoundary::walls ? "walls" : "periodic";
     su.sigma3 = r.params.sigma3;
     su.mu_s = cfg.ball.mu_s;
     su.mu_r = cfg.ball.mu_r;
     su.balls = static_cast<long>(balls.size());
     su.void_ratio0 = r.void_ratio0;
     su.q_peak = r.q_peak;
-    // The cell has no boundary: its one q is every measure's.
+    // The cell has one q: the periodic cell's from its contacts, the walled cell's from its walls.
     su.q_peak_area = su.q_peak_parabolic = su.q_peak_membrane = su.q_peak_lw = r.q_peak;
     su.phi_peak_deg = r.phi_peak_deg;
     su.eps_a_peak = r.eps_a_peak;

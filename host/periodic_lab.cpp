@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <optional>
 #include <stdexcept>
@@ -141,11 +142,40 @@ MatchPlan match_plan(const Config& base, int jobs) {
 }
 
 namespace {
-/// The plan's mean void ratio after preparation with friction u^2.
+/// The plan's store file of the packing of `c` (friction, cell and seeds named in its hash), "" without a store.
+std::string stored_packing_path(const Config& c, const MatchPlan& plan) {
+  if (plan.store.empty()) return "";
+  const std::string version = program_version();
+  std::uint64_t h = fnv1a(version.data(), version.size());
+  h = fnv1a(c.fingerprint.data(), c.fingerprint.size(), h);
+  const Real v[] = {c.periodic.prep_mu_s, c.box.size[0], c.box.size[1], c.box.size[2]};
+  h = fnv1a(v, sizeof v, h);
+  const long n[] = {c.particles.count, plan.cell_factor, plan.specimens, static_cast<long>(plan.first_seed)};
+  h = fnv1a(n, sizeof n, h);
+  return plan.store + "/packing_" + hex16(h) + ".e";
+}
+
+/// The plan's mean void ratio after preparation with friction u^2, read from the plan's store where it was kept.
 Real void_ratio_at(const Config& base, Real u, const MatchPlan& plan) {
   Config c = base;
   c.periodic.prep_mu_s = u * u;
-  return prepared_void_ratio(c, plan);
+  const std::string path = stored_packing_path(c, plan);
+  Real e = 0;
+  if (!path.empty()) {
+    std::ifstream in(path, std::ios::binary);
+    if (in.read(reinterpret_cast<char*>(&e), sizeof e)) return e;
+  }
+  e = prepared_void_ratio(c, plan);
+  if (!path.empty()) {  // written beside and renamed in, as a run is
+    std::filesystem::create_directories(plan.store);
+    {
+      std::ofstream out(path + ".tmp", std::ios::binary);
+      out.write(reinterpret_cast<const char*>(&e), sizeof e);
+      if (!out) throw std::runtime_error(path + ".tmp: cannot be written (the calibration's run store)");
+    }
+    std::filesystem::rename(path + ".tmp", path);
+  }
+  return e;
 }
 }  // namespace
 
@@ -168,7 +198,22 @@ Real prep_friction_for(const Config& base, Real target, Real& reached, bool verb
     packed(1);
     return e;
   };
-  Real lo = 0, hi = 1;
+  const Real resolution = std::ldexp(Real(1), -plan.steps);
+  auto bisect = [&](Real lo, Real hi, Real e_lo, Real e_hi) {
+    while (hi - lo > resolution) {
+      const Real mid = 0.5 * (lo + hi), e = at(mid);
+      (e < target ? lo : hi) = mid;
+      (e < target ? e_lo : e_hi) = e;
+    }
+    const bool low = target - e_lo < e_hi - target;
+    reached = low ? e_lo : e_hi;
+    return low ? lo * lo : hi * hi;
+  };
+  if (plan.around >= 0) {
+    const Real lo = std::max(Real(0), plan.around - kMatchBracket), hi = std::min(Real(1), plan.around + kMatchBracket);
+    const Real e_lo = at(lo), e_hi = at(hi);
+    if (e_lo <= target && target <= e_hi) return bisect(lo, hi, e_lo, e_hi);
+  }
   auto [e_lo, e_hi] = preparation_reach(base, plan);
   packed(2);
   if (verbose)
@@ -185,14 +230,7 @@ Real prep_friction_for(const Config& base, Real target, Real& reached, bool verb
   }
   if (target <= e_lo) return reached = e_lo, 0;
   if (target >= e_hi) return reached = e_hi, 1;
-  for (int k = 0; k < plan.steps; ++k) {
-    const Real mid = 0.5 * (lo + hi), e = at(mid);
-    (e < target ? lo : hi) = mid;
-    (e < target ? e_lo : e_hi) = e;
-  }
-  const bool low = target - e_lo < e_hi - target;
-  reached = low ? e_lo : e_hi;
-  return low ? lo * lo : hi * hi;
+  return bisect(0, 1, e_lo, e_hi);
 }
 
 Config matched_state(const Config& base, const std::vector<MeasuredTest>& tests, StateMatch& m, bool verbose,
@@ -238,7 +276,7 @@ MeasuredTest PeriodicLab::run(const Model& m, Real sigma3, const std::string& ma
   p.verbose = false;
   p.snapshot_strains.clear();
   try {
-    auto sim = make_periodic_simulation(sp.balls, sp.cell, m.law, cfg_.solver);
+    auto sim = make_periodic_simulation(sp.balls, sp.cell, m.law, cfg_.solver, cfg_.periodic.boundary);
     const PeriodicTriaxialResult r = run_periodic_triaxial(*sim, p);
     t = summarised(r.series, sigma3);
     t.void_ratio = r.void_ratio0;

@@ -134,7 +134,16 @@ struct MatchPlan {
   int steps = 8;
   int jobs = 1;
   int cell_factor = 1;  ///< the specimens are packed in cells of this many times the base config's balls
+  /// Where the answer is expected (sqrt(prep_mu_s), from a smaller cell's match; negative: nowhere): the halvings
+  /// start from the bracket of +-kMatchBracket around it, and from [0, 1] only where the target lies outside.
+  Real around = -1;
+  /// A run store (PeriodicLab::set_run_store) that keeps each packing's mean void ratio; "" keeps nothing.
+  std::string store;
 };
+/// Half the width of a MatchPlan's bracket in sqrt(prep_mu_s): a cell of four times the balls packs within about
+/// 0.005 in void ratio of the smaller one at one friction, 0.02-0.05 in sqrt(prep_mu_s) on the shipped configs.
+/// Its two ends and two halvings reach the 1/32 of five halvings of [0, 1] with four packings instead of seven.
+constexpr Real kMatchBracket = 1.0 / 16;
 /// The plan for a lab's specimens: its first seeds ([run] seed on), in the cell it runs ([calibrate] cell_factor,
 /// the config's own where "auto"), 8 halvings, `jobs` at once.
 MatchPlan match_plan(const Config& base, int jobs);
@@ -153,7 +162,8 @@ std::pair<Real, Real> preparation_reach(const Config& base, const MatchPlan& pla
 /// mean void ratio of `target` after their preparation: bisection on sqrt(prep_mu_s) over [0, 1] (more friction,
 /// a looser packing; the root spreads the steps where the void ratio changes fastest). `reached` receives their
 /// mean void ratio at the answer; a target beyond what [0, 1] reaches gets the nearest end, and one more than
-/// kMaxStateGap beyond it throws DataError. 8 halvings take sqrt(prep_mu_s) to 1/256 of its range.
+/// kMaxStateGap beyond it throws DataError. 8 halvings take sqrt(prep_mu_s) to 1/256 of its range; a plan's
+/// bracket (MatchPlan::around) needs fewer to reach the same resolution.
 Real prep_friction_for(const Config& base, Real target, Real& reached, bool verbose, const MatchPlan& plan);
 
 /// The measured specimens' state and the preparation that packs it (matched_state).

@@ -11,6 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "cell_boundary.hpp"
 #include "measured.hpp"
 #include "kernels/reduce.hpp"
 #include "job.hpp"
@@ -50,8 +51,8 @@ class CellServo {
 
   /// servo[d]: axis d is servoed to target[d] (Pa); otherwise its rate is fixed[d] (1/s, extension positive).
   void update(Simulation& sim, const bool servo[3], const Real fixed[3], const Real target[3]) {
-    if (calls_++ % prm_.stiffness_every == 0) k_ = cell_stiffness(sim);
-    stress_ = sim.contact_stress_diagonal(sim.domain().volume());
+    if (calls_++ % prm_.stiffness_every == 0) k_ = boundary_stiffness(sim);
+    stress_ = cell_stress(sim);
     const Real dt = sim.params().integ.dt;
     Real rate[3];
     for (int d = 0; d < 3; ++d) {
@@ -62,7 +63,7 @@ class CellServo {
                                : (err > 0 ? max_rate_ : (err < 0 ? -max_rate_ : Real(0)));
       rate[d] = std::clamp(r, -max_rate_, max_rate_);
     }
-    sim.set_strain_rate(Vec3(rate[0], rate[1], rate[2]));
+    set_cell_rates(sim, Vec3(rate[0], rate[1], rate[2]));
   }
 
  private:
@@ -74,28 +75,29 @@ class CellServo {
 };
 
 /// Lateral confinement per axis: sigma3 plus the membrane's, from the cell's lateral strains since L0.
-std::array<Real, 3> lateral_targets(const Domain& dom, const PeriodicTriaxialParams& prm, const std::array<Real, 3>& L0) {
+std::array<Real, 3> lateral_targets(const std::array<Real, 3>& lengths, const PeriodicTriaxialParams& prm,
+                                    const std::array<Real, 3>& L0) {
   std::array<Real, 3> t{};
   for (int d = 0; d < 3; ++d)
-    t[d] = prm.sigma3 + membrane_confinement(prm.membrane_stiffness, dom.length(d) / L0[d] - 1);
+    t[d] = prm.sigma3 + membrane_confinement(prm.membrane_stiffness, lengths[d] / L0[d] - 1);
   return t;
 }
 
 PeriodicTriaxialRecord measure_row(Simulation& sim, const PeriodicTriaxialParams& prm, const GrainScales& g,
                                    Real h0, Real V0, const std::array<Real, 3>& L0) {
   PeriodicTriaxialRecord r;
-  const Domain& dom = sim.domain();
-  const Real V = dom.volume();
-  const auto s = sim.contact_stress(V);
+  const std::array<Real, 3> lengths = cell_lengths(sim);
+  const Real V = cell_volume(sim);
+  const std::array<Real, 3> s = cell_stress(sim);
   r.step = sim.step_count();
   r.time = sim.time();
-  r.eps_a = (h0 - dom.length(2)) / h0;
+  r.eps_a = (h0 - lengths[2]) / h0;
   r.eps_v = -(V - V0) / V0;
-  r.sigma1 = s[8];
+  r.sigma1 = s[2];
   r.sigma2 = s[0];
-  r.sigma3 = s[4];
+  r.sigma3 = s[1];
   const Real lateral = 0.5 * (r.sigma2 + r.sigma3);
-  const std::array<Real, 3> target = lateral_targets(dom, prm, L0);
+  const std::array<Real, 3> target = lateral_targets(lengths, prm, L0);
   r.membrane = 0.5 * (target[0] + target[1]) - prm.sigma3;
   r.q = r.sigma1 - (lateral - r.membrane);
   r.p = (r.sigma1 + r.sigma2 + r.sigma3) / 3;
@@ -107,8 +109,9 @@ PeriodicTriaxialRecord measure_row(Simulation& sim, const PeriodicTriaxialParams
   r.unbalanced = sim.unbalanced_ratio();
   r.kinetic = sim.stats().kinetic;
   r.inertial = r.p > 0 ? prm.axial_rate * g.d * std::sqrt(g.rho_eff / r.p) : std::numeric_limits<Real>::infinity();
-  r.rate_x = dom.strain_rate[0];
-  r.rate_y = dom.strain_rate[1];
+  const Vec3 rates = cell_rates(sim);
+  r.rate_x = rates.x;
+  r.rate_y = rates.y;
   return r;
 }
 
@@ -156,8 +159,10 @@ std::array<Real, 3> cell_stiffness(Simulation& sim) {
 PeriodicTriaxialParams resolve_periodic_params(Simulation& sim, PeriodicTriaxialParams prm) {
   auto bad = [](const std::string& what) { throw std::invalid_argument("periodic triaxial: " + what); };
   const Domain& dom = sim.domain();
-  if (!(dom.periodic[0] && dom.periodic[1] && dom.periodic[2])) bad("the cell must be periodic along x, y and z");
-  if (sim.num_walls() > 0 || sim.membrane().ntri > 0) bad("the simulation must have no walls, facets or membrane");
+  const bool periodic = dom.periodic[0] && dom.periodic[1] && dom.periodic[2];
+  if (!periodic && !walled(sim)) bad("the cell must be periodic along x, y and z, or lie between six walls");
+  if ((periodic && sim.num_walls() > 0) || sim.membrane().ntri > 0)
+    bad("a periodic cell must have no walls, facets or membrane");
   if (norm2(sim.params().integ.gravity) != 0) bad("gravity must be zero in a fully periodic cell");
   if (sim.params().integ.dt <= 0) bad("the time step is not set");
   if (!(prm.sigma3 > 0)) bad("sigma3 must be > 0");
@@ -195,7 +200,7 @@ long consolidate_isotropic(Simulation& sim, const PeriodicTriaxialParams& prm_in
   const Real none[3] = {0, 0, 0};
   Progress progress(prm.name + " consolidation (ETA to the step cap)", prm.max_consolidation_steps);
   Real err = 0, ratio = 1;
-  std::array<Real, 9> s{};
+  std::array<Real, 3> s{};
   const auto t0 = std::chrono::steady_clock::now();
   const bool tty = isatty(fileno(stdout)) != 0;
   double next_log = 10;
@@ -205,14 +210,14 @@ long consolidate_isotropic(Simulation& sim, const PeriodicTriaxialParams& prm_in
     const bool check = n % prm.check_every == 0;
     sim.step(check);
     if (!check) continue;
-    s = sim.contact_stress(sim.domain().volume());
+    s = cell_stress(sim);
     err = 0;
-    for (int d = 0; d < 3; ++d) err = std::max(err, std::fabs(s[4 * d] - prm.sigma3) / prm.sigma3);
+    for (int d = 0; d < 3; ++d) err = std::max(err, std::fabs(s[d] - prm.sigma3) / prm.sigma3);
     ratio = sim.unbalanced_ratio();
     if (prm.verbose) {
       char extra[128];
       std::snprintf(extra, sizeof extra, "p %.1f kPa, stress error %.2e, unbalanced %.2e",
-                    1e-3 * (s[0] + s[4] + s[8]) / 3, err, ratio);
+                    1e-3 * (s[0] + s[1] + s[2]) / 3, err, ratio);
       progress.update(n, extra);
       // The end of consolidation is not known in advance: logs get a line every 10 s besides the deciles.
       const double now = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -223,16 +228,16 @@ long consolidate_isotropic(Simulation& sim, const PeriodicTriaxialParams& prm_in
       }
     }
     if (err < prm.stress_tolerance && ratio < prm.unbalanced_tolerance) {
-      sim.set_strain_rate(Vec3());
+      set_cell_rates(sim, Vec3());
       if (prm.verbose) progress.finish("(converged after " + std::to_string(n) + " steps)");
       return n;
     }
   }
-  sim.set_strain_rate(Vec3());
+  set_cell_rates(sim, Vec3());
   std::ostringstream msg;
   msg << "periodic triaxial: isotropic consolidation to sigma3 = " << 1e-3 * prm.sigma3 << " kPa did not converge in "
-      << prm.max_consolidation_steps << " steps: stresses (xx, yy, zz) = (" << 1e-3 * s[0] << ", " << 1e-3 * s[4]
-      << ", " << 1e-3 * s[8] << ") kPa, largest error " << err << " (tolerance " << prm.stress_tolerance
+      << prm.max_consolidation_steps << " steps: stresses (xx, yy, zz) = (" << 1e-3 * s[0] << ", " << 1e-3 * s[1]
+      << ", " << 1e-3 * s[2] << ") kPa, largest error " << err << " (tolerance " << prm.stress_tolerance
       << "), unbalanced-force ratio " << ratio << " (tolerance " << prm.unbalanced_tolerance
       << "). Raise max_consolidation_steps, or loosen unbalanced_tolerance if the ratio is still falling";
   throw std::runtime_error(msg.str());
@@ -257,9 +262,9 @@ PeriodicTriaxialResult run_periodic_triaxial(Simulation& sim, const PeriodicTria
 
   res.consolidation_steps = consolidate_isotropic(sim, prm);
 
-  res.h0 = sim.domain().length(2);
-  const std::array<Real, 3> L0{sim.domain().length(0), sim.domain().length(1), res.h0};
-  res.V0 = sim.domain().volume();
+  const std::array<Real, 3> L0 = cell_lengths(sim);
+  res.h0 = L0[2];
+  res.V0 = cell_volume(sim);
   res.void_ratio0 = res.V0 / g.v_solid - 1;
   if (out) out->set_series_columns(kSeriesColumns);
   auto record = [&]() {
@@ -289,9 +294,9 @@ PeriodicTriaxialResult run_periodic_triaxial(Simulation& sim, const PeriodicTria
   Progress progress(prm.name + " shear", total);
   Real next_record = prm.record_strain;
   for (long n = 1;; ++n) {
-    const std::array<Real, 3> target = lateral_targets(sim.domain(), prm, L0);
+    const std::array<Real, 3> target = lateral_targets(cell_lengths(sim), prm, L0);
     servo.update(sim, lateral, axial, target.data());
-    const Real h = sim.domain().length(2);
+    const Real h = cell_lengths(sim)[2];
     const Real eps_next = (res.h0 - h * (1 - prm.axial_rate * dt)) / res.h0;
     const bool last = eps_next >= prm.target_strain;
     const bool due = last || eps_next >= next_record - 1e-12;
@@ -308,10 +313,10 @@ PeriodicTriaxialResult run_periodic_triaxial(Simulation& sim, const PeriodicTria
       }
       if (out && res.series.size() % 50 == 0) out->flush_series();
     }
-    snapshot_due((res.h0 - sim.domain().length(2)) / res.h0);
+    snapshot_due((res.h0 - cell_lengths(sim)[2]) / res.h0);
     if (last) break;
   }
-  sim.set_strain_rate(Vec3());
+  set_cell_rates(sim, Vec3());
   if (out) out->flush_series();
 
   take_curve_values(res, summarised(res.series, prm.sigma3));

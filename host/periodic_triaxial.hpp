@@ -96,18 +96,22 @@ Real membrane_confinement(Real stiffness, Real eps);
 /// K_ii = (1/V) sum_c (Fn/overlap) l_i^2 over touching ball-ball contacts (Pa): the servo's stiffness.
 std::array<Real, 3> cell_stiffness(Simulation& sim);
 
-/// A fully periodic simulation of `balls` in [0, cell) with one contact law for every pair, no walls and
-/// no gravity; the solver settings (damping, dt, mass scale, skin in mean diameters) from `solver`.
+/// A simulation of `balls` in [0, cell) with one contact law for every pair of balls and no gravity: fully
+/// periodic, or between the six walls of cell_walls (host/cell_boundary.hpp), frictionless and otherwise of the
+/// balls' law; the solver settings (damping, dt, mass scale, skin in mean diameters) from `solver`.
 std::unique_ptr<Simulation> make_periodic_simulation(const std::vector<BallSpec>& balls,
                                                      const std::array<Real, 3>& cell, const ContactParams& law,
-                                                     const SolverConfig& solver);
+                                                     const SolverConfig& solver,
+                                                     CellBoundary boundary = CellBoundary::periodic);
 
-/// The balls' current state in gid order (positions wrapped into the cell, velocities kept), to rebuild a
-/// specimen with another contact law or numbering. `cell` receives the cell lengths.
+/// The balls' current state in gid order (positions wrapped into the cell, or taken from the walled cell's
+/// lower corner, velocities kept), to rebuild a specimen with another contact law or numbering. `cell` receives
+/// the cell lengths.
 std::vector<BallSpec> extract_balls(Simulation& sim, std::array<Real, 3>& cell);
 
 
-/// Refuses a config that is not a fully periodic cell without gravity.
+/// Refuses a config that is not a cell without gravity: fully periodic, or with [periodic] boundary = "walls"
+/// (whose [box] is then the cuboid the balls are inserted into, periodic or not).
 void check_periodic_config(const Config& cfg);
 
 /// The specimen of a periodic job: the packing of [particles]/[box], consolidated to [periodic] sigma3_kPa

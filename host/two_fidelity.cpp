@@ -25,6 +25,12 @@ std::vector<Real> sample_variance(const Misfit& misfit, std::size_t k, const std
 
 }  // namespace
 
+Config reference_cell(const Config& base, const std::string& cli) {
+  Config c = base;
+  if ((cli.empty() ? base.calibrate.reference_test : cli) == "walls") c.periodic.boundary = CellBoundary::walls;
+  return c;
+}
+
 bool two_fidelity_wanted(const Config& base, const std::string& cli, bool membrane) {
   if ((cli.empty() ? base.calibrate.reference_test : cli) != "two_fidelity") return false;
   const std::string key = cli.empty() ? base.path + ": [calibrate] reference_test" : "--reference-test";

@@ -21,6 +21,11 @@ struct Discrepancy {
   std::vector<std::vector<Real>> delta, sd;  ///< [test][feature], the feature's unit (Pa for q)
 };
 
+/// The base config with the cell of the reference test: `cli` (--reference-test), else the base config's
+/// [calibrate] reference_test; "walls" puts the cell between six walls ([periodic] boundary, host/cell_boundary.hpp),
+/// the others keep the config's own boundary.
+Config reference_cell(const Config& base, const std::string& cli);
+
 /// Whether the calibration fits two fidelities: `cli` (--reference-test), else the base config's [calibrate]
 /// reference_test. Two fidelities need a membrane test to predict with (`membrane`) on at least 2 specimens;
 /// ConfigError names the key before any run.

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <string>
 
@@ -305,6 +306,46 @@ TEST(Calibrate, StateIsMatchedOnTheMeanOfTheLabsFirstSpecimens) {
   Real big_sum = 0;
   for (int k = 0; k < kStateMatchSpecimens; ++k) big_sum += big_lab.prepared_void_ratio(k);
   EXPECT_EQ(big_match.reached, big_sum / kStateMatchSpecimens);
+}
+
+// A match near a friction already known (the cell-bias check's larger cells, near the lab's own): the halvings
+// start from the bracket of +-kMatchBracket around it and end at the same resolution as from [0, 1]; a target
+// outside the bracket falls back to the whole range, bit for bit the plain match. With a store, each packing's
+// mean void ratio is kept and read back instead of packed again: values planted in the store are what the match
+// then sees (no real packing gives exactly the target).
+TEST(Calibrate, AMatchNearAKnownFrictionBracketsItAndStoresItsPackings) {
+  namespace fs = std::filesystem;
+  const Config cfg = tiny_cell();
+  MatchPlan plan = match_plan(cfg, 1);
+  plan.steps = 4;
+  plan.store = (dem::test::scratch_dir("match_store") / "full").string();
+  const auto [e0, e1] = preparation_reach(cfg, plan);
+  const Real target = e0 + 0.4 * (e1 - e0);
+  Real full_reached = 0;
+  const Real full = prep_friction_for(cfg, target, full_reached, false, plan);
+  MatchPlan far = plan;
+  far.around = 1;  // the loosest packings: the target lies outside
+  Real far_reached = 0;
+  EXPECT_EQ(prep_friction_for(cfg, target, far_reached, false, far), full);
+  EXPECT_EQ(far_reached, full_reached);
+
+  MatchPlan near = plan;
+  near.around = std::sqrt(full);
+  near.store = (dem::test::scratch_dir("match_store") / "near").string();
+  Real near_reached = 0;
+  const Real u = std::sqrt(prep_friction_for(cfg, target, near_reached, false, near));
+  EXPECT_LE(std::fabs(u - near.around), kMatchBracket);
+  EXPECT_LT(std::fabs(near_reached - target), std::min(target - e0, e1 - target));
+  long packings = 0;
+  for (const auto& f : fs::directory_iterator(near.store)) {
+    ++packings;
+    std::ofstream(f.path(), std::ios::binary | std::ios::trunc).write(reinterpret_cast<const char*>(&target),
+                                                                      sizeof target);
+  }
+  EXPECT_LE(packings, 3) << "two ends and one halving reach 1/16 from a bracket of 1/8";
+  Real planted = 0;
+  prep_friction_for(cfg, target, planted, false, near);
+  EXPECT_EQ(planted, target) << "the stored packings are read";
 }
 
 // The cell an "auto" [calibrate] cell_factor chooses (measure_misfit): where even all the scatter specimens leave the

@@ -4,9 +4,10 @@
 #include <filesystem>
 #include <fstream>
 
-#include "host/config.hpp"
 #include "host/builder.hpp"
+#include "host/config.hpp"
 #include "host/job.hpp"
+#include "host/two_fidelity.hpp"
 #include "test_util.hpp"
 
 
@@ -266,6 +267,29 @@ TEST(Config, CalibrateFreeListIsRead) {
   const std::string e = error_of("[calibrate]\nfree = [\"mu_s\", 3]\n");
   EXPECT_NE(e.find("bad.toml: [calibrate] free: expected a non-empty array of strings"), std::string::npos) << e;
   EXPECT_NE(error_of("[calibrate]\nfree = []\n").find("non-empty"), std::string::npos);
+}
+
+// The cell's boundary and the reference test: [periodic] boundary "periodic" (default) or "walls"; [calibrate]
+// reference_test "walls" (or --reference-test walls) puts the calibration's cell between walls and leaves every
+// other setting as it was; "periodic" and "two_fidelity" keep the config's own boundary. Other words are refused
+// with the key and the allowed values.
+TEST(Config, TheCellsBoundaryAndTheWallsReferenceTest) {
+  EXPECT_EQ(dem::Config().periodic.boundary, dem::CellBoundary::periodic);
+  const dem::Config w = dem::load_config(write_config("walls.toml", "[periodic]\nboundary = \"walls\"\n"));
+  EXPECT_EQ(w.periodic.boundary, dem::CellBoundary::walls);
+  dem::Config base = dem::load_config(write_config("ref.toml", "[calibrate]\nreference_test = \"walls\"\n"));
+  EXPECT_EQ(base.periodic.boundary, dem::CellBoundary::periodic);
+  EXPECT_EQ(dem::reference_cell(base, "").periodic.boundary, dem::CellBoundary::walls);
+  EXPECT_EQ(dem::reference_cell(base, "periodic").periodic.boundary, dem::CellBoundary::periodic);
+  EXPECT_EQ(dem::reference_cell(base, "walls").fingerprint, base.fingerprint);
+  base.calibrate.reference_test = "two_fidelity";
+  EXPECT_EQ(dem::reference_cell(base, "").periodic.boundary, dem::CellBoundary::periodic);
+  EXPECT_EQ(dem::reference_cell(w, "").periodic.boundary, dem::CellBoundary::walls);
+  const std::string e = error_of("[periodic]\nboundary = \"membrane\"\n");
+  EXPECT_NE(e.find("bad.toml: [periodic] boundary"), std::string::npos) << e;
+  EXPECT_NE(e.find("walls"), std::string::npos) << e;
+  const std::string r = error_of("[calibrate]\nreference_test = \"membrane\"\n");
+  EXPECT_NE(r.find("walls"), std::string::npos) << r;
 }
 
 // [calibrate] ensemble and scatter_specimens: integers in 1-64 (the seeds of synthetic data start 100000 above
