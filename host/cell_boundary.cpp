@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "kernels/reduce.hpp"
+#include "packing.hpp"
 #include "periodic_triaxial.hpp"
 #include "simulation.hpp"
 
@@ -11,20 +12,11 @@ namespace dem {
 bool walled(const Simulation& sim) { return sim.num_walls() == 6 && !sim.domain().periodic[0]; }
 
 std::vector<WallSpec> cell_walls(const std::array<Real, 3>& cell) {
-  std::vector<WallSpec> walls;
-  for (int d = 0; d < 3; ++d)
-    for (int side = 0; side < 2; ++side) {
-      WallSpec w;
-      w.kind = kPlane;
-      Real p[3] = {0, 0, 0}, n[3] = {0, 0, 0};
-      p[d] = side == 0 ? 0 : cell[d];
-      n[d] = side == 0 ? 1 : -1;
-      w.point = Vec3(p[0], p[1], p[2]);
-      w.normal = Vec3(n[0], n[1], n[2]);
-      w.material = 1;
-      walls.push_back(w);
-    }
-  return walls;
+  Config box;
+  box.box.size = cell;
+  box.box.periodic = {false, false, false};
+  box.box.walls = true;
+  return box_walls(box);
 }
 
 namespace {

@@ -27,7 +27,7 @@ class Simulation;
 /// True for a cell between six walls (cell_walls), false for a periodic cell.
 bool walled(const Simulation& sim);
 
-/// The six plane walls of a cuboid [0, cell): x-, x+, y-, y+, z-, z+, normals into the box, material 1.
+/// The six plane walls of a cuboid [0, cell) (box_walls): x-, x+, y-, y+, z-, z+, normals into the box, material 1.
 std::vector<WallSpec> cell_walls(const std::array<Real, 3>& cell);
 
 /// L_d (m).

@@ -76,8 +76,10 @@ std::pair<long, Real> compact(Simulation& sim, Real z_target, const SpecimenConf
                          "the next run builds the specimen again", 128 + StopSignals::signal());
       ratio = sim.unbalanced_ratio();
       if (progress) {
-        char extra[80];
-        std::snprintf(extra, sizeof extra, "(um of platen travel), unbalanced ratio %.1e (stop at %.0e)", ratio,
+        // At its height the platen has no travel left to report: the line says the layer settles, and until when.
+        char extra[96];
+        std::snprintf(extra, sizeof extra, "%s, unbalanced ratio %.1e (stop at %.0e)",
+                      z - z_target < 1e-9 ? "platen at its height, settling" : "(um of platen travel)", ratio,
                       sc.stop_ratio);
         progress->update(std::lround((z_start - z) * 1e6), extra);
       }

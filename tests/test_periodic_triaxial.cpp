@@ -21,14 +21,6 @@ namespace {
 constexpr int kBalls = 300;
 constexpr Real kSigma3 = 100e3;
 
-SolverConfig solver() {
-  SolverConfig s;
-  s.gravity = {0, 0, 0};
-  s.damping = 0.7;
-  s.dt_safety = 0.2;
-  return s;
-}
-
 PeriodicTriaxialParams quiet(Real target_strain) {
   PeriodicTriaxialParams p;
   p.verbose = false;
@@ -58,7 +50,7 @@ Specimen dense_specimen(int n, unsigned seed) {
   cfg.run.seed = seed;
   Specimen s;
   s.balls = make_packing(cfg);
-  auto sim = make_periodic_simulation(s.balls, cfg.box.size, test::law(1e8, 1.5, 0, 0), solver());
+  auto sim = make_periodic_simulation(s.balls, cfg.box.size, test::law(1e8, 1.5, 0, 0), test::cell_solver());
   PeriodicTriaxialParams p = quiet(0.05);
   p.consolidation_rate = 100;  // a gas compresses freely; the servo takes over once contacts carry load
   p.unbalanced_tolerance = 5e-2;
@@ -68,7 +60,7 @@ Specimen dense_specimen(int n, unsigned seed) {
 }
 
 PeriodicTriaxialResult shear(const Specimen& s, Real mu_s, const PeriodicTriaxialParams& p) {
-  auto sim = make_periodic_simulation(s.balls, s.cell, test::law(1e8, 1.5, mu_s, 0), solver());
+  auto sim = make_periodic_simulation(s.balls, s.cell, test::law(1e8, 1.5, mu_s, 0), test::cell_solver());
   return run_periodic_triaxial(*sim, p);
 }
 
@@ -200,7 +192,7 @@ TEST(PeriodicTriaxial, RefusesFastRatesAndReportsUnconvergedConsolidation) {
   const Real L = std::cbrt(100 * test::kPi / 6 * 8e-9 / 0.1);  // small boxes lose more room to the seams
   cfg.box.size = {L, L, L};
   cfg.box.periodic = {true, true, true};
-  auto sim = make_periodic_simulation(make_packing(cfg), cfg.box.size, test::law(1e8, 1.5, 0.3, 0), solver());
+  auto sim = make_periodic_simulation(make_packing(cfg), cfg.box.size, test::law(1e8, 1.5, 0.3, 0), test::cell_solver());
   PeriodicTriaxialParams p = quiet(0.05);
   // Default rate: I = target_inertial at p = sigma3 (d = 2 mm, rho = 2500 kg/m^3: I = rate x 3.16e-4 s).
   const PeriodicTriaxialParams auto_rate = resolve_periodic_params(*sim, p);

@@ -33,6 +33,15 @@ inline std::filesystem::path scratch_dir(const std::string& name) {
 }
 
 /// Contact parameters in one line: E* (Pa), kn/ks, mu_s, mu_r, normal damping ratio.
+/// The cell tests' solver: no gravity, local damping 0.7, dt a fifth of the critical step.
+inline SolverConfig cell_solver() {
+  SolverConfig s;
+  s.gravity = {0, 0, 0};
+  s.damping = 0.7;
+  s.dt_safety = 0.2;
+  return s;
+}
+
 inline ContactParams law(double emod, double kratio, double mu_s, double mu_r, double beta_n = 0) {
   ContactParams p;
   p.emod = emod;

@@ -18,14 +18,6 @@ namespace {
 
 constexpr Real kR = 1e-3, kE = 1e8, kSigma3 = 100e3;
 
-SolverConfig solver() {
-  SolverConfig s;
-  s.gravity = {0, 0, 0};
-  s.damping = 0.7;
-  s.dt_safety = 0.2;
-  return s;
-}
-
 PeriodicTriaxialParams quiet() {
   PeriodicTriaxialParams p;
   p.verbose = false;
@@ -58,7 +50,7 @@ TEST(WalledCell, ServoHoldsALatticeAtItsAnalyticSize) {
         balls.push_back(b);
       }
   const Real side = gap * 2 * n * kR;
-  auto sim = make_periodic_simulation(balls, {side, side, side}, test::law(kE, 1.5, 0.3, 0), solver(),
+  auto sim = make_periodic_simulation(balls, {side, side, side}, test::law(kE, 1.5, 0.3, 0), test::cell_solver(),
                                       CellBoundary::walls);
   ASSERT_TRUE(walled(*sim));
   PeriodicTriaxialParams p = quiet();
@@ -110,14 +102,14 @@ TEST(WalledCell, WallStressIsLoveWebersOfAllContactsLessTheBallsNetForces) {
   p.consolidation_rate = 100;
   // Packed dense without friction (e about 0.6; with it a gas jams at e 1.0 and collapses under shear), then
   // given its friction.
-  auto sim = make_periodic_simulation(make_packing(cfg), cfg.box.size, test::law(kE, 1.5, 0, 0), solver(),
+  auto sim = make_periodic_simulation(make_packing(cfg), cfg.box.size, test::law(kE, 1.5, 0, 0), test::cell_solver(),
                                       CellBoundary::walls);
   p.unbalanced_tolerance = 5e-2;
   consolidate_isotropic(*sim, p);
   p.unbalanced_tolerance = 1e-3;
   std::array<Real, 3> cell{};
   const std::vector<BallSpec> dense = extract_balls(*sim, cell);
-  sim = make_periodic_simulation(dense, cell, test::law(kE, 1.5, 0.3, 0.05), solver(), CellBoundary::walls);
+  sim = make_periodic_simulation(dense, cell, test::law(kE, 1.5, 0.3, 0.05), test::cell_solver(), CellBoundary::walls);
   p.target_strain = 0.02;
   for (int stage = 0; stage < 2; ++stage) {
     if (stage == 0) consolidate_isotropic(*sim, p);

@@ -35,7 +35,7 @@ triaxdem (kernels/contact_law.hpp): kn = pi r^2 E / (r1+r2), ks = kn/1.5, kr = k
   linear: young = pi E / 2 (E = 1e8), poisson = 1/1.5, alphaKr = 1/4 (kr identical), etaRoll = mu_r / 2.
   hertz:  mu_r(triaxdem) = eta * r / Rbar = 2 eta; ks/kt = 2(1-v)/(2-v) equals triaxdem's 1/1.5 for v = 0.5.
 """
-import sys, math, time, os, subprocess
+import sys, math, time, os
 
 # ---------------------------------------------------------------- arguments
 args = dict(a.split('=', 1) for a in sys.argv[1:] if '=' in a)
@@ -88,10 +88,12 @@ if PREP_MUR < 0:
     PREP_MUR = MU_R
 
 CLOUD = {}
-TARGETS_PCT = [0.02 * k for k in range(0, 51)] + [1.0 + 0.1 * k for k in range(1, 141)]
 
 # ---------------------------------------------------------------- helpers
 from yade import pack, utils
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))  # yade -x runs the script with its path in argv[0]
+from yade_curves import take_rows, debian_version, write_csv
 
 
 def log(*a):
@@ -252,20 +254,7 @@ def record():
     q = s[2, 2] - 0.5 * (s[0, 0] + s[1, 1])
     lat = 0.5 * (s[0, 0] + s[1, 1])
     cur = (eps, q, epsv, lat)
-    prev = st.get('prev')
-    while st['k'] < len(TARGETS_PCT) and eps * 100 >= TARGETS_PCT[st['k']] - 1e-12:
-        t = TARGETS_PCT[st['k']] / 100
-        if prev is None or eps <= prev[0]:
-            w = 1.0
-        else:
-            w = (t - prev[0]) / (eps - prev[0])
-            w = min(1.0, max(0.0, w))
-        vals = [cur[j] if prev is None else prev[j] + w * (cur[j] - prev[j]) for j in range(4)]
-        rows.append((st['sigma3'], TARGETS_PCT[st['k']], vals[1] / 1e3, vals[2] * 100, st['e0']))
-        st['laterr'] = max(st.get('laterr', 0.0), abs(vals[3] / 1e3 - st['sigma3']) / st['sigma3'])
-        st['k'] += 1
-    st['prev'] = cur
-    if st['k'] >= len(TARGETS_PCT):
+    if take_rows(st, cur, rows):
         O.pause()
 
 
@@ -305,10 +294,7 @@ for sigma3 in PRESSURES:
         (O.iter - it0, max(qs), max(qs) / sigma3, state.get('laterr', 0), wall))
 
 # ---------------------------------------------------------------- output
-try:
-    deb = subprocess.run(['dpkg-query', '-W', '-f=${Version}', 'yade'], capture_output=True, text=True).stdout
-except Exception:
-    deb = '?'
+deb = debian_version()
 import yade.config
 hdr = []
 hdr.append('# generator: tests/data/crosscode/yade_peri_triax.py (YADE periodic-cell drained triaxial test)')
@@ -339,10 +325,6 @@ for s in summary:
     hdr.append('# test sigma3 %g kPa: cloud solid fraction %g, e0 %.4f, Z %.3f, rate %.4g 1/s, %d shear steps, q_peak/sigma3 %.3f, max |lateral stress - sigma3|/sigma3 at records %.3g, wall %.0f s' %
                (s[0], CLOUD[s[0]], s[1], s[2], s[3], s[4], s[7] / s[0], s[6], s[5]))
 hdr.append('# total wall time %.0f s (one core)' % (time.time() - t_all))
-with open(OUT, 'w') as f:
-    f.write('\n'.join(hdr) + '\n')
-    f.write('material,sigma3_kPa,eps_a_pct,q_kPa,eps_v_pct,void_ratio\n')
-    for r in rows:
-        f.write('%s,%.6g,%.6g,%.6g,%.6g,%.6g\n' % (MATNAME, r[0], r[1], r[2], r[3], r[4]))
+write_csv(OUT, hdr, rows, MATNAME)
 log('wrote', OUT, len(rows), 'rows')
 sys.exit(0)

@@ -18,7 +18,7 @@ and cap), there derived as triaxdem's rrlinear with emod 1e8 Pa, kn/ks 1.5, mu_s
 CohFrictMat without friction or rolling moment, 1e4 times stiffer than the balls, so that their stiffness with a
 ball is triaxdem's (2 E r); it is measured in the run and written in the header.
 """
-import sys, math, time, os, subprocess
+import sys, math, time, os
 
 args = dict(a.split('=', 1) for a in sys.argv[1:] if '=' in a)
 SEED = int(args.get('seed', '1'))
@@ -47,9 +47,11 @@ ETA_ROLL = MU_R * RBAR / R
 # YADE's ball-wall kn = 2 Ew E r / (Ew + E) (measured: E r with Ew = E); triaxdem's is pi E_triax r = 2 E r (a wall
 # counts as a ball of the same radius against a flat, kernels/contact_law.hpp): stiff walls take YADE to 0.9999 of it.
 WALL_YOUNG = 1e4 * YOUNG
-TARGETS_PCT = [0.02 * k for k in range(0, 51)] + [1.0 + 0.1 * k for k in range(1, 141)]
 
 from yade import pack, utils
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))  # yade -x runs the script with its path in argv[0]
+from yade_curves import take_rows, debian_version, write_csv
 
 
 def log(*a):
@@ -147,16 +149,7 @@ def record():
     q = s[2] - 0.5 * (s[0] + s[1])
     lat = 0.5 * (s[0] + s[1])
     cur = (eps, q, epsv, lat)
-    prev = st.get('prev')
-    while st['k'] < len(TARGETS_PCT) and eps * 100 >= TARGETS_PCT[st['k']] - 1e-12:
-        t = TARGETS_PCT[st['k']] / 100
-        w = 1.0 if prev is None or eps <= prev[0] else min(1.0, max(0.0, (t - prev[0]) / (eps - prev[0])))
-        vals = [cur[j] if prev is None else prev[j] + w * (cur[j] - prev[j]) for j in range(4)]
-        rows.append((st['sigma3'], TARGETS_PCT[st['k']], vals[1] / 1e3, vals[2] * 100, st['e0']))
-        st['laterr'] = max(st.get('laterr', 0.0), abs(vals[3] / 1e3 - st['sigma3']) / st['sigma3'])
-        st['k'] += 1
-    st['prev'] = cur
-    if st['k'] >= len(TARGETS_PCT):
+    if take_rows(st, cur, rows):
         O.pause()
 
 
@@ -196,10 +189,7 @@ for sigma3 in PRESSURES:
     log('  done: %d shear steps, q_peak %.1f kPa (q/s3 %.3f), max lateral stress error %.3g, wall %.0f s' %
         (O.iter - it0, max(qs), max(qs) / sigma3, state.get('laterr', 0), wall))
 
-try:
-    deb = subprocess.run(['dpkg-query', '-W', '-f=${Version}', 'yade'], capture_output=True, text=True).stdout
-except Exception:
-    deb = '?'
+deb = debian_version()
 import yade.config
 hdr = []
 hdr.append('# generator: tests/data/crosscode/yade_walled_triax.py (YADE drained triaxial test on a cuboid between six rigid walls, TriaxialStressController)')
@@ -222,10 +212,6 @@ for s in summary:
     hdr.append('# test sigma3 %g kPa: e0 %.4f, Z %.3f, rate %.4g 1/s, %d shear steps, q_peak/sigma3 %.3f, max |lateral stress - sigma3|/sigma3 at records %.3g, wall %.0f s' %
                (s[0], s[1], s[2], s[3], s[4], s[7] / s[0], s[6], s[5]))
 hdr.append('# total wall time %.0f s (one core)' % (time.time() - t_all))
-with open(OUT, 'w') as f:
-    f.write('\n'.join(hdr) + '\n')
-    f.write('material,sigma3_kPa,eps_a_pct,q_kPa,eps_v_pct,void_ratio\n')
-    for r in rows:
-        f.write('%s,%.6g,%.6g,%.6g,%.6g,%.6g\n' % (MATNAME, r[0], r[1], r[2], r[3], r[4]))
+write_csv(OUT, hdr, rows, MATNAME)
 log('wrote', OUT, len(rows), 'rows')
 sys.exit(0)
