@@ -356,8 +356,8 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
   std::ostringstream md, csv;
   md << "# Diagnosis of " << o.data << "\n\n"
      << "Simulator: the cell triaxial test in " << ss.cell_text() << ", an ensemble of " << ss.lab.members()
-     << " specimens of " << ss.lab.balls() << " balls (packing seeds from " << base.run.seed << "), each prepared once; every parameter point runs them all "
-        "and compares their mean. Free base parameters:";
+     << " specimens of " << ss.lab.balls() << " balls (packing seeds from " << base.run.seed
+     << "), each prepared once; every parameter point runs them all and compares their mean. Free base parameters:";
   for (const FreeParam& f : ss.free) md << " " << f.name;
   md << ". Misfit: chi2 over " << (ss.data.curves ? "q and eps_v at fixed axial strains (0.02% to 15%)"
                                                   : "the summary quantities given")

@@ -1,7 +1,5 @@
 #include "cell_boundary.hpp"
 
-#include <cmath>
-
 #include "kernels/reduce.hpp"
 #include "packing.hpp"
 #include "periodic_triaxial.hpp"
@@ -19,15 +17,16 @@ std::vector<WallSpec> cell_walls(const std::array<Real, 3>& cell) {
   return box_walls(box);
 }
 
-namespace {
-Real component(const Vec3& v, int d) { return d == 0 ? v.x : (d == 1 ? v.y : v.z); }
-}  // namespace
+Vec3 cell_corner(const Simulation& sim) {
+  const Domain& dom = sim.domain();
+  if (!walled(sim)) return Vec3(dom.lo[0], dom.lo[1], dom.lo[2]);
+  return Vec3(sim.wall_point(0).x, sim.wall_point(2).y, sim.wall_point(4).z);
+}
 
 std::array<Real, 3> cell_lengths(const Simulation& sim) {
   if (!walled(sim)) return {sim.domain().length(0), sim.domain().length(1), sim.domain().length(2)};
-  std::array<Real, 3> l{};
-  for (int d = 0; d < 3; ++d) l[d] = component(sim.wall_point(2 * d + 1), d) - component(sim.wall_point(2 * d), d);
-  return l;
+  const Vec3 lo = cell_corner(sim);
+  return {sim.wall_point(1).x - lo.x, sim.wall_point(3).y - lo.y, sim.wall_point(5).z - lo.z};
 }
 
 Real cell_volume(const Simulation& sim) {
@@ -43,7 +42,7 @@ std::array<Real, 3> cell_stress(Simulation& sim) {
   std::array<Real, 3> s{};
   for (int d = 0; d < 3; ++d) {
     // The balls push the lower wall towards -d and the upper one towards +d.
-    const Real push = 0.5 * (component(f[2 * d + 1], d) - component(f[2 * d], d));
+    const Real push = 0.5 * (f[2 * d + 1][d] - f[2 * d][d]);
     s[d] = push / (l[(d + 1) % 3] * l[(d + 2) % 3]);
   }
   return s;
@@ -77,13 +76,14 @@ void set_cell_rates(Simulation& sim, const Vec3& rate) {
     return;
   }
   const std::array<Real, 3> l = cell_lengths(sim);
+  std::vector<Vec3> v(6);
   for (int d = 0; d < 3; ++d) {
-    const Real v = component(rate, d) * l[d] / 2;
     Real e[3] = {0, 0, 0};
-    e[d] = v;
-    sim.set_wall_velocity(2 * d, Vec3(-e[0], -e[1], -e[2]));
-    sim.set_wall_velocity(2 * d + 1, Vec3(e[0], e[1], e[2]));
+    e[d] = rate[d] * l[d] / 2;
+    v[2 * d] = Vec3(-e[0], -e[1], -e[2]);
+    v[2 * d + 1] = Vec3(e[0], e[1], e[2]);
   }
+  sim.set_wall_velocities(v);
 }
 
 Vec3 cell_rates(const Simulation& sim) {
@@ -91,7 +91,7 @@ Vec3 cell_rates(const Simulation& sim) {
   const std::array<Real, 3> l = cell_lengths(sim);
   Real r[3];
   for (int d = 0; d < 3; ++d)
-    r[d] = (component(sim.wall_velocity(2 * d + 1), d) - component(sim.wall_velocity(2 * d), d)) / l[d];
+    r[d] = (sim.wall_velocity(2 * d + 1)[d] - sim.wall_velocity(2 * d)[d]) / l[d];
   return Vec3(r[0], r[1], r[2]);
 }
 

@@ -30,6 +30,8 @@ bool walled(const Simulation& sim);
 /// The six plane walls of a cuboid [0, cell) (box_walls): x-, x+, y-, y+, z-, z+, normals into the box, material 1.
 std::vector<WallSpec> cell_walls(const std::array<Real, 3>& cell);
 
+/// The lower corner (m): the periodic cell's domain.lo, the walled cell's x-, y- and z- walls.
+Vec3 cell_corner(const Simulation& sim);
 /// L_d (m).
 std::array<Real, 3> cell_lengths(const Simulation& sim);
 /// L_x L_y L_z (m^3).

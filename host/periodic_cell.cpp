@@ -15,7 +15,9 @@
 namespace dem {
 
 namespace {
-const char* cell_name(CellBoundary b) { return b == CellBoundary::walls ? "a cuboid between six walls" : "a periodic cell"; }
+const char* cell_name(CellBoundary b) {
+  return b == CellBoundary::walls ? "a cuboid between six walls" : "a periodic cell";
+}
 }  // namespace
 
 std::unique_ptr<Simulation> make_periodic_simulation(const std::vector<BallSpec>& balls,
@@ -63,8 +65,7 @@ std::vector<BallSpec> extract_balls(Simulation& sim, std::array<Real, 3>& cell) 
   auto mat = Kokkos::create_mirror_view_and_copy(HostSpace(), p.material);
   const Domain& dom = sim.domain();
   const bool walls = walled(sim);
-  Vec3 corner(dom.lo[0], dom.lo[1], dom.lo[2]);
-  if (walls) corner = Vec3(sim.wall_point(0).x, sim.wall_point(2).y, sim.wall_point(4).z);
+  const Vec3 corner = cell_corner(sim);
   std::vector<BallSpec> out(p.n);
   for (int i = 0; i < p.n; ++i) {
     BallSpec& b = out[gid(i)];

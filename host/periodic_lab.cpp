@@ -1,13 +1,8 @@
 #include "periodic_lab.hpp"
 
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <limits>
 #include <optional>
 #include <stdexcept>
@@ -22,7 +17,7 @@
 #include "forked_runs.hpp"
 #include "periodic_triaxial.hpp"
 #include "progress.hpp"
-#include "provenance.hpp"
+#include "run_store.hpp"
 
 namespace dem {
 
@@ -121,134 +116,12 @@ void PeriodicLab::grow_cell(int factor, StateMatch* state) {
   pack(specimens(), false);
 }
 
-namespace {
-/// The plan's specimens' mean void ratio after their preparation, summed in seed order: packed as a lab packs
-/// its specimens, so that the mean matched is the mean of a lab's first specimens, bit for bit.
-Real prepared_void_ratio(const Config& cfg, const MatchPlan& plan) {
-  const int n = std::max(plan.specimens, 1);
-  const PeriodicLab lab(larger_cell(cfg, plan.cell_factor), false, n, plan.first_seed, n, plan.jobs);
-  Real sum = 0;
-  for (int k = 0; k < n; ++k) sum += lab.prepared_void_ratio(k);
-  return sum / static_cast<Real>(n);
-}
-}  // namespace
-
 MatchPlan match_plan(const Config& base, int jobs) {
   MatchPlan p;
   p.first_seed = base.run.seed;
   p.cell_factor = fixed_cell_factor(base);
   p.jobs = runs_at_once(jobs);
   return p;
-}
-
-namespace {
-/// The plan's store file of the packing of `c` (friction, cell and seeds named in its hash), "" without a store.
-std::string stored_packing_path(const Config& c, const MatchPlan& plan) {
-  if (plan.store.empty()) return "";
-  const std::string version = program_version();
-  std::uint64_t h = fnv1a(version.data(), version.size());
-  h = fnv1a(c.fingerprint.data(), c.fingerprint.size(), h);
-  const Real v[] = {c.periodic.prep_mu_s, c.box.size[0], c.box.size[1], c.box.size[2]};
-  h = fnv1a(v, sizeof v, h);
-  const long n[] = {c.particles.count, plan.cell_factor, plan.specimens, static_cast<long>(plan.first_seed)};
-  h = fnv1a(n, sizeof n, h);
-  return plan.store + "/packing_" + hex16(h) + ".e";
-}
-
-/// The plan's mean void ratio after preparation with friction u^2, read from the plan's store where it was kept.
-Real void_ratio_at(const Config& base, Real u, const MatchPlan& plan) {
-  Config c = base;
-  c.periodic.prep_mu_s = u * u;
-  const std::string path = stored_packing_path(c, plan);
-  Real e = 0;
-  if (!path.empty()) {
-    std::ifstream in(path, std::ios::binary);
-    if (in.read(reinterpret_cast<char*>(&e), sizeof e)) return e;
-  }
-  e = prepared_void_ratio(c, plan);
-  if (!path.empty()) {  // written beside and renamed in, as a run is
-    std::filesystem::create_directories(plan.store);
-    {
-      std::ofstream out(path + ".tmp", std::ios::binary);
-      out.write(reinterpret_cast<const char*>(&e), sizeof e);
-      if (!out) throw std::runtime_error(path + ".tmp: cannot be written (the calibration's run store)");
-    }
-    std::filesystem::rename(path + ".tmp", path);
-  }
-  return e;
-}
-}  // namespace
-
-std::pair<Real, Real> preparation_reach(const Config& base, const MatchPlan& plan) {
-  return {void_ratio_at(base, 0, plan), void_ratio_at(base, 1, plan)};
-}
-
-Real prep_friction_for(const Config& base, Real target, Real& reached, bool verbose, const MatchPlan& plan) {
-  // Each packing of the plan's specimens takes seconds to minutes: the match reports them (the ends, then the
-  // bisection's steps; it may stop early at an end).
-  std::optional<Progress> progress;
-  if (verbose) progress.emplace("triaxdem: matching the void ratio", 2L + plan.steps);
-  long packings = 0;
-  auto packed = [&](long count) {
-    packings += count;
-    if (progress) progress->update(packings, "packings");
-  };
-  auto at = [&](Real u) {
-    const Real e = void_ratio_at(base, u, plan);
-    packed(1);
-    return e;
-  };
-  const Real resolution = std::ldexp(Real(1), -plan.steps);
-  auto bisect = [&](Real lo, Real hi, Real e_lo, Real e_hi) {
-    while (hi - lo > resolution) {
-      const Real mid = 0.5 * (lo + hi), e = at(mid);
-      (e < target ? lo : hi) = mid;
-      (e < target ? e_lo : e_hi) = e;
-    }
-    const bool low = target - e_lo < e_hi - target;
-    reached = low ? e_lo : e_hi;
-    return low ? lo * lo : hi * hi;
-  };
-  if (plan.around >= 0) {
-    const Real lo = std::max(Real(0), plan.around - kMatchBracket), hi = std::min(Real(1), plan.around + kMatchBracket);
-    const Real e_lo = at(lo), e_hi = at(hi);
-    if (e_lo <= target && target <= e_hi) return bisect(lo, hi, e_lo, e_hi);
-  }
-  auto [e_lo, e_hi] = preparation_reach(base, plan);
-  packed(2);
-  if (verbose)
-    std::printf("triaxdem: preparation friction 0 to 1 packs void ratios %.4f to %.4f (mean of %d specimens); "
-                "target %.4f\n", e_lo, e_hi, plan.specimens, target);
-  // A state far outside what the cell packs is another material state, not a calibration target (a data void
-  // ratio of 4.5 was matched by the loosest packing, 0.87, and calibrated on).
-  if (target < e_lo - kMaxStateGap || target > e_hi + kMaxStateGap) {
-    char msg[360];
-    std::snprintf(msg, sizeof msg, "the data's void ratio %.4f is beyond this cell's reach: preparation friction 0 to "
-                  "1 packs it at %.4f to %.4f, and a state more than %.2f outside that range cannot be matched (check "
-                  "the data's void_ratio or porosity column)", target, e_lo, e_hi, kMaxStateGap);
-    throw DataError(msg);
-  }
-  if (target <= e_lo) return reached = e_lo, 0;
-  if (target >= e_hi) return reached = e_hi, 1;
-  return bisect(0, 1, e_lo, e_hi);
-}
-
-Config matched_state(const Config& base, const std::vector<MeasuredTest>& tests, StateMatch& m, bool verbose,
-                     const MatchPlan& plan) {
-  m = StateMatch{};
-  Real sum = 0;
-  for (const MeasuredTest& t : tests)
-    if (std::isfinite(t.void_ratio)) sum += t.void_ratio, ++m.tests;
-  if (m.tests == 0) return base;
-  m.target = sum / m.tests;
-  m.specimens = plan.specimens;
-  Config c = base;
-  c.periodic.prep_mu_s = m.prep_mu_s = prep_friction_for(base, m.target, m.reached, verbose, plan);
-  if (verbose)
-    std::printf("triaxdem: the data's void ratio %.4f (mean of %d tests): preparation friction %.4g packs %.4f "
-                "(mean of %d specimens)\n",
-                m.target, m.tests, m.prep_mu_s, m.reached, m.specimens);
-  return c;
 }
 
 PeriodicLab::PeriodicLab(const Config& base, bool verbose, int jobs)
@@ -307,13 +180,19 @@ int PeriodicLab::set_jobs(int jobs) { return jobs_ = runs_at_once(jobs); }
 
 namespace {
 
-/// The curves of a test through a pipe: row count, then eps_a, q, eps_v (a count of -1: the run blew up).
-void send_curves(int fd, const MeasuredTest& t) {
+/// The curves of a test as bytes to `put(pointer, count)`: row count, void ratio, then eps_a, q, eps_v (a count of
+/// -1: the run blew up). Through a child's pipe (send_curves) and into the run store.
+template <class Put>
+void put_curves(const MeasuredTest& t, Put put) {
   const long n = std::isfinite(t.q_peak) ? static_cast<long>(t.q.size()) : -1;
-  put_bytes(fd, &n, sizeof n);
-  put_bytes(fd, &t.void_ratio, sizeof t.void_ratio);
+  put(&n, sizeof n);
+  put(&t.void_ratio, sizeof t.void_ratio);
   for (const std::vector<Real>* v : {&t.eps_a, &t.q, &t.eps_v})
-    if (n > 0) put_bytes(fd, v->data(), sizeof(Real) * v->size());
+    if (n > 0) put(v->data(), sizeof(Real) * v->size());
+}
+
+void send_curves(int fd, const MeasuredTest& t) {
+  put_curves(t, [fd](const void* p, std::size_t n) { put_bytes(fd, p, n); });
 }
 
 bool receive_curves(int fd, MeasuredTest& t) {
@@ -337,9 +216,7 @@ void PeriodicLab::set_run_store(std::string folder) { store_ = std::move(folder)
 
 std::string PeriodicLab::stored_path(const Model& m, const Case& c) const {
   if (store_.empty()) return "";
-  const std::string version = program_version();
-  std::uint64_t h = fnv1a(version.data(), version.size());
-  h = fnv1a(cfg_.fingerprint.data(), cfg_.fingerprint.size(), h);
+  std::uint64_t h = store_hash(cfg_);
   h = fnv1a(&m.law, sizeof m.law, h);  // Reals only: no padding
   h = fnv1a(&m.membrane, sizeof m.membrane, h);
   h = fnv1a(&c.sigma3, sizeof c.sigma3, h);
@@ -354,26 +231,12 @@ std::string PeriodicLab::stored_path(const Model& m, const Case& c) const {
 }
 
 namespace {
-/// A stored run's curves (send_curves' bytes), or false where there is none or it is cut short.
-bool read_stored(const std::string& path, MeasuredTest& t) {
-  if (path.empty()) return false;
-  const int fd = ::open(path.c_str(), O_RDONLY);
-  if (fd < 0) return false;
-  const bool ok = receive_curves(fd, t);
-  ::close(fd);
-  return ok;
-}
-
-/// Writes a run's curves beside their place and renames them in: a killed calibration leaves whole files only.
+/// A run's curves into the store (put_curves' bytes, as through a pipe).
 void store_run(const std::string& path, const MeasuredTest& t) {
   if (path.empty()) return;
-  std::filesystem::create_directories(std::filesystem::path(path).parent_path());  // at the first run
-  const std::string tmp = path + ".tmp";
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  if (fd < 0) throw std::runtime_error(tmp + ": cannot be written (the calibration's run store)");
-  send_curves(fd, t);
-  ::close(fd);
-  std::filesystem::rename(tmp, path);
+  std::string bytes;
+  put_curves(t, [&](const void* p, std::size_t n) { bytes.append(static_cast<const char*>(p), n); });
+  write_stored(path, bytes);
 }
 }  // namespace
 
@@ -391,7 +254,7 @@ std::vector<MeasuredTest> PeriodicLab::run_cases(const Model& m, const std::vect
     paths[j] = stored_path(m, cases[j]);
     out[j].material = cases[j].material;
     out[j].sigma3 = cases[j].sigma3;
-    if (read_stored(paths[j], out[j])) {
+    if (read_stored(paths[j], [&](int fd) { return receive_curves(fd, out[j]); })) {
       ++stored_read_;
       ++runs_;  // a run of the search, read: the counts a resumed search reports are those it reported
       one_done();

@@ -294,9 +294,10 @@ PeriodicTriaxialResult run_periodic_triaxial(Simulation& sim, const PeriodicTria
   Progress progress(prm.name + " shear", total);
   Real next_record = prm.record_strain;
   for (long n = 1;; ++n) {
-    const std::array<Real, 3> target = lateral_targets(cell_lengths(sim), prm, L0);
+    const std::array<Real, 3> lengths = cell_lengths(sim);
+    const std::array<Real, 3> target = lateral_targets(lengths, prm, L0);
     servo.update(sim, lateral, axial, target.data());
-    const Real h = cell_lengths(sim)[2];
+    const Real h = lengths[2];
     const Real eps_next = (res.h0 - h * (1 - prm.axial_rate * dt)) / res.h0;
     const bool last = eps_next >= prm.target_strain;
     const bool due = last || eps_next >= next_record - 1e-12;

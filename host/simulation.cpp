@@ -288,6 +288,14 @@ void Simulation::set_wall_velocity(int w, const Vec3& v) {
   Kokkos::deep_copy(walls_.velocity, hwall_vel_);
 }
 
+void Simulation::set_wall_velocities(const std::vector<Vec3>& v) {
+  if (static_cast<int>(v.size()) != walls_.n)
+    throw std::invalid_argument("set_wall_velocities: " + std::to_string(v.size()) + " velocities for " +
+                                std::to_string(walls_.n) + " walls");
+  for (int w = 0; w < walls_.n; ++w) store(hwall_vel_, w, v[static_cast<std::size_t>(w)]);
+  Kokkos::deep_copy(walls_.velocity, hwall_vel_);
+}
+
 Vec3 Simulation::wall_velocity(int w) const { return load(hwall_vel_, w); }
 
 Vec3 Simulation::wall_point(int w) const { return load(hwall_point_, w); }

@@ -99,6 +99,8 @@ class Simulation {
 
   /// Rigid wall velocity (m/s) and position (m) control.
   void set_wall_velocity(int w, const Vec3& v);
+  /// Every analytic wall's velocity at once (one per wall), in one copy to the device: a servo's every step.
+  void set_wall_velocities(const std::vector<Vec3>& v);
   Vec3 wall_velocity(int w) const;
   Vec3 wall_point(int w) const;
   void set_wall_point(int w, const Vec3& p);

@@ -128,8 +128,7 @@ TEST(WalledCell, WallStressIsLoveWebersOfAllContactsLessTheBallsNetForces) {
     for (int d = 0; d < 3; ++d) {
       Real total = 0;
       for (int i = 0; i < pt.n; ++i) total += f(i, d);
-      const Real lo = d == 0 ? sim->wall_point(0).x : (d == 1 ? sim->wall_point(2).y : sim->wall_point(4).z);
-      const Real centre = lo + 0.5 * cell_lengths(*sim)[d];
+      const Real centre = cell_corner(*sim)[d] + 0.5 * cell_lengths(*sim)[d];
       EXPECT_NEAR(s[d], b[4 * d] + centre * total / V, 1e-9 * pressure) << "stage " << stage << ", axis " << d;
     }
     std::printf("stage %d: walls q %.2f kPa, Love-Weber q of all contacts %.2f kPa, net forces' q %.3f kPa\n", stage,

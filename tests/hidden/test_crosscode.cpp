@@ -68,7 +68,8 @@ TEST_P(CrossCode, DiagnosisOfAnotherCodesCurves) {
     const Real rise = dg.base.region_rise({0.4, 0.04});
     std::printf("  generating friction (0.4, 0.04): chi2 rise %.2f of the joint 95%% region's (inside at most 1)\n",
                 rise);
-    if (c.cell_factor > 1 || c.region) EXPECT_LE(rise, 1.0) << "the generating friction lies outside the joint 95% region";
+    if (c.cell_factor > 1 || c.region)
+      EXPECT_LE(rise, 1.0) << "the generating friction lies outside the joint 95% region";
   } else {
     for (const ExtensionFit& f : dg.fits)
       if (f.ext.name == c.verdict) {  // the report's claim: both tests passed by the margin
@@ -92,7 +93,8 @@ INSTANTIATE_TEST_SUITE_P(Yade, CrossCode,
 // different ends of the mu_s-mu_r ridge.
 INSTANTIATE_TEST_SUITE_P(LongYade, CrossCode,
                          ::testing::Values(CrossCase{"linear_600", "linear_seed1.csv", "linear_base.toml", "none", 4},
-                                           CrossCase{"walled", "walled_seed1.csv", "walled_base.toml", "none", 1, true}),
+                                           CrossCase{"walled", "walled_seed1.csv", "walled_base.toml", "none", 1,
+                                                     true}),
                          case_name);
 
 }  // namespace
