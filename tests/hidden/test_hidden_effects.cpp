@@ -89,12 +89,14 @@ TEST_P(HiddenEffect, DiagnosisNamesIt) {
 // ensembles (verdict none); the membrane gave 2.2 and the roughness fit 6.5 (verdict roughness, a wrong name).
 // They passed before only because the data came from the diagnosis's own specimen. perf/hidden_sweep measures
 // their identification rate; a CI case for them needs a larger ensemble or cell than the CI budget allows.
-INSTANTIATE_TEST_SUITE_P(OneCasePerExtension, HiddenEffect,
-                         ::testing::Values(HiddenCase{"none", 0, 1}, HiddenCase{"roughness", 1e-2, 1}),
+INSTANTIATE_TEST_SUITE_P(OneCasePerExtension, HiddenEffect, ::testing::Values(HiddenCase{"roughness", 1e-2, 1}),
                          [](const ::testing::TestParamInfo<HiddenCase>& i) { return i.param.extension; });
-// Hertz contacts hidden in this simulator's own data: a long case (about 2 minutes), since the suite's cross-code
-// case (test_crosscode.cpp) asks the same of YADE's Hertz-Mindlin data, which the simulator did not make.
-INSTANTIATE_TEST_SUITE_P(LongOneCasePerExtension, HiddenEffect, ::testing::Values(HiddenCase{"hertz", 3e-3, 1}),
+// Long cases (about 2.5 minutes each on 2 cores), each asked of data the simulator did not make by the suite's
+// cross-code cases (test_crosscode.cpp): Hertz contacts hidden in this simulator's own data (the suite names hertz
+// in YADE's Hertz-Mindlin data), and the null case (the suite must name nothing in YADE's linear data, whose
+// preparation, rate, cell and rolling law differ from the simulator's: a harder null than the simulator's own).
+INSTANTIATE_TEST_SUITE_P(LongOneCasePerExtension, HiddenEffect,
+                         ::testing::Values(HiddenCase{"hertz", 3e-3, 1}, HiddenCase{"none", 0, 1}),
                          [](const ::testing::TestParamInfo<HiddenCase>& i) { return i.param.extension; });
 
 // The verdict must not hinge on the ensemble: the same data, diagnosed by an ensemble of other specimens
