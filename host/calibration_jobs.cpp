@@ -139,10 +139,18 @@ struct Session {
                ? "the cell between six walls (stresses measured at the walls, as a walled test measures them)"
                : "the periodic cell (stresses from its contacts: the specimen's interior, without a boundary)";
   }
-  /// "N runs", and how many of them a resumed session read from its store.
+  /// "N runs", how many of them a resumed session read from its store, and how many a blow-up stopped: their data
+  /// count as missing (kMissingResidual), which pushes the fit away from where they happen.
   std::string runs_text() const {
     const long read = lab.stored_runs_read();
-    return fmt("%ld runs", lab.runs()) + (read > 0 ? fmt(" (%ld of them read from the run store)", read) : "");
+    return fmt("%ld runs", lab.runs()) + (read > 0 ? fmt(" (%ld of them read from the run store)", read) : "") +
+           (lab.failed_runs() > 0 ? "; WARNING: " + failed_text() : "");
+  }
+  std::string failed_text() const {
+    return fmt("%ld of the runs stopped at a blow-up", lab.failed_runs()) +
+           fmt(" (up to %g kPa), their data counted as missing: where the overlaps are the contacts' physics (soft "
+               "contacts at high pressure), raise [solver] overlap_limit (docs/config.md)",
+               1e-3 * lab.highest_failed_sigma3());
   }
   std::vector<std::string> free_names() const {
     std::vector<std::string> names;
@@ -446,6 +454,7 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
     all_sim.insert(all_sim.end(), dg.base.best.sim.begin(), dg.base.best.sim.end());
     models[material] = Calibrated{tests, dg.base.model, dg.base.best.sim};
   }
+  if (ss.lab.failed_runs() > 0) md << "**Warning:** " << ss.failed_text() << ".\n\n";
   md << "![measured and simulated: the base model in full lines, the extended one dashed](calibration.png)\n";
   if (all_ext.size() == all_meas.size())
     write_measured_curves(ss.folder + "/extended_curves.csv", all_ext, "simulated by the extended model of each material");

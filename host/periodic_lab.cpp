@@ -241,6 +241,13 @@ void store_run(const std::string& path, const MeasuredTest& t) {
 }  // namespace
 
 std::vector<MeasuredTest> PeriodicLab::run_cases(const Model& m, const std::vector<Case>& cases) {
+  std::vector<MeasuredTest> out = run_or_read(m, cases);
+  for (const MeasuredTest& t : out)
+    if (!std::isfinite(t.q_peak)) ++failed_, failed_sigma3_ = std::max(failed_sigma3_, t.sigma3);
+  return out;
+}
+
+std::vector<MeasuredTest> PeriodicLab::run_or_read(const Model& m, const std::vector<Case>& cases) {
   std::vector<MeasuredTest> out(cases.size());
   std::optional<Progress> progress;
   if (!progress_label_.empty()) progress.emplace(progress_label_, static_cast<long>(cases.size()));

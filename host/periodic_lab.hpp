@@ -81,6 +81,9 @@ class PeriodicLab {
   /// calibration's search reports its own progress, the scatter measurement and the state match this way.
   void set_progress(std::string label) { progress_label_ = std::move(label); }
   long runs() const { return runs_; }
+  /// Of runs(), those a blow-up stopped (their data count as missing), and the highest pressure of one (Pa).
+  long failed_runs() const { return failed_; }
+  Real highest_failed_sigma3() const { return failed_sigma3_; }
   double seconds() const { return seconds_; }
   std::size_t balls() const { return specimens_.front().balls.size(); }
   /// Void ratio of member k's specimen after its preparation (at the preparation pressure).
@@ -95,6 +98,8 @@ class PeriodicLab {
   Config cfg_;
   std::vector<Specimen> specimens_;
   long runs_ = 0;
+  long failed_ = 0;
+  Real failed_sigma3_ = 0;
   double seconds_ = 0;
   std::string progress_label_;
   std::string store_;
@@ -110,8 +115,9 @@ class PeriodicLab {
     Real sigma3;
     int member;
   };
-  /// The cases in order, up to jobs() at once; those in the run store are read.
+  /// The cases in order, up to jobs() at once; those in the run store are read. Counts the blown-up ones.
   std::vector<MeasuredTest> run_cases(const Model& m, const std::vector<Case>& cases);
+  std::vector<MeasuredTest> run_or_read(const Model& m, const std::vector<Case>& cases);
   /// The run store's file of a case ("" without a store).
   std::string stored_path(const Model& m, const Case& c) const;
 };

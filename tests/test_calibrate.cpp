@@ -249,6 +249,31 @@ TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
   for (int k = 0; k < 3; ++k) EXPECT_EQ(each[k].q, one[k][k % 2].q) << "sigma3 " << like[k].sigma3;
 }
 
+// A run stopped by a blow-up gives no test (every quantity missing) and is counted with its pressure, so that the
+// calibration can say why data went missing (a walled diagnosis once lost most of its 300 kPa runs to the default
+// overlap guard, silently). Contacts 10^5 times softer than the specimen was packed with overlap by far more than
+// the 10% guard as soon as sigma3 loads them; the packing's own contacts run at the config's stiffness.
+TEST(Calibrate, BlownUpRunsAreCountedWithTheirPressure) {
+  const Config cfg = tiny_cell();
+  PeriodicLab lab(cfg, false, 1, 1);
+  Model soft;
+  soft.law = cfg.ball;
+  soft.law.emod = 1e-5 * cfg.ball.emod;
+  std::vector<MeasuredTest> like(2);
+  like[0].sigma3 = 100e3;
+  like[1].sigma3 = 200e3;
+  const Ensemble out = lab.run_ensemble(soft, like);
+  EXPECT_EQ(lab.runs(), 2);
+  EXPECT_EQ(lab.failed_runs(), 2);
+  EXPECT_EQ(lab.highest_failed_sigma3(), 200e3);
+  for (const auto& runs : out) EXPECT_FALSE(std::isfinite(runs.at(0).q_peak));
+  Model stiff;
+  stiff.law = cfg.ball;
+  lab.run_ensemble(stiff, like);
+  EXPECT_EQ(lab.runs(), 4);
+  EXPECT_EQ(lab.failed_runs(), 2) << "runs that end are not counted";
+}
+
 // The preparation friction is matched on the mean void ratio of the lab's first kStateMatchSpecimens specimens
 // (matched_state): the reached value reported is exactly their mean in the lab built from the matched config (one
 // specimen's would leave its own scatter, about 0.01, as an offset of all of them), packing them side by side gives
