@@ -143,11 +143,12 @@ struct Session {
   /// count as missing (kMissingResidual), which pushes the fit away from where they happen.
   std::string runs_text() const {
     const long read = lab.stored_runs_read();
-    return fmt("%ld runs", lab.runs()) + (read > 0 ? fmt(" (%ld of them read from the run store)", read) : "") +
+    return std::to_string(lab.runs()) + " runs" +
+           (read > 0 ? " (" + std::to_string(read) + " of them read from the run store)" : "") +
            (lab.failed_runs() > 0 ? "; WARNING: " + failed_text() : "");
   }
   std::string failed_text() const {
-    return fmt("%ld of the runs stopped at a blow-up", lab.failed_runs()) +
+    return std::to_string(lab.failed_runs()) + " of the runs stopped at a blow-up" +
            fmt(" (up to %g kPa), their data counted as missing: where the overlaps are the contacts' physics (soft "
                "contacts at high pressure), raise [solver] overlap_limit (docs/config.md)",
                1e-3 * lab.highest_failed_sigma3());
@@ -173,7 +174,8 @@ struct Session {
              "any difference in density.\n";
     std::string s = "The simulator's specimens were prepared to the data's void ratio " + fmt("%.4f", state.target) +
                     " (preparation friction " + fmt("%.4g", state.prep_mu_s) + ", which packs " +
-                    fmt("%.4f", state.reached) + fmt(" on the mean of its first %.0f", state.specimens) +
+                    fmt("%.4f", state.reached) +
+                    fmt(" on the mean of its first %.0f", static_cast<double>(state.specimens)) +
                     "). At the start of shear, measured and simulated (mean of the scatter specimens at the base "
                     "model):";
     for (std::size_t k = 0; k < tests.size(); ++k)

@@ -53,7 +53,8 @@ void measure_cell_bias(PeriodicLab& lab, const Model& base, const std::vector<Me
   }
   std::sort(share.begin(), share.end());
   const Real median = share.empty() ? 0 : share[share.size() / 2], top = share.empty() ? 0 : share.back();
-  std::string note = fmt("the simulator's cell: %.0f cells of ", kCellCheckSpecimens) + fmt("%.0f balls", factor * n) +
+  std::string note = fmt("the simulator's cell: %.0f cells of ", static_cast<double>(kCellCheckSpecimens)) +
+                     fmt("%.0f balls", factor * n) +
                      " at the base model" +
                      (state.tests > 0 ? fmt(" (prepared to e = %.4f", state.target) + fmt(", reached %.4f)", state.reached)
                                       : std::string()) +
