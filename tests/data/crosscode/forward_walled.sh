@@ -2,7 +2,7 @@
 # triaxdem's walled cell at the friction that generated walled_seed1.csv (mu_s 0.4, mu_r 0.04), at the data's rate
 # (I = 1e-3) and strain (15%), on 8 specimens per pressure (packing seeds 1-4, preparation friction 0.10 and 0.12, which
 # bracket the data's void ratios), then compare_forward.py: each compared quantity at the data's void ratio (a line
-# fitted over the 8), against the data and the specimens' scatter. About 2 minutes on 2 cores.
+# fitted over the 8), against the data and the specimens' scatter. About 5 minutes on 2 cores.
 #   tests/data/crosscode/forward_walled.sh [BUILD] [WORK]
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
