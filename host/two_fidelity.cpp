@@ -27,7 +27,12 @@ std::vector<Real> sample_variance(const Misfit& misfit, std::size_t k, const std
 
 Config reference_cell(const Config& base, const std::string& cli) {
   Config c = base;
-  if ((cli.empty() ? base.calibrate.reference_test : cli) == "walls") c.periodic.boundary = CellBoundary::walls;
+  if ((cli.empty() ? base.calibrate.reference_test : cli) == "walls") {
+    c.periodic.boundary = CellBoundary::walls;
+  } else if (!cli.empty()) {  // --reference-test periodic (or two_fidelity) asks for the periodic cell by name
+    c.periodic.boundary = CellBoundary::periodic;
+    c.box.periodic = {true, true, true};
+  }
   return c;
 }
 

@@ -22,8 +22,9 @@ struct Discrepancy {
 };
 
 /// The base config with the cell of the reference test: `cli` (--reference-test), else the base config's
-/// [calibrate] reference_test; "walls" puts the cell between six walls ([periodic] boundary, host/cell_boundary.hpp),
-/// the others keep the config's own boundary.
+/// [calibrate] reference_test; "walls" puts the cell between six walls ([periodic] boundary, host/cell_boundary.hpp);
+/// --reference-test periodic or two_fidelity makes it periodic; the config's own periodic or two_fidelity keep its
+/// boundary.
 Config reference_cell(const Config& base, const std::string& cli);
 
 /// Whether the calibration fits two fidelities: `cli` (--reference-test), else the base config's [calibrate]

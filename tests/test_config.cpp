@@ -271,8 +271,10 @@ TEST(Config, CalibrateFreeListIsRead) {
 
 // The cell's boundary and the reference test: [periodic] boundary "periodic" (default) or "walls"; [calibrate]
 // reference_test "walls" (or --reference-test walls) puts the calibration's cell between walls and leaves every
-// other setting as it was; "periodic" and "two_fidelity" keep the config's own boundary. Other words are refused
-// with the key and the allowed values.
+// other setting as it was; the config's "periodic" and "two_fidelity" keep its own boundary, and --reference-test
+// periodic (or two_fidelity) asks for the periodic cell by name, whatever the config's boundary (a walled config
+// calibrated against the periodic cell once ran between walls). Other words are refused with the key and the
+// allowed values.
 TEST(Config, TheCellsBoundaryAndTheWallsReferenceTest) {
   EXPECT_EQ(dem::Config().periodic.boundary, dem::CellBoundary::periodic);
   const dem::Config w = dem::load_config(write_config("walls.toml", "[periodic]\nboundary = \"walls\"\n"));
@@ -285,6 +287,13 @@ TEST(Config, TheCellsBoundaryAndTheWallsReferenceTest) {
   base.calibrate.reference_test = "two_fidelity";
   EXPECT_EQ(dem::reference_cell(base, "").periodic.boundary, dem::CellBoundary::periodic);
   EXPECT_EQ(dem::reference_cell(w, "").periodic.boundary, dem::CellBoundary::walls);
+  dem::Config walled_box = w;
+  walled_box.box.periodic = {false, false, false};
+  for (const char* cli : {"periodic", "two_fidelity"}) {
+    const dem::Config p = dem::reference_cell(walled_box, cli);
+    EXPECT_EQ(p.periodic.boundary, dem::CellBoundary::periodic) << cli;
+    EXPECT_TRUE(p.box.periodic[0] && p.box.periodic[1] && p.box.periodic[2]) << cli;
+  }
   const std::string e = error_of("[periodic]\nboundary = \"membrane\"\n");
   EXPECT_NE(e.find("bad.toml: [periodic] boundary"), std::string::npos) << e;
   EXPECT_NE(e.find("walls"), std::string::npos) << e;
