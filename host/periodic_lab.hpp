@@ -115,8 +115,9 @@ class PeriodicLab {
     Real sigma3;
     int member;
   };
-  /// The cases in order, up to jobs() at once; those in the run store are read. Counts the blown-up ones.
+  /// run_or_read, then the blown-up runs among them counted (failed_runs), whichever way each test came.
   std::vector<MeasuredTest> run_cases(const Model& m, const std::vector<Case>& cases);
+  /// The cases in order, up to jobs() at once; those in the run store are read.
   std::vector<MeasuredTest> run_or_read(const Model& m, const std::vector<Case>& cases);
   /// The run store's file of a case ("" without a store).
   std::string stored_path(const Model& m, const Case& c) const;
