@@ -104,6 +104,16 @@ struct EmptyFolderRemover {
   }
 };
 
+/// --predict walls, checked: the reference test must not be the walled cell already.
+bool walls_prediction_wanted(const Config& base, const CalibrationOptions& o) {
+  if (!predicts_walls(base, o.predict)) return false;
+  if (reference_cell(base, o.reference_test).periodic.boundary == CellBoundary::walls)
+    throw ConfigError((o.predict.empty() ? base.path + ": [calibrate] predict" : std::string("--predict")) +
+                      ": walls: the reference test is the cell between six walls already; predict a membrane test "
+                      "(a config of configs/small/) or none");
+  return true;
+}
+
 /// What calibrate and diagnose share: the data, the free parameters, the simulator and a new result folder.
 struct Session {
   MeasuredData data;
@@ -111,6 +121,8 @@ struct Session {
   std::vector<FreeParam> free;
   StateMatch state;  ///< the data's void ratio and the preparation that packs it
   std::optional<Config> predict_template;
+  bool walls_prediction = false;  ///< the prediction is the reference cell between six walls (kPredictWalls)
+  int jobs = 1;
   bool two_fidelity = false;  ///< the reference test: the periodic cell corrected by the membrane test
   std::string discrepancy;    ///< what the two fidelities measured, for the report
   PeriodicLab lab;
@@ -121,6 +133,7 @@ struct Session {
         ref(o.reference.empty() ? ReferenceValues{}
                                 : load_reference(o.reference, [](const std::string& n) { free_param(n); })),
         free(free_params(base, o.free)), predict_template(prediction_template(base, o.predict)),
+        walls_prediction(walls_prediction_wanted(base, o)), jobs(o.jobs),
         two_fidelity(two_fidelity_wanted(base, o.reference_test, predict_template.has_value())),
         lab(matched(reference_cell(base, o.reference_test), o.jobs), true, o.jobs),
         folder(o.resume.empty() ? new_dated_folder(o.output, kind) : resumed_folder(o.resume, kind)),
@@ -149,9 +162,9 @@ struct Session {
   }
   std::string failed_text() const {
     return std::to_string(lab.failed_runs()) + " of the runs stopped at a blow-up" +
-           fmt(" (up to %g kPa), their data counted as missing: where the overlaps are the contacts' physics (soft "
-               "contacts at high pressure), raise [solver] overlap_limit (docs/config.md)",
-               1e-3 * lab.highest_failed_sigma3());
+           fmt(" (up to %g kPa)", 1e-3 * lab.highest_failed_sigma3()) +
+           ", their data counted as missing: where the overlaps are the contacts' physics (soft contacts at high "
+           "pressure), raise [solver] overlap_limit (docs/config.md)";
   }
   std::vector<std::string> free_names() const {
     std::vector<std::string> names;
@@ -225,24 +238,32 @@ struct Session {
     auto v = m->second.find(name);
     return v == m->second.end() ? std::nan("") : v->second;
   }
-  /// The membrane test at each material's calibrated model (`models`, by material), beside the data: writes
-  /// prediction.csv, prediction_curves.csv and prediction.png, prints the table, and returns it as Markdown ("" when
-  /// there is no template).
-  std::string predict_membrane(const Config& base, const std::map<std::string, Calibrated>& models) const {
-    if (!predict_template) {
-      std::printf("%s: no membrane prediction ([calibrate] predict or --predict names a membrane test)\n",
+  /// The test with a boundary at each material's calibrated model (`models`, by material), beside the data: the
+  /// membrane test of the template or the walled cell. Writes prediction.csv, prediction_curves.csv and
+  /// prediction.png, prints the table, and returns it as Markdown ("" when there is no prediction).
+  std::string predict_boundary(const Config& base, const std::map<std::string, Calibrated>& models) const {
+    if (!predict_template && !walls_prediction) {
+      std::printf("%s: no prediction ([calibrate] predict or --predict names a membrane test, or walls)\n",
                   folder.c_str());
       return "";
     }
-    const Config& t = *predict_template;
+    std::optional<Config> walls;
+    if (walls_prediction) {
+      StateMatch walls_state;  // the walled cell's own preparation to the data's state
+      const Config cell = reference_cell(base, kPredictWalls);
+      walls = matched_state(cell, data.tests, walls_state, true, match_plan(cell, jobs));
+    }
+    const std::string test = walls ? walled_cell_text(*walls) : membrane_test_text(*predict_template);
+    const int specimens = static_cast<int>(base.calibrate.predict_specimens);
     std::vector<Prediction> all;
     std::vector<MeasuredTest> curves;
     for (const auto& [material, cal] : models) {
       const std::vector<MeasuredTest>& tests = cal.tests;
-      std::printf("%s: %s: predicting the membrane test (%s) at the calibrated parameters: %zu pressures x %ld "
-                  "specimens\n", folder.c_str(), material.c_str(), t.path.c_str(), tests.size(),
-                  base.calibrate.predict_specimens);
-      std::vector<Prediction> p = predict_at(base, cal.model, tests);
+      std::printf("%s: %s: predicting %s at the calibrated parameters: %zu pressures x %d specimens\n",
+                  folder.c_str(), material.c_str(), walls ? "the walled cell" : predict_template->path.c_str(),
+                  tests.size(), specimens);
+      std::vector<Prediction> p = walls ? predict_walls(*walls, cal.model, tests, specimens, jobs)
+                                        : predict_at(base, cal.model, tests);
       for (std::size_t k = 0; k < p.size() && k < cal.sim.size(); ++k) p[k].periodic_q_peak = cal.sim[k].q_peak;
       for (Prediction& x : p) {
         curves.insert(curves.end(), x.members.begin(), x.members.end());
@@ -251,12 +272,11 @@ struct Session {
     }
     const std::string md = prediction_markdown(all, data.q_measure);
     io::write_text_atomic(folder + "/prediction.csv", prediction_csv(all, data.q_measure));
-    write_measured_curves(folder + "/prediction_curves.csv", curves,
-                          "membrane tests predicted at the calibrated parameters, " + t.path,
+    write_measured_curves(folder + "/prediction_curves.csv", curves, test + " at the calibrated parameters",
                           name_of(data.q_measure));
-    std::printf("\nprediction (%s, the membrane test at the calibrated parameters):\n%s", t.path.c_str(), md.c_str());
+    std::printf("\nprediction (%s at the calibrated parameters):\n%s", test.c_str(), md.c_str());
     run_plot_script("plot_prediction.py", {folder});
-    return prediction_section(t, base.calibrate.predict_specimens, data.q_measure, md, discrepancy);
+    return prediction_section(test, specimens, data.q_measure, md, discrepancy);
   }
   /// The errors table, the curves in the measured-data format and the figure.
   void finish(const std::vector<MeasuredTest>& meas, const std::vector<MeasuredTest>& sim,
@@ -353,7 +373,7 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
   std::printf("calibrate: %s in %s; results in %s (calibrated.csv, errors.csv, simulated_curves.csv)\n",
               ss.runs_text().c_str(), format_duration(ss.lab.seconds()).c_str(), ss.folder.c_str());
   ss.finish(all_meas, all_sim, "the calibrated parameters");
-  const std::string prediction = ss.predict_membrane(base, models);
+  const std::string prediction = ss.predict_boundary(base, models);
   if (!prediction.empty()) io::write_text_atomic(ss.folder + "/prediction.md", prediction);
   return 0;
 }
@@ -466,7 +486,7 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
               format_duration(ss.lab.seconds()).c_str(), ss.folder.c_str());
   ss.finish(all_meas, all_sim, "the calibrated base model");
   // The report stands before the membrane tests run; their section is added when they end.
-  const std::string prediction = ss.predict_membrane(base, models);
+  const std::string prediction = ss.predict_boundary(base, models);
   if (!prediction.empty()) io::write_text_atomic(ss.folder + "/diagnosis.md", md.str() + "\n" + prediction);
   return 0;
 }

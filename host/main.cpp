@@ -172,9 +172,10 @@ int main(int argc, char** argv) {
                   "curves' own scatter), lab (a lab's fixed scatter) or a lab noise file like "
                   "configs/calibration/lab_noise.toml; default data")
         ->check(CLI::IsMember({"data", "lab"}) | CLI::ExistingFile);
-    c->add_option("--predict", cal.predict, "the membrane test to end with at the calibrated parameters: a config "
-                  "with [specimen] and [triaxial] (configs/small/ by default through [calibrate] predict; "
-                  "configs/paper/ for full scale), or none");
+    c->add_option("--predict", cal.predict, "the test with a boundary to end with at the calibrated parameters: a "
+                  "membrane test's config with [specimen] and [triaxial] (configs/small/ by default through "
+                  "[calibrate] predict; configs/paper/ for full scale), walls (the config's cell between six walls: "
+                  "the boundary's share of a walled test), or none");
     c->add_option("--resume", cal.resume, "continue in the result folder of an earlier run of this command on the "
                   "same data and config: the runs it stored are read, not run again")->check(CLI::ExistingDirectory);
     c->add_option("--reference-test", cal.reference_test, "what the calibration fits: periodic (the cell), walls "

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
+#include <stdexcept>
 
 #include "calibrate.hpp"
 #include "progress.hpp"
@@ -25,8 +27,13 @@ void check_prediction_template(const Config& membrane, const std::string& key) {
                       fmt("%g", kMinDiametersAcross) + " (" + fmt("%g", 1e3 * least) + " mm)");
 }
 
+bool predicts_walls(const Config& base, const std::string& cli) {
+  return (cli.empty() ? base.calibrate.predict : cli) == kPredictWalls;
+}
+
 std::optional<Config> prediction_template(const Config& base, const std::string& cli) {
-  if (cli == "none" || (cli.empty() && base.calibrate.predict.empty())) return std::nullopt;
+  if (cli == "none" || (cli.empty() && base.calibrate.predict.empty()) || predicts_walls(base, cli))
+    return std::nullopt;
   const std::string key = cli.empty() ? base.path + ": [calibrate] predict" : "--predict";
   const std::string path = cli.empty() ? (std::filesystem::path(base.path).parent_path() / base.calibrate.predict)
                                              .lexically_normal()
@@ -59,8 +66,7 @@ Config prediction_config(const Config& membrane, const Model& calibrated, const 
 std::vector<Prediction> predict(const Config& membrane, const Model& calibrated, const std::vector<std::string>& free,
                                 const std::vector<MeasuredTest>& tests, QMeasure measure, int specimens,
                                 const std::string& cache, bool verbose) {
-  std::vector<Prediction> out(tests.size());
-  for (std::size_t j = 0; j < tests.size(); ++j) out[j].measured = tests[j];
+  Ensemble runs(tests.size());
   Progress progress("prediction: membrane tests", static_cast<long>(tests.size() * specimens));
   long done = 0;
   for (int k = 0; k < specimens; ++k) {
@@ -77,13 +83,23 @@ std::vector<Prediction> predict(const Config& membrane, const Model& calibrated,
       t.replicate = std::to_string(k + 1);
       t.void_ratio = r.void_ratio_consolidated;
       t.specimen_balls = static_cast<Real>(sp.balls.size());
-      out[j].members.push_back(t);
+      runs[j].push_back(t);
       if (verbose)
         progress.update(++done, t.material + " at " + fmt("%g kPa", 1e-3 * t.sigma3) + ", specimen " + t.replicate +
                                     ": q_peak " + fmt("%.1f kPa", 1e-3 * t.q_peak));
     }
   }
   if (verbose) progress.finish("");
+  return predictions_of(tests, std::move(runs));
+}
+
+std::vector<Prediction> predictions_of(const std::vector<MeasuredTest>& tests, Ensemble runs) {
+  if (runs.size() != tests.size()) throw std::logic_error("predictions_of: runs for other tests than those given");
+  std::vector<Prediction> out(tests.size());
+  for (std::size_t j = 0; j < tests.size(); ++j) {
+    out[j].measured = tests[j];
+    out[j].members = std::move(runs[j]);
+  }
   for (Prediction& p : out) {
     Real sum = 0, sum2 = 0;
     for (const MeasuredTest& t : p.members) sum += t.q_peak;
@@ -94,6 +110,19 @@ std::vector<Prediction> predict(const Config& membrane, const Model& calibrated,
     p.error = (p.q_peak_mean - p.measured.q_peak) / p.measured.q_peak;
   }
   return out;
+}
+
+std::vector<Prediction> predict_walls(const Config& walls, const Model& calibrated,
+                                      const std::vector<MeasuredTest>& tests, int specimens, int jobs) {
+  PeriodicLab lab(walls, false, specimens, walls.run.seed, specimens, jobs);
+  lab.set_progress("prediction: walled cells");
+  Ensemble runs = lab.run_ensemble(calibrated, tests);
+  for (std::size_t j = 0; j < tests.size(); ++j)
+    for (std::size_t k = 0; k < runs[j].size(); ++k) {
+      runs[j][k].material = tests[j].material;
+      runs[j][k].replicate = std::to_string(k + 1);
+    }
+  return predictions_of(tests, std::move(runs));
 }
 
 namespace {
@@ -126,8 +155,16 @@ std::string prediction_markdown(const std::vector<Prediction>& p, QMeasure measu
           (cell ? fmt("%.0f%%", 100 * boundary_share(x)) : "-") + " |\n";
   }
   const auto [mean, most] = error_summary(p);
-  return md + "\nq as the data report it: " + name_of(measure) + ". Mean |error| " + fmt("%.1f%%", 100 * mean) +
-         ", at most " + fmt("%.1f%%", 100 * most) + ".\n";
+  md += "\nq as the data report it: " + std::string(name_of(measure)) + ". Mean |error| " + fmt("%.1f%%", 100 * mean) +
+        ", at most " + fmt("%.1f%%", 100 * most) + ".";
+  Real low = std::numeric_limits<Real>::infinity(), high = -low;
+  for (const Prediction& x : p)
+    if (std::isfinite(x.periodic_q_peak)) low = std::min(low, boundary_share(x)), high = std::max(high, boundary_share(x));
+  if (low <= high)
+    md += " The boundary's share of the predicted q_peak is " + fmt("%.0f", 100 * low) + " to " +
+          fmt("%.0f%%", 100 * high) + ": what the test's boundary adds to what the grains carry, which a calibration "
+          "on the periodic cell against such data puts into the contact parameters.";
+  return md + "\n";
 }
 
 std::string prediction_csv(const std::vector<Prediction>& p, QMeasure measure) {
@@ -144,17 +181,27 @@ std::string prediction_csv(const std::vector<Prediction>& p, QMeasure measure) {
   return csv;
 }
 
-std::string prediction_section(const Config& membrane, long specimens, QMeasure measure, const std::string& markdown,
-                               const std::string& discrepancy) {
+std::string membrane_test_text(const Config& membrane) {
   const long across = static_cast<long>(membrane.specimen.diameter / membrane.particles.diameter);
-  return "## Prediction: the membrane test\n\nThe calibration's periodic cell measures the grains inside a specimen, "
-         "free of any boundary; the lab measured a membrane-confined cylinder at its platens (q as " +
-         std::string(name_of(measure)) + "). The membrane test of " + membrane.path + " (" + std::to_string(across) +
-         " particle diameters across) run at each material's calibrated parameters and each pressure of the data, on " +
+  return "The membrane test of " + membrane.path + " (" + std::to_string(across) + " particle diameters across, q "
+         "at its platens as a lab measures it)";
+}
+
+std::string walled_cell_text(const Config& walls) {
+  return "The cell of " + walls.path + " between six walls (" + std::to_string(walls.particles.count) +
+         " balls prepared to the data's state, every stress a wall's force over its face, as a walled test measures "
+         "it)";
+}
+
+std::string prediction_section(const std::string& test, long specimens, QMeasure measure, const std::string& markdown,
+                               const std::string& discrepancy) {
+  return "## Prediction: the test with a boundary\n\nThe calibration's periodic cell measures the grains inside a "
+         "specimen, free of any boundary; the data were measured at a boundary (q as " + std::string(name_of(measure)) +
+         "). " + test + ", run at each material's calibrated parameters and each pressure of the data, on " +
          std::to_string(specimens) + " specimens (prediction.csv, prediction_curves.csv):\n\n" + markdown +
          (discrepancy.empty() ? "" : "\nTwo fidelities: the periodic cell was calibrated again to the data less the "
                                      "membrane test's excess over it at the first optimum:\n\n" + discrepancy) +
-         "\n![predicted membrane tests beside the data](prediction.png)\n";
+         "\n![predicted tests beside the data](prediction.png)\n";
 }
 
 }  // namespace dem

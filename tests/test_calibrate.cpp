@@ -179,31 +179,6 @@ TEST(Calibrate, MeasuredCurvesRoundTrip) {
   EXPECT_EQ(d.tests[0].sigma3, 200e3);
 }
 
-namespace {
-// A tiny periodic cell: 100 balls sheared to 1%, a few seconds a run. 100 balls: consolidated and sheared, the
-// cell's side is about 1.19 times the 3 contact cut-offs a periodic cell needs. 64 balls (1.03) ended 0.1% short of
-// it in the sanitizer build, whose rounding differs; the config check now refuses them
-// (PeriodicCell.TooFewBallsForTheCellAreRefused).
-Config tiny_cell() {
-  Config cfg;
-  cfg.particles.count = 100;
-  cfg.particles.diameter = 2e-3;
-  const Real L = std::cbrt(100 * M_PI / 6 * 8e-9 / 0.1);  // loose: insertion keeps off the seams of a small box
-  cfg.box.size = {L, L, L};
-  cfg.box.periodic = {true, true, true};
-  cfg.solver.gravity = {0, 0, 0};
-  cfg.solver.damping = 0.7;
-  cfg.solver.dt_safety = 0.2;
-  cfg.ball.mu_s = 0.3;
-  cfg.periodic.prep_mu_s = 0;
-  cfg.periodic.prep_unbalanced_tolerance = 5e-2;
-  cfg.periodic.triax.consolidation_rate = 100;
-  cfg.periodic.triax.target_strain = 0.01;
-  cfg.periodic.triax.target_inertial = 1e-3;
-  cfg.periodic.triax.record_strain = 0.001;
-  return cfg;
-}
-}  // namespace
 
 // Parallel runs (child processes) give the same tests as runs one at a time, bit for bit: each child runs the
 // same specimen and law as the parent would, for each member of a two-specimen ensemble; and specimens packed in
@@ -211,7 +186,7 @@ Config tiny_cell() {
 // It runs at one thread only (tests/CMakeLists.txt): with two, set_jobs refuses (forking a multithreaded OpenMP
 // process is unsafe) and both paths would be the in-process one.
 TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
-  const Config cfg = tiny_cell();
+  const Config cfg = test::tiny_cell_config();
   PeriodicLab lab(cfg, false, 2, 1);
   Model m;
   m.law = cfg.ball;
@@ -254,7 +229,7 @@ TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
 // overlap guard, silently). Contacts 10^5 times softer than the specimen was packed with overlap by far more than
 // the 10% guard as soon as sigma3 loads them; the packing's own contacts run at the config's stiffness.
 TEST(Calibrate, BlownUpRunsAreCountedWithTheirPressure) {
-  const Config cfg = tiny_cell();
+  const Config cfg = test::tiny_cell_config();
   PeriodicLab lab(cfg, false, 1, 1);
   Model soft;
   soft.law = cfg.ball;
@@ -280,7 +255,7 @@ TEST(Calibrate, BlownUpRunsAreCountedWithTheirPressure) {
 // the same friction, and the bisection ends nearer the target than either end of the friction's range; a lab of a
 // fixed larger cell is matched on its own cells.
 TEST(Calibrate, StateIsMatchedOnTheMeanOfTheLabsFirstSpecimens) {
-  const Config cfg = tiny_cell();
+  const Config cfg = test::tiny_cell_config();
   MatchPlan plan = match_plan(cfg, 1);
   plan.steps = 4;
   const auto [e0, e1] = preparation_reach(cfg, plan);
@@ -340,7 +315,7 @@ TEST(Calibrate, StateIsMatchedOnTheMeanOfTheLabsFirstSpecimens) {
 // then sees (no real packing gives exactly the target).
 TEST(Calibrate, AMatchNearAKnownFrictionBracketsItAndStoresItsPackings) {
   namespace fs = std::filesystem;
-  const Config cfg = tiny_cell();
+  const Config cfg = test::tiny_cell_config();
   MatchPlan plan = match_plan(cfg, 1);
   plan.steps = 4;
   plan.store = (dem::test::scratch_dir("match_store") / "full").string();
@@ -382,7 +357,7 @@ TEST(Calibrate, AMatchNearAKnownFrictionBracketsItAndStoresItsPackings) {
 // The cell's bias, which measure_misfit measures next on cells of four times the balls, is left out: it does not
 // bear on the choice and would cost more than the rest of the test.
 TEST(Calibrate, AutoCellGrowsWhereAllScatterSpecimensFallShort) {
-  Config cfg = tiny_cell();
+  Config cfg = test::tiny_cell_config();
   cfg.periodic.triax.target_strain = 0.005;  // the scatter at small strain is enough to decide
   cfg.calibrate.scatter_specimens = 2;
   Model m;
@@ -431,7 +406,7 @@ TEST(Calibrate, AutoCellGrowsWhereAllScatterSpecimensFallShort) {
 // measure_misfit measures the cell's bias on 4 cells of 4 times the balls and says so in the report's words; a data
 // specimen of the simulator's own size has no bias against it, whatever the cells show (host/cell_bias.hpp).
 TEST(Calibrate, MeasureMisfitCountsTheCellsBias) {
-  Config cfg = tiny_cell();
+  Config cfg = test::tiny_cell_config();
   cfg.periodic.triax.target_strain = 0.005;
   cfg.calibrate.scatter_specimens = 2;
   cfg.calibrate.ensemble = 2;

@@ -325,6 +325,20 @@ TEST(CliEdges, ARefusedCalibrationLeavesNoFolder) {
   EXPECT_TRUE(fs::is_empty(dir / "out")) << "a refused calibration left its dated folder";
 }
 
+// A prediction of the walled cell beside a walled reference would compare the cell with itself: refused before any
+// run or folder, naming the option and what to give instead.
+TEST(CliEdges, AWalledPredictionOfAWalledCalibrationIsRefused) {
+  const fs::path dir = dem::test::scratch_dir("cli_predict_walls");
+  std::ofstream(dir / "d.csv") << "material,sigma3_kPa,eps_a_pct,q_kPa,eps_v_pct\n"
+                                  "A,100,0,0,0\nA,100,1,60,0.1\nA,100,2,70,-0.1\nA,100,3,65,-0.3\n";
+  const Outcome o = triaxdem("calibrate " + (dir / "d.csv").string() + " --config tests/data/hidden_effects.toml "
+                             "--reference-test walls --predict walls -j 1 -o " + (dir / "out").string(), dir);
+  EXPECT_EQ(o.code, 1) << o.output;
+  EXPECT_NE(o.output.find("--predict: walls: the reference test is the cell between six walls already"),
+            std::string::npos) << o.output;
+  EXPECT_FALSE(fs::exists(dir / "out") && !fs::is_empty(dir / "out")) << "a refused calibration left a folder";
+}
+
 // The periodic job's time line read "membrane 0.0 s, walls 22.8 s" for a cell with neither: the stage is called
 // boundaries (the cell's stretch, walls or membrane nodes), and the membrane's time shows only where it ran.
 TEST(CliEdges, TheTimeLineNamesOnlyStagesThatRan) {

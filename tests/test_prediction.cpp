@@ -12,6 +12,7 @@
 #include "host/io_hdf5.hpp"
 #include "host/prediction.hpp"
 #include "host/triaxial.hpp"
+#include "host/two_fidelity.hpp"
 #include "test_util.hpp"
 
 using namespace dem;
@@ -114,4 +115,44 @@ TEST(Prediction, EachPressureIsTheMembraneTestAtTheCalibratedParameters) {
                           dir.string() + " > /dev/null";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
   EXPECT_TRUE(std::filesystem::exists(dir / "prediction.png"));
+}
+
+// A periodic calibration of data from a walled test ends with the walled cell at the calibrated parameters
+// (--predict walls): each member is the walled cell's own run there, bit for bit, labelled with the data's material,
+// the mean and sample sd are over the members, and the table gives the walls' share against the periodic cell's
+// q_peak with its range in words.
+TEST(Prediction, TheWalledPredictionIsTheWalledCellsRunsAtTheCalibratedPoint) {
+  const Config walls = reference_cell(test::tiny_cell_config(), kPredictWalls);
+  ASSERT_EQ(walls.periodic.boundary, CellBoundary::walls);
+  Model m{walls.ball, 0};
+  set_param(m, "mu_s", 0.4);
+  std::vector<MeasuredTest> data(2);
+  for (int k = 0; k < 2; ++k) {
+    data[k].material = "W";
+    data[k].sigma3 = 100e3 * (k + 1);
+    data[k].q_peak = 150e3 * (k + 1);
+  }
+  std::vector<Prediction> p = predict_walls(walls, m, data, 2, 1);
+  ASSERT_EQ(p.size(), 2u);
+  PeriodicLab lab(walls, false, 2, walls.run.seed, 2, 1);
+  for (int k = 0; k < 2; ++k) {
+    ASSERT_EQ(p[k].members.size(), 2u);
+    const MeasuredTest a = lab.run(m, data[k].sigma3, "W", 0), b = lab.run(m, data[k].sigma3, "W", 1);
+    ASSERT_GT(a.q.size(), 5u);
+    EXPECT_EQ(p[k].members[0].q, a.q);
+    EXPECT_EQ(p[k].members[1].q, b.q);
+    EXPECT_NE(a.q, b.q) << "two specimens";
+    EXPECT_EQ(p[k].members[1].material, "W");
+    EXPECT_EQ(p[k].members[1].replicate, "2");
+    EXPECT_DOUBLE_EQ(p[k].q_peak_mean, (a.q_peak + b.q_peak) / 2);
+    EXPECT_NEAR(p[k].q_peak_sd, std::fabs(a.q_peak - b.q_peak) / std::sqrt(2.0), 1e-9 * a.q_peak);
+    EXPECT_DOUBLE_EQ(p[k].error, (p[k].q_peak_mean - data[k].q_peak) / data[k].q_peak);
+  }
+  p[0].periodic_q_peak = 0.8 * p[0].q_peak_mean;  // the walls carry a fifth of the first, a third of the second
+  p[1].periodic_q_peak = (2.0 / 3) * p[1].q_peak_mean;
+  const std::string md = prediction_markdown(p, QMeasure::kFixedArea);
+  EXPECT_NE(md.find("| 20% |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| 33% |"), std::string::npos) << md;
+  EXPECT_NE(md.find("The boundary's share of the predicted q_peak is 20 to 33%"), std::string::npos) << md;
+  EXPECT_NE(walled_cell_text(walls).find("between six walls (100 balls"), std::string::npos);
 }

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
-"""Draws the membrane tests that `triaxdem calibrate` and `diagnose` predict at the calibrated parameters beside
-the data, as the paper's Figure 8 sets its lab curves beside its simulations: one column per material, q (top)
+"""Draws the tests (membrane or walled) that `triaxdem calibrate` and `diagnose` predict at the calibrated parameters
+beside the data, as the paper's Figure 8 sets its lab curves beside its simulations: one column per material, q (top)
 and eps_v (bottom) against axial strain; each pressure one colour, each predicted specimen a line, the data as
 dots (curves) or as a star at each measured peak (summary data, at the predicted peak's strain where the data
 give none). Writes FOLDER/prediction.png.
@@ -63,7 +63,8 @@ def main():
     ax[1][0].set_ylabel("volumetric strain eps_v (%, contraction +)")
     for a in ax[0]:
         a.legend(fontsize=7)
-    fig.suptitle("membrane test at the calibrated parameters (lines), the data (marks)", fontsize=9)
+    fig.suptitle("the predicted test (membrane or walled) at the calibrated parameters (lines), the data (marks)",
+                 fontsize=9)
     fig.tight_layout()
     out = args.output or os.path.join(args.folder, "prediction.png")
     fig.savefig(out, dpi=130)
