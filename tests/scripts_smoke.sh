@@ -54,6 +54,10 @@ grep -q "^| tiny_triaxial | " "$work/doc.md" && grep -q "^kept$" "$work/doc.md" 
 check tools/plot_calibration.py "$py" "$root/tools/plot_calibration.py" "$cal" -o "$work/calibration.png"
 check tools/plot_prediction.py "$py" "$root/tools/plot_prediction.py" "$cal" -o "$work/prediction.png"
 exists "$work/calibration.png" "$work/prediction.png"
+check tools/sweep_table.py "$py" "$root/tools/sweep_table.py" \
+  --level lab="$root/data/sweeps/hidden_sweep_lab_cellbias_seeds1-6.csv"
+grep -q "identifiable cases named right: \*\*14 of 14\*\*" "$work/sweep_table.py.log" ||
+  { cat "$work/sweep_table.py.log"; echo "scripts_smoke: sweep_table miscounted the shipped lab-like sweep" >&2; exit 1; }
 
 check perf/scaling.sh env BUILD="$build" WORK="$work/scaling" K=4 STEPS=20 bash "$root/perf/scaling.sh"
 check perf/device_check.sh bash -c "TINY=1 CPU_BUILD='$build' bash '$root/perf/device_check.sh' prepare '$work/dc_ref' &&
