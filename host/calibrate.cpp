@@ -403,6 +403,18 @@ std::vector<std::string> CalibrationResult::inseparable() const {
   return out;
 }
 
+void adopt_best(CalibrationResult& r, const Evaluation& better, const Model& base) {
+  r.design.push_back(better);
+  r.best = better;
+  r.model = base;
+  r.values.clear();
+  for (std::size_t k = 0; k < r.free.size(); ++k) {
+    r.values.push_back(r.free[k].value(better.u[k]));
+    set_param(r.model, r.free[k].name, r.values.back());
+  }
+  add_uncertainty(r);
+}
+
 long planned_points(int d, int rounds) {
   long design = 1;
   for (int k = 0; k < d; ++k) design *= 3;

@@ -149,6 +149,11 @@ CalibrationResult calibrate(const Simulator& simulate, const Model& base, const 
 CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,
                             const std::vector<MeasuredTest>& measured, const Misfit& misfit, int rounds = 4,
                             const CalibrationProgress& progress = {}, int widen = 2);
+/// A run of the base model found after the calibration (a nested model's run at strength 0) that beats its best:
+/// it joins the design and becomes the best, and the values, the model (`base` with them) and the uncertainty are
+/// computed again at it, so that the intervals and correlation belong to the reported point.
+void adopt_best(CalibrationResult& r, const Evaluation& better, const Model& base);
+
 /// Parameter points a calibration of d free parameters runs at most before any widening: the design, the
 /// surrogate rounds and the compass stage (for a progress bar's plan).
 long planned_points(int d, int rounds = 4);

@@ -138,9 +138,10 @@ Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreePa
   const int n = dg.base.data;
   dg.chi2_limit = n > d ? chi2_quantile(n - d, kZ99) : 0;  // no degrees of freedom: any misfit is too much
   dg.base_bic = bic(dg.base.best.chi2, d, n);
-  // The base surfaces, shifted to agree with the best run where they are used most.
+  // The base surfaces, shifted to agree with the best run where they are used most (set again where a nested
+  // run becomes the base fit, below).
   std::vector<QuadraticSurface> surf = response_surfaces(dg.base.design, dg.base.best.u);
-  const std::vector<Real> at_best = evaluate_surfaces(surf, dg.base.best.u);
+  std::vector<Real> at_best = evaluate_surfaces(surf, dg.base.best.u);
   auto base_model = [&](const std::vector<Real>& u) {
     std::vector<Real> r = evaluate_surfaces(surf, u);
     for (std::size_t i = 0; i < r.size(); ++i) r[i] += dg.base.best.r[i] - at_best[i];
@@ -225,21 +226,19 @@ Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreePa
                   "the base calibration's %.1f: it is the base fit", base_runs.chi2, dg.base.best.chi2);
     dg.notes.push_back(note);
     say("diagnose: %s\n", note);
-    dg.base.best = base_runs;
-    dg.base.values.clear();
-    dg.base.model = base;
-    for (int k = 0; k < d; ++k) {
-      dg.base.values.push_back(free[k].value(base_runs.u[k]));
-      set_param(dg.base.model, free[k].name, dg.base.values[k]);
-    }
+    adopt_best(dg.base, base_runs, base);
+    surf = response_surfaces(dg.base.design, dg.base.best.u);
+    at_best = evaluate_surfaces(surf, dg.base.best.u);
     dg.base_bic = bic(dg.base.best.chi2, d, n);
+    dg.base_heldout = heldout_chi2(base_model, d, measured, base_at, lab, misfit);
     for (ExtensionFit& f : dg.fits)
-      if (f.best.chi2 > dg.base.best.chi2) {
+      if (f.best.chi2 > dg.base.best.chi2) {  // now at the base point: its values and held-out chi2 are the base's
         f.best = dg.base.best;
         f.strength = 0;
         f.values = dg.base.values;
         f.values.push_back(0);
         f.bic = bic(f.best.chi2, d + 1, n);
+        f.heldout = dg.base_heldout;
       }
   }
 

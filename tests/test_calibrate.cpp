@@ -494,3 +494,49 @@ TEST(Calibrate, SearchFindsAValleyTheSurfacesMiss) {
   EXPECT_EQ(static_cast<long>(r.design.size()), runs) << "every run is counted";
   EXPECT_LT(r.flat_share(), 0.25) << "the valley is a defined minimum";
 }
+
+// A diagnosis that finds a better run of the base model after the calibration (an extension fit's run at strength
+// 0) reported that run's values with the intervals, correlation and surfaces of the old best point. adopt_best
+// makes the run the best and computes the uncertainty again at it: the surrogate agrees with the new run there,
+// the intervals hold the new values, and they are those of a calibration whose best run it had been.
+TEST(Calibrate, ABetterBaseRunFoundLaterCarriesItsOwnIntervals) {
+  Model base;
+  base.law.mu_s = 0.3;
+  base.law.mu_r = 0.02;
+  const std::vector<FreeParam> free{free_param("mu_s", base), free_param("mu_r", base)};
+  constexpr int kData = 6;
+  // A smooth bowl in the unit coordinates: residuals linear in (x, y), chi2 minimal at (0.3, 0.4).
+  const Simulator simulate = [&](const Model& m) {
+    const Real x = free[0].unit(m.law.mu_s), y = free[1].unit(m.law.mu_r);
+    SimulatedPoint s;
+    for (int i = 0; i < kData; ++i)
+      s.r.push_back(0.5 + 4 * (x - 0.3) * (i % 2 ? 1 : 0.5) + 3 * (y - 0.4) * (i % 3 ? 1 : -1));
+    return s;
+  };
+  CalibrationResult r = calibrate(simulate, base, free, kData);
+  const std::vector<std::pair<Real, Real>> old_interval = r.interval;
+  // A run elsewhere, better than the best: the bowl's residuals there, a hundredth of them (a run with less of the
+  // specimens' scatter, say).
+  Evaluation better;
+  better.u = {0.6, 0.7};
+  Model at = base;
+  set_param(at, "mu_s", free[0].value(0.6));
+  set_param(at, "mu_r", free[1].value(0.7));
+  better.r = simulate(at).r;
+  better.chi2 = 0;
+  for (Real& v : better.r) v *= 0.01, better.chi2 += v * v;
+  ASSERT_LT(better.chi2, r.best.chi2);
+  const std::size_t runs = r.design.size();
+  adopt_best(r, better, base);
+  EXPECT_EQ(r.design.size(), runs + 1);
+  EXPECT_EQ(r.best.u, better.u);
+  EXPECT_DOUBLE_EQ(r.values[0], free[0].value(0.6));
+  EXPECT_DOUBLE_EQ(r.model.law.mu_r, free[1].value(0.7));
+  EXPECT_NEAR(r.surrogate_chi2(r.best.u), better.chi2, 1e-9) << "the surrogate is shifted to the new best run";
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_LE(r.interval[k].first, r.values[k]) << free[k].name;
+    EXPECT_GE(r.interval[k].second, r.values[k]) << free[k].name;
+    EXPECT_FALSE(old_interval[k].first <= r.values[k] && r.values[k] <= old_interval[k].second)
+        << free[k].name << ": the old interval held the new value, so this test could not tell them apart";
+  }
+}
