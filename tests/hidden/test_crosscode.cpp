@@ -12,6 +12,7 @@
 #include "host/config.hpp"
 #include "host/diagnose.hpp"
 #include "host/measured.hpp"
+#include "host/prediction.hpp"
 #include "host/two_fidelity.hpp"
 
 using namespace dem;
@@ -99,5 +100,42 @@ INSTANTIATE_TEST_SUITE_P(LongYade, CrossCode,
                                            CrossCase{"walled", "walled_seed1.csv", "walled_base.toml", "none", 1,
                                                      true}),
                          case_name);
+
+// Outside the suite's budget too: the walled data calibrated against the periodic cell, as a user who does not know
+// the data had walls would, and the walled cell run at that optimum (`--predict walls`). The periodic cell measures
+// no boundary, so the calibration puts the walls' looser layer and stress measure into friction, and the walled
+// test at the calibrated friction reads far above the data: the report states that share. On 27 November (1000
+// balls, box 28 mm for random insertion, 2 cores, 10 minutes) the cell gave mu_s 0.844 [0.625, 0.914], mu_r 0.062,
+// chi2 172 on 60 data, and the walled cell there read 255, 511 and 767 kPa at 100, 200 and 300 kPa against the
+// data's 136, 298 and 433 (+72 to +88%), the walls' share 40-46% of its q_peak. The bounds below, a share of a
+// fifth and an excess of a fifth, are half of what was seen: the members' scatter (7-19 kPa) is a few % of q, so
+// anything under a fifth would mean the cell and the walled test measure about the same, which is what this
+// test must rule out.
+TEST(LongWalledData, APeriodicCalibrationStatesTheWallsShare) {
+  const std::string dir = std::string(TRIAXDEM_SOURCE_DIR) + "/tests/data/crosscode/";
+  const MeasuredData data = load_measured(dir + "walled_seed1.csv");
+  Config periodic = reference_cell(load_config(dir + "walled_base.toml"), "periodic");
+  periodic.box.size = {28e-3, 28e-3, 28e-3};  // random insertion of 1000 balls needs room in a periodic box
+  StateMatch state;
+  const Config cfg = matched_state(periodic, data.tests, state, false, match_plan(periodic, 2));
+  PeriodicLab lab(cfg, false, 2);
+  const Model base = model_of(cfg);
+  const std::vector<FreeParam> free{free_param("mu_s", base), free_param("mu_r", base)};
+  const CalibrationResult r = calibrate(lab, base, free, data.tests, measure_misfit(lab, base, data.tests,
+                                                                                      NoiseOptions()));
+  StateMatch walls_state;
+  const Config cell = reference_cell(periodic, kPredictWalls);
+  const Config walls = matched_state(cell, data.tests, walls_state, false, match_plan(cell, 2));
+  std::vector<Prediction> p = predict_walls(walls, r.model, data.tests, 2, 2);
+  ASSERT_EQ(p.size(), r.best.sim.size());
+  for (std::size_t k = 0; k < p.size(); ++k) p[k].periodic_q_peak = r.best.sim[k].q_peak;
+  std::printf("periodic calibration of walled data: mu_s %.4g [%.4g, %.4g], mu_r %.4g, chi2 %.1f\n%s", r.values[0],
+              r.interval[0].first, r.interval[0].second, r.values[1], r.best.chi2,
+              prediction_markdown(p, data.q_measure).c_str());
+  for (const Prediction& x : p) {
+    EXPECT_GT((x.q_peak_mean - x.periodic_q_peak) / x.q_peak_mean, 0.2) << x.measured.sigma3 << " Pa";
+    EXPECT_GT(x.error, 0.2) << x.measured.sigma3 << " Pa: the walled test at the periodic optimum";
+  }
+}
 
 }  // namespace
