@@ -18,17 +18,31 @@ Progress::Progress(std::string what, long total, long first)
     : what_(std::move(what)), total_(total), first_(first), tty_(isatty(fileno(stdout)) != 0),
       start_(std::chrono::steady_clock::now()), last_(start_) {}
 
-void Progress::update(long done, const std::string& extra) {
+bool Progress::due(int decile) {
   const auto now = std::chrono::steady_clock::now();
-  const double frac = total_ > 0 ? static_cast<double>(done) / total_ : 1.0;
-  const int decile = static_cast<int>(frac * 10);
   // A terminal line is rewritten twice a second; a log gets a line per tenth of the work, and at least one
   // every 30 s so that a long stage (a settling layer) still shows its state.
   const double since = std::chrono::duration<double>(now - last_).count();
-  if (tty_ ? since < 0.5 : decile == last_decile_ && since < 30) return;
+  if (tty_ ? since < 0.5 : decile == last_decile_ && since < 30) return false;
   last_ = now;
   last_decile_ = decile;
-  const double elapsed = std::chrono::duration<double>(now - start_).count();
+  return true;
+}
+
+void Progress::settling(const std::string& extra) {
+  // Its own "tenth" (-2: update's are 0 and up, the first -1): the first settling line is due at once, as the line
+  // before it promised an ETA that no longer holds, and a log then gets one every 30 s.
+  if (!due(-2)) return;
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  std::printf("%s%s %ld/%ld (100%%) elapsed %s, no ETA: %s%s", tty_ ? "\r" : "", what_.c_str(), total_, total_,
+              format_duration(elapsed).c_str(), extra.c_str(), tty_ ? "   " : "\n");
+  std::fflush(stdout);
+}
+
+void Progress::update(long done, const std::string& extra) {
+  const double frac = total_ > 0 ? static_cast<double>(done) / total_ : 1.0;
+  if (!due(static_cast<int>(frac * 10))) return;
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   if (done > total_) {  // past the plan (a search that widens its range): no ETA to give, but the line goes on
     std::printf("%s%s %ld, beyond the %ld planned; elapsed %s %s%s", tty_ ? "\r" : "", what_.c_str(), done, total_,
                 format_duration(elapsed).c_str(), extra.c_str(), tty_ ? "   " : "\n");

@@ -13,6 +13,9 @@ class Progress {
   /// Reports `done` of `total`; `extra` is appended (e.g. current unbalanced-force ratio). Past `total` the line
   /// says so, without an ETA.
   void update(long done, const std::string& extra = "");
+  /// The planned work is done, but the stage goes on until a condition holds (a layer settling): the line shows
+  /// the time so far and `extra` (what it waits for, and any bound), with no ETA.
+  void settling(const std::string& extra);
   void finish(const std::string& extra = "");
 
  private:
@@ -20,6 +23,8 @@ class Progress {
   long total_, first_;
   bool tty_;
   int last_decile_ = -1;
+  /// Whether a line is due now (twice a second on a terminal; in a log, at a new tenth of the work or after 30 s).
+  bool due(int decile);
   std::chrono::steady_clock::time_point start_, last_;
 };
 

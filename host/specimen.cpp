@@ -76,12 +76,19 @@ std::pair<long, Real> compact(Simulation& sim, Real z_target, const SpecimenConf
                          "the next run builds the specimen again", 128 + StopSignals::signal());
       ratio = sim.unbalanced_ratio();
       if (progress) {
-        // At its height the platen has no travel left to report: the line says the layer settles, and until when.
-        char extra[96];
-        std::snprintf(extra, sizeof extra, "%s, unbalanced ratio %.1e (stop at %.0e)",
-                      z - z_target < 1e-9 ? "platen at its height, settling" : "(um of platen travel)", ratio,
-                      sc.stop_ratio);
-        progress->update(std::lround((z_start - z) * 1e6), extra);
+        // At its height the platen has no travel left to report, and the unbalanced ratio does not fall steadily
+        // enough to extrapolate: the line says what the layer waits for and the step cap that bounds it.
+        char extra[160];
+        if (z - z_target < 1e-9) {
+          std::snprintf(extra, sizeof extra, "platen at its height, settling until the unbalanced ratio is below "
+                        "%.0e (now %.1e), at most %ld steps more (the layer's step cap)", sc.stop_ratio, ratio,
+                        sc.max_steps_per_layer - s);
+          progress->settling(extra);
+        } else {
+          std::snprintf(extra, sizeof extra, "(um of platen travel), unbalanced ratio %.1e (stop at %.0e)", ratio,
+                        sc.stop_ratio);
+          progress->update(std::lround((z_start - z) * 1e6), extra);
+        }
       }
       const bool blocked = load > 0.9;
       // Pressed to its height (or as far as it goes, nearly at rest): friction now only helps the layer come

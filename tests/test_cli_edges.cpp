@@ -255,6 +255,21 @@ TEST(CliEdges, ProgressPastItsPlanSaysSo) {
   EXPECT_EQ(out.find("12/10"), std::string::npos) << out;
 }
 
+// A specimen layer printed "12000/12000 (100%) ETA 0m00s" for 20-30 s while it settled (the platen at its height,
+// the unbalanced ratio going up and down): a settling stage gives no ETA, says what it waits for, and its first
+// line comes at once.
+TEST(CliEdges, ASettlingStageGivesNoETA) {
+  testing::internal::CaptureStdout();
+  dem::Progress p("specimen layer 3/5", 12000);
+  p.update(12000, "(um of platen travel)");
+  p.settling("settling until the unbalanced ratio is below 1e-03 (now 4.5e-03)");
+  p.settling("not due yet: a log gets one line a tenth or every 30 s");
+  const std::string out = testing::internal::GetCapturedStdout();
+  EXPECT_NE(out.find("specimen layer 3/5 12000/12000 (100%) elapsed 0m00s, no ETA: settling until the unbalanced "
+                     "ratio is below 1e-03 (now 4.5e-03)"), std::string::npos) << out;
+  EXPECT_EQ(out.find("not due yet"), std::string::npos) << out;
+}
+
 // `triaxdem check /dev/zero` read without end (9.7 GB after 16 s): a device is refused by name, and so is a
 // config over the size cap, with the cap, before it is held in memory.
 TEST(CliEdges, ADeviceOrAHugeFileIsNoConfig) {
