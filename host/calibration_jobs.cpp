@@ -17,7 +17,7 @@
 #include "progress.hpp"
 #include "calibration_report.hpp"
 #include "text_format.hpp"
-#include "study.hpp"
+#include "summary.hpp"
 
 namespace dem {
 

@@ -16,12 +16,6 @@ namespace {
 constexpr Real kNaN = std::numeric_limits<Real>::quiet_NaN();
 }  // namespace
 
-const char* quantity_name(int q) {
-  static const char* names[kQuantities] = {"E_ini", "q_1pct", "q_3pct", "q_peak", "eps_a_peak", "q_end",
-                                           "max_dilatancy"};
-  return names[q];
-}
-
 std::array<Real, kQuantities> quantities(const MeasuredTest& t) {
   return {t.e_ini, t.q_1pct, t.q_3pct, t.q_peak, t.eps_a_peak, t.q_end, t.max_dilatancy};
 }
@@ -35,10 +29,6 @@ NoiseOptions lab_noise_options(const std::string& path) {
   o.lab_name = "the lab model of " + path;
   return o;
 }
-
-Real NoiseModel::sigma(int q, Real measured) const { return std::max(rel[q] * std::fabs(measured), abs[q]); }
-
-bool NoiseModel::is_stress(int q) { return q != kStrainAtPeak && q != kDilatancy; }
 
 namespace {
 

@@ -7,10 +7,10 @@
 
 #include "cell_boundary.hpp"
 #include "checkpoint.hpp"
-#include "job.hpp"
+#include "setup.hpp"
 #include "packing.hpp"
 #include "periodic_triaxial.hpp"
-#include "study.hpp"
+#include "summary.hpp"
 
 namespace dem {
 

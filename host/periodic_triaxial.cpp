@@ -14,7 +14,7 @@
 #include "cell_boundary.hpp"
 #include "measured.hpp"
 #include "kernels/reduce.hpp"
-#include "job.hpp"
+#include "setup.hpp"
 #include "progress.hpp"
 
 namespace dem {

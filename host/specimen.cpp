@@ -14,7 +14,7 @@
 #include "io_hdf5.hpp"
 #include "packing.hpp"
 #include "progress.hpp"
-#include "job.hpp"
+#include "setup.hpp"
 #include "simulation.hpp"
 
 namespace dem {
@@ -310,6 +310,26 @@ void require_settled(const Config& cfg, const Specimen& sp) {
                   k + 1, sp.layers.size(), sc.max_steps_per_layer, l.unbalanced, sc.stop_ratio);
     throw ConfigError(cfg.path + ": " + msg);
   }
+}
+
+void write_specimen_report(const std::string& folder, const Config& cfg, const Specimen& sp) {
+  std::string layers = "layer,z_bottom_mm,z_top_mm,z_platen_mm,void_ratio,steps,unbalanced_ratio\n";
+  for (std::size_t k = 0; k < sp.layers.size(); ++k) {
+    const LayerReport& l = sp.layers[k];
+    char row[160];
+    std::snprintf(row, sizeof row, "%zu,%.4f,%.4f,%.4f,%.5f,%ld,%.3e\n", k + 1, l.z_bottom * 1e3, l.z_top * 1e3,
+                  l.z_platen * 1e3, l.void_ratio, l.steps, l.unbalanced);
+    layers += row;
+  }
+  io::write_text_atomic(folder + "/layers.csv", layers);
+  std::string profile = "z_mm,porosity\n";
+  const std::size_t nb = sp.porosity_profile.size();
+  for (std::size_t b = 0; b < nb; ++b) {
+    char row[64];
+    std::snprintf(row, sizeof row, "%.4f,%.5f\n", (b + 0.5) * cfg.specimen.height / nb * 1e3, sp.porosity_profile[b]);
+    profile += row;
+  }
+  io::write_text_atomic(folder + "/porosity_profile.csv", profile);
 }
 
 }  // namespace dem

@@ -61,4 +61,7 @@ Real sphere_slab_volume(Real zc, Real r, Real z0, Real z1);
 /// Void ratio of the cylinder slab of radius R between z0 and z1 (balls assumed inside the cylinder).
 Real slab_void_ratio(const std::vector<BallSpec>& balls, Real radius, Real z0, Real z1);
 
+/// Writes layers.csv (each layer's void ratio in the finished specimen) and porosity_profile.csv.
+void write_specimen_report(const std::string& folder, const Config& cfg, const Specimen& sp);
+
 }  // namespace dem

@@ -9,12 +9,12 @@
 #include <string>
 
 #include "host/membrane_mesh.hpp"
-#include "job.hpp"
+#include "setup.hpp"
 #include "measured.hpp"
 #include "micro_report.hpp"
 #include "progress.hpp"
 #include "servo.hpp"
-#include "study.hpp"
+#include "summary.hpp"
 #include "triaxial_measure.hpp"
 #include "triaxial_state.hpp"
 #include "simulation.hpp"

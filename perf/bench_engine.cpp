@@ -7,6 +7,7 @@
 #include <Kokkos_Core.hpp>
 
 #include "host/job.hpp"
+#include "host/setup.hpp"
 
 namespace {
 

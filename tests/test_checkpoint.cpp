@@ -18,6 +18,7 @@
 #include "host/config.hpp"
 #include "host/io_hdf5.hpp"
 #include "host/job.hpp"
+#include "host/setup.hpp"
 #include "test_util.hpp"
 
 extern char** environ;

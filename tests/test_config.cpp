@@ -7,6 +7,7 @@
 #include "host/builder.hpp"
 #include "host/config.hpp"
 #include "host/job.hpp"
+#include "host/setup.hpp"
 #include "host/two_fidelity.hpp"
 #include "test_util.hpp"
 

@@ -8,6 +8,7 @@
 
 #include "host/config.hpp"
 #include "host/job.hpp"
+#include "host/setup.hpp"
 #include "host/simulation.hpp"
 
 using namespace dem;
