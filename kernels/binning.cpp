@@ -1,4 +1,4 @@
-#include "binning.hpp"
+#include "kernels/binning.hpp"
 
 #include <cmath>
 #include <stdexcept>

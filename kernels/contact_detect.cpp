@@ -1,4 +1,4 @@
-#include "contact_detect.hpp"
+#include "kernels/contact_detect.hpp"
 
 #include <algorithm>
 #include <vector>

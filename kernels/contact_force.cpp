@@ -1,6 +1,6 @@
-#include "contact_force.hpp"
+#include "kernels/contact_force.hpp"
 
-#include "contact_detect.hpp"
+#include "kernels/contact_detect.hpp"
 
 namespace dem {
 

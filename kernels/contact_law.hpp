@@ -29,8 +29,8 @@
 ///     with s the sliding distance accumulated by the contact (reset when it opens): asperities worn by
 ///     sliding, a lower residual strength after the peak. The default s_c is half a radius: much shorter,
 ///     the contacts wear before the peak and the effect is a lower mu_s (diagnose cannot tell them apart).
-#include "contact_params.hpp"
-#include "vec3.hpp"
+#include "kernels/contact_params.hpp"
+#include "kernels/vec3.hpp"
 
 namespace dem {
 

@@ -1,4 +1,4 @@
-#include "contact_list.hpp"
+#include "kernels/contact_list.hpp"
 
 #include <Kokkos_Sort.hpp>
 

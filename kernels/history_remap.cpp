@@ -1,4 +1,4 @@
-#include "history_remap.hpp"
+#include "kernels/history_remap.hpp"
 
 namespace dem {
 

@@ -1,6 +1,6 @@
-#include "integrate.hpp"
+#include "kernels/integrate.hpp"
 
-#include "reduce.hpp"
+#include "kernels/reduce.hpp"
 
 namespace dem {
 

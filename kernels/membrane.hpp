@@ -9,9 +9,9 @@
 /// never changes), so node forces are bit-for-bit the same for any thread count.
 #include <vector>
 
-#include "contact_list.hpp"
-#include "vec3.hpp"
-#include "walls.hpp"
+#include "kernels/contact_list.hpp"
+#include "kernels/vec3.hpp"
+#include "kernels/walls.hpp"
 
 namespace dem {
 

@@ -1,4 +1,4 @@
-#include "particles.hpp"
+#include "kernels/particles.hpp"
 
 namespace dem {
 

@@ -1,4 +1,4 @@
-#include "reduce.hpp"
+#include "kernels/reduce.hpp"
 
 namespace dem {
 

@@ -4,7 +4,7 @@
 #include <Kokkos_Core.hpp>
 #include <cstdint>
 
-#include "contact_params.hpp"
+#include "kernels/contact_params.hpp"
 
 namespace dem {
 

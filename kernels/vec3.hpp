@@ -5,9 +5,9 @@
 #include <cstring>
 #include <type_traits>
 
-#include "det_math.hpp"
-#include "simd.hpp"
-#include "types.hpp"
+#include "kernels/det_math.hpp"
+#include "kernels/simd.hpp"
+#include "kernels/types.hpp"
 
 namespace dem {
 namespace kc {

@@ -6,8 +6,8 @@
 
 #include <Kokkos_Core.hpp>
 
-#include "host/job.hpp"
-#include "host/setup.hpp"
+#include "host/cli/job.hpp"
+#include "host/engine/setup.hpp"
 
 namespace {
 

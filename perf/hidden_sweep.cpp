@@ -19,10 +19,10 @@
 #include <string>
 #include <vector>
 
-#include "host/calibrate.hpp"
-#include "host/config.hpp"
-#include "host/diagnose.hpp"
-#include "host/progress.hpp"
+#include "host/fit/calibrate.hpp"
+#include "host/config/config.hpp"
+#include "host/fit/diagnose.hpp"
+#include "host/util/progress.hpp"
 
 using namespace dem;
 

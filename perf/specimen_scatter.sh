@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# How a periodic cell's scatter falls with its size (host/misfit.hpp, kSpecimenScatterExponent): the hidden-effect
+# How a periodic cell's scatter falls with its size (host/fit/misfit.hpp, kSpecimenScatterExponent): the hidden-effect
 # simulator (tests/data/hidden_effects.toml, base model) in cells of 120, 480 and 1920 balls (the box scaled to the
 # same solid fraction), SEEDS specimens a size at 100 and 300 kPa, then q / sigma3 and eps_v read at 0.05-8% strain
 # and the exponent a of sd ~ N^-a between the sizes, with each size's mean and its standard error

@@ -1,4 +1,4 @@
-/// Calibration machinery (host/calibrate.hpp, host/diagnose.hpp, host/calibration_jobs.hpp) without the
+/// Calibration machinery (host/fit/calibrate.hpp, host/fit/diagnose.hpp, host/cli/calibration_jobs.hpp) without the
 /// simulator: the response surface, the box minimiser, the misfit, the parameter registry, the chi2 quantile,
 /// dated result folders and the synthetic-data writer.
 #include <gtest/gtest.h>
@@ -11,11 +11,11 @@
 #include <limits>
 #include <string>
 
-#include "host/calibrate.hpp"
-#include "host/calibration_jobs.hpp"
-#include "host/diagnose.hpp"
-#include "host/measured.hpp"
-#include "host/misfit.hpp"
+#include "host/fit/calibrate.hpp"
+#include "host/cli/calibration_jobs.hpp"
+#include "host/fit/diagnose.hpp"
+#include "host/data/measured.hpp"
+#include "host/fit/misfit.hpp"
 #include "test_util.hpp"
 
 using namespace dem;
@@ -404,7 +404,7 @@ TEST(Calibrate, AutoCellGrowsWhereAllScatterSpecimensFallShort) {
 }
 
 // measure_misfit measures the cell's bias on 4 cells of 4 times the balls and says so in the report's words; a data
-// specimen of the simulator's own size has no bias against it, whatever the cells show (host/cell_bias.hpp).
+// specimen of the simulator's own size has no bias against it, whatever the cells show (host/fit/cell_bias.hpp).
 TEST(Calibrate, MeasureMisfitCountsTheCellsBias) {
   Config cfg = test::tiny_cell_config();
   cfg.periodic.triax.target_strain = 0.005;

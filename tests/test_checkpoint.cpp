@@ -14,11 +14,11 @@
 #include <sstream>
 #include <thread>
 
-#include "host/checkpoint.hpp"
-#include "host/config.hpp"
-#include "host/io_hdf5.hpp"
-#include "host/job.hpp"
-#include "host/setup.hpp"
+#include "host/engine/checkpoint.hpp"
+#include "host/config/config.hpp"
+#include "host/io/io_hdf5.hpp"
+#include "host/cli/job.hpp"
+#include "host/engine/setup.hpp"
 #include "test_util.hpp"
 
 extern char** environ;

@@ -17,9 +17,9 @@
 #include <string>
 #include <vector>
 
-#include "host/folder_lock.hpp"
-#include "host/progress.hpp"
-#include "host/simulation.hpp"
+#include "host/util/folder_lock.hpp"
+#include "host/util/progress.hpp"
+#include "host/engine/simulation.hpp"
 #include "test_util.hpp"
 
 namespace fs = std::filesystem;

@@ -4,11 +4,11 @@
 #include <filesystem>
 #include <fstream>
 
-#include "host/builder.hpp"
-#include "host/config.hpp"
-#include "host/job.hpp"
-#include "host/setup.hpp"
-#include "host/two_fidelity.hpp"
+#include "host/engine/builder.hpp"
+#include "host/config/config.hpp"
+#include "host/cli/job.hpp"
+#include "host/engine/setup.hpp"
+#include "host/fit/two_fidelity.hpp"
 #include "test_util.hpp"
 
 

@@ -11,7 +11,7 @@
 #include <random>
 #include <vector>
 
-#include "host/builder.hpp"
+#include "host/engine/builder.hpp"
 #include "test_util.hpp"
 #include "kernels/contact_force.hpp"
 #include "kernels/contact_law.hpp"

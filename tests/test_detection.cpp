@@ -11,8 +11,8 @@
 #include <random>
 #include <vector>
 
-#include "host/builder.hpp"
-#include "host/simulation.hpp"
+#include "host/engine/builder.hpp"
+#include "host/engine/simulation.hpp"
 #include "kernels/binning.hpp"
 #include "kernels/contact_detect.hpp"
 #include "kernels/history_remap.hpp"

@@ -13,10 +13,10 @@
 #include <string>
 #include <vector>
 
-#include "host/builder.hpp"
-#include "host/micro_report.hpp"
-#include "host/simulation.hpp"
-#include "host/triaxial.hpp"
+#include "host/engine/builder.hpp"
+#include "host/triax/micro_report.hpp"
+#include "host/engine/simulation.hpp"
+#include "host/triax/triaxial.hpp"
 #include "test_util.hpp"
 
 using namespace dem;

@@ -6,9 +6,9 @@
 #include <random>
 #include <vector>
 
-#include "host/builder.hpp"
+#include "host/engine/builder.hpp"
 #include "test_util.hpp"
-#include "host/simulation.hpp"
+#include "host/engine/simulation.hpp"
 
 using namespace dem;
 

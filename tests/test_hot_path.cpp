@@ -6,10 +6,10 @@
 
 #include <string>
 
-#include "host/config.hpp"
-#include "host/job.hpp"
-#include "host/setup.hpp"
-#include "host/simulation.hpp"
+#include "host/config/config.hpp"
+#include "host/cli/job.hpp"
+#include "host/engine/setup.hpp"
+#include "host/engine/simulation.hpp"
 
 using namespace dem;
 

@@ -1,4 +1,4 @@
-#include "host/io_hdf5.hpp"
+#include "host/io/io_hdf5.hpp"
 #include "test_util.hpp"
 
 #include <gtest/gtest.h>

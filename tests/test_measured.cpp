@@ -1,4 +1,4 @@
-// Measured triaxial data (host/measured.hpp): the shipped Table 6, curves, and refusals with line and column.
+// Measured triaxial data (host/data/measured.hpp): the shipped Table 6, curves, and refusals with line and column.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -6,8 +6,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "host/diagnose.hpp"
-#include "host/measured.hpp"
+#include "host/fit/diagnose.hpp"
+#include "host/data/measured.hpp"
 #include "test_util.hpp"
 
 using namespace dem;

@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "host/builder.hpp"
-#include "host/membrane_mesh.hpp"
+#include "host/engine/builder.hpp"
+#include "host/engine/membrane_mesh.hpp"
 #include "kernels/accumulate.hpp"
 
 using namespace dem;

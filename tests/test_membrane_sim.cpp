@@ -6,9 +6,9 @@
 
 #include <cmath>
 
-#include "host/builder.hpp"
-#include "host/membrane_mesh.hpp"
-#include "host/simulation.hpp"
+#include "host/engine/builder.hpp"
+#include "host/engine/membrane_mesh.hpp"
+#include "host/engine/simulation.hpp"
 
 using namespace dem;
 

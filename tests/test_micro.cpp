@@ -1,4 +1,4 @@
-// Micromechanics (host/micro.hpp) against sets with known answers: anisotropy recovered from sampled
+// Micromechanics (host/engine/micro.hpp) against sets with known answers: anisotropy recovered from sampled
 // contact sets, coordination and networks on hand-built graphs, the cube cut and the force-chain file.
 #include <gtest/gtest.h>
 
@@ -11,8 +11,8 @@
 #include <fstream>
 #include <random>
 
-#include "host/micro.hpp"
-#include "host/micro_report.hpp"
+#include "host/engine/micro.hpp"
+#include "host/triax/micro_report.hpp"
 #include "test_util.hpp"
 
 using namespace dem;

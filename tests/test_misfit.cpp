@@ -1,4 +1,4 @@
-/// The misfit (host/misfit.hpp) without the simulator: reading curves at fixed strains, the rows' noise, the
+/// The misfit (host/fit/misfit.hpp) without the simulator: reading curves at fixed strains, the rows' noise, the
 /// covariance from an ensemble, and what the whole-curve comparison sees that the seven-number summary missed.
 #include <gtest/gtest.h>
 
@@ -7,10 +7,10 @@
 #include <limits>
 #include <random>
 
-#include "host/cell_bias.hpp"
-#include "host/config.hpp"
-#include "host/misfit.hpp"
-#include "host/two_fidelity.hpp"
+#include "host/fit/cell_bias.hpp"
+#include "host/config/config.hpp"
+#include "host/fit/misfit.hpp"
+#include "host/fit/two_fidelity.hpp"
 #include "test_util.hpp"
 
 using namespace dem;
@@ -70,7 +70,7 @@ TEST(Misfit, CurveValueReadsLinesExactlyAndStaysInside) {
 // so 15% is about three of them), and its lag-1 correlation near 0. An AR(1) noise of correlation 0.7 is told from
 // white noise: its estimate lies above 0.25, five standard errors (1 / sqrt(n) = 0.045) above white noise's 0.
 // The estimate reads low (0.37 here): a parabola through 21 rows takes up part of a correlated noise as trend,
-// so strongly correlated noise is understated; the specimen term covers the slow part (host/misfit.hpp).
+// so strongly correlated noise is understated; the specimen term covers the slow part (host/fit/misfit.hpp).
 TEST(Misfit, RowNoiseRecoversTheScatterAndItsCorrelation) {
   MeasuredTest t = smooth_test(100e3, 0, 2e-4);
   std::mt19937_64 rng(7);
@@ -108,7 +108,7 @@ TEST(Misfit, EnsembleScatterIsPooledAndInflated) {
 }
 
 // A data specimen of 16 times the simulator's balls counts as one simulator specimen's scatter over sqrt(16), as the
-// specimens of perf/specimen_scatter.sh scatter (host/misfit.hpp). A member scatter of 20% keeps the lab floor (2%
+// specimens of perf/specimen_scatter.sh scatter (host/fit/misfit.hpp). A member scatter of 20% keeps the lab floor (2%
 // of q) out of the way: 20% / 4 is 5%.
 TEST(Misfit, ADataSpecimensScatterFallsAsTheSquareRootOfItsSize) {
   MeasuredTest t = smooth_test(100e3);
@@ -244,7 +244,7 @@ TEST(Misfit, EnsembleSizeForTheGoalIsTheFewestThatReachIt) {
   EXPECT_EQ(Misfit({t}, lab, ref, k, 0.1).members_for(kEnsembleRatioGoal), k) << "asking again changes nothing";
 }
 
-// The simulator's finite-cell bias (host/cell_bias.hpp): its extrapolation to the data's specimen, its estimate
+// The simulator's finite-cell bias (host/fit/cell_bias.hpp): its extrapolation to the data's specimen, its estimate
 // beyond the check's own scatter, and what counting it does to a misfit.
 
 // Under the power law N^-1/2, the difference between cells of N and 4N is half of what separates N from an unlimited
@@ -297,7 +297,7 @@ TEST(CellBias, ACountedBiasTakesUpTheShiftItMeasuredAndNothingElse) {
     if (f.quantity == 0) EXPECT_NEAR(f.cell_sd, 0.1 * f.measured, 1e-6 * f.measured) << f.name;
 }
 
-// Two fidelities (host/two_fidelity.hpp): the lab's test reads q 30% above what the periodic cell gives at the same
+// Two fidelities (host/fit/two_fidelity.hpp): the lab's test reads q 30% above what the periodic cell gives at the same
 // parameters. Compared with the data as they are, the cell at the true parameters is far outside the noise; with
 // the discrepancy measured (membrane specimens against periodic ones at those parameters) and taken off the data,
 // it fits, and the discrepancy's standard error is what its two sets of specimens scatter by: two membrane

@@ -1,4 +1,4 @@
-// Periodic-cell triaxial test (host/periodic_triaxial.hpp): servo, numbering independence, friction and
+// Periodic-cell triaxial test (host/triax/periodic_triaxial.hpp): servo, numbering independence, friction and
 // dilatancy. Small specimens: 300 monodisperse balls of 2 mm (E* = 1e8 Pa, kn/ks = 1.5, no rolling
 // resistance, local damping 0.7, no density scaling), prepared dense by frictionless isotropic consolidation
 // to sigma3 = 100 kPa, then sheared at I = 9e-4 (just below the quasi-static limit) to 4-5% axial strain.
@@ -10,8 +10,8 @@
 #include <numeric>
 #include <random>
 
-#include "host/packing.hpp"
-#include "host/periodic_triaxial.hpp"
+#include "host/engine/packing.hpp"
+#include "host/triax/periodic_triaxial.hpp"
 #include "test_util.hpp"
 
 using namespace dem;

@@ -1,4 +1,4 @@
-// The loop closed (host/prediction.hpp): the membrane test at calibrated parameters beside the data, on the tiny
+// The loop closed (host/fit/prediction.hpp): the membrane test at calibrated parameters beside the data, on the tiny
 // membrane specimen of test_triaxial.cpp (16 mm, 452 beads, seconds a run).
 #include <gtest/gtest.h>
 
@@ -7,12 +7,12 @@
 #include <filesystem>
 #include <string>
 
-#include "host/calibrate.hpp"
-#include "host/diagnose.hpp"
-#include "host/io_hdf5.hpp"
-#include "host/prediction.hpp"
-#include "host/triaxial.hpp"
-#include "host/two_fidelity.hpp"
+#include "host/fit/calibrate.hpp"
+#include "host/fit/diagnose.hpp"
+#include "host/io/io_hdf5.hpp"
+#include "host/fit/prediction.hpp"
+#include "host/triax/triaxial.hpp"
+#include "host/fit/two_fidelity.hpp"
 #include "test_util.hpp"
 
 using namespace dem;

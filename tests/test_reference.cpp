@@ -8,14 +8,14 @@
 #include <string>
 #include <vector>
 
-#include "host/builder.hpp"
-#include "host/calibrate.hpp"
-#include "host/curve_reading.hpp"
-#include "host/diagnose.hpp"
-#include "host/micro_report.hpp"
-#include "host/periodic_lab.hpp"
-#include "host/simulation.hpp"
-#include "host/triaxial.hpp"
+#include "host/engine/builder.hpp"
+#include "host/fit/calibrate.hpp"
+#include "host/data/curve_reading.hpp"
+#include "host/fit/diagnose.hpp"
+#include "host/triax/micro_report.hpp"
+#include "host/lab/periodic_lab.hpp"
+#include "host/engine/simulation.hpp"
+#include "host/triax/triaxial.hpp"
 #include "reference.hpp"
 #include "test_util.hpp"
 

@@ -10,7 +10,7 @@
 #include <random>
 #include <vector>
 
-#include "host/builder.hpp"
+#include "host/engine/builder.hpp"
 #include "kernels/contact_force.hpp"
 #include "kernels/integrate.hpp"
 #include "test_util.hpp"

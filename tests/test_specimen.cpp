@@ -6,7 +6,7 @@
 
 #include <cmath>
 
-#include "host/specimen.hpp"
+#include "host/triax/specimen.hpp"
 #include "test_util.hpp"
 
 using namespace dem;

@@ -3,8 +3,8 @@
 
 #include <cmath>
 
-#include "host/builder.hpp"
-#include "host/simulation.hpp"
+#include "host/engine/builder.hpp"
+#include "host/engine/simulation.hpp"
 #include "test_util.hpp"
 
 using namespace dem;

@@ -7,7 +7,7 @@
 #include <limits>
 #include <tuple>
 
-#include "host/study.hpp"
+#include "host/study/study.hpp"
 #include "test_util.hpp"
 
 using namespace dem;

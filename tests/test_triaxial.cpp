@@ -11,9 +11,9 @@
 #include <iterator>
 #include <string>
 
-#include "host/micro_report.hpp"
-#include "host/triaxial.hpp"
-#include "host/triaxial_measure.hpp"
+#include "host/triax/micro_report.hpp"
+#include "host/triax/triaxial.hpp"
+#include "host/triax/triaxial_measure.hpp"
 #include "test_util.hpp"
 
 using namespace dem;

@@ -13,12 +13,12 @@
 #include <tuple>
 #include <vector>
 
-#include "host/builder.hpp"
-#include "host/checkpoint.hpp"
-#include "host/io_hdf5.hpp"
-#include "host/micro.hpp"
-#include "host/simulation.hpp"
-#include "host/triaxial_state.hpp"
+#include "host/engine/builder.hpp"
+#include "host/engine/checkpoint.hpp"
+#include "host/io/io_hdf5.hpp"
+#include "host/engine/micro.hpp"
+#include "host/engine/simulation.hpp"
+#include "host/triax/triaxial_state.hpp"
 #include "test_util.hpp"
 
 using namespace dem;

@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <string>
 
-#include "host/config.hpp"
+#include "host/config/config.hpp"
 #include "kernels/contact_law.hpp"
 
 namespace dem::test {

@@ -1,15 +1,15 @@
-// The cell test between six rigid walls (host/cell_boundary.hpp, [periodic] boundary = "walls"): the wall servo
+// The cell test between six rigid walls (host/triax/cell_boundary.hpp, [periodic] boundary = "walls"): the wall servo
 // against a lattice whose size under load is known in closed form, and the average-stress theorem at the walls.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "host/cell_boundary.hpp"
-#include "host/micro.hpp"
-#include "host/packing.hpp"
-#include "host/periodic_triaxial.hpp"
-#include "host/simulation.hpp"
-#include "host/triaxial_measure.hpp"
+#include "host/triax/cell_boundary.hpp"
+#include "host/engine/micro.hpp"
+#include "host/engine/packing.hpp"
+#include "host/triax/periodic_triaxial.hpp"
+#include "host/engine/simulation.hpp"
+#include "host/triax/triaxial_measure.hpp"
 #include "test_util.hpp"
 
 using namespace dem;

@@ -19,7 +19,7 @@ import sys
 
 from _csv_rows import read_rows
 
-THRESHOLD = 6.0  # host/diagnose.hpp kStrongEvidence: BIC and held-out chi2 both lower by at least this
+THRESHOLD = 6.0  # host/fit/diagnose.hpp kStrongEvidence: BIC and held-out chi2 both lower by at least this
 
 
 def first_name(verdict):

@@ -5,7 +5,7 @@
 #include <fuzzer/FuzzedDataProvider.h>
 
 #include "fuzz_file.hpp"
-#include "host/checkpoint.hpp"
+#include "host/engine/checkpoint.hpp"
 
 namespace {
 std::vector<double> values(FuzzedDataProvider& in, std::size_t n) {

@@ -3,7 +3,7 @@
 #include <cstdint>
 #include <string>
 
-#include "host/config.hpp"
+#include "host/config/config.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   try {

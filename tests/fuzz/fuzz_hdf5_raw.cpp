@@ -6,10 +6,10 @@
 /// (tests/fuzz/run_fuzz.sh SECONDS fuzz_hdf5_raw), not the CI gate; the gate fuzzes the same readers through
 /// well-formed files (fuzz_checkpoint_values, fuzz_snapshot_values).
 #include "fuzz_file.hpp"
-#include "host/checkpoint.hpp"
-#include "host/measured.hpp"
-#include "host/micro.hpp"
-#include "host/micro_report.hpp"
+#include "host/engine/checkpoint.hpp"
+#include "host/data/measured.hpp"
+#include "host/engine/micro.hpp"
+#include "host/triax/micro_report.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size == 0) return 0;

@@ -7,7 +7,7 @@
 #include <cstdio>
 #include <string>
 
-#include "host/measured.hpp"
+#include "host/data/measured.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static const std::string path = "/tmp/triaxdem_fuzz_measured_" + std::to_string(::getpid()) + ".csv";

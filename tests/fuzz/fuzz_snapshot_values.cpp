@@ -5,9 +5,9 @@
 #include <fuzzer/FuzzedDataProvider.h>
 
 #include "fuzz_file.hpp"
-#include "host/h5_file.hpp"
-#include "host/micro.hpp"
-#include "host/micro_report.hpp"
+#include "host/io/h5_file.hpp"
+#include "host/engine/micro.hpp"
+#include "host/triax/micro_report.hpp"
 
 namespace {
 namespace h5 = dem::io::h5;

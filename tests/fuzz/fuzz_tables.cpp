@@ -2,9 +2,9 @@
 /// summary.csv, a calibration reference-values CSV and the specimen cache. (Measured data in HDF5 form: the raw
 /// HDF5 harness.)
 #include "fuzz_file.hpp"
-#include "host/measured.hpp"
-#include "host/specimen.hpp"
-#include "host/study.hpp"
+#include "host/data/measured.hpp"
+#include "host/triax/specimen.hpp"
+#include "host/study/study.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size == 0) return 0;

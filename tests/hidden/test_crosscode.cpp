@@ -8,12 +8,12 @@
 #include <cstdio>
 #include <string>
 
-#include "host/calibrate.hpp"
-#include "host/config.hpp"
-#include "host/diagnose.hpp"
-#include "host/measured.hpp"
-#include "host/prediction.hpp"
-#include "host/two_fidelity.hpp"
+#include "host/fit/calibrate.hpp"
+#include "host/config/config.hpp"
+#include "host/fit/diagnose.hpp"
+#include "host/data/measured.hpp"
+#include "host/fit/prediction.hpp"
+#include "host/fit/two_fidelity.hpp"
 
 using namespace dem;
 

@@ -1,7 +1,7 @@
 /// Hidden-effect tests: the generator runs the simulator with one model extension switched on (or none) on a
 /// specimen per pressure that the diagnosis never runs (packing seeds 100000 above the config's, cells of four
 /// times the balls; the file gives their void ratio and particle count, as a user would), adds lab-like
-/// noise (host/diagnose.hpp, synthetic_tests) and writes only a measured-data file. The diagnosis reads that file,
+/// noise (host/fit/diagnose.hpp, synthetic_tests) and writes only a measured-data file. The diagnosis reads that file,
 /// calibrates the base model on its own ensemble and must name the hidden effect, or none for the null case;
 /// where an effect was hidden, the extended model must lower the held-out misfit by the strong-evidence margin
 /// (kStrongEvidence). A case per extension (hertz among the long cases) and a null case, on the cheap simulator of
@@ -16,10 +16,10 @@
 #include <string>
 #include <vector>
 
-#include "host/calibrate.hpp"
-#include "host/config.hpp"
-#include "host/diagnose.hpp"
-#include "host/measured.hpp"
+#include "host/fit/calibrate.hpp"
+#include "host/config/config.hpp"
+#include "host/fit/diagnose.hpp"
+#include "host/data/measured.hpp"
 #include "tests/test_util.hpp"
 
 using namespace dem;
@@ -107,7 +107,7 @@ INSTANTIATE_TEST_SUITE_P(LongAnotherEnsemble, HiddenEffect, ::testing::Values(Hi
 
 // A precise simulator must not find an effect in precise data that have none. With the ensemble and cell it chooses
 // itself, the diagnosis measures its mean to within half of a 480-ball data specimen's scatter, and then sees
-// how a cell of 120 balls differs from one of 480 on average. Before that difference was counted (host/cell_bias.hpp)
+// how a cell of 120 balls differs from one of 480 on average. Before that difference was counted (host/fit/cell_bias.hpp)
 // these data were named wear (BIC 11.2 lower, held-out chi2 98.0 -> 78.9; docs/calibration.md). A long case: about
 // 8 minutes on 2 cores (ctest -L long).
 INSTANTIATE_TEST_SUITE_P(LongAutoEnsemble, HiddenEffect, ::testing::Values(HiddenCase{"none", 0, 6, 1, true, 0}),

@@ -1,0 +1,54 @@
+#pragma once
+/// The command-line jobs of calibration and diagnosis (issue 5): `triaxdem calibrate`, `triaxdem diagnose` and
+/// `triaxdem synth` (synthetic measured data with a hidden effect, for tests and studies).
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "host/config/config.hpp"
+
+namespace dem {
+
+struct CalibrationOptions {
+  std::string data;                       ///< measured-data CSV
+  std::string output = "out";             ///< parent of the dated result folder
+  std::vector<std::string> free;          ///< empty: the config's [calibrate] free
+  std::string material;                   ///< empty: every material of the file
+  int jobs = 1;                           ///< simulator runs at once (PeriodicLab::set_jobs)
+  std::string reference;                  ///< optional reference values (load_reference) to set beside the fit
+  std::string noise = "data";             ///< the data's noise: data, lab or a lab noise file
+  /// The membrane test to predict with (host/fit/prediction.hpp): a config path, "none" for no prediction, or ""
+  /// for the base config's [calibrate] predict.
+  std::string predict;
+  /// The reference test: "periodic", "two_fidelity", or "" for the base config's [calibrate] reference_test.
+  std::string reference_test;
+  /// A result folder of an earlier calibrate or diagnose of the same data to continue in: its stored runs
+  /// (PeriodicLab::set_run_store) are read instead of run again. "": a new dated folder.
+  std::string resume;
+};
+
+/// Calibrates each material of the data; writes calibrate_<date>/ under options.output. Returns 0.
+int calibrate_job(const Config& base, const CalibrationOptions& o);
+
+/// Diagnoses each material of the data; writes diagnose_<date>/ with diagnosis.md. Returns 0.
+int diagnose_job(const Config& base, const CalibrationOptions& o);
+
+struct SynthOptions {
+  std::string output;                     ///< CSV to write
+  std::string extension = "none";         ///< hertz, roughness, wear, membrane or none
+  /// The extension parameter in its key's unit, within its range (free_param); NaN: drawn from the seed.
+  Real strength = std::numeric_limits<Real>::quiet_NaN();
+  bool overwrite = false;                 ///< replace an existing output file (never the config)
+  unsigned seed = 1;
+  long specimen_seed = -1;                ///< packing seed; < 0: the config's seed + kForeignSeedOffset
+  std::vector<Real> sigma3{100e3, 200e3, 300e3};  ///< Pa
+  std::string material = "synthetic";
+};
+
+/// Writes synthetic measured curves of the base config's model with the extension switched on. Returns 0.
+int synth_job(const Config& base, const SynthOptions& o);
+
+/// A new folder `<parent>/<prefix>_<YYYYmmdd-HHMMSS>` (a suffix -2, -3 ... if it exists): never an old one.
+std::string new_dated_folder(const std::string& parent, const std::string& prefix);
+
+}  // namespace dem

@@ -1,0 +1,158 @@
+#pragma once
+/// One DEM system and its time loop: named stages (rebuild, forces, gather, integrate, boundaries),
+/// each timed. Boundary control (servos, membrane) steers it from outside through the wall setters.
+#include <array>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "kernels/accumulate.hpp"
+#include "kernels/binning.hpp"
+#include "kernels/contact_detect.hpp"
+#include "kernels/contact_force.hpp"
+#include "kernels/integrate.hpp"
+#include "kernels/membrane.hpp"
+#include "host/engine/sim_state.hpp"
+
+namespace dem {
+
+/// A run stopped because the state became unphysical. what() names the step, particle and a fix.
+struct BlowUp : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct SimParams {
+  Domain domain;
+  IntegrateParams integ;        ///< dt must be set (see critical_dt)
+  Real skin = 0;                ///< Verlet skin (m)
+  Real overlap_limit = 0.1;     ///< stop when an overlap exceeds this fraction of the radius
+};
+
+/// Wall-clock seconds spent per stage.
+struct StageTimes {
+  double rebuild = 0, forces = 0, integrate = 0, boundaries = 0;  ///< integrate includes the gather
+  double membrane = 0;  ///< membrane elasticity, pressure, reactions and node integration
+  long rebuilds = 0;
+  double loop() const { return rebuild + forces + membrane + integrate + boundaries; }
+};
+
+/// One line for a log: seconds per stage, rebuild count and particle-steps per second of the time loop.
+std::string describe(const StageTimes& t, long particles, long steps);
+
+class Simulation {
+ public:
+  /// table: nmat x nmat contact parameters (row-major); walls and mesh may be empty.
+  Simulation(Particles particles, WallSet walls, FacetMesh mesh, const std::vector<ContactParams>& table, int nmat,
+             SimParams prm);
+
+  /// One time step. `measure`: fill stats() (unbalanced force, kinetic energy) for this step; the
+  /// sums cost a pass of square roots, so unmeasured steps skip them.
+  void step(bool measure = true);
+  /// nsteps steps; stats() describe the last one.
+  void run(long nsteps) { for (long s = 0; s < nsteps; ++s) step(s + 1 == nsteps); }
+
+  Particles& particles() { return p_; }
+  const ContactList& ball_contacts() const { return balls_; }
+  const ContactList& wall_contacts() const { return wall_c_; }
+  const StepStats& stats() const { return stats_; }
+  const StageTimes& times() const { return times_; }
+  /// The stage times of the run segments before a resume, so that reports cover the whole run.
+  void set_times(const StageTimes& t) { times_ = t; }
+  const SimParams& params() const { return prm_; }
+  long step_count() const { return step_; }
+  Real time() const { return time_; }
+  int num_walls() const { return walls_.n; }
+  const WallSet& walls() const { return walls_; }
+  const FacetMesh& mesh() const { return mesh_; }
+
+  /// Largest stable time step estimate (s): min over particles of sqrt(m/kn) and sqrt(I/k_rot) for the
+  /// stiffest (ball-wall) contact; the caller multiplies by a safety factor.
+  Real critical_dt() const;
+  /// Replaces the contact laws (same nmat x nmat layout as the constructor's); contact history is kept.
+  void set_contact_params(const std::vector<ContactParams>& table);
+  void set_dt(Real dt) { prm_.integ.dt = dt; }
+  /// Local damping about the mean flow v = rate (x - origin) from now on (IntegrateParams::about_flow).
+  void set_damping_flow(const Vec3& rate, const Vec3& origin) {
+    prm_.integ.about_flow = true;
+    prm_.integ.flow_rate = rate;
+    prm_.integ.flow_origin = origin;
+  }
+
+  /// Makes the facet mesh a flexible membrane (m.mesh must be the mesh given to the constructor: the
+  /// Views are shared). Each step then loads its nodes with CST elasticity, the cell pressure and the
+  /// ball reactions, and advances their velocities; move_boundaries moves them (prm.move_nodes is forced off).
+  void set_membrane(const Membrane& m, const MembraneIntegrateParams& prm);
+  /// Cell pressure on the membrane (Pa), positive towards the axis.
+  void set_cell_pressure(Real p) { cell_pressure_ = p; }
+  Membrane& membrane() { return membrane_; }
+  const MembraneStepStats& membrane_stats() const { return membrane_stats_; }
+
+  /// Homogeneous deformation of a periodic cell: each step the cell and the particle positions are
+  /// stretched about domain.lo by (1 + rate dt) along each axis (1/s, extension positive).
+  void set_strain_rate(const Vec3& rate);
+  const Domain& domain() const { return prm_.domain; }
+  /// Love-Weber stress of the ball-ball contacts over `volume` (m^3), compression positive, row-major
+  /// 3 x 3 (Pa): sigma = -(1/V) sum fc (x) (x2 - x1). Boundary (wall, facet) contacts are not included.
+  std::array<Real, 9> contact_stress(Real volume) const;
+  /// Its diagonal (xx, yy, zz) alone, bit for bit the same values, at a third of the sums: a servo's every step.
+  std::array<Real, 3> contact_stress_diagonal(Real volume) const;
+
+  /// Rigid wall velocity (m/s) and position (m) control.
+  void set_wall_velocity(int w, const Vec3& v);
+  /// Every analytic wall's velocity at once (one per wall), in one copy to the device: a servo's every step.
+  void set_wall_velocities(const std::vector<Vec3>& v);
+  Vec3 wall_velocity(int w) const;
+  Vec3 wall_point(int w) const;
+  void set_wall_point(int w, const Vec3& p);
+  /// Force exerted by the balls on wall object `obj` (analytic walls first, then facets), N.
+  std::vector<Vec3> wall_forces();
+
+  /// Touching contacts on each wall object (analytic walls first, then facets).
+  std::vector<int> wall_contact_counts() const;
+
+  /// Mean unbalanced force over mean contact force (YADE/PFC definition) after the last measured step;
+  /// 1 when there are no contacts.
+  Real unbalanced_ratio() const;
+  /// Number of touching contacts (ball-ball, ball-wall).
+  std::array<long, 2> touching() const;
+
+  /// The whole dynamic state, for a checkpoint (host/engine/sim_state.cpp).
+  SimState state() const;
+  /// Continues from a state taken from a Simulation built the same way (same balls, walls, mesh and laws):
+  /// the next steps are bit for bit those the original would have taken. Throws std::runtime_error when
+  /// the counts of balls, walls or mesh nodes differ.
+  void restore(const SimState& s);
+
+ private:
+  Particles p_;
+  WallSet walls_;
+  decltype(Kokkos::create_mirror_view(WallSet().point)) hwall_point_, hwall_vel_;
+  FacetMesh mesh_;
+  ParamTableView params_;
+  SimParams prm_;
+  CellList cells_;
+  ContactList balls_, wall_c_;
+  Adjacency adj_balls_, adj_walls_;
+  Index2View own_;
+  IndexView obj_offsets_;
+  Vec3View wall_force_;
+  Membrane membrane_;
+  MembraneIntegrateParams membrane_prm_;
+  Vec3View membrane_f_;
+  MembraneStepStats membrane_stats_;
+  Real cell_pressure_ = 0;
+  StepStats stats_;
+  StageTimes times_;
+  Real rmax_ = 0, wall_disp_ = 0;
+  long step_ = 0;
+  Real time_ = 0;
+  bool fresh_ = true;
+
+  bool rebuild_due() const;
+  void rebuild();
+  void index_contacts();  ///< owner ranges, adjacency and object offsets of the contact lists
+  void move_boundaries();
+  void check_blowup(const OverlapStat& ob, const OverlapStat& ow) const;
+};
+
+}  // namespace dem

@@ -1,0 +1,449 @@
+#include "host/fit/calibrate.hpp"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+
+namespace dem {
+
+// ---------------------------------------------------------------------------------------------------
+// Free parameters
+
+Real FreeParam::value(Real u) const { return log ? lo * std::pow(hi / lo, u) : lo + u * (hi - lo); }
+Real FreeParam::unit(Real v) const {
+  return std::clamp(log ? std::log(v / lo) / std::log(hi / lo) : (v - lo) / (hi - lo), Real(0), Real(1));
+}
+
+namespace {
+struct ParamSpec {
+  FreeParam range;
+  Real ContactParams::*field;  ///< null: the membrane
+};
+const std::vector<ParamSpec>& param_specs() {
+  static const std::vector<ParamSpec> specs = {
+      {{"mu_s", 0.02, 1.0, true}, &ContactParams::mu_s},
+      {{"mu_r", 0.0, 0.2, false}, &ContactParams::mu_r},
+      {{"emod_Pa", 1e6, 1e10, true}, &ContactParams::emod},
+      {{"kratio", 1.0, 4.0, false}, &ContactParams::kratio},
+      {{"hertz_overlap", 3e-4, 0.03, true}, &ContactParams::hertz_overlap},
+      {{"roughness", 1e-4, 5e-2, true}, &ContactParams::roughness},
+      {{"wear", 0.0, 0.9, false}, &ContactParams::wear},
+      {{"wear_slip", 0.005, 0.5, true}, &ContactParams::wear_slip},
+      {{"membrane_kPa", 0.0, 3e6, false, 1e-3}, nullptr},
+  };
+  return specs;
+}
+const ParamSpec& spec(const std::string& name) {
+  std::string names;
+  for (const ParamSpec& s : param_specs()) {
+    if (s.range.name == name) return s;
+    names += (names.empty() ? "" : ", ") + s.range.name;
+  }
+  throw std::invalid_argument("unknown free parameter '" + name + "' (allowed: " + names + ")");
+}
+}  // namespace
+
+FreeParam free_param(const std::string& name) { return spec(name).range; }
+
+FreeParam free_param(const std::string& name, const Model& base) {
+  FreeParam f = free_param(name);
+  const Real v = get_param(base, name);
+  if ((name == "mu_s" || name == "emod_Pa") && v > 0) {
+    f.lo = v / 3;
+    f.hi = 3 * v;
+    f.log = true;
+  } else if (name == "mu_r") {
+    f.lo = 0;
+    f.hi = std::max(4 * v, Real(0.05));
+  }
+  return f;
+}
+
+void set_param(Model& m, const std::string& name, Real v) {
+  const ParamSpec& s = spec(name);
+  if (s.field) m.law.*s.field = v;
+  else m.membrane = v;
+}
+
+bool is_contact_param(const std::string& name) { return spec(name).field != nullptr; }
+
+Real get_param(const Model& m, const std::string& name) {
+  const ParamSpec& s = spec(name);
+  return s.field ? m.law.*s.field : m.membrane;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Surrogate and search
+
+std::vector<Real> QuadraticSurface::basis(const std::vector<Real>& u) {
+  std::vector<Real> b{1};
+  for (Real x : u) b.push_back(x);
+  for (std::size_t i = 0; i < u.size(); ++i)
+    for (std::size_t j = i; j < u.size(); ++j) b.push_back(u[i] * u[j]);
+  return b;
+}
+
+QuadraticSurface::QuadraticSurface(const std::vector<std::vector<Real>>& u, const std::vector<Real>& y,
+                                   const std::vector<Real>& w) {
+  const int n = static_cast<int>(u.size());
+  const int m = static_cast<int>(basis(u.front()).size());
+  Eigen::MatrixXd A(n, m);
+  Eigen::VectorXd b(n);
+  for (int i = 0; i < n; ++i) {
+    const std::vector<Real> row = basis(u[i]);
+    const Real sw = std::sqrt(w[i]);
+    for (int j = 0; j < m; ++j) A(i, j) = sw * row[j];
+    b(i) = sw * y[i];
+  }
+  // Complete orthogonal decomposition: a minimum-norm answer when the design cannot fix every term.
+  const Eigen::VectorXd c = A.completeOrthogonalDecomposition().solve(b);
+  c_.assign(c.data(), c.data() + m);
+}
+
+Real QuadraticSurface::operator()(const std::vector<Real>& u) const {
+  const std::vector<Real> b = basis(u);
+  Real v = 0;
+  for (std::size_t j = 0; j < b.size(); ++j) v += c_[j] * b[j];
+  return v;
+}
+
+std::vector<Real> minimise_unit_box(const std::function<Real(const std::vector<Real>&)>& f, int d, int per_axis) {
+  if (d == 0) return {};
+  const int n = d <= 3 ? per_axis : 7;
+  std::vector<Real> best(d, 0.5), u(d);
+  Real fbest = std::numeric_limits<Real>::infinity();
+  std::vector<int> idx(d, 0);
+  for (;;) {
+    for (int k = 0; k < d; ++k) u[k] = static_cast<Real>(idx[k]) / (n - 1);
+    const Real v = f(u);
+    if (v < fbest) fbest = v, best = u;
+    int k = 0;
+    while (k < d && ++idx[k] == n) idx[k++] = 0;
+    if (k == d) break;
+  }
+  for (Real step = 0.5 / (n - 1); step > 1e-4; step /= 2) {
+    for (bool moved = true; moved;) {
+      moved = false;
+      for (int k = 0; k < d; ++k)
+        for (Real s : {-step, step}) {
+          u = best;
+          u[k] = std::clamp(u[k] + s, Real(0), Real(1));
+          const Real v = f(u);
+          if (v < fbest) fbest = v, best = u, moved = true;
+        }
+    }
+  }
+  return best;
+}
+
+namespace {
+
+Real chi2_of(const std::vector<Real>& r) {
+  Real s = 0;
+  for (Real x : r) s += x * x;
+  return s;
+}
+
+}  // namespace
+
+/// Weights: a Gaussian of width 0.3 in unit coordinates around `centre`, floor 0.1 (far points still hold
+/// the curvature).
+std::vector<QuadraticSurface> response_surfaces(const std::vector<Evaluation>& pts, const std::vector<Real>& centre) {
+  std::vector<std::vector<Real>> u;
+  std::vector<Real> w;
+  for (const Evaluation& e : pts) {
+    u.push_back(e.u);
+    Real d2 = 0;
+    for (std::size_t k = 0; k < centre.size(); ++k) d2 += (e.u[k] - centre[k]) * (e.u[k] - centre[k]);
+    w.push_back(0.1 + std::exp(-d2 / (2 * 0.3 * 0.3)));
+  }
+  std::vector<QuadraticSurface> s;
+  for (std::size_t i = 0; i < pts.front().r.size(); ++i) {
+    std::vector<Real> y;
+    for (const Evaluation& e : pts) y.push_back(e.r[i]);
+    s.emplace_back(u, y, w);
+  }
+  return s;
+}
+
+std::vector<std::string> CalibrationResult::at_edge() const {
+  std::vector<std::string> out;
+  for (std::size_t k = 0; k < free.size(); ++k)
+    if (((best.u[k] < 0.01 && free[k].lo > 0) || best.u[k] > 0.99) &&
+        std::find(searched_beyond.begin(), searched_beyond.end(), free[k].name) == searched_beyond.end())
+      out.push_back(free[k].name);
+  return out;
+}
+
+bool recentre(FreeParam& f, Real v) {
+  const FreeParam hard = free_param(f.name);
+  const Real lo = std::max(f.log ? v * std::sqrt(f.lo / f.hi) : v - 0.5 * (f.hi - f.lo), hard.lo);
+  const Real hi = std::min(f.log ? v * std::sqrt(f.hi / f.lo) : v + 0.5 * (f.hi - f.lo), hard.hi);
+  const Real tol = 1e-3 * (f.hi - f.lo);
+  // It moves only outwards, past the edge the value lies on; a range stopped by a hard limit stays.
+  const bool moves = f.unit(v) > 0.5 ? hi > f.hi + tol : lo < f.lo - tol;
+  if (!moves) return false;
+  f.lo = lo;
+  f.hi = hi;
+  return true;
+}
+
+namespace {
+
+CalibrationResult search(const Simulator& simulate, const Model& base, const std::vector<FreeParam>& free, int data,
+                         int rounds, int widen) {
+  const int d = static_cast<int>(free.size());
+  CalibrationResult res;
+  res.free = free;
+  res.data = data;
+  auto model_at = [&](const std::vector<Real>& u) {
+    Model m = base;
+    for (int k = 0; k < d; ++k) set_param(m, free[k].name, free[k].value(u[k]));
+    return m;
+  };
+  auto run_before = [&](const std::vector<Real>& u) {
+    for (const Evaluation& e : res.design) {
+      Real d2 = 0;
+      for (int k = 0; k < d; ++k) d2 += (e.u[k] - u[k]) * (e.u[k] - u[k]);
+      if (d2 < 1e-6) return true;
+    }
+    return false;
+  };
+  auto evaluate = [&](const std::vector<Real>& u) {
+    Evaluation e;
+    e.u = u;
+    SimulatedPoint s = simulate(model_at(u));
+    e.sim = std::move(s.sim);
+    e.r = std::move(s.r);
+    e.chi2 = chi2_of(e.r);
+    res.design.push_back(e);
+    const bool better = res.design.size() == 1 || e.chi2 < res.best.chi2;
+    if (better) res.best = e;
+    return better;
+  };
+  // Runs the surrogate's optimum, the surfaces centred on the best run; false when that point was run before.
+  auto surrogate_step = [&]() {
+    const std::vector<QuadraticSurface> s = response_surfaces(res.design, res.best.u);
+    const std::vector<Real> u = minimise_unit_box([&](const std::vector<Real>& x) {
+      Real c = 0;
+      for (const QuadraticSurface& q : s) c += q(x) * q(x);
+      return c;
+    }, d);
+    if (run_before(u)) return false;
+    evaluate(u);
+    return true;
+  };
+  long design_points = 1;
+  for (int k = 0; k < d; ++k) design_points *= 3;
+  for (long p = 0; p < design_points; ++p) {
+    std::vector<Real> u(d);
+    long c = p;
+    for (int k = 0; k < d; ++k, c /= 3) u[k] = 0.5 * static_cast<Real>(c % 3);
+    evaluate(u);
+  }
+  for (int round = 0; round < rounds && d > 0; ++round) {
+    const Real before = res.best.chi2;
+    if (!surrogate_step()) break;  // the surface points at a point already run: converged
+    if (round > 0 && res.best.chi2 > 0.98 * before) break;  // stopped improving
+  }
+  if (d > 0) {
+    bool moved = false;
+    for (Real step : {0.25, 0.125}) {
+      for (bool better = true; better;) {
+        better = false;
+        const std::vector<Real> from = res.best.u;
+        for (int k = 0; k < d && !better; ++k)
+          for (Real sign : {-1.0, 1.0}) {
+            std::vector<Real> u = from;
+            u[k] += sign * step;
+            if (u[k] < -1e-9 || u[k] > 1 + 1e-9 || run_before(u)) continue;
+            if (evaluate(u)) {
+              better = moved = true;
+              break;
+            }
+          }
+      }
+    }
+    if (moved) surrogate_step();
+  }
+  res.model = model_at(res.best.u);
+  for (int k = 0; k < d; ++k) res.values.push_back(free[k].value(res.best.u[k]));
+  if (widen <= 0) return res;
+  std::vector<FreeParam> moved = free;
+  std::vector<std::string> notes;
+  for (int k = 0; k < d; ++k) {
+    if (res.best.u[k] >= 0.01 && res.best.u[k] <= 0.99) continue;
+    if (!recentre(moved[k], res.values[k])) continue;
+    char line[160];
+    std::snprintf(line, sizeof line, "%s: best %.4g on the edge of [%.4g, %.4g]; searched again over [%.4g, %.4g]",
+                  free[k].name.c_str(), free[k].shown * res.values[k], free[k].shown * free[k].lo,
+                  free[k].shown * free[k].hi, moved[k].shown * moved[k].lo, moved[k].shown * moved[k].hi);
+    notes.push_back(line);
+  }
+  if (notes.empty()) return res;
+  CalibrationResult again = search(simulate, base, moved, data, rounds, widen - 1);
+  if (again.best.chi2 >= res.best.chi2) {
+    notes.push_back("the wider search found no better point");
+    for (int k = 0; k < d; ++k)
+      if (moved[k].lo != free[k].lo || moved[k].hi != free[k].hi) res.searched_beyond.push_back(free[k].name);
+  }
+  CalibrationResult& out = again.best.chi2 < res.best.chi2 ? again : res;
+  out.widened.insert(out.widened.begin(), notes.begin(), notes.end());
+  return out;
+}
+
+/// The 95% quantile of chi2 with d degrees of freedom (d = 1..4; beyond, Wilson-Hilferty).
+Real chi2_95(int d) {
+  static const Real q[] = {3.841, 5.991, 7.815, 9.488};
+  if (d >= 1 && d <= 4) return q[d - 1];
+  const Real a = 2.0 / (9 * d);
+  return d * std::pow(1 - a + 1.645 * std::sqrt(a), 3);
+}
+
+void add_uncertainty(CalibrationResult& r) {
+  const int d = static_cast<int>(r.free.size());
+  if (d == 0 || r.design.size() < 2) return;
+  r.surfaces = response_surfaces(r.design, r.best.u);
+  r.offset.clear();
+  for (std::size_t i = 0; i < r.surfaces.size(); ++i) r.offset.push_back(r.best.r[i] - r.surfaces[i](r.best.u));
+  r.scale = std::max(Real(1), r.best.chi2 / std::max(1, r.data - d));
+  // Profile intervals: each parameter on a grid of its unit range, the surrogate minimised over the others.
+  const Real best = r.surrogate_chi2(r.best.u), rise = 3.841 * r.scale;
+  r.interval.clear();
+  for (int j = 0; j < d; ++j) {
+    constexpr int kGrid = 201;
+    std::vector<Real> profile(kGrid);
+    for (int g = 0; g < kGrid; ++g) {
+      const Real t = static_cast<Real>(g) / (kGrid - 1);
+      const std::vector<Real> rest = minimise_unit_box([&](const std::vector<Real>& x) {
+        std::vector<Real> u(x);
+        u.insert(u.begin() + j, t);
+        return r.surrogate_chi2(u);
+      }, d - 1, 11);
+      std::vector<Real> u(rest);
+      u.insert(u.begin() + j, t);
+      profile[g] = r.surrogate_chi2(u);
+    }
+    int at = static_cast<int>(std::lround(r.best.u[j] * (kGrid - 1)));
+    int lo = at, hi = at;
+    while (lo > 0 && profile[lo - 1] - best <= rise) --lo;
+    while (hi < kGrid - 1 && profile[hi + 1] - best <= rise) ++hi;
+    r.interval.emplace_back(r.free[j].value(static_cast<Real>(lo) / (kGrid - 1)),
+                            r.free[j].value(static_cast<Real>(hi) / (kGrid - 1)));
+  }
+  // Correlation: J = d residuals / du at the best point (central differences of the surfaces).
+  Eigen::MatrixXd J(static_cast<int>(r.surfaces.size()), d);
+  for (int j = 0; j < d; ++j) {
+    std::vector<Real> up = r.best.u, dn = r.best.u;
+    up[j] += 1e-3, dn[j] -= 1e-3;
+    for (std::size_t i = 0; i < r.surfaces.size(); ++i)
+      J(static_cast<int>(i), j) = (r.surfaces[i](up) - r.surfaces[i](dn)) / 2e-3;
+  }
+  const Eigen::MatrixXd cov = (J.transpose() * J).completeOrthogonalDecomposition().pseudoInverse();
+  r.correlation.assign(d, std::vector<Real>(d, 0));
+  for (int a = 0; a < d; ++a)
+    for (int b = 0; b < d; ++b) {
+      const Real den = std::sqrt(cov(a, a) * cov(b, b));
+      r.correlation[a][b] = den > 0 ? cov(a, b) / den : (a == b ? 1 : 0);
+    }
+}
+
+}  // namespace
+
+Real CalibrationResult::surrogate_chi2(const std::vector<Real>& u) const {
+  Real c = 0;
+  for (std::size_t i = 0; i < surfaces.size(); ++i) {
+    const Real v = surfaces[i](u) + offset[i];
+    c += v * v;
+  }
+  return c;
+}
+
+Real CalibrationResult::region_rise(const std::vector<Real>& values) const {
+  std::vector<Real> u;
+  for (std::size_t k = 0; k < free.size(); ++k) {
+    if (values[k] < free[k].lo || values[k] > free[k].hi) return std::numeric_limits<Real>::infinity();
+    u.push_back(free[k].unit(values[k]));
+  }
+  return (surrogate_chi2(u) - surrogate_chi2(best.u)) / (chi2_95(static_cast<int>(free.size())) * scale);
+}
+
+Real CalibrationResult::flat_share() const {
+  const int d = static_cast<int>(free.size());
+  if (d == 0 || surfaces.empty()) return 0;
+  const int n = d <= 3 ? 21 : 7;
+  const Real limit = surrogate_chi2(best.u) + chi2_95(d) * scale;
+  long inside = 0, all = 0;
+  std::vector<int> idx(d, 0);
+  std::vector<Real> u(d);
+  for (;;) {
+    for (int k = 0; k < d; ++k) u[k] = static_cast<Real>(idx[k]) / (n - 1);
+    inside += surrogate_chi2(u) <= limit;
+    ++all;
+    int k = 0;
+    while (k < d && ++idx[k] == n) idx[k++] = 0;
+    if (k == d) break;
+  }
+  return static_cast<Real>(inside) / all;
+}
+
+std::vector<std::string> CalibrationResult::inseparable() const {
+  std::vector<std::string> out;
+  for (std::size_t a = 0; a < correlation.size(); ++a)
+    for (std::size_t b = a + 1; b < correlation.size(); ++b)
+      if (std::fabs(correlation[a][b]) > 0.9) {
+        char c[32];
+        std::snprintf(c, sizeof c, " (%+.2f)", correlation[a][b]);
+        out.push_back(free[a].name + " and " + free[b].name + c);
+      }
+  return out;
+}
+
+void adopt_best(CalibrationResult& r, const Evaluation& better, const Model& base) {
+  r.design.push_back(better);
+  r.best = better;
+  r.model = base;
+  r.values.clear();
+  for (std::size_t k = 0; k < r.free.size(); ++k) {
+    r.values.push_back(r.free[k].value(better.u[k]));
+    set_param(r.model, r.free[k].name, r.values.back());
+  }
+  add_uncertainty(r);
+}
+
+long planned_points(int d, int rounds) {
+  long design = 1;
+  for (int k = 0; k < d; ++k) design *= 3;
+  return design + rounds + (d > 0 ? 4 * d + 1 : 0);  // the compass: both steps' polls once, and its last round
+}
+
+CalibrationResult calibrate(const Simulator& simulate, const Model& base, const std::vector<FreeParam>& free, int data,
+                            int rounds, int widen) {
+  CalibrationResult r = search(simulate, base, free, data, rounds, widen);
+  add_uncertainty(r);
+  return r;
+}
+
+CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,
+                            const std::vector<MeasuredTest>& measured, const Misfit& misfit, int rounds,
+                            const CalibrationProgress& progress, int widen) {
+  const long planned = planned_points(static_cast<int>(free.size()), rounds) * static_cast<long>(measured.size()) *
+                       lab.members();
+  Real best = std::numeric_limits<Real>::infinity();
+  auto simulate = [&](const Model& m) {
+    SimulatedPoint s;
+    const Ensemble ens = lab.run_ensemble(m, measured);
+    for (const auto& members : ens) s.sim.push_back(mean_curve(members));
+    s.r = misfit.residuals(ens);
+    best = std::min(best, chi2_of(s.r));
+    if (progress) progress(lab.runs(), planned, best);
+    return s;
+  };
+  return calibrate(simulate, base, free, misfit.data(), rounds, widen);
+}
+
+}  // namespace dem

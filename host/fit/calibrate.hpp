@@ -1,0 +1,168 @@
+#pragma once
+/// Calibration against measured triaxial data (issue 5). The simulator, PeriodicLab, is in periodic_lab.cpp.
+///
+/// The simulator is the periodic-cell triaxial test (host/triax/periodic_triaxial.hpp) on one specimen prepared once
+/// from the base config, so that every run differs from the others only by its parameters (common random
+/// numbers: the response is then a smooth function of the parameters, up to the chaos of a small cell).
+///
+/// Each test (material, sigma3) is reduced to seven quantities, the same for measured and simulated curves
+/// (summarise in host/data/measured.hpp): initial stiffness E_ini, q at 1% and at 3% axial strain (the shape of
+/// the hardening: an effect that grows or fades with strain shows there), q_peak, eps_a at the peak, q at the
+/// end, maximum dilatancy. A summary file gives those it has. The misfit is a chi-square with a lab-like noise
+/// per quantity:
+///   chi2 = sum over tests and present quantities of ((simulated - measured) / s_q)^2,
+///   s_q = max(rel_q |measured|, abs_q)   (NoiseModel: E_ini 10%, q at 1% and 3% 6%, q_peak 4%, eps_a at
+///                                         peak 2% strain, q_end 5%, dilatancy 20% or 0.05)
+/// so a model that is right to within the noise has chi2 about the number of data. The levels are a lab's
+/// specimen-to-specimen scatter (2-3% on strength) plus the scatter of a 200-ball cell, whose broad peak
+/// moves by a few % of strain with a small change of parameters.
+///
+/// Search (for d free parameters, each mapped to [0, 1], linearly or logarithmically):
+///   1. a 3^d factorial design (every test of the material at every point);
+///   2. a quadratic response surface per datum (Eigen least squares on the normalised residuals), minimised
+///      by a dense grid and then coordinate refinement;
+///   3. a run at the surrogate's optimum, added to the design; the surface is refitted with weights that
+///      favour points near the optimum; repeated until the run's chi2 stops improving (at most `rounds`);
+///   4. a compass stage on the simulator itself: from the best run, steps of 1/4 and then 1/8 of each unit
+///      range along every axis, moving to any better run. A quadratic surface cannot follow a misfit that
+///      saturates or has a second, narrower valley between the design's points, and stops at an edge of the range
+///      when the optimum lies inside (seen on another code's data: chi2 76 at the edge, 37 inside). 1/8 is
+///      the finest step worth a run: below it the runs of a small ensemble differ by their chaos more than by
+///      the step. A last surrogate round, centred on the compass's best, refines between its points;
+///   5. when the best point lies on the edge of a range that can move (not a hard limit such as mu_r = 0), the
+///      range is re-centred on it and the search starts again (at most `widen` times); the better answer wins.
+/// The reported fit is the best point actually run, never a surrogate value.
+#include <array>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "host/config/config.hpp"
+#include "host/engine/builder.hpp"
+#include "host/data/measured.hpp"
+#include "host/fit/misfit.hpp"
+#include "host/lab/periodic_lab.hpp"
+
+namespace dem {
+
+/// A parameter that calibration may vary: its config key, its range, log or linear search.
+struct FreeParam {
+  std::string name;
+  Real lo = 0, hi = 1;
+  bool log = false;
+  Real value(Real u) const;   ///< u in [0, 1] to the parameter
+  Real unit(Real v) const;    ///< the inverse
+  Real shown = 1;             ///< factor from SI to the config key's unit (1e-3 for membrane_kPa)
+};
+
+/// The parameters triaxdem can free, with their default ranges: mu_s, mu_r, emod_Pa, kratio, hertz_overlap,
+/// roughness, wear, wear_slip, membrane_kPa (in Pa inside). Throws std::invalid_argument naming the allowed
+/// names.
+FreeParam free_param(const std::string& name);
+/// The same, centred on the base model's value where that is set: mu_s and emod_Pa over a factor 3
+/// either way (log), mu_r over [0, max(4 x value, 0.05)]. A 3 x 3 design then lands near a sensible answer.
+FreeParam free_param(const std::string& name, const Model& base);
+void set_param(Model& m, const std::string& name, Real v);
+/// True for a parameter of the contact law (every test has it); false for the periodic cell's membrane extension.
+bool is_contact_param(const std::string& name);
+Real get_param(const Model& m, const std::string& name);
+
+/// A quadratic response surface in unit coordinates: value(u) = c . basis(u), fitted by weighted least squares.
+class QuadraticSurface {
+ public:
+  QuadraticSurface() = default;
+  QuadraticSurface(const std::vector<std::vector<Real>>& u, const std::vector<Real>& y, const std::vector<Real>& w);
+  Real operator()(const std::vector<Real>& u) const;
+  static std::vector<Real> basis(const std::vector<Real>& u);
+
+ private:
+  std::vector<Real> c_;
+};
+
+/// One evaluated point of a search.
+struct Evaluation {
+  std::vector<Real> u;                ///< unit coordinates of the free parameters
+  std::vector<MeasuredTest> sim;      ///< simulated tests: the mean curves of the ensemble (mean_curve)
+  std::vector<Real> r;                ///< normalised residuals (all tests)
+  Real chi2 = 0;
+};
+
+struct CalibrationResult {
+  Model model;                        ///< base model with the calibrated values
+  std::vector<FreeParam> free;
+  std::vector<Real> values;
+  Evaluation best;                    ///< the best point run
+  std::vector<Evaluation> design;     ///< every point run, in order
+  int data = 0;                       ///< number of data in the misfit
+  /// Names of the parameters whose best value lies on an edge of its range (within 1% of it): the true
+  /// optimum may lie outside, and a misfit found there may be the range's and not the model's. A lower edge
+  /// at zero is not one: nothing lies below it (no rolling resistance, no wear).
+  std::vector<std::string> at_edge() const;
+  /// What the search did to ranges whose best value fell on an edge ("mu_s range moved to [0.15, 1.35]").
+  std::vector<std::string> widened;
+  /// Parameters searched beyond the edge their best value lies on, without a better point there: the
+  /// optimum is at the edge within the scatter of the runs, and at_edge() does not flag them.
+  std::vector<std::string> searched_beyond;
+
+  /// Uncertainty, from the response surfaces of the residuals around the best run (the surrogate chi2, shifted
+  /// to agree with that run): each parameter's 95% profile interval (where the chi2 minimised over the others
+  /// rises by 3.84 x scale), the correlation of the free parameters (Gauss-Newton, (J^T J)^-1), and the joint
+  /// 95% region (a rise of the chi2 quantile with d degrees of freedom). scale = chi2 / (n - d) where that
+  /// exceeds 1: a misfit beyond the noise widens the region by its root, as the noise was understated.
+  std::vector<std::pair<Real, Real>> interval;     ///< SI, per free parameter
+  std::vector<std::vector<Real>> correlation;      ///< d x d
+  Real scale = 1;
+  /// The surrogate chi2 at unit coordinates u.
+  Real surrogate_chi2(const std::vector<Real>& u) const;
+  /// How far parameter values (SI, in free order) lie from the best, as the surrogate chi2's rise over the
+  /// joint 95% region's: at most 1 inside the region; infinite outside the searched ranges.
+  Real region_rise(const std::vector<Real>& values) const;
+  /// Pairs of parameters whose correlation is beyond +-0.9, in words ("mu_s and mu_r (-0.95)"): these data
+  /// cannot separate them.
+  std::vector<std::string> inseparable() const;
+  /// How flat the minimum is: the share of the searched box (unit coordinates, a grid) where the surrogate chi2
+  /// lies within the joint 95% rise of the best. A few % is a sharp optimum; tens of % say the data hardly
+  /// constrain the parameters over their ranges.
+  Real flat_share() const;
+  std::vector<QuadraticSurface> surfaces;          ///< the residuals' surfaces around the best run
+  std::vector<Real> offset;                        ///< best-run residual minus surface value there
+};
+
+/// Moves f's range to centre on v, keeping its width (its ratio when logarithmic), inside the registry's range
+/// for the name (free_param(name)); false when it cannot move (v on a hard limit, such as mu_r = 0).
+bool recentre(FreeParam& f, Real v);
+
+/// Called after each run with (runs done, runs planned, best chi2 so far).
+using CalibrationProgress = std::function<void(long, long, Real)>;
+
+/// What a search asks of its simulator at one model: the simulated tests and the normalised residuals.
+struct SimulatedPoint {
+  std::vector<MeasuredTest> sim;
+  std::vector<Real> r;
+};
+using Simulator = std::function<SimulatedPoint(const Model&)>;
+
+/// Calibrates `free` from `base` on a misfit of `data` data; see the top of the file.
+CalibrationResult calibrate(const Simulator& simulate, const Model& base, const std::vector<FreeParam>& free, int data,
+                            int rounds = 4, int widen = 2);
+/// The same on `measured` (one material, any number of pressures), simulated by the lab's ensemble.
+CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,
+                            const std::vector<MeasuredTest>& measured, const Misfit& misfit, int rounds = 4,
+                            const CalibrationProgress& progress = {}, int widen = 2);
+/// A run of the base model found after the calibration (a nested model's run at strength 0) that beats its best:
+/// it joins the design and becomes the best, and the values, the model (`base` with them) and the uncertainty are
+/// computed again at it, so that the intervals and correlation belong to the reported point.
+void adopt_best(CalibrationResult& r, const Evaluation& better, const Model& base);
+
+/// Parameter points a calibration of d free parameters runs at most before any widening: the design, the
+/// surrogate rounds and the compass stage (for a progress bar's plan).
+long planned_points(int d, int rounds = 4);
+
+/// One response surface per residual of the evaluations, weighted towards `centre` (unit coordinates).
+std::vector<QuadraticSurface> response_surfaces(const std::vector<Evaluation>& pts, const std::vector<Real>& centre);
+
+/// Minimises f over [0, 1]^d: a grid of `per_axis` points per axis (fewer for d > 3), then coordinate steps
+/// that halve down to 1e-4.
+std::vector<Real> minimise_unit_box(const std::function<Real(const std::vector<Real>&)>& f, int d, int per_axis = 21);
+
+}  // namespace dem

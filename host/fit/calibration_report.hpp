@@ -1,0 +1,25 @@
+#pragma once
+/// The tables of `triaxdem calibrate` and `diagnose`: errors per test (like the paper's Table 6), calibrated values
+/// with their intervals, the noise used, and the gain of an extension. They read only the results they are handed.
+#include <string>
+#include <vector>
+
+#include "host/fit/calibrate.hpp"
+#include "host/data/measured.hpp"
+#include "host/fit/misfit.hpp"
+
+namespace dem {
+
+/// Measured, simulated and error per test and quantity, as CSV.
+std::string errors_csv(const std::vector<MeasuredTest>& meas, const std::vector<MeasuredTest>& sim);
+/// The same table on stdout.
+void print_errors(const std::vector<MeasuredTest>& meas, const std::vector<MeasuredTest>& sim);
+/// The calibrated values with their 95% intervals and correlations, in lines prefixed "<job>: <material>: ".
+std::string uncertainty_text(const CalibrationResult& r, const std::string& material, const std::string& job);
+/// The noise used, per test and quantity (markdown).
+std::string noise_table(const Misfit& mf, const std::vector<MeasuredTest>& tests);
+/// The gain of an extension over the base by pressure, strain range and quantity, then every datum (markdown).
+std::string gain_tables(const Misfit& mf, const std::vector<MeasuredTest>& tests, const Evaluation& base,
+                        const Evaluation& ext, const std::string& name);
+
+}  // namespace dem

@@ -1,0 +1,170 @@
+#pragma once
+/// The misfit between measured tests and the simulator's ensemble (issue 26): what is compared, with which
+/// noise, and the whitened residuals that calibration and diagnosis minimise.
+///
+/// What is compared. Curve data: q and eps_v at the strains of kFeatureStrains (log-spaced, where the stiffness
+/// and the early contraction live, then through the peak to the end), each read off a curve by a local
+/// straight-line fit over +-min(30%, 0.25% strain) of the strain (curve_value), for measured and simulated
+/// curves alike; a strain is used when both curves reach it. Summary data: the seven quantities of summarise.
+///
+/// With which noise, per test (the three kinds of scatter of ../shared/notes/discrepancy_methods.md, added):
+///   Sigma = Sigma_data + Sigma_specimen + Sigma_ensemble / K + Sigma_cell
+///   Sigma_data      the measured curve's own noise: its standard-deviation columns, or, without them, the
+///                   scatter of its rows about a smooth curve (row_noise, with the lag-1 correlation along
+///                   strain counted: a window of n rows counts n (1 - rho) / (1 + rho)); zero where replicates
+///                   give the specimen term, which holds it.
+///   Sigma_specimen  the measured specimen is one specimen: from replicates when the data have them (the pooled
+///                   scatter between replicates, q relative to sigma3), else as variable as one specimen of the
+///                   simulator's ensemble, times (N_sim / N)^kSpecimenScatterExponent where the data say their
+///                   specimen has N particles (specimen_balls); without N, a conservative stand-in
+///                   for a larger specimen. Never below a lab's specimen scatter (LabCurveNoise: q_shared of q,
+///                   ev_abs on eps_v): a real specimen differs from the next by more than its particle count.
+///   Sigma_ensemble  the simulator's specimen-to-specimen covariance, measured once at the base model on the
+///                   scatter specimens (more than the K of the ensemble): per-feature variances pooled over the
+///                   tests (q in units of sigma3, eps_v as it is), correlated along strain as
+///                   exp(-|ln e1 - ln e2| / l), l fitted to the specimens. A variance estimated from S specimens
+///                   has S - 1 degrees of freedom (the tests share the specimens, so pooling over tests adds
+///                   none); a deviation measured against it follows Student's t, whose variance is
+///                   nu / (nu - 2) times the estimate: the estimate is inflated by that factor.
+///   Sigma_cell      the simulator's finite-cell bias against the data's specimen (host/fit/cell_bias.hpp), measured
+///                   by measure_misfit on larger cells, correlated along strain as Sigma_ensemble.
+/// Tests are independent of each other. The `lab` noise replaces the data and specimen terms by a lab's
+/// scatter (LabCurveNoise); summary data use NoiseModel, with the ensemble's variance added.
+/// The residuals are whitened per test, r = L^-1 (mean of the members - measured), Sigma = L L^T, so that
+/// chi2 = sum r^2 is about the number of data for a model right within the noise.
+#include <array>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "host/data/curve_reading.hpp"
+#include "host/data/measured.hpp"
+#include "host/config/noise_model.hpp"
+#include "host/lab/periodic_lab.hpp"
+
+namespace dem {
+
+/// The quantities of a test (NaN where absent).
+std::array<Real, kQuantities> quantities(const MeasuredTest& t);
+
+/// The simulator's standard error that an ensemble aims below, as a share of the data's noise: its mean then adds
+/// at most a quarter to the variance.
+constexpr Real kEnsembleRatioGoal = 0.5;
+
+/// A periodic cell of N balls scatters from the next as N^-kSpecimenScatterExponent, which scales the simulator's
+/// measured scatter to a data specimen of another size: the exponent of independent fluctuations. Between cells of
+/// 120 and 1920 balls of this simulator (perf/specimen_scatter.sh: 12-16 specimens a size, 100 and 300 kPa, q and
+/// eps_v at nine strains to 8%), two sets of specimens gave 0.44 and 0.58 on average, and q at 8% from both sets
+/// together 0.45 (100 kPa) and 0.49 (300 kPa): one set's exponents scatter by about 0.15 either way, and 1/2 stands.
+constexpr Real kSpecimenScatterExponent = 0.5;
+
+/// The largest cell an "auto" cell grows to, in multiples of the config's balls: a run's cost grows with it.
+constexpr int kMaxCellFactor = 8;
+
+/// Residual of a datum the simulation could not produce (no peak, a blow-up): ten standard deviations.
+constexpr Real kMissingResidual = 10;
+
+/// Whitened residuals of one summary test against one simulated test with lab noise, one per quantity (NaN where
+/// the measured test lacks it). L is lower triangular in quantity order: r_q is what datum q says beyond the
+/// quantities before it (E_ini first), the shared specimen factor counted once.
+std::array<Real, kQuantities> test_residuals(const MeasuredTest& measured, const MeasuredTest& simulated,
+                                             const NoiseModel& noise);
+
+/// How the data's noise is taken: "data" (standard-deviation columns, else replicates, else the curves'
+/// own scatter; the lab model where none of these is possible) or "lab" (the lab model: the defaults, or a file's).
+struct NoiseOptions {
+  std::string mode = "data";
+  LabCurveNoise lab;
+  NoiseModel summary;
+  std::string lab_name = "the lab model";  ///< how the report names the lab model (a file's path when read from one)
+};
+/// The lab noise of a file (`--noise FILE`, read_lab_noise) as the noise options of mode "lab".
+NoiseOptions lab_noise_options(const std::string& path);
+
+/// One compared datum of a test, with the parts of its noise (standard deviations, in its unit: Pa or -).
+struct Feature {
+  std::string name;          ///< "q at 0.1%", "eps_v at 2%", or a summary quantity's name
+  int quantity = 0;          ///< 0: q, 1: eps_v; summary data: the Quantity
+  Real strain = 0;           ///< curve features
+  Real measured = 0;
+  Real data_sd = 0, specimen_sd = 0, ensemble_sd = 0;  ///< ensemble_sd: one member's; the mean's is / sqrt(K)
+  Real cell_sd = 0;  ///< the simulator's finite-cell bias against the data's specimen (host/fit/cell_bias.hpp)
+  /// The uncertainty of the measured discrepancy between the reference test and this simulator (add_discrepancy).
+  Real discrepancy_sd = 0;
+  /// The data side's noise: the measured curve's and the measured specimen's, what the simulator's parts are set
+  /// against.
+  Real data_noise() const { return std::hypot(data_sd, specimen_sd); }
+};
+
+class Misfit {
+ public:
+  /// `reference`: runs at the base model on the scatter specimens ([test][specimen], tests as in `measured`),
+  /// which measure the simulator's scatter; `members`: the ensemble size whose mean is compared; `sim_end`: the
+  /// simulator's last axial strain.
+  /// `sim_balls`: particles in a simulator specimen, against which a test's specimen_balls scales its specimen
+  /// term.
+  Misfit(const std::vector<MeasuredTest>& measured, const NoiseOptions& noise, const Ensemble& reference,
+         int members, Real sim_end, Real sim_balls = 0);
+  std::size_t tests() const { return features_.size(); }
+  int data() const;                               ///< compared data in all tests
+  int data(std::size_t test) const { return static_cast<int>(features_[test].size()); }
+  const std::vector<Feature>& features(std::size_t test) const { return features_[test]; }
+  /// Whitened residuals of test k against its members' runs.
+  std::vector<Real> test_residuals(std::size_t k, const std::vector<MeasuredTest>& members) const;
+  /// All tests', concatenated in test order.
+  std::vector<Real> residuals(const Ensemble& sim) const;
+  /// The members' mean feature values of test k (NaN where no member has one).
+  std::vector<Real> mean_values(std::size_t k, const std::vector<MeasuredTest>& members) const;
+  /// What noise was used, per test and in words, for the report.
+  const std::vector<std::string>& notes() const { return notes_; }
+  std::string source() const { return source_; }
+  Real correlation_length() const { return length_; }
+  /// The simulator's standard error over the data-side noise, median over the data: the ensemble is large
+  /// enough when it is below 1/2 (its mean then adds at most a quarter to the variance).
+  Real ensemble_ratio() const;
+  /// The ensemble size that brings ensemble_ratio() to `target` (the standard error goes as 1 / sqrt(K)).
+  int members_for(Real target) const;
+  int members() const { return members_; }
+  /// Particles in a simulator specimen (0: not given).
+  Real sim_balls() const { return sim_balls_; }
+  /// Sigma_cell: adds the simulator's finite-cell bias, sd[test][feature] (host/fit/cell_bias.hpp), correlated along
+  /// strain as the ensemble's scatter is (a bias moves a curve smoothly); `note` says how it was measured.
+  void add_cell_bias(const std::vector<std::vector<Real>>& sd, const std::string& note);
+  /// Two fidelities (host/fit/two_fidelity.hpp): the data are what the reference test measures, which exceeds what this
+  /// simulator gives at the same parameters by delta[test][feature]; the simulator is then compared with the data
+  /// less delta, and delta's uncertainty sd[test][feature] is counted, correlated along strain as a bias is.
+  void add_discrepancy(const std::vector<std::vector<Real>>& delta, const std::vector<std::vector<Real>>& sd,
+                       const std::string& note);
+  /// The scatter specimens' mean void ratio at the start of shear of test k, at the base model.
+  Real reached_void_ratio(std::size_t k) const { return void_ratio_[k]; }
+
+ private:
+  std::vector<Real> void_ratio_;
+  std::vector<Real> values(std::size_t k, const MeasuredTest& t) const;
+  void build_curve_noise(const std::vector<MeasuredTest>& measured, const NoiseOptions& noise, const Ensemble& ref,
+                         Real sim_balls);
+  void build_summary_noise(const std::vector<MeasuredTest>& measured, const NoiseOptions& noise, const Ensemble& ref);
+  /// Sets each feature's `field` to sd[test][feature] and adds it to Sigma, correlated along strain.
+  void add_correlated(const std::vector<std::vector<Real>>& sd, Real Feature::*field, const std::string& what);
+  std::vector<std::vector<Feature>> features_;
+  std::vector<std::vector<Real>> cov_;   ///< per test, Sigma (n x n, row-major)
+  std::vector<std::string> notes_;
+  std::string source_;
+  Real length_ = 1;
+  int members_ = 1;
+  Real sim_balls_ = 0;
+  bool curves_ = true;
+};
+
+/// The simulator's scatter measured: `lab`'s scatter specimens run at `base` on every measured test, and the
+/// misfit built on it. With an "auto" ensemble ([calibrate] ensemble), the lab's ensemble becomes the fewest
+/// specimens (at most all the scatter specimens) whose mean's standard error is below kEnsembleRatioGoal of the
+/// data's noise. Where all of them fall short and the cell is "auto" too ([calibrate] cell_factor), the cell grows
+/// by the factor that makes up the rest (at most kMaxCellFactor; the mean of K specimens of N balls scatters as
+/// 1 / sqrt(K N)) and the scatter is measured again on it; where `state` holds the lab's match to the data's void
+/// ratio, the grown cell is matched again (PeriodicLab::grow_cell) and `state` says what it reaches. Then the cell's
+/// bias is measured and counted (measure_cell_bias) unless `cell_bias` is false.
+Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<MeasuredTest>& measured,
+                      const NoiseOptions& noise, bool cell_bias = true, StateMatch* state = nullptr);
+
+}  // namespace dem

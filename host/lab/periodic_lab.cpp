@@ -1,0 +1,321 @@
+#include "host/lab/periodic_lab.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <optional>
+#include <stdexcept>
+#include <type_traits>
+
+#include <Kokkos_Core.hpp>
+#if defined(KOKKOS_ENABLE_OPENMP)
+#include <omp.h>
+#endif
+
+#include "host/util/fnv1a.hpp"
+#include "host/util/forked_runs.hpp"
+#include "host/triax/periodic_triaxial.hpp"
+#include "host/util/progress.hpp"
+#include "host/lab/run_store.hpp"
+
+namespace dem {
+
+namespace {
+
+/// A run that produced no test (a blow-up): every quantity NaN, counted as missing by residuals().
+void mark_failed(MeasuredTest& t) {
+  t.q_peak = t.eps_a_peak = t.q_end = t.max_dilatancy = t.e_ini = t.q_1pct = t.q_3pct =
+      std::numeric_limits<Real>::quiet_NaN();
+}
+
+/// Cell volume over the balls' volume, less one.
+Real void_ratio_of(const std::vector<BallSpec>& balls, const std::array<Real, 3>& cell) {
+  return cell[0] * cell[1] * cell[2] / solid_volume(balls) - 1;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------------
+// Simulator
+
+Model model_of(const Config& cfg) {
+  Model m;
+  m.law = cfg.ball;
+  m.membrane = cfg.periodic.triax.membrane_stiffness;
+  return m;
+}
+
+namespace {
+/// The config's fixed cell factor; an "auto" cell starts as the config's own (1).
+int fixed_cell_factor(const Config& c) { return static_cast<int>(std::max(c.calibrate.cell_factor, 1L)); }
+}  // namespace
+
+Config larger_cell(const Config& base, int factor) {
+  Config c = base;
+  c.particles.count *= factor;
+  for (Real& side : c.box.size) side *= std::cbrt(static_cast<Real>(factor));
+  return c;
+}
+
+PeriodicLab::PeriodicLab(const Config& base, bool verbose, int members, unsigned first_seed, int specimens, int jobs)
+    : cfg_(base), members_(std::max(members, 1)), first_seed_(first_seed) {
+  set_jobs(jobs);
+  pack(std::max(members_, specimens), verbose);
+}
+
+void PeriodicLab::pack(int count, bool verbose) {
+  specimens_.assign(static_cast<std::size_t>(count), Specimen{});
+  auto prepare = [&](std::size_t k) {
+    Config c = cfg_;
+    c.run.seed = first_seed_ + static_cast<unsigned>(k);
+    Specimen& s = specimens_[k];
+    prepare_periodic_specimen(c, s.balls, s.cell, verbose && k == 0);
+    s.void_ratio = void_ratio_of(s.balls, s.cell);
+  };
+  if (jobs_ <= 1 || count <= 1) {
+    for (std::size_t k = 0; k < specimens_.size(); ++k) prepare(k);
+    return;
+  }
+  // Each specimen in a child, sent back as its ball count, balls (plain data), cell and void ratio.
+  static_assert(std::is_trivially_copyable<BallSpec>::value, "BallSpec goes through a pipe as bytes");
+  forked_runs(
+      specimens_.size(), jobs_,
+      [&](std::size_t k, int fd) {
+        prepare(k);
+        const Specimen& s = specimens_[k];
+        const std::size_t n = s.balls.size();
+        put_bytes(fd, &n, sizeof n);
+        put_bytes(fd, s.balls.data(), n * sizeof(BallSpec));
+        put_bytes(fd, s.cell.data(), sizeof s.cell);
+        put_bytes(fd, &s.void_ratio, sizeof s.void_ratio);
+      },
+      [&](std::size_t k, int fd) {
+        Specimen& s = specimens_[k];
+        std::size_t n = 0;
+        if (!get_bytes(fd, &n, sizeof n)) return false;
+        s.balls.resize(n);
+        return get_bytes(fd, s.balls.data(), n * sizeof(BallSpec)) && get_bytes(fd, s.cell.data(), sizeof s.cell) &&
+               get_bytes(fd, &s.void_ratio, sizeof s.void_ratio);
+      },
+      "specimen preparation");
+}
+
+void PeriodicLab::grow_cell(int factor, StateMatch* state) {
+  if (factor < 1) throw std::invalid_argument("cell factor " + std::to_string(factor) + " (allowed: 1 or more)");
+  cfg_ = larger_cell(cfg_, factor);
+  cell_factor_ *= factor;
+  // The friction that packs the data's void ratio in a small cell packs a larger one to another.
+  if (state && state->tests > 0) {
+    MatchPlan plan;
+    plan.first_seed = first_seed_;
+    plan.specimens = state->specimens;
+    plan.jobs = jobs_;
+    cfg_.periodic.prep_mu_s = state->prep_mu_s = prep_friction_for(cfg_, state->target, state->reached, false, plan);
+  }
+  pack(specimens(), false);
+}
+
+MatchPlan match_plan(const Config& base, int jobs) {
+  MatchPlan p;
+  p.first_seed = base.run.seed;
+  p.cell_factor = fixed_cell_factor(base);
+  p.jobs = runs_at_once(jobs);
+  return p;
+}
+
+PeriodicLab::PeriodicLab(const Config& base, bool verbose, int jobs)
+    : PeriodicLab(larger_cell(base, fixed_cell_factor(base)), verbose,
+                  static_cast<int>(base.calibrate.ensemble == kAutoEnsemble ? base.calibrate.scatter_specimens
+                                                                            : base.calibrate.ensemble),
+                  base.run.seed, static_cast<int>(base.calibrate.scatter_specimens), jobs) {
+  cell_factor_ = fixed_cell_factor(base);
+}
+
+void PeriodicLab::set_members(int k) {
+  if (k < 1 || k > specimens())
+    throw std::invalid_argument("ensemble of " + std::to_string(k) + " specimens (allowed: 1 to " +
+                                std::to_string(specimens()) + ")");
+  members_ = k;
+}
+
+MeasuredTest PeriodicLab::run(const Model& m, Real sigma3, const std::string& material, int member) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const Specimen& sp = specimens_.at(static_cast<std::size_t>(member));
+  MeasuredTest t;
+  PeriodicTriaxialParams p = cfg_.periodic.triax;
+  p.sigma3 = sigma3;
+  p.membrane_stiffness = m.membrane;
+  p.verbose = false;
+  p.snapshot_strains.clear();
+  try {
+    auto sim = make_periodic_simulation(sp.balls, sp.cell, m.law, cfg_.solver, cfg_.periodic.boundary);
+    const PeriodicTriaxialResult r = run_periodic_triaxial(*sim, p);
+    t = summarised(r.series, sigma3);
+    t.void_ratio = r.void_ratio0;
+  } catch (const BlowUp&) {
+    t.sigma3 = sigma3;
+    mark_failed(t);
+  }
+  t.material = material;
+  ++runs_;
+  seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return t;
+}
+
+void prepare_parallel_runs(int jobs) {
+#if defined(KOKKOS_ENABLE_OPENMP)
+  if (jobs > 1) omp_set_num_threads(1);
+#else
+  (void)jobs;
+#endif
+}
+
+int runs_at_once(int jobs) {
+  constexpr bool host = std::is_same<ExecSpace::memory_space, Kokkos::HostSpace>::value;
+  return host && ExecSpace().concurrency() == 1 ? std::max(jobs, 1) : 1;
+}
+
+int PeriodicLab::set_jobs(int jobs) { return jobs_ = runs_at_once(jobs); }
+
+namespace {
+
+/// The curves of a test as bytes to `put(pointer, count)`: row count, void ratio, then eps_a, q, eps_v (a count of
+/// -1: the run blew up). Through a child's pipe (send_curves) and into the run store.
+template <class Put>
+void put_curves(const MeasuredTest& t, Put put) {
+  const long n = std::isfinite(t.q_peak) ? static_cast<long>(t.q.size()) : -1;
+  put(&n, sizeof n);
+  put(&t.void_ratio, sizeof t.void_ratio);
+  for (const std::vector<Real>* v : {&t.eps_a, &t.q, &t.eps_v})
+    if (n > 0) put(v->data(), sizeof(Real) * v->size());
+}
+
+void send_curves(int fd, const MeasuredTest& t) {
+  put_curves(t, [fd](const void* p, std::size_t n) { put_bytes(fd, p, n); });
+}
+
+bool receive_curves(int fd, MeasuredTest& t) {
+  long n = 0;
+  if (!get_bytes(fd, &n, sizeof n) || !get_bytes(fd, &t.void_ratio, sizeof t.void_ratio)) return false;
+  if (n < 0) {
+    mark_failed(t);
+    return true;
+  }
+  for (std::vector<Real>* v : {&t.eps_a, &t.q, &t.eps_v}) {
+    v->resize(static_cast<std::size_t>(n));
+    if (n > 0 && !get_bytes(fd, v->data(), sizeof(Real) * v->size())) return false;
+  }
+  summarise(t);
+  return true;
+}
+
+}  // namespace
+
+void PeriodicLab::set_run_store(std::string folder) { store_ = std::move(folder); }
+
+std::string PeriodicLab::stored_path(const Model& m, const Case& c) const {
+  if (store_.empty()) return "";
+  std::uint64_t h = store_hash(cfg_);
+  h = fnv1a(&m.law, sizeof m.law, h);  // Reals only: no padding
+  h = fnv1a(&m.membrane, sizeof m.membrane, h);
+  h = fnv1a(&c.sigma3, sizeof c.sigma3, h);
+  const Specimen& sp = specimens_.at(static_cast<std::size_t>(c.member));
+  for (const BallSpec& b : sp.balls) {
+    const Real v[] = {b.x.x, b.x.y, b.x.z, b.v.x, b.v.y, b.v.z, b.w.x, b.w.y, b.w.z, b.radius, b.density};
+    h = fnv1a(v, sizeof v, h);
+    h = fnv1a(&b.material, sizeof b.material, h);
+  }
+  h = fnv1a(sp.cell.data(), sizeof(Real) * sp.cell.size(), h);
+  return store_ + "/" + hex16(h) + ".run";
+}
+
+namespace {
+/// A run's curves into the store (put_curves' bytes, as through a pipe).
+void store_run(const std::string& path, const MeasuredTest& t) {
+  if (path.empty()) return;
+  std::string bytes;
+  put_curves(t, [&](const void* p, std::size_t n) { bytes.append(static_cast<const char*>(p), n); });
+  write_stored(path, bytes);
+}
+}  // namespace
+
+std::vector<MeasuredTest> PeriodicLab::run_cases(const Model& m, const std::vector<Case>& cases) {
+  std::vector<MeasuredTest> out = run_or_read(m, cases);
+  for (const MeasuredTest& t : out)
+    if (!std::isfinite(t.q_peak)) ++failed_, failed_sigma3_ = std::max(failed_sigma3_, t.sigma3);
+  return out;
+}
+
+std::vector<MeasuredTest> PeriodicLab::run_or_read(const Model& m, const std::vector<Case>& cases) {
+  std::vector<MeasuredTest> out(cases.size());
+  std::optional<Progress> progress;
+  if (!progress_label_.empty()) progress.emplace(progress_label_, static_cast<long>(cases.size()));
+  long done = 0;
+  const auto one_done = [&]() {
+    if (progress) progress->update(++done, "runs");
+  };
+  std::vector<std::string> paths(cases.size());
+  std::vector<std::size_t> todo;  // the cases not in the store
+  for (std::size_t j = 0; j < cases.size(); ++j) {
+    paths[j] = stored_path(m, cases[j]);
+    out[j].material = cases[j].material;
+    out[j].sigma3 = cases[j].sigma3;
+    if (read_stored(paths[j], [&](int fd) { return receive_curves(fd, out[j]); })) {
+      ++stored_read_;
+      ++runs_;  // a run of the search, read: the counts a resumed search reports are those it reported
+      one_done();
+    } else {
+      out[j] = MeasuredTest{};
+      todo.push_back(j);
+    }
+  }
+  if (jobs_ <= 1 || todo.size() <= 1) {
+    for (const std::size_t j : todo) {
+      out[j] = run(m, cases[j].sigma3, cases[j].material, cases[j].member);
+      store_run(paths[j], out[j]);
+      one_done();
+    }
+    return out;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  forked_runs(
+      todo.size(), jobs_,
+      [&](std::size_t k, int fd) {
+        const Case& c = cases[todo[k]];
+        send_curves(fd, run(m, c.sigma3, c.material, c.member));
+      },
+      [&](std::size_t k, int fd) {
+        const std::size_t j = todo[k];
+        out[j].material = cases[j].material;
+        out[j].sigma3 = cases[j].sigma3;
+        const bool received = receive_curves(fd, out[j]);
+        if (received) store_run(paths[j], out[j]);
+        one_done();
+        return received;
+      },
+      "calibration");
+  runs_ += static_cast<long>(todo.size());
+  seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+Ensemble PeriodicLab::run_ensemble(const Model& m, const std::vector<MeasuredTest>& like, bool all) {
+  const std::size_t M = all ? specimens_.size() : static_cast<std::size_t>(members_);
+  std::vector<Case> cases;  // case j: test j / M on member j % M
+  for (std::size_t j = 0; j < like.size() * M; ++j)
+    cases.push_back({like[j / M].material, like[j / M].sigma3, static_cast<int>(j % M)});
+  const std::vector<MeasuredTest> done = run_cases(m, cases);
+  Ensemble out(like.size());
+  for (std::size_t j = 0; j < done.size(); ++j) out[j / M].push_back(done[j]);
+  return out;
+}
+
+std::vector<MeasuredTest> PeriodicLab::run_each(const Model& m, const std::vector<MeasuredTest>& like) {
+  std::vector<Case> cases;
+  for (std::size_t j = 0; j < like.size(); ++j)
+    cases.push_back({like[j].material, like[j].sigma3, static_cast<int>(j % static_cast<std::size_t>(members_))});
+  return run_cases(m, cases);
+}
+
+}  // namespace dem

@@ -1,0 +1,195 @@
+#pragma once
+/// The calibration simulator: periodic-cell triaxial runs (host/triax/periodic_triaxial.hpp) on an ensemble of
+/// specimens, each prepared once from the base config with its own packing seed and reused at every parameter
+/// point (common random numbers: the difference between two points is then the parameters' effect, not the
+/// specimens'). Member k packs with seed first_seed + k; data made for tests draw their specimens from seeds
+/// outside that set (kForeignSeedOffset), as real data come from specimens the simulator never saw.
+#include <array>
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "host/config/config.hpp"
+#include "host/engine/builder.hpp"
+#include "host/data/measured.hpp"
+
+namespace dem {
+
+/// A model to simulate: contact law (with extensions) and the membrane extension (Pa, E_m t / R0).
+struct Model {
+  ContactParams law;
+  Real membrane = 0;
+};
+
+/// The model of a config: its ball law and the periodic cell's membrane.
+Model model_of(const Config& cfg);
+
+/// Simulated tests of an ensemble: [test][member], each summarised like measured curves.
+using Ensemble = std::vector<std::vector<MeasuredTest>>;
+
+/// Packing seeds of synthetic data start this far above the config's seed: never a member of an ensemble
+/// (at most 64 members, config.cpp).
+constexpr unsigned kForeignSeedOffset = 100000;
+
+/// The base config with `factor` times the balls in a box as many times larger (same packing density).
+Config larger_cell(const Config& base, int factor);
+
+struct StateMatch;
+
+class PeriodicLab {
+ public:
+  /// `specimens` specimens with packing seeds first_seed, first_seed + 1, ..., of which the first `members`
+  /// (at most all) form the ensemble that run_ensemble runs. They are packed up to `jobs` at once (set_jobs).
+  PeriodicLab(const Config& base, bool verbose, int members, unsigned first_seed, int specimens = 0, int jobs = 1);
+  /// The config's ensemble ([calibrate] ensemble, scatter_specimens), cell ([calibrate] cell_factor) and seed
+  /// ([run] seed); an "auto" ensemble starts as all the scatter specimens and an "auto" cell as the config's,
+  /// until measure_misfit chooses.
+  PeriodicLab(const Config& base, bool verbose, int jobs = 1);
+  /// One simulated test (curves, summarised; its void ratio at the start of shear) of one member at sigma3 (Pa).
+  MeasuredTest run(const Model& m, Real sigma3, const std::string& material = "sim", int member = 0);
+  /// Every test of `like` (its materials and pressures) on every member (on every specimen with `all`); up to
+  /// jobs() runs at once.
+  Ensemble run_ensemble(const Model& m, const std::vector<MeasuredTest>& like, bool all = false);
+  /// Test j of `like` (its material and pressure) on member j % members(): data made on a specimen per test.
+  std::vector<MeasuredTest> run_each(const Model& m, const std::vector<MeasuredTest>& like);
+  /// Runs at once: each in a child process (fork) with the same specimens; the results are the same as one at a
+  /// time, bit for bit. Only where that is safe: a host backend on one thread (OMP_NUM_THREADS=1); otherwise
+  /// the runs go one at a time with all threads. Returns the value in effect.
+  int set_jobs(int jobs);
+  int jobs() const { return jobs_; }
+  int members() const { return members_; }
+  /// Makes the first k specimens the ensemble (1 <= k <= specimens()).
+  void set_members(int k);
+  /// Packs every specimen again (same seeds) in a cell of `factor` times the balls (larger_cell), jobs() at once.
+  /// Where `state` holds a match to the data's void ratio, the preparation friction is matched again, on the larger
+  /// cell's first specimens (prep_friction_for), and `state` gets what it reaches.
+  void grow_cell(int factor, StateMatch* state = nullptr);
+  /// The cell's balls as a multiple of the config's.
+  int cell_factor() const { return cell_factor_; }
+  int specimens() const { return static_cast<int>(specimens_.size()); }
+  const Config& config() const { return cfg_; }
+  /// Keeps every run's curves in `folder` (one file each, named by a hash of the model, the pressure, the
+  /// specimen's balls, the config and the program's version) as it ends, and reads a run found there instead of
+  /// running it again: a calibration writes what it has as it goes, and one resumed in its folder replays its
+  /// search from the stored runs, bit for bit. "" keeps nothing.
+  void set_run_store(std::string folder);
+  const std::string& run_store() const { return store_; }
+  /// Of runs(), those read from the store instead of run.
+  long stored_runs_read() const { return stored_read_; }
+  /// Names the runs that follow in a progress line with ETA (each batch of runs counts them); "" for none: a
+  /// calibration's search reports its own progress, the scatter measurement and the state match this way.
+  void set_progress(std::string label) { progress_label_ = std::move(label); }
+  long runs() const { return runs_; }
+  /// Of runs(), those a blow-up stopped (their data count as missing), and the highest pressure of one (Pa).
+  long failed_runs() const { return failed_; }
+  Real highest_failed_sigma3() const { return failed_sigma3_; }
+  double seconds() const { return seconds_; }
+  std::size_t balls() const { return specimens_.front().balls.size(); }
+  /// Void ratio of member k's specimen after its preparation (at the preparation pressure).
+  Real prepared_void_ratio(int k) const { return specimens_[static_cast<std::size_t>(k)].void_ratio; }
+
+ private:
+  struct Specimen {
+    std::vector<BallSpec> balls;
+    std::array<Real, 3> cell{};
+    Real void_ratio = 0;
+  };
+  Config cfg_;
+  std::vector<Specimen> specimens_;
+  long runs_ = 0;
+  long failed_ = 0;
+  Real failed_sigma3_ = 0;
+  double seconds_ = 0;
+  std::string progress_label_;
+  std::string store_;
+  long stored_read_ = 0;
+  int jobs_ = 1;
+  int members_ = 1;
+  int cell_factor_ = 1;
+  unsigned first_seed_ = 0;
+  void pack(int count, bool verbose);
+  /// One run to make: a test's material and pressure on one member's specimen.
+  struct Case {
+    std::string material;
+    Real sigma3;
+    int member;
+  };
+  /// run_or_read, then the blown-up runs among them counted (failed_runs), whichever way each test came.
+  std::vector<MeasuredTest> run_cases(const Model& m, const std::vector<Case>& cases);
+  /// The cases in order, up to jobs() at once; those in the run store are read.
+  std::vector<MeasuredTest> run_or_read(const Model& m, const std::vector<Case>& cases);
+  /// The run store's file of a case ("" without a store).
+  std::string stored_path(const Model& m, const Case& c) const;
+};
+
+/// Runs at once that `jobs` asks for, where that is safe (PeriodicLab::set_jobs); otherwise 1.
+int runs_at_once(int jobs);
+
+/// Specimens whose mean void ratio the preparation friction is matched on. One specimen of 120 balls scatters by
+/// about 0.011 in void ratio at one friction (perf/specimen_scatter.sh), and a void ratio 0.001 lower adds about
+/// 0.01-0.02 to q/sigma3 (docs/calibration.md): a match on one specimen leaves that scatter as an offset of every
+/// specimen packed with its friction. The mean of two, packed side by side with 2 jobs, costs no more time.
+constexpr int kStateMatchSpecimens = 2;
+
+/// How the preparation friction is looked for: `steps` halvings, each packing the specimens of packing seeds
+/// first_seed, first_seed + 1, ... (`specimens` of them, up to `jobs` at once: the answer is the same for any
+/// jobs).
+struct MatchPlan {
+  unsigned first_seed = 0;
+  int specimens = kStateMatchSpecimens;
+  int steps = 8;
+  int jobs = 1;
+  int cell_factor = 1;  ///< the specimens are packed in cells of this many times the base config's balls
+  /// Where the answer is expected (sqrt(prep_mu_s), from a smaller cell's match; negative: nowhere): the halvings
+  /// start from the bracket of +-kMatchBracket around it, and from [0, 1] only where the target lies outside.
+  Real around = -1;
+  /// A run store (PeriodicLab::set_run_store) that keeps each packing's mean void ratio; "" keeps nothing.
+  std::string store;
+};
+/// Half the width of a MatchPlan's bracket in sqrt(prep_mu_s): a cell of four times the balls packs within about
+/// 0.005 in void ratio of the smaller one at one friction, 0.02-0.05 in sqrt(prep_mu_s) on the shipped configs.
+/// Its two ends and two halvings reach the 1/32 of five halvings of [0, 1] with four packings instead of seven.
+constexpr Real kMatchBracket = 1.0 / 16;
+/// The plan for a lab's specimens: its first seeds ([run] seed on), in the cell it runs ([calibrate] cell_factor,
+/// the config's own where "auto"), 8 halvings, `jobs` at once.
+MatchPlan match_plan(const Config& base, int jobs);
+
+/// How far (in void ratio) a data state may lie outside what a cell's preparation reaches and still be matched
+/// by the nearest end. Table 6's glass beads (e 0.60-0.61) lie 0.01-0.02 from the densest packing of the shipped
+/// cells (0.589 for 120 balls), which the nearest end serves; a gap of a tenth is as large as the whole range the
+/// preparation friction spans (0.59-0.87), another state, and is refused.
+constexpr Real kMaxStateGap = 0.05;
+
+/// The mean void ratios the plan's specimens of the base config pack to after their preparation with friction 0
+/// (the densest) and 1 (the loosest): the states a calibration can match.
+std::pair<Real, Real> preparation_reach(const Config& base, const MatchPlan& plan);
+
+/// The preparation friction ([periodic] prep_mu_s) with which the plan's specimens of the base config pack to a
+/// mean void ratio of `target` after their preparation: bisection on sqrt(prep_mu_s) over [0, 1] (more friction,
+/// a looser packing; the root spreads the steps where the void ratio changes fastest). `reached` receives their
+/// mean void ratio at the answer; a target beyond what [0, 1] reaches gets the nearest end, and one more than
+/// kMaxStateGap beyond it throws DataError. 8 halvings take sqrt(prep_mu_s) to 1/256 of its range; a plan's
+/// bracket (MatchPlan::around) needs fewer to reach the same resolution.
+Real prep_friction_for(const Config& base, Real target, Real& reached, bool verbose, const MatchPlan& plan);
+
+/// The measured specimens' state and the preparation that packs it (matched_state).
+struct StateMatch {
+  int tests = 0;                                            ///< tests that give a void ratio
+  Real target = std::numeric_limits<Real>::quiet_NaN();     ///< their mean void ratio
+  Real reached = std::numeric_limits<Real>::quiet_NaN();    ///< the matched specimens' mean after preparation
+  int specimens = 0;                                        ///< how many were matched
+  Real prep_mu_s = std::numeric_limits<Real>::quiet_NaN();
+};
+
+/// The base config with the preparation friction that packs the mean void ratio of the tests that give one
+/// (prep_friction_for); the base config itself when none does.
+Config matched_state(const Config& base, const std::vector<MeasuredTest>& tests, StateMatch& m, bool verbose,
+                     const MatchPlan& plan);
+
+/// Before Kokkos starts, in a program that will run `jobs` > 1 simulator runs at once: sets OpenMP to one
+/// thread (its runtime read OMP_NUM_THREADS when it was loaded, before main, so through its API), as
+/// PeriodicLab::set_jobs requires.
+void prepare_parallel_runs(int jobs);
+
+}  // namespace dem

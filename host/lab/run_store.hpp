@@ -1,0 +1,23 @@
+#pragma once
+/// The run store of a calibration (PeriodicLab::set_run_store): files named by a hash of what decides them, read
+/// back instead of recomputed. Shared by the lab's runs and the state match's packings.
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "host/config/config.hpp"
+
+namespace dem {
+
+/// The hash every stored file's name starts from: the program's version and the config's fingerprint; the caller
+/// hashes in what else decides the file.
+std::uint64_t store_hash(const Config& cfg);
+
+/// Reads a stored file through `read` (given its descriptor); false where there is none or `read` finds it cut short.
+bool read_stored(const std::string& path, const std::function<bool(int fd)>& read);
+
+/// Writes `bytes` to `path` atomically (io::write_text_atomic), making its folder at the first file: a killed
+/// calibration leaves whole files only. Throws std::runtime_error naming the path.
+void write_stored(const std::string& path, const std::string& bytes);
+
+}  // namespace dem

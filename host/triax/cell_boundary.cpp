@@ -1,0 +1,98 @@
+#include "host/triax/cell_boundary.hpp"
+
+#include "kernels/reduce.hpp"
+#include "host/engine/packing.hpp"
+#include "host/triax/periodic_triaxial.hpp"
+#include "host/engine/simulation.hpp"
+
+namespace dem {
+
+bool walled(const Simulation& sim) { return sim.num_walls() == 6 && !sim.domain().periodic[0]; }
+
+std::vector<WallSpec> cell_walls(const std::array<Real, 3>& cell) {
+  Config box;
+  box.box.size = cell;
+  box.box.periodic = {false, false, false};
+  box.box.walls = true;
+  return box_walls(box);
+}
+
+Vec3 cell_corner(const Simulation& sim) {
+  const Domain& dom = sim.domain();
+  if (!walled(sim)) return Vec3(dom.lo[0], dom.lo[1], dom.lo[2]);
+  return Vec3(sim.wall_point(0).x, sim.wall_point(2).y, sim.wall_point(4).z);
+}
+
+std::array<Real, 3> cell_lengths(const Simulation& sim) {
+  if (!walled(sim)) return {sim.domain().length(0), sim.domain().length(1), sim.domain().length(2)};
+  const Vec3 lo = cell_corner(sim);
+  return {sim.wall_point(1).x - lo.x, sim.wall_point(3).y - lo.y, sim.wall_point(5).z - lo.z};
+}
+
+Real cell_volume(const Simulation& sim) {
+  if (!walled(sim)) return sim.domain().volume();
+  const std::array<Real, 3> l = cell_lengths(sim);
+  return l[0] * l[1] * l[2];
+}
+
+std::array<Real, 3> cell_stress(Simulation& sim) {
+  if (!walled(sim)) return sim.contact_stress_diagonal(sim.domain().volume());
+  const std::vector<Vec3> f = sim.wall_forces();  // by the balls on each wall
+  const std::array<Real, 3> l = cell_lengths(sim);
+  std::array<Real, 3> s{};
+  for (int d = 0; d < 3; ++d) {
+    // The balls push the lower wall towards -d and the upper one towards +d.
+    const Real push = 0.5 * (f[2 * d + 1][d] - f[2 * d][d]);
+    s[d] = push / (l[(d + 1) % 3] * l[(d + 2) % 3]);
+  }
+  return s;
+}
+
+std::array<Real, 3> boundary_stiffness(Simulation& sim) {
+  if (!walled(sim)) return cell_stiffness(sim);
+  const ContactList c = sim.wall_contacts();
+  const WallSet w = sim.walls();
+  Particles& p = sim.particles();
+  auto x = p.x;
+  auto r = p.radius;
+  Real k[6];
+  deterministic_reduce<6, 0>("dem::cell::wall_stiffness", c.n, KOKKOS_LAMBDA(const int s, Real* v) {
+    const Real fn = c.fn(s);
+    if (!(fn > 0) || c.j(s) >= 6) return;
+    const int o = c.j(s);
+    const Real overlap = r(c.i(s)) - dot(load(x, c.i(s)) - load(w.point, o), load(w.normal, o));
+    if (overlap > 0) v[o] = fn / overlap;
+  }, k);
+  const std::array<Real, 3> l = cell_lengths(sim);
+  std::array<Real, 3> out{};
+  for (int d = 0; d < 3; ++d)
+    out[d] = 0.5 * (k[2 * d] + k[2 * d + 1]) * l[d] / (2 * l[(d + 1) % 3] * l[(d + 2) % 3]);
+  return out;
+}
+
+void set_cell_rates(Simulation& sim, const Vec3& rate) {
+  if (!walled(sim)) {
+    sim.set_strain_rate(rate);
+    return;
+  }
+  const std::array<Real, 3> l = cell_lengths(sim);
+  std::vector<Vec3> v(6);
+  for (int d = 0; d < 3; ++d) {
+    Real e[3] = {0, 0, 0};
+    e[d] = rate[d] * l[d] / 2;
+    v[2 * d] = Vec3(-e[0], -e[1], -e[2]);
+    v[2 * d + 1] = Vec3(e[0], e[1], e[2]);
+  }
+  sim.set_wall_velocities(v);
+}
+
+Vec3 cell_rates(const Simulation& sim) {
+  if (!walled(sim)) return Vec3(sim.domain().strain_rate[0], sim.domain().strain_rate[1], sim.domain().strain_rate[2]);
+  const std::array<Real, 3> l = cell_lengths(sim);
+  Real r[3];
+  for (int d = 0; d < 3; ++d)
+    r[d] = (sim.wall_velocity(2 * d + 1)[d] - sim.wall_velocity(2 * d)[d]) / l[d];
+  return Vec3(r[0], r[1], r[2]);
+}
+
+}  // namespace dem

@@ -1,0 +1,196 @@
+/// The periodic cell's set-up (a Simulation on a periodic box, its specimen, the balls back out of it) and the
+/// `periodic` CLI job; the test itself is in periodic_triaxial.cpp.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+#include "host/triax/cell_boundary.hpp"
+#include "host/engine/checkpoint.hpp"
+#include "host/engine/setup.hpp"
+#include "host/engine/packing.hpp"
+#include "host/triax/periodic_triaxial.hpp"
+#include "host/triax/summary.hpp"
+
+namespace dem {
+
+namespace {
+const char* cell_name(CellBoundary b) {
+  return b == CellBoundary::walls ? "a cuboid between six walls" : "a periodic cell";
+}
+}  // namespace
+
+std::unique_ptr<Simulation> make_periodic_simulation(const std::vector<BallSpec>& balls,
+                                                     const std::array<Real, 3>& cell, const ContactParams& law,
+                                                     const SolverConfig& solver, CellBoundary boundary) {
+  if (balls.empty()) throw std::invalid_argument("periodic triaxial: no balls");
+  Real dmean = 0;
+  for (const BallSpec& b : balls) dmean += 2 * b.radius;
+  dmean /= static_cast<Real>(balls.size());
+  const bool walls = boundary == CellBoundary::walls;
+  SimParams prm;
+  for (int k = 0; k < 3; ++k) {
+    prm.domain.lo[k] = 0;
+    prm.domain.hi[k] = cell[k];
+    prm.domain.periodic[k] = !walls;
+  }
+  prm.integ.gravity = Vec3();
+  prm.integ.alpha = solver.damping;
+  prm.integ.mass_scale = solver.mass_scale;
+  prm.skin = solver.skin * dmean;
+  prm.overlap_limit = solver.overlap_limit;
+  std::vector<BallSpec> b = balls;
+  for (BallSpec& s : b) s.material = 0;
+  std::unique_ptr<Simulation> sim;
+  if (walls) {
+    ContactParams smooth = law;  // walls without friction, as a walled test's lubricated or polished walls
+    smooth.mu_s = smooth.mu_r = 0;
+    sim = std::make_unique<Simulation>(make_particles(b), make_walls(cell_walls(cell)), FacetMesh(),
+                                       std::vector<ContactParams>{law, smooth, smooth, smooth}, 2, prm);
+  } else {
+    sim = std::make_unique<Simulation>(make_particles(b), WallSet(), FacetMesh(), std::vector<ContactParams>{law}, 1,
+                                       prm);
+  }
+  sim->set_dt(time_step(solver, sim->critical_dt(), "the periodic cell's config"));
+  return sim;
+}
+
+std::vector<BallSpec> extract_balls(Simulation& sim, std::array<Real, 3>& cell) {
+  Particles& p = sim.particles();
+  const HostParticles h = to_host_by_gid(p);
+  auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), p.gid);
+  auto rad = Kokkos::create_mirror_view_and_copy(HostSpace(), p.radius);
+  auto mass = Kokkos::create_mirror_view_and_copy(HostSpace(), p.mass);
+  auto spec = Kokkos::create_mirror_view_and_copy(HostSpace(), p.specimen);
+  auto mat = Kokkos::create_mirror_view_and_copy(HostSpace(), p.material);
+  const Domain& dom = sim.domain();
+  const bool walls = walled(sim);
+  const Vec3 corner = cell_corner(sim);
+  std::vector<BallSpec> out(p.n);
+  for (int i = 0; i < p.n; ++i) {
+    BallSpec& b = out[gid(i)];
+    b.radius = rad(i);
+    b.density = mass(i) / (4.0 / 3.0 * M_PI * rad(i) * rad(i) * rad(i));
+    b.specimen = spec(i);
+    b.material = mat(i);
+  }
+  for (int k = 0; k < p.n; ++k) {
+    out[k].x = (walls ? h.x[k] : dom.wrap(h.x[k])) - corner;
+    out[k].v = h.v[k];
+    out[k].w = h.w[k];
+  }
+  cell = cell_lengths(sim);
+  return out;
+}
+
+void check_periodic_config(const Config& cfg) {
+  const bool walls = cfg.periodic.boundary == CellBoundary::walls;
+  if (!walls && !(cfg.box.periodic[0] && cfg.box.periodic[1] && cfg.box.periodic[2]))
+    throw ConfigError(cfg.path + ": [box] periodic: the periodic triaxial needs [true, true, true] (or [periodic] "
+                      "boundary = \"walls\")");
+  if (cfg.solver.gravity[0] != 0 || cfg.solver.gravity[1] != 0 || cfg.solver.gravity[2] != 0)
+    throw ConfigError(cfg.path + ": [solver] gravity: must be [0, 0, 0] in the cell test");
+  if (walls) return;  // no minimum image between walls
+  // Consolidation shrinks the cell and shear shortens its axis: at random close packing (solid fraction 0.64,
+  // the densest a packing of spheres reaches unloaded) and the end strain, each side must still hold 3
+  // contact cut-offs, or the minimum image becomes ambiguous and the run stops part way. 5% more for the
+  // overlaps under load (a 64-ball cell at 1.03 times the limit by this estimate ended 0.1% short of it).
+  const ParticleConfig& pc = cfg.particles;
+  const Real d = pc.diameter, dmax = 2 * d * pc.diameter_ratio / (1 + pc.diameter_ratio);
+  const Real cutoff = dmax + cfg.solver.skin * d;
+  const Real box = cfg.box.size[0] * cfg.box.size[1] * cfg.box.size[2];
+  const Real dense = std::cbrt(static_cast<Real>(pc.count) * M_PI / 6 * d * d * d / 0.64 / box);
+  const Real shortest = dense * std::min({cfg.box.size[0], cfg.box.size[1], cfg.box.size[2]}) *
+                        (1 - cfg.periodic.triax.target_strain);
+  if (shortest < 1.05 * 3 * cutoff) {
+    const Real need = std::ceil(pc.count * std::pow(1.05 * 3 * cutoff / shortest, 3));
+    throw ConfigError(cfg.path + ": [particles] count: " + std::to_string(pc.count) + " balls consolidate to a "
+                      "periodic cell whose shortest side (about " + std::to_string(1e3 * shortest) +
+                      " mm at the end strain) holds fewer than 3 contact cut-offs and 5% (" +
+                      std::to_string(1.05 * 3e3 * cutoff) +
+                      " mm); allowed: at least " + std::to_string(static_cast<long>(need)) + " balls in this box shape");
+  }
+}
+
+void prepare_periodic_specimen(const Config& cfg, std::vector<BallSpec>& balls, std::array<Real, 3>& cell,
+                               bool verbose) {
+  check_periodic_config(cfg);
+  const PeriodicConfig& pc = cfg.periodic;
+  Config inside = cfg;  // between walls every ball starts inside the box
+  if (pc.boundary == CellBoundary::walls) inside.box.periodic = {false, false, false};
+  balls = make_packing(inside);
+  cell = cfg.box.size;
+  ContactParams prep = cfg.ball.base();
+  if (pc.prep_mu_s >= 0) prep.mu_s = pc.prep_mu_s;
+  if (pc.prep_mu_r >= 0) prep.mu_r = pc.prep_mu_r;
+  if (prep.mu_s == cfg.ball.mu_s && prep.mu_r == cfg.ball.mu_r) return;
+  auto sim = make_periodic_simulation(balls, cell, prep, cfg.solver, pc.boundary);
+  if (verbose)
+    std::printf("triaxdem: preparation: %zu balls in %s %.2f x %.2f x %.2f mm, consolidated with "
+                "mu_s = %g, mu_r = %g; dt %.3e s\n", balls.size(), cell_name(pc.boundary), 1e3 * cell[0],
+                1e3 * cell[1], 1e3 * cell[2], prep.mu_s, prep.mu_r, sim->params().integ.dt);
+  PeriodicTriaxialParams pp = resolve_periodic_params(*sim, pc.triax);
+  pp.name = cfg.run.name + " preparation";
+  pp.verbose = verbose;
+  pp.unbalanced_tolerance = pc.prep_unbalanced_tolerance;
+  consolidate_isotropic(*sim, pp);
+  balls = extract_balls(*sim, cell);
+}
+
+int run_periodic_job(const Config& cfg) {
+  std::vector<BallSpec> balls;
+  std::array<Real, 3> cell{};
+  prepare_periodic_specimen(cfg, balls, cell, true);
+  PeriodicTriaxialParams tp = cfg.periodic.triax;
+  tp.name = cfg.run.name;
+  io::Output out(cfg.run.output);
+  std::unique_ptr<Simulation> sim;
+  auto announce = [&](const char* what) {
+    const std::array<Real, 3> l = cell_lengths(*sim);
+    std::printf("triaxdem: %s: %zu balls in %s %.2f x %.2f x %.2f mm; critical dt %.3e s, dt %.3e s\n", what,
+                balls.size(), cell_name(cfg.periodic.boundary), 1e3 * l[0], 1e3 * l[1], 1e3 * l[2],
+                sim->critical_dt(), sim->params().integ.dt);
+    if (cfg.solver.mass_scale != 1)
+      std::printf("triaxdem: DENSITY SCALING x%g is on: inertia is not physical (quasi-static runs only)\n",
+                  cfg.solver.mass_scale);
+  };
+  try {
+    sim = make_periodic_simulation(balls, cell, cfg.ball, cfg.solver, cfg.periodic.boundary);
+    announce("test");
+    const PeriodicTriaxialResult r = run_periodic_triaxial(*sim, tp, &out);
+    TestSummary su;
+    su.kind = cfg.periodic.boundary == CellBoundary::walls ? "walls" : "periodic";
+    su.sigma3 = r.params.sigma3;
+    su.mu_s = cfg.ball.mu_s;
+    su.mu_r = cfg.ball.mu_r;
+    su.balls = static_cast<long>(balls.size());
+    su.void_ratio0 = r.void_ratio0;
+    su.q_peak = r.q_peak;
+    // The cell has one q: the periodic cell's from its contacts, the walled cell's from its walls.
+    su.q_peak_area = su.q_peak_parabolic = su.q_peak_membrane = su.q_peak_lw = r.q_peak;
+    su.phi_peak_deg = r.phi_peak_deg;
+    su.eps_a_peak = r.eps_a_peak;
+    su.q_end = r.q_end;
+    su.eps_a_end = r.series.back().eps_a;
+    su.max_dilatancy = r.max_dilatancy;
+    su.inertial_number = r.inertial;
+    su.wall_seconds = r.wall_seconds;
+    su.provenance = provenance_of(cfg);
+    write_summary(out.folder(), su);
+  } catch (const BlowUp& e) {
+    out.flush_series();
+    if (sim) {
+      out.write_snapshot(take_snapshot(*sim, "blow-up"));
+      write_checkpoint(blowup_path(out.folder()), checkpoint_of("periodic", *sim, &out, cfg.fingerprint));
+    }
+    std::fprintf(stderr, "\ntriaxdem: %s\n  state at the blow-up saved in %s (snapshot and %s)\n", e.what(),
+                 out.folder().c_str(), blowup_path(out.folder()).c_str());
+    return 2;
+  }
+  std::printf("time loop (test): %s\n", describe(sim->times(), sim->particles().n, sim->step_count()).c_str());
+  std::printf("output: %s/series.csv, summary.csv, snapshots.xdmf\n", out.folder().c_str());
+  run_plot_script("plot_triaxial.py", {out.folder(), "--title", cfg.run.name});
+  return 0;
+}
+
+}  // namespace dem

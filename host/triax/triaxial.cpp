@@ -1,0 +1,447 @@
+#include "host/triax/triaxial.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "host/engine/membrane_mesh.hpp"
+#include "host/engine/setup.hpp"
+#include "host/data/measured.hpp"
+#include "host/triax/micro_report.hpp"
+#include "host/util/progress.hpp"
+#include "host/engine/servo.hpp"
+#include "host/triax/summary.hpp"
+#include "host/triax/triaxial_measure.hpp"
+#include "host/triax/triaxial_state.hpp"
+#include "host/engine/simulation.hpp"
+
+namespace dem {
+
+namespace {
+
+enum Platen { kBottomPlaten = 0, kTopPlaten = 1 };
+
+/// The test cell: two platens, the membrane (sides tangent to the mould, so no ball starts inside a
+/// facet) and the specimen's balls.
+struct Cell {
+  std::unique_ptr<Simulation> sim;
+  Membrane membrane;
+  Real radius = 0, area = 0;  ///< m, m^2: mould radius and platen area
+  Real kn_wall = 0;           ///< N/m, platen contact stiffness of a mean ball
+  Real solid_volume = 0;      ///< m^3
+  Real mean_radius = 0;       ///< m
+};
+
+Cell make_cell(const Config& cfg, const Specimen& sp) {
+  const TriaxialConfig& tc = cfg.triaxial;
+  Cell c;
+  c.radius = cfg.specimen.diameter / 2;
+  c.area = M_PI * c.radius * c.radius;
+  const Real r_nodes = c.radius / std::cos(M_PI / tc.membrane_around);
+  MembraneMaterial mat;
+  mat.young = tc.membrane_modulus;
+  mat.poisson = tc.membrane_poisson;
+  mat.thickness = tc.membrane_thickness;
+  mat.density = tc.membrane_density;
+  c.membrane = make_membrane(make_cylinder_membrane(tc.membrane_around, tc.membrane_segments, r_nodes, 0, sp.height),
+                             mat, 1);
+  std::vector<WallSpec> w(2);
+  w[kBottomPlaten].normal = Vec3(0, 0, 1);
+  w[kTopPlaten].point = Vec3(0, 0, sp.height);
+  w[kTopPlaten].normal = Vec3(0, 0, -1);
+  for (auto& x : w) x.material = 1;
+  SimParams prm = solver_params(cfg);
+  // Bounds far outside anything the membrane can bulge to: a ball beyond them has escaped (a blow-up).
+  for (int d = 0; d < 2; ++d) prm.domain.lo[d] = -2 * c.radius, prm.domain.hi[d] = 2 * c.radius;
+  prm.domain.lo[2] = -0.5 * sp.height;
+  prm.domain.hi[2] = 1.5 * sp.height;
+  std::vector<BallSpec> balls = sp.balls;
+  Real r_max = 0;
+  for (const BallSpec& b : balls) r_max = std::max(r_max, b.radius);
+  sort_like_cells(balls, 2 * r_max);
+  c.sim = std::make_unique<Simulation>(make_particles(balls), make_walls(w), c.membrane.mesh,
+                                       std::vector<ContactParams>{cfg.ball, cfg.wall, cfg.wall, cfg.wall}, 2, prm);
+  MembraneIntegrateParams mp;
+  mp.gravity = prm.integ.gravity;
+  mp.alpha = cfg.solver.damping;
+  mp.mass_scale = cfg.solver.mass_scale;
+  c.sim->set_membrane(c.membrane, mp);
+  c.sim->set_cell_pressure(cfg.triaxial.sigma3);
+  c.sim->set_dt(time_step(cfg.solver, c.sim->critical_dt(), cfg.path));
+  c.kn_wall = NormalElastic::stiffness(cfg.wall, cfg.particles.diameter / 2, 0);
+  c.solid_volume = solid_volume(sp.balls);
+  for (const BallSpec& b : sp.balls) c.mean_radius += b.radius / sp.balls.size();
+  return c;
+}
+
+/// Moves the top platen and the membrane's top ring together (the ring is tied to the platen).
+void set_top_velocity(Cell& c, Real vz) {
+  c.sim->set_wall_velocity(kTopPlaten, Vec3(0, 0, vz));
+  auto ring = c.membrane.ring_top;
+  auto v = c.membrane.mesh.node_v;
+  Kokkos::parallel_for("dem::triaxial::tie_ring", RangePolicy(0, ring.extent(0)), KOKKOS_LAMBDA(const int k) {
+    v(ring(k), 0) = 0;
+    v(ring(k), 1) = 0;
+    v(ring(k), 2) = vz;
+  });
+}
+
+/// Axial stresses on the two platens (Pa, compression positive) from the wall forces `f`.
+std::pair<Real, Real> platen_stresses(const Cell& c, const std::vector<Vec3>& f) {
+  return {f[kTopPlaten].z / c.area, -f[kBottomPlaten].z / c.area};
+}
+
+Real specimen_volume(const Cell& c) { return enclosed_volume(c.membrane, 0, c.sim->wall_point(kTopPlaten).z); }
+
+/// series.csv's columns before the micro ones, and a record's values in them (series_row): one order for both.
+const std::vector<std::string> kSeriesColumns = {
+    "eps_a_pct",        "eps_v_pct",          "q_kPa",            "sigma1_kPa",      "sigma1_bottom_kPa",
+    "sigma3_kPa",       "sigma3_balls_kPa",   "eps_v_envelope_pct", "unbalanced_ratio", "kinetic_energy_J",
+    "q_area_kPa",       "q_parabolic_kPa",    "q_membrane_kPa",   "sigma3_hoop_kPa", "q_lw_kPa",
+    "p_lw_kPa",         "q_boundary_kPa",     "p_boundary_kPa",   "q_net_kPa",       "p_net_kPa",
+    "p_kPa",            "void_ratio",         "phi_mob_deg"};
+
+/// `e0`: the void ratio after consolidation, from which eps_v counts. p and phi_mob are the lab's, of the q the
+/// paper reports (q_kPa) and the cell pressure: p = sigma3 + q / 3, as the periodic series has them.
+std::vector<double> series_row(const TriaxialRecord& r, Real sigma3, Real e0) {
+  return {100 * r.eps_a,         100 * r.eps_v,        r.q / 1e3,           r.sigma1 / 1e3,     r.sigma1_bottom / 1e3,
+          sigma3 / 1e3,          r.sigma3_balls / 1e3, 100 * r.eps_v_envelope, r.unbalanced,     r.kinetic,
+          r.q_area / 1e3,        r.q_parabolic / 1e3,  r.q_membrane / 1e3,  r.sigma3_hoop / 1e3, r.q_lw / 1e3,
+          r.p_lw / 1e3,          r.q_boundary / 1e3,   r.p_boundary / 1e3,  r.q_net / 1e3,      r.p_net / 1e3,
+          (sigma3 + r.q / 3) / 1e3, (1 + e0) * (1 - r.eps_v) - 1, friction_angle_deg(r.q, sigma3)};
+}
+
+/// The record's deviators as labs report them and the specimen's mean stress over the enclosed `volume`, from
+/// the platen force (r.sigma1, r.sigma3_balls and the strains set) and the contacts. `a0`: the cross-section
+/// after consolidation, V0 / h0.
+void measure_stresses(const Cell& c, const TriaxialConfig& tc, const ContactSet& cs, Real volume, Real a0,
+                      TriaxialRecord& r) {
+  const Real force = r.sigma1 * c.area;
+  r.q_area = force / right_cylinder_area(a0, r.eps_a, r.eps_v) - tc.sigma3;
+  r.q_parabolic = force / parabolic_mid_area(a0, r.eps_a, r.eps_v) - tc.sigma3;
+  r.q_membrane = r.q_area + tc.sigma3 - r.sigma3_balls;
+  r.sigma3_hoop = tc.sigma3 + membrane_hoop_stress(tc.membrane_modulus, tc.membrane_thickness,
+                                                   std::sqrt(4 * a0 / M_PI), r.eps_a, r.eps_v);
+  const Tensor lw = love_weber(cs, volume, true), b = boundary_stress(cs, volume);
+  const Tensor net = net_force_stress(*c.sim, volume);
+  r.q_lw = axial_deviator(lw);
+  r.p_lw = mean_stress(lw);
+  r.q_boundary = axial_deviator(b);
+  r.p_boundary = mean_stress(b);
+  r.q_net = axial_deviator(net);
+  r.p_net = mean_stress(net);
+}
+
+}  // namespace
+
+ShearPlan shear_plan(const Config& cfg, Real dt) {
+  const TriaxialConfig& tc = cfg.triaxial;
+  // Constant platen speed from the inertial number (density scaling counts in rho).
+  const Real rho = cfg.particles.density * cfg.solver.mass_scale;
+  ShearPlan p;
+  p.rate = tc.inertial_number / (cfg.particles.diameter * std::sqrt(rho / tc.sigma3));
+  // The platen speeds up linearly over the steps of kRampStrain at full rate (the strain lost to the ramp,
+  // half of that, is added at the end). Started at full speed at once, it sends a stress wave that the top
+  // platen reads as a peak before the bottom one feels any load: 160 kPa at 0.1% strain against a
+  // quasi-static plateau of 140 kPa in the full-scale S-1 case at 100 kPa.
+  constexpr Real kRampStrain = 0.005;
+  p.ramp = std::max(1L, std::lround(kRampStrain / (p.rate * dt)));
+  p.steps = static_cast<long>(std::ceil(tc.axial_strain_end / (p.rate * dt))) + p.ramp / 2;
+  return p;
+}
+
+Real TriaxialRecord::*q_field(QMeasure m) {
+  switch (m) {
+    case QMeasure::kAreaCorrected: return &TriaxialRecord::q_area;
+    case QMeasure::kParabolic: return &TriaxialRecord::q_parabolic;
+    case QMeasure::kMembraneCorrected: return &TriaxialRecord::q_membrane;
+    case QMeasure::kFixedArea: break;
+  }
+  return &TriaxialRecord::q;
+}
+
+MeasuredTest curves_of(const TriaxialResult& r, Real TriaxialRecord::*q, Real sigma3) {
+  std::vector<TriaxialRecord> rows = r.records;
+  for (TriaxialRecord& x : rows) x.q = x.*q;
+  return summarised(rows, sigma3);
+}
+
+TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* out, bool verbose,
+                            CheckpointPlan* plan) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const TriaxialConfig& tc = cfg.triaxial;
+  Cell cell = make_cell(cfg, sp);
+  Simulation& sim = *cell.sim;
+  const Real dt = sim.params().integ.dt;
+  TriaxialResult res;
+  const MicroConfig& mc = cfg.micro;
+  std::vector<std::string> columns = kSeriesColumns;
+  if (mc.enabled)
+    for (const std::string& prefix : {std::string(), std::string("rve_")})
+      for (const std::string& c : micro_columns(prefix)) columns.push_back(c);
+  if (out) out->set_series_columns(columns);
+  Stage st;
+  // Wall time of the whole test: a resumed run adds what the segments before it took.
+  double wall_before = 0;
+  auto elapsed = [&] { return wall_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+  if (plan && plan->from) {
+    restore_triaxial(*plan->from, plan->path, sim, out, st, res);
+    wall_before = res.wall_seconds;
+    if (verbose)
+      std::printf("triaxial: resuming %s at step %ld (%s)\n", plan->path.c_str(), sim.step_count(),
+                  st.shear != 0 ? "shear" : "consolidation");
+  }
+  // After each loop step: a checkpoint when due, and a stop when asked for.
+  auto checkpoint = [&](const Stage& now) {
+    if (!plan || !plan->due(sim.step_count())) return;
+    if (out) out->flush_series();
+    res.wall_seconds = elapsed();
+    save_triaxial(plan->path, sim, out, now, res, plan->config);
+    plan->clock.written();
+    if (plan->stop(sim.step_count())) throw run_stopped(*plan, sim.step_count());
+  };
+
+  // A blow-up saves the state it happened in (balls, membrane, contacts) and the curve so far, then stops.
+  try {
+    if (st.shear == 0) {
+      // Isotropic consolidation: cell pressure on the membrane, stress servo on the top platen.
+      StressServo servo;
+      servo.target = tc.sigma3;
+      servo.area = cell.area;
+      servo.v_max = 0.05 * sp.height / (2000 * dt);  // at most 5% of the height in 2000 steps
+      long s = static_cast<long>(st.step);
+      Progress cons("consolidation (ETA to the step cap)", tc.max_consolidation_steps, s);
+      for (; s < tc.max_consolidation_steps; ++s) {
+        const auto [top, bottom] = platen_stresses(cell, sim.wall_forces());
+        const int n = sim.wall_contact_counts()[kTopPlaten];
+        set_top_velocity(cell, -servo.speed(top, n * cell.kn_wall, dt));
+        const bool check = (s + 1) % 200 == 0;
+        sim.step(check);
+        if (check) {
+          const Real ratio = sim.unbalanced_ratio();
+          // The servo holds the top platen; the bottom one differs by what the membrane carries through
+          // friction and its own axial stiffness, so only the controlled stress decides.
+          const Real err = std::fabs(top - tc.sigma3) / tc.sigma3;
+          if (verbose) {
+            char extra[96];
+            std::snprintf(extra, sizeof extra, "sigma_top %.1f kPa, sigma_bottom %.1f kPa, unbalanced %.1e",
+                          top / 1e3, bottom / 1e3, ratio);
+            cons.update(s + 1, extra);
+          }
+          if (err < tc.consolidation_tol && ratio < tc.stop_ratio) break;
+        }
+        st.step = static_cast<Real>(s + 1);
+        checkpoint(st);
+      }
+      if (s >= tc.max_consolidation_steps)
+        throw ConfigError(cfg.path + ": [triaxial] max_consolidation_steps: consolidation to " +
+                          std::to_string(tc.sigma3 / 1e3) + " kPa did not settle within " +
+                          std::to_string(tc.max_consolidation_steps) + " steps");
+      st.shear = 1;
+      st.step = 0;
+      st.consolidation_steps = static_cast<Real>(s + 1);
+      st.h0 = sim.wall_point(kTopPlaten).z;
+      st.v0 = specimen_volume(cell);
+      st.v0_envelope = envelope_volume(sim, st.h0, cell.mean_radius, tc.membrane_segments);
+      st.void_ratio = st.v0 / cell.solid_volume - 1;
+      if (verbose)
+        std::printf("\nconsolidated at %.0f kPa: e = %.4f, height %.3f mm after %ld steps\n", tc.sigma3 / 1e3,
+                    st.void_ratio, st.h0 * 1e3, static_cast<long>(st.consolidation_steps));
+    }
+    res.consolidation_steps = static_cast<long>(st.consolidation_steps);
+    res.void_ratio_consolidated = st.void_ratio;
+    const Real h0 = st.h0, v0 = st.v0, v0_envelope = st.v0_envelope;
+    const int env_slabs = tc.membrane_segments;
+
+    const ShearPlan plan_of_shear = shear_plan(cfg, dt);
+    res.shear_rate = plan_of_shear.rate;
+    res.inertial_number = tc.inertial_number;
+    const long ramp = plan_of_shear.ramp, steps = plan_of_shear.steps;
+    if (verbose && st.step == 0)
+      std::printf("shear: strain rate %.3g 1/s (inertial number %.1e%s), %ld steps to %.0f%%\n", res.shear_rate,
+                  tc.inertial_number, cfg.solver.mass_scale != 1 ? ", with density scaling" : "", steps,
+                  tc.axial_strain_end * 100);
+    const Real snaps[kSnapshotStrains] = {0.0, 0.01, 0.05, tc.axial_strain_end};
+    const char* snap_labels[] = {"A", "B", "C", "D"};  // the paper's points A-D (Figure 8)
+    Progress shear("shear", steps, static_cast<long>(st.step));
+    for (long k = static_cast<long>(st.step); k <= steps; ++k) {
+      const Real eps_a = (h0 - sim.wall_point(kTopPlaten).z) / h0;
+      // The contacts are copied to the host at most once a step, for the record and the snapshot alike.
+      std::optional<ContactSet> contacts;
+      auto contacts_now = [&]() -> const ContactSet& {
+        if (!contacts) contacts = contact_set(sim);
+        return *contacts;
+      };
+      if (eps_a >= st.next_record - 1e-12 || k == steps) {
+        TriaxialRecord r;
+        const std::vector<Vec3> wall_f = sim.wall_forces();
+        const auto [top, bottom] = platen_stresses(cell, wall_f);
+        const Real top_z = sim.wall_point(kTopPlaten).z, volume = specimen_volume(cell);
+        r.eps_a = eps_a;
+        r.eps_v = (v0 - volume) / v0;
+        r.sigma1 = top;
+        r.sigma1_bottom = bottom;
+        r.q = top - tc.sigma3;
+        r.sigma3_balls = lateral_stress(sim, cell.membrane, wall_f);
+        r.eps_v_envelope = (v0_envelope - envelope_volume(sim, top_z, cell.mean_radius, env_slabs)) / v0_envelope;
+        r.unbalanced = sim.unbalanced_ratio();
+        r.kinetic = sim.stats().kinetic;
+        measure_stresses(cell, tc, contacts_now(), volume, v0 / h0, r);
+        res.records.push_back(r);
+        std::vector<double> row = series_row(r, tc.sigma3, st.void_ratio);
+        const int next_snap = static_cast<int>(st.next_snap);
+        if (mc.enabled) {
+          const ContactSet& cs = contacts_now();
+          const ContactSet rve = restrict_to_cube(cs, Vec3(0, 0, top_z / 2), mc.rve_edge);
+          const MicroRow m = micro_row(cs, volume);
+          res.micro.push_back(m);
+          for (const MicroRow& x : {m, micro_row(rve, mc.rve_edge * mc.rve_edge * mc.rve_edge)})
+            for (double v : micro_values(x)) row.push_back(v);
+          const bool snap_due = next_snap < kSnapshotStrains && eps_a >= snaps[next_snap] - 1e-12;
+          if (out && snap_due) write_micro_state(out->folder(), snap_labels[next_snap], cs, rve, mc.rose_bins);
+          if (out && r.q > st.q_max) write_micro_state(out->folder(), "peak", cs, rve, mc.rose_bins);
+        }
+        st.q_max = std::max(st.q_max, r.q);
+        if (out) {
+          out->append_series(row);
+          if (res.records.size() % 25 == 0) out->flush_series();  // a crash keeps the curve so far
+        }
+        st.next_record += tc.record_every;
+        if (verbose) {
+          char extra[64];
+          std::snprintf(extra, sizeof extra, "eps_a %.2f%%, q %.1f kPa", 100 * eps_a, r.q / 1e3);
+          shear.update(k, extra);
+        }
+      }
+      const int next_snap = static_cast<int>(st.next_snap);
+      if (out && next_snap < kSnapshotStrains && eps_a >= snaps[next_snap] - 1e-12) {
+        char label[48];
+        std::snprintf(label, sizeof label, "shear eps_a=%.0f%%", 100 * snaps[next_snap]);
+        const io::SurfaceSnapshot surface = membrane_surface(cell.membrane);
+        const io::ContactTable table = mc.enabled ? contact_table(contacts_now()) : io::ContactTable();
+        out->write_snapshot(take_snapshot(sim, label), &surface, mc.enabled ? &table : nullptr);
+        st.next_snap += 1;
+      }
+      if (k == steps) break;
+      if (k < ramp) set_top_velocity(cell, -res.shear_rate * h0 * static_cast<Real>(k + 1) / ramp);
+      if (tc.damping_about_flow) {  // the bottom platen rests at z = 0: the flow is v_z = v_top z / h
+        const Real h = sim.wall_point(kTopPlaten).z;
+        sim.set_damping_flow(Vec3(0, 0, sim.wall_velocity(kTopPlaten).z / h), Vec3());
+      }
+      // The unbalanced ratio and kinetic energy cost a pass: measured on the steps before a record only.
+      sim.step((h0 - sim.wall_point(kTopPlaten).z) / h0 + res.shear_rate * dt >= st.next_record - 1e-12 ||
+               k + 1 == steps);
+      st.step = static_cast<Real>(k + 1);
+      checkpoint(st);
+    }
+  } catch (const BlowUp&) {
+    if (out) {
+      out->flush_series();
+      const io::SurfaceSnapshot surface = membrane_surface(cell.membrane);
+      const io::ContactTable contacts = contact_table(contact_set(sim));
+      out->write_snapshot(take_snapshot(sim, "blow-up"), &surface, &contacts);
+      if (plan) save_triaxial(blowup_path(out->folder()), sim, out, st, res, plan->config);
+      std::fprintf(stderr, "triaxdem: state at the blow-up saved in %s (snapshots.xdmf, last entry; %s)\n",
+                   out->folder().c_str(), blowup_path(out->folder()).c_str());
+    }
+    throw;
+  }
+  if (out) out->flush_series();
+  if (!res.records.empty()) {
+    take_curve_values(res, summarised(res.records, tc.sigma3));
+    res.highest_record = static_cast<std::size_t>(
+        std::max_element(res.records.begin(), res.records.end(),
+                         [](const TriaxialRecord& a, const TriaxialRecord& b) { return a.q < b.q; }) -
+        res.records.begin());
+  }
+  res.escaped = count_escaped(sim, cell.membrane, sim.wall_point(kTopPlaten).z);
+  res.wall_seconds = elapsed();
+  res.times = sim.times();
+  res.steps = sim.step_count();
+  res.balls = sim.particles().n;
+  return res;
+}
+
+int triaxial_job(const Config& cfg, bool resume, long stop_at_step) {
+  if (!cfg.has_specimen) throw ConfigError(cfg.path + ": [specimen]: table missing (the triaxial job needs it)");
+  io::Output out(cfg.run.output);
+  CheckpointPlan plan{checkpoint_path(out.folder()), CheckpointClock(cfg.run.checkpoint_every,
+                      cfg.run.checkpoint_minutes), nullptr, stop_at_step, cfg.fingerprint};
+  Checkpoint from;
+  if (resume) {
+    from = resume_checkpoint(plan.path, "triaxial", cfg.fingerprint);
+    plan.from = &from;
+  }
+  StopSignals signals;
+  try {
+    // Specimens are shared through a cache beside the output folder (the nine paper cases build one), and each run
+    // keeps its own copy, which a resume reads first.
+    const Specimen sp = cached_specimen(cfg, (std::filesystem::path(out.folder()).parent_path() / ".specimens").string(),
+                                        true, out.folder() + "/specimen.csv");
+    std::printf("specimen: %zu balls, e = %.4f, height %.3f mm (layers.csv, porosity_profile.csv)\n",
+                sp.balls.size(), sp.void_ratio, sp.height * 1e3);
+    write_specimen_report(out.folder(), cfg, sp);
+    const TriaxialResult r = run_triaxial(cfg, sp, &out, true, &plan);
+    const Real q_highest = r.records.empty() ? 0 : r.records[r.highest_record].q;
+    std::printf("\nresult: q_peak %.1f kPa at eps_a %.2f%% (moving mean over +-%.2f%% strain; highest record %.1f kPa), "
+                "peak friction angle %.1f deg, q at %.0f%% %.1f kPa (mean over the last %.0f%%), max dilatancy %.3f, "
+                "wall time %s\n",
+                r.q_peak / 1e3, 100 * r.eps_a_peak, 100 * kSmoothHalfWidth, q_highest / 1e3, r.phi_peak_deg,
+                100 * cfg.triaxial.axial_strain_end, r.q_end / 1e3, 100 * kEndWindow, r.max_dilatancy,
+                format_duration(r.wall_seconds).c_str());
+    if (r.escaped > 0) std::printf("WARNING: %d balls ended outside the membrane\n", r.escaped);
+    if (!r.micro.empty()) {
+      // The stress-force-fabric relation beside the boundary's q/p (p = sigma3 + q/3) at the highest record,
+      // where the run wrote its micro_*_peak files (the smoothed peak is known only at the end).
+      const std::size_t k = r.highest_record;
+      const MicroRow& m = r.micro[k];
+      std::printf("at the highest record (micro_*_peak.csv): q/p %.3f at the boundary, %.3f from the contacts "
+                  "(Love-Weber), %.3f from the stress-force-fabric relation, with a_c %.3f, a_n %.3f, a_t %.3f; "
+                  "Z %.2f\n",
+                  r.records[k].q / (cfg.triaxial.sigma3 + r.records[k].q / 3), m.q_over_p, m.q_over_p_sff, m.all.a_c,
+                  m.all.a_n, m.all.a_t, m.z.z);
+    }
+    std::printf("time loop (consolidation and shear): %s; measurements and output %.1f s\n",
+                describe(r.times, r.balls, r.steps).c_str(), r.wall_seconds - r.times.loop());
+    TestSummary s;
+    s.kind = "membrane";
+    s.sigma3 = cfg.triaxial.sigma3;
+    s.mu_s = cfg.ball.mu_s;
+    s.mu_r = cfg.ball.mu_r;
+    s.balls = static_cast<long>(sp.balls.size());
+    s.void_ratio0 = r.void_ratio_consolidated;
+    s.q_peak = r.q_peak;
+    if (!r.records.empty()) {
+      s.q_peak_area = curves_of(r, q_field(QMeasure::kAreaCorrected), s.sigma3).q_peak;
+      s.q_peak_parabolic = curves_of(r, q_field(QMeasure::kParabolic), s.sigma3).q_peak;
+      s.q_peak_membrane = curves_of(r, q_field(QMeasure::kMembraneCorrected), s.sigma3).q_peak;
+      s.q_peak_lw = curves_of(r, &TriaxialRecord::q_lw, s.sigma3).q_peak;
+    }
+    s.phi_peak_deg = r.phi_peak_deg;
+    s.eps_a_peak = r.eps_a_peak;
+    s.q_end = r.q_end;
+    s.eps_a_end = r.records.empty() ? 0 : r.records.back().eps_a;
+    s.max_dilatancy = r.max_dilatancy;
+    s.inertial_number = r.inertial_number;
+    s.wall_seconds = r.wall_seconds;
+    s.provenance = provenance_of(cfg);
+    write_summary(out.folder(), s);
+    std::printf("output: %s/series.csv, summary.csv, snapshots.xdmf (ParaView: balls and membrane)\n",
+                out.folder().c_str());
+    run_plot_script("plot_triaxial.py", {out.folder(), "--title", cfg.run.name});
+    if (cfg.micro.enabled) run_plot_script("plot_micro.py", {out.folder()});
+  } catch (const BlowUp& e) {
+    std::fprintf(stderr, "\ntriaxdem: %s\n", e.what());
+    return 2;
+  } catch (const RunStopped& e) {
+    std::printf("\ntriaxdem: %s\n", e.what());
+    return e.code;
+  }
+  return 0;
+}
+
+}  // namespace dem
