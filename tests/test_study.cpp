@@ -7,6 +7,7 @@
 #include <limits>
 #include <tuple>
 
+#include "host/cli/job.hpp"
 #include "host/study/study.hpp"
 #include "test_util.hpp"
 

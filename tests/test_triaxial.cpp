@@ -11,6 +11,7 @@
 #include <iterator>
 #include <string>
 
+#include "host/cli/job.hpp"
 #include "host/triax/micro_report.hpp"
 #include "host/triax/triaxial.hpp"
 #include "host/triax/triaxial_measure.hpp"

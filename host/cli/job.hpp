@@ -1,7 +1,10 @@
 #pragma once
-/// The `run` job: a box of balls built from a config, run for [run] steps with time series,
-/// snapshots (HDF5 + XDMF for ParaView) and a progress line.
+/// The commands (`triaxdem <command>`), one function each, called by main: the layers below hold what they run.
+#include <string>
+#include <vector>
+
 #include "host/config/config.hpp"
+#include "host/study/study.hpp"
 
 namespace dem {
 
@@ -20,5 +23,25 @@ int check_job(const Config& cfg);
 /// Builds the [specimen] of a config by multilayer compaction and writes it (snapshot, layers.csv with
 /// the void ratio of each layer, porosity_profile.csv). Returns 0 on success, 2 on a blow-up.
 int specimen_job(const Config& cfg);
+
+/// The `triaxial` CLI job: specimen, then run_triaxial with checkpoints in OUT/checkpoint.h5 ([run]
+/// checkpoint_every, checkpoint_minutes, SIGINT, SIGTERM), outputs and a summary. `resume`: continue from the
+/// checkpoint. Returns 0, 2 on a blow-up, 128 + the signal or 3 (stop_at_step) when stopped with a checkpoint.
+int triaxial_job(const Config& cfg, bool resume = false, long stop_at_step = -1);
+
+/// The `periodic` job: packing from [particles]/[box] (box.periodic must be all true, gravity zero),
+/// optional preparatory consolidation, then run_periodic_triaxial with output in [run] output.
+/// Returns 0, or 2 on a blow-up (state saved).
+int run_periodic_job(const Config& cfg);
+
+/// `triaxdem micro`: the micromechanics of one saved state. `source` is a run folder (then `at_pct` picks
+/// the snapshot taken at that axial strain) or a snapshot file. Writes micro_<label>.csv (one row of the
+/// micro columns for the specimen and the cube), the distributions and the force chains into `output`
+/// and prints the headline numbers. Throws std::runtime_error with what was asked and what exists.
+int micro_job(const std::string& source, double at_pct, double rve_edge_mm, int rose_bins, const std::string& output);
+
+/// Runs the study; returns 0 when every case finished, 1 otherwise (the summary then lists the failures).
+/// study_summary.csv is rewritten whenever a case finishes, so a study stopped half-way leaves its table.
+int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, const char* self_exe);
 
 }  // namespace dem

@@ -63,8 +63,4 @@ struct StudyTable {
 StudyTable study_table(const std::vector<StudyCase>& cases, const std::vector<int>& status, const std::string& output,
                        const std::vector<MeasuredData>& compare);
 
-/// Runs the study; returns 0 when every case finished, 1 otherwise (the summary then lists the failures).
-/// study_summary.csv is rewritten whenever a case finishes, so a study stopped half-way leaves its table.
-int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, const char* self_exe);
-
 }  // namespace dem

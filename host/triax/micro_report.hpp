@@ -40,10 +40,4 @@ void write_micro_state(const std::string& folder, const std::string& label, cons
 /// axis point on the bottom platen, plus the cone over the top cap.
 Real surface_volume(const io::SurfaceSnapshot& surface);
 
-/// `triaxdem micro`: the micromechanics of one saved state. `source` is a run folder (then `at_pct` picks
-/// the snapshot taken at that axial strain) or a snapshot file. Writes micro_<label>.csv (one row of the
-/// micro columns for the specimen and the cube), the distributions and the force chains into `output`
-/// and prints the headline numbers. Throws std::runtime_error with what was asked and what exists.
-int micro_job(const std::string& source, double at_pct, double rve_edge_mm, int rose_bins, const std::string& output);
-
 }  // namespace dem

@@ -1,5 +1,5 @@
-/// The periodic cell's set-up (a Simulation on a periodic box, its specimen, the balls back out of it) and the
-/// `periodic` CLI job; the test itself is in periodic_triaxial.cpp.
+/// The periodic cell's set-up (a Simulation on a periodic box, its specimen, the balls back out of it); the test
+/// itself is in periodic_triaxial.cpp, the `periodic` command in host/cli/test_jobs.cpp.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -14,11 +14,9 @@
 
 namespace dem {
 
-namespace {
 const char* cell_name(CellBoundary b) {
   return b == CellBoundary::walls ? "a cuboid between six walls" : "a periodic cell";
 }
-}  // namespace
 
 std::unique_ptr<Simulation> make_periodic_simulation(const std::vector<BallSpec>& balls,
                                                      const std::array<Real, 3>& cell, const ContactParams& law,
@@ -137,60 +135,5 @@ void prepare_periodic_specimen(const Config& cfg, std::vector<BallSpec>& balls, 
   balls = extract_balls(*sim, cell);
 }
 
-int run_periodic_job(const Config& cfg) {
-  std::vector<BallSpec> balls;
-  std::array<Real, 3> cell{};
-  prepare_periodic_specimen(cfg, balls, cell, true);
-  PeriodicTriaxialParams tp = cfg.periodic.triax;
-  tp.name = cfg.run.name;
-  io::Output out(cfg.run.output);
-  std::unique_ptr<Simulation> sim;
-  auto announce = [&](const char* what) {
-    const std::array<Real, 3> l = cell_lengths(*sim);
-    std::printf("triaxdem: %s: %zu balls in %s %.2f x %.2f x %.2f mm; critical dt %.3e s, dt %.3e s\n", what,
-                balls.size(), cell_name(cfg.periodic.boundary), 1e3 * l[0], 1e3 * l[1], 1e3 * l[2],
-                sim->critical_dt(), sim->params().integ.dt);
-    if (cfg.solver.mass_scale != 1)
-      std::printf("triaxdem: DENSITY SCALING x%g is on: inertia is not physical (quasi-static runs only)\n",
-                  cfg.solver.mass_scale);
-  };
-  try {
-    sim = make_periodic_simulation(balls, cell, cfg.ball, cfg.solver, cfg.periodic.boundary);
-    announce("test");
-    const PeriodicTriaxialResult r = run_periodic_triaxial(*sim, tp, &out);
-    TestSummary su;
-    su.kind = cfg.periodic.boundary == CellBoundary::walls ? "walls" : "periodic";
-    su.sigma3 = r.params.sigma3;
-    su.mu_s = cfg.ball.mu_s;
-    su.mu_r = cfg.ball.mu_r;
-    su.balls = static_cast<long>(balls.size());
-    su.void_ratio0 = r.void_ratio0;
-    su.q_peak = r.q_peak;
-    // The cell has one q: the periodic cell's from its contacts, the walled cell's from its walls.
-    su.q_peak_area = su.q_peak_parabolic = su.q_peak_membrane = su.q_peak_lw = r.q_peak;
-    su.phi_peak_deg = r.phi_peak_deg;
-    su.eps_a_peak = r.eps_a_peak;
-    su.q_end = r.q_end;
-    su.eps_a_end = r.series.back().eps_a;
-    su.max_dilatancy = r.max_dilatancy;
-    su.inertial_number = r.inertial;
-    su.wall_seconds = r.wall_seconds;
-    su.provenance = provenance_of(cfg);
-    write_summary(out.folder(), su);
-  } catch (const BlowUp& e) {
-    out.flush_series();
-    if (sim) {
-      out.write_snapshot(take_snapshot(*sim, "blow-up"));
-      write_checkpoint(blowup_path(out.folder()), checkpoint_of("periodic", *sim, &out, cfg.fingerprint));
-    }
-    std::fprintf(stderr, "\ntriaxdem: %s\n  state at the blow-up saved in %s (snapshot and %s)\n", e.what(),
-                 out.folder().c_str(), blowup_path(out.folder()).c_str());
-    return 2;
-  }
-  std::printf("time loop (test): %s\n", describe(sim->times(), sim->particles().n, sim->step_count()).c_str());
-  std::printf("output: %s/series.csv, summary.csv, snapshots.xdmf\n", out.folder().c_str());
-  run_plot_script("plot_triaxial.py", {out.folder(), "--title", cfg.run.name});
-  return 0;
-}
 
 }  // namespace dem

@@ -96,6 +96,9 @@ Real membrane_confinement(Real stiffness, Real eps);
 /// K_ii = (1/V) sum_c (Fn/overlap) l_i^2 over touching ball-ball contacts (Pa): the servo's stiffness.
 std::array<Real, 3> cell_stiffness(Simulation& sim);
 
+/// "a periodic cell" or "a cuboid between six walls", for messages.
+const char* cell_name(CellBoundary b);
+
 /// A simulation of `balls` in [0, cell) with one contact law for every pair of balls and no gravity: fully
 /// periodic, or between the six walls of cell_walls (host/triax/cell_boundary.hpp), frictionless and otherwise of the
 /// balls' law; the solver settings (damping, dt, mass scale, skin in mean diameters) from `solver`.
@@ -119,10 +122,5 @@ void check_periodic_config(const Config& cfg);
 /// model extensions. `balls` and `cell` receive it.
 void prepare_periodic_specimen(const Config& cfg, std::vector<BallSpec>& balls, std::array<Real, 3>& cell,
                                bool verbose);
-
-/// The `periodic` job: packing from [particles]/[box] (box.periodic must be all true, gravity zero),
-/// optional preparatory consolidation, then run_periodic_triaxial with output in [run] output.
-/// Returns 0, or 2 on a blow-up (state saved).
-int run_periodic_job(const Config& cfg);
 
 }  // namespace dem

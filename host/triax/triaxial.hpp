@@ -80,9 +80,4 @@ struct ShearPlan {
 };
 ShearPlan shear_plan(const Config& cfg, Real dt);
 
-/// The `triaxial` CLI job: specimen, then run_triaxial with checkpoints in OUT/checkpoint.h5 ([run]
-/// checkpoint_every, checkpoint_minutes, SIGINT, SIGTERM), outputs and a summary. `resume`: continue from the
-/// checkpoint. Returns 0, 2 on a blow-up, 128 + the signal or 3 (stop_at_step) when stopped with a checkpoint.
-int triaxial_job(const Config& cfg, bool resume = false, long stop_at_step = -1);
-
 }  // namespace dem

@@ -1,0 +1,156 @@
+/// The `study` command: each case a child process of this program, as many at once as the machine has cores to
+/// spare, and the table rewritten as each one ends.
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <stdexcept>
+#include <thread>
+
+#include "host/cli/job.hpp"
+#include "host/engine/checkpoint.hpp"
+#include "host/io/io_hdf5.hpp"
+#include "host/study/study.hpp"
+#include "host/util/progress.hpp"
+
+namespace dem {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Running {
+  std::size_t index;
+  std::chrono::steady_clock::time_point start;
+};
+
+/// Starts `self job config -o folder` with its output in folder/log.txt and `threads` OpenMP threads.
+/// `resume`: the case continues from its checkpoint, and its log goes on.
+pid_t launch(const char* self, const StudyCase& c, const std::string& folder, int threads, bool resume) {
+  fs::create_directories(folder);
+  const std::string log = folder + "/log.txt";
+  const pid_t pid = fork();
+  if (pid < 0) throw std::runtime_error("study: cannot start a process for " + c.config);
+  if (pid == 0) {
+    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | (resume ? O_APPEND : O_TRUNC), 0644);
+    if (fd >= 0) {
+      dup2(fd, 1);
+      dup2(fd, 2);
+      close(fd);
+    }
+    setenv("OMP_NUM_THREADS", std::to_string(threads).c_str(), 1);
+    setenv("OMP_PROC_BIND", "false", 0);
+    execl(self, self, c.job.c_str(), c.config.c_str(), "-o", folder.c_str(), resume ? "--resume" : nullptr,
+          static_cast<char*>(nullptr));
+    std::perror("study: exec");
+    _exit(127);
+  }
+  return pid;
+}
+
+}  // namespace
+
+int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, const char* self_exe) {
+  const std::vector<StudyCase> cases = study_cases(inputs);
+  std::vector<MeasuredData> compare;  // read before anything runs: a bad file stops the study at once
+  for (const std::string& f : opt.compare) compare.push_back(load_measured(f));
+  const int cores = std::max(1u, std::thread::hardware_concurrency());
+  const int jobs = std::clamp(opt.jobs > 0 ? opt.jobs : cores / 2, 1, static_cast<int>(cases.size()));
+  const int threads = opt.threads > 0 ? opt.threads : std::max(1, cores / jobs);
+  fs::create_directories(opt.output);
+  std::printf("study: %zu cases, %d at a time with %d OpenMP threads each; logs in %s/<case>/log.txt\n",
+              cases.size(), jobs, threads, opt.output.c_str());
+  std::vector<int> status(cases.size(), -1);
+  std::map<pid_t, Running> running;
+  std::size_t next = 0, done = 0;
+  auto finished_before = [&](std::size_t k) {
+    return opt.resume && fs::exists(opt.output + "/" + cases[k].name + "/summary.csv");
+  };
+  long kept = 0;
+  for (std::size_t k = 0; k < cases.size(); ++k) kept += finished_before(k);
+  // Kept cases took no time in this run: left out of the rate behind the ETA.
+  Progress progress("study", static_cast<long>(cases.size()), kept);
+  while (done < cases.size()) {
+    while (next < cases.size() && static_cast<int>(running.size()) < jobs) {
+      const std::string folder = opt.output + "/" + cases[next].name;
+      if (finished_before(next)) {
+        std::printf("study: %s finished before (summary.csv): kept\n", cases[next].name.c_str());
+        status[next++] = 0;
+        ++done;
+        continue;
+      }
+      // Only the triaxial job checkpoints; a periodic case (minutes) starts again.
+      const bool go_on = opt.resume && cases[next].job == "triaxial" && fs::exists(checkpoint_path(folder));
+      const pid_t pid = launch(self_exe, cases[next], folder, threads, go_on);
+      running[pid] = {next, std::chrono::steady_clock::now()};
+      std::printf("study: %s %s (%s)\n", go_on ? "resumed" : "started", cases[next].name.c_str(),
+                  cases[next].config.c_str());
+      ++next;
+    }
+    if (running.empty()) break;
+    int ws = 0;
+    const pid_t pid = waitpid(-1, &ws, 0);
+    if (pid < 0) throw std::runtime_error("study: lost track of the running cases");
+    auto it = running.find(pid);
+    if (it == running.end()) continue;
+    const std::size_t k = it->second.index;
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - it->second.start).count();
+    running.erase(it);
+    status[k] = WIFEXITED(ws) ? WEXITSTATUS(ws) : 128 + WTERMSIG(ws);
+    ++done;
+    std::printf("study: %s %s after %s\n", cases[k].name.c_str(),
+                status[k] == 0 ? "finished" : ("FAILED (exit " + std::to_string(status[k]) + ", see its log.txt)").c_str(),
+                format_duration(secs).c_str());
+    io::write_text_atomic(opt.output + "/study_summary.csv", study_table(cases, status, opt.output, compare).csv);
+    progress.update(static_cast<long>(done));
+  }
+  progress.finish("");
+
+  const StudyTable table = study_table(cases, status, opt.output, compare);
+  const std::vector<PeakComparison>& cmp = table.cmp;
+  int failed = 0;
+  std::printf("\n%-14s %8s %6s %6s %10s %9s %10s %10s %8s", "case", "s3 kPa", "mu_s", "mu_r", "q_peak kPa",
+              "phi deg", "eps_pk %", "q_end kPa", "max dil");
+  for (std::size_t j = 0; j < cmp.size(); ++j) std::printf(" %7s%zu %6s%zu", "ref kPa ", j + 1, "err % ", j + 1);
+  std::printf("\n");
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    const StudyCase& c = cases[k];
+    if (!table.ok[k]) {
+      ++failed;
+      std::printf("%-14s FAILED: see %s/%s/log.txt\n", c.name.c_str(), opt.output.c_str(), c.name.c_str());
+      continue;
+    }
+    const TestSummary& s = table.summaries[k];
+    std::printf("%-14s %8.0f %6.3f %6.3f %10.1f %9.2f %10.2f %10.1f %8.3f", c.name.c_str(), s.sigma3 / 1e3, s.mu_s,
+                s.mu_r, s.q_peak / 1e3, s.phi_peak_deg, 100 * s.eps_a_peak, s.q_end / 1e3, s.max_dilatancy);
+    for (const PeakComparison& p : cmp) {
+      if (std::isfinite(p.error[k])) std::printf(" %9.1f %8.1f", p.measured[k] / 1e3, 100 * p.error[k]);
+      else std::printf(" %9s %8s", "-", "-");
+    }
+    std::printf("\n");
+  }
+  for (std::size_t j = 0; j < cmp.size(); ++j) {
+    const PeakComparison& p = cmp[j];
+    if (p.matched == 0) {
+      std::printf("ref %zu, %s: no case matched (a case needs [run] material and its sigma3 in the file)\n", j + 1,
+                  p.source.c_str());
+      continue;
+    }
+    std::printf("ref %zu, %s (q %s): %d of %zu cases matched; q_peak off by %.1f%% on average (|error|), %.1f%% "
+                "at most (%s)\n", j + 1, p.source.c_str(), name_of(p.measure), p.matched, cases.size(),
+                100 * p.mean_abs_error, 100 * p.max_abs_error, cases[p.worst].name.c_str());
+  }
+  io::write_text_atomic(opt.output + "/study_summary.csv", table.csv);
+  std::printf("\nstudy: summary in %s/study_summary.csv\n", opt.output.c_str());
+  if (run_plot_script("plot_study.py", {opt.output}))
+    std::printf("study: figure in %s/study.png\n", opt.output.c_str());
+  return failed == 0 ? 0 : 1;
+}
+
+}  // namespace dem

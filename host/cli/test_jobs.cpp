@@ -1,0 +1,154 @@
+/// The `triaxial` and `periodic` commands: a test from a config into its output folder, with its summary, plots
+/// and the lines a user reads at the end.
+#include <cstdio>
+#include <filesystem>
+
+#include "host/cli/job.hpp"
+#include "host/config/provenance.hpp"
+#include "host/engine/checkpoint.hpp"
+#include "host/engine/setup.hpp"
+#include "host/io/io_hdf5.hpp"
+#include "host/triax/cell_boundary.hpp"
+#include "host/triax/periodic_triaxial.hpp"
+#include "host/triax/specimen.hpp"
+#include "host/triax/summary.hpp"
+#include "host/triax/triaxial.hpp"
+#include "host/util/progress.hpp"
+
+namespace dem {
+
+int triaxial_job(const Config& cfg, bool resume, long stop_at_step) {
+  if (!cfg.has_specimen) throw ConfigError(cfg.path + ": [specimen]: table missing (the triaxial job needs it)");
+  io::Output out(cfg.run.output);
+  CheckpointPlan plan{checkpoint_path(out.folder()), CheckpointClock(cfg.run.checkpoint_every,
+                      cfg.run.checkpoint_minutes), nullptr, stop_at_step, cfg.fingerprint};
+  Checkpoint from;
+  if (resume) {
+    from = resume_checkpoint(plan.path, "triaxial", cfg.fingerprint);
+    plan.from = &from;
+  }
+  StopSignals signals;
+  try {
+    // Specimens are shared through a cache beside the output folder (the nine paper cases build one), and each run
+    // keeps its own copy, which a resume reads first.
+    const Specimen sp = cached_specimen(cfg, (std::filesystem::path(out.folder()).parent_path() / ".specimens").string(),
+                                        true, out.folder() + "/specimen.csv");
+    std::printf("specimen: %zu balls, e = %.4f, height %.3f mm (layers.csv, porosity_profile.csv)\n",
+                sp.balls.size(), sp.void_ratio, sp.height * 1e3);
+    write_specimen_report(out.folder(), cfg, sp);
+    const TriaxialResult r = run_triaxial(cfg, sp, &out, true, &plan);
+    const Real q_highest = r.records.empty() ? 0 : r.records[r.highest_record].q;
+    std::printf("\nresult: q_peak %.1f kPa at eps_a %.2f%% (moving mean over +-%.2f%% strain; highest record %.1f kPa), "
+                "peak friction angle %.1f deg, q at %.0f%% %.1f kPa (mean over the last %.0f%%), max dilatancy %.3f, "
+                "wall time %s\n",
+                r.q_peak / 1e3, 100 * r.eps_a_peak, 100 * kSmoothHalfWidth, q_highest / 1e3, r.phi_peak_deg,
+                100 * cfg.triaxial.axial_strain_end, r.q_end / 1e3, 100 * kEndWindow, r.max_dilatancy,
+                format_duration(r.wall_seconds).c_str());
+    if (r.escaped > 0) std::printf("WARNING: %d balls ended outside the membrane\n", r.escaped);
+    if (!r.micro.empty()) {
+      // The stress-force-fabric relation beside the boundary's q/p (p = sigma3 + q/3) at the highest record,
+      // where the run wrote its micro_*_peak files (the smoothed peak is known only at the end).
+      const std::size_t k = r.highest_record;
+      const MicroRow& m = r.micro[k];
+      std::printf("at the highest record (micro_*_peak.csv): q/p %.3f at the boundary, %.3f from the contacts "
+                  "(Love-Weber), %.3f from the stress-force-fabric relation, with a_c %.3f, a_n %.3f, a_t %.3f; "
+                  "Z %.2f\n",
+                  r.records[k].q / (cfg.triaxial.sigma3 + r.records[k].q / 3), m.q_over_p, m.q_over_p_sff, m.all.a_c,
+                  m.all.a_n, m.all.a_t, m.z.z);
+    }
+    std::printf("time loop (consolidation and shear): %s; measurements and output %.1f s\n",
+                describe(r.times, r.balls, r.steps).c_str(), r.wall_seconds - r.times.loop());
+    TestSummary s;
+    s.kind = "membrane";
+    s.sigma3 = cfg.triaxial.sigma3;
+    s.mu_s = cfg.ball.mu_s;
+    s.mu_r = cfg.ball.mu_r;
+    s.balls = static_cast<long>(sp.balls.size());
+    s.void_ratio0 = r.void_ratio_consolidated;
+    s.q_peak = r.q_peak;
+    if (!r.records.empty()) {
+      s.q_peak_area = curves_of(r, q_field(QMeasure::kAreaCorrected), s.sigma3).q_peak;
+      s.q_peak_parabolic = curves_of(r, q_field(QMeasure::kParabolic), s.sigma3).q_peak;
+      s.q_peak_membrane = curves_of(r, q_field(QMeasure::kMembraneCorrected), s.sigma3).q_peak;
+      s.q_peak_lw = curves_of(r, &TriaxialRecord::q_lw, s.sigma3).q_peak;
+    }
+    s.phi_peak_deg = r.phi_peak_deg;
+    s.eps_a_peak = r.eps_a_peak;
+    s.q_end = r.q_end;
+    s.eps_a_end = r.records.empty() ? 0 : r.records.back().eps_a;
+    s.max_dilatancy = r.max_dilatancy;
+    s.inertial_number = r.inertial_number;
+    s.wall_seconds = r.wall_seconds;
+    s.provenance = provenance_of(cfg);
+    write_summary(out.folder(), s);
+    std::printf("output: %s/series.csv, summary.csv, snapshots.xdmf (ParaView: balls and membrane)\n",
+                out.folder().c_str());
+    run_plot_script("plot_triaxial.py", {out.folder(), "--title", cfg.run.name});
+    if (cfg.micro.enabled) run_plot_script("plot_micro.py", {out.folder()});
+  } catch (const BlowUp& e) {
+    std::fprintf(stderr, "\ntriaxdem: %s\n", e.what());
+    return 2;
+  } catch (const RunStopped& e) {
+    std::printf("\ntriaxdem: %s\n", e.what());
+    return e.code;
+  }
+  return 0;
+}
+
+int run_periodic_job(const Config& cfg) {
+  std::vector<BallSpec> balls;
+  std::array<Real, 3> cell{};
+  prepare_periodic_specimen(cfg, balls, cell, true);
+  PeriodicTriaxialParams tp = cfg.periodic.triax;
+  tp.name = cfg.run.name;
+  io::Output out(cfg.run.output);
+  std::unique_ptr<Simulation> sim;
+  auto announce = [&](const char* what) {
+    const std::array<Real, 3> l = cell_lengths(*sim);
+    std::printf("triaxdem: %s: %zu balls in %s %.2f x %.2f x %.2f mm; critical dt %.3e s, dt %.3e s\n", what,
+                balls.size(), cell_name(cfg.periodic.boundary), 1e3 * l[0], 1e3 * l[1], 1e3 * l[2],
+                sim->critical_dt(), sim->params().integ.dt);
+    if (cfg.solver.mass_scale != 1)
+      std::printf("triaxdem: DENSITY SCALING x%g is on: inertia is not physical (quasi-static runs only)\n",
+                  cfg.solver.mass_scale);
+  };
+  try {
+    sim = make_periodic_simulation(balls, cell, cfg.ball, cfg.solver, cfg.periodic.boundary);
+    announce("test");
+    const PeriodicTriaxialResult r = run_periodic_triaxial(*sim, tp, &out);
+    TestSummary su;
+    su.kind = cfg.periodic.boundary == CellBoundary::walls ? "walls" : "periodic";
+    su.sigma3 = r.params.sigma3;
+    su.mu_s = cfg.ball.mu_s;
+    su.mu_r = cfg.ball.mu_r;
+    su.balls = static_cast<long>(balls.size());
+    su.void_ratio0 = r.void_ratio0;
+    su.q_peak = r.q_peak;
+    // The cell has one q: the periodic cell's from its contacts, the walled cell's from its walls.
+    su.q_peak_area = su.q_peak_parabolic = su.q_peak_membrane = su.q_peak_lw = r.q_peak;
+    su.phi_peak_deg = r.phi_peak_deg;
+    su.eps_a_peak = r.eps_a_peak;
+    su.q_end = r.q_end;
+    su.eps_a_end = r.series.back().eps_a;
+    su.max_dilatancy = r.max_dilatancy;
+    su.inertial_number = r.inertial;
+    su.wall_seconds = r.wall_seconds;
+    su.provenance = provenance_of(cfg);
+    write_summary(out.folder(), su);
+  } catch (const BlowUp& e) {
+    out.flush_series();
+    if (sim) {
+      out.write_snapshot(take_snapshot(*sim, "blow-up"));
+      write_checkpoint(blowup_path(out.folder()), checkpoint_of("periodic", *sim, &out, cfg.fingerprint));
+    }
+    std::fprintf(stderr, "\ntriaxdem: %s\n  state at the blow-up saved in %s (snapshot and %s)\n", e.what(),
+                 out.folder().c_str(), blowup_path(out.folder()).c_str());
+    return 2;
+  }
+  std::printf("time loop (test): %s\n", describe(sim->times(), sim->particles().n, sim->step_count()).c_str());
+  std::printf("output: %s/series.csv, summary.csv, snapshots.xdmf\n", out.folder().c_str());
+  run_plot_script("plot_triaxial.py", {out.folder(), "--title", cfg.run.name});
+  return 0;
+}
+
+}  // namespace dem
