@@ -17,6 +17,7 @@
 #include "host/io/io_hdf5.hpp"
 #include "host/data/measured.hpp"
 #include "host/config/config.hpp"
+#include "host/config/model_keys.hpp"
 #include "host/cli/job.hpp"
 #include "host/triax/micro_report.hpp"
 #include "host/triax/periodic_triaxial.hpp"
@@ -161,7 +162,8 @@ int main(int argc, char** argv) {
         ->check(CLI::ExistingFile);
     c->add_option("--config", config_path, "base config: a periodic cell ([box], [periodic], [material])")
         ->required()->check(CLI::ExistingFile);
-    c->add_option("--free", free_list, "free parameters, comma-separated (default: the config's [calibrate] free, else mu_s,mu_r)");
+    c->add_option("--free", free_list, "free parameters, comma-separated, of " + dem::free_key_names() +
+                  " (default: the config's [calibrate] free, else mu_s,mu_r)");
     c->add_option("--material", cal.material, "only this material of the data");
     c->add_option("--reference", cal.reference, "CSV of reference values (material, then one column per parameter) "
                   "to set beside the calibrated ones")->check(CLI::ExistingFile);
@@ -193,7 +195,7 @@ int main(int argc, char** argv) {
   synth->add_option("--config", config_path, "base config (periodic cell)")->required()->check(CLI::ExistingFile);
   synth->add_option("-o,--output", syn.output, "CSV to write")->required();
   synth->add_flag("--overwrite", syn.overwrite, "replace an existing output file (never the config)");
-  synth->add_option("--extension", syn.extension, "hertz, roughness, wear, membrane or none");
+  synth->add_option("--extension", syn.extension, dem::extension_names() + " or none");
   synth->add_option("--strength", syn.strength, "the extension's parameter in its config unit (default: drawn from the seed)");
   synth->add_option("--seed", syn.seed, "noise and strength seed");
   synth->add_option("--specimen-seed", syn.specimen_seed, "packing seed of the specimen (default: the config's [run] "

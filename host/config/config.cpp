@@ -1,5 +1,6 @@
 #include "host/config/config.hpp"
 #include "host/config/config_checks.hpp"
+#include "host/config/model_keys.hpp"
 #include "host/util/fnv1a.hpp"
 #include "host/config/noise_model.hpp"
 #include "host/config/toml_reader.hpp"
@@ -14,16 +15,8 @@ namespace dem {
 namespace {
 
 void read_contact(TableReader& r, ContactParams& c) {
-  r.number("emod_Pa", c.emod, 0, 1e13, 1, true);
-  r.number("kratio", c.kratio, 0, 1e3, 1, true);
-  r.number("mu_s", c.mu_s, 0, 10);
-  r.number("mu_r", c.mu_r, 0, 10);
-  r.number("beta_n", c.beta_n, 0, 1);
-  // Model extensions (kernels/contact_law.hpp), 0 = off.
-  r.number("hertz_overlap", c.hertz_overlap, 0, 0.5);
-  r.number("roughness", c.roughness, 0, 0.1);
-  r.number("wear", c.wear, 0, 0.99);
-  r.number("wear_slip", c.wear_slip, 0, 10, 1, true);
+  for (const ModelKey& k : model_keys())
+    if (k.field) r.number(k.key, c.*k.field, k.lo, k.hi, k.scale, k.open_lo);
   r.finish();
 }
 
@@ -214,7 +207,8 @@ Config parse_config(const std::string& text, const std::string& path) {
   pr.integer("check_every", t.check_every, 1, 1000000L);
   pr.integer("stiffness_every", t.stiffness_every, 1, 1000000L);
   pr.number("record_strain_pct", t.record_strain, 0, 90, 1e-2, true);
-  pr.number("membrane_kPa", t.membrane_stiffness, 0, 1e5, 1e3);
+  const ModelKey& membrane = model_key("membrane_kPa");
+  pr.number(membrane.key, t.membrane_stiffness, membrane.lo, membrane.hi, membrane.scale, membrane.open_lo);
   pr.numbers("snapshot_strains_pct", t.snapshot_strains, 0, 90, 1e-2);
   pr.number("prep_mu_s", c.periodic.prep_mu_s, 0, 10);
   pr.number("prep_mu_r", c.periodic.prep_mu_r, 0, 10);

@@ -1,5 +1,7 @@
 #include "host/fit/calibrate.hpp"
 
+#include "host/config/model_keys.hpp"
+
 #include <Eigen/Dense>
 
 #include <algorithm>
@@ -19,31 +21,25 @@ Real FreeParam::unit(Real v) const {
 }
 
 namespace {
+/// A parameter a calibration may free (host/config/model_keys.hpp), as the search sees it.
 struct ParamSpec {
   FreeParam range;
   Real ContactParams::*field;  ///< null: the membrane
 };
 const std::vector<ParamSpec>& param_specs() {
-  static const std::vector<ParamSpec> specs = {
-      {{"mu_s", 0.02, 1.0, true}, &ContactParams::mu_s},
-      {{"mu_r", 0.0, 0.2, false}, &ContactParams::mu_r},
-      {{"emod_Pa", 1e6, 1e10, true}, &ContactParams::emod},
-      {{"kratio", 1.0, 4.0, false}, &ContactParams::kratio},
-      {{"hertz_overlap", 3e-4, 0.03, true}, &ContactParams::hertz_overlap},
-      {{"roughness", 1e-4, 5e-2, true}, &ContactParams::roughness},
-      {{"wear", 0.0, 0.9, false}, &ContactParams::wear},
-      {{"wear_slip", 0.005, 0.5, true}, &ContactParams::wear_slip},
-      {{"membrane_kPa", 0.0, 3e6, false, 1e-3}, nullptr},
-  };
+  static const std::vector<ParamSpec> specs = [] {
+    std::vector<ParamSpec> out;
+    for (const ModelKey& k : model_keys())
+      if (k.fit) out.push_back({{k.key, k.fit_lo, k.fit_hi, k.fit_log, 1 / k.scale}, k.field});
+    return out;
+  }();
   return specs;
 }
 const ParamSpec& spec(const std::string& name) {
-  std::string names;
-  for (const ParamSpec& s : param_specs()) {
-    if (s.range.name == name) return s;
-    names += (names.empty() ? "" : ", ") + s.range.name;
-  }
-  throw std::invalid_argument("unknown free parameter '" + name + "' (allowed: " + names + ")");
+  const ModelKey& k = model_key(name);  // refuses a name that is no free parameter, naming the allowed ones
+  for (const ParamSpec& s : param_specs())
+    if (s.range.name == k.key) return s;
+  throw std::logic_error("calibrate: no search range for " + name);
 }
 }  // namespace
 

@@ -55,9 +55,8 @@ struct FreeParam {
   Real shown = 1;             ///< factor from SI to the config key's unit (1e-3 for membrane_kPa)
 };
 
-/// The parameters triaxdem can free, with their default ranges: mu_s, mu_r, emod_Pa, kratio, hertz_overlap,
-/// roughness, wear, wear_slip, membrane_kPa (in Pa inside). Throws std::invalid_argument naming the allowed
-/// names.
+/// A parameter triaxdem can free (host/config/model_keys.hpp: its key and default search range; membrane_kPa in
+/// Pa inside). Throws std::invalid_argument naming the allowed names.
 FreeParam free_param(const std::string& name);
 /// The same, centred on the base model's value where that is set: mu_s and emod_Pa over a factor 3
 /// either way (log), mu_r over [0, max(4 x value, 0.05)]. A 3 x 3 design then lands near a sensible answer.

@@ -1,5 +1,7 @@
 #include "host/fit/diagnose.hpp"
 
+#include "host/config/model_keys.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -16,19 +18,13 @@
 namespace dem {
 
 const std::vector<Extension>& extensions() {
-  // Strengths span the physical range in equal ratios: Hertz reference overlaps of 0.1-1% of the radius
-  // (the overlaps of E* = 1e8 Pa beads at 100-300 kPa); combined roughness 0.1-1% of the radius (1-10 um on
-  // 2 mm beads; Table 2 gives Sq = 5-53 um, but over 1.3 mm areas that include the beads' waviness); 20-60% of the friction lost by wear; a
-  // membrane of 0.1-1 MPa over the specimen's radius (latex, 1.4 MPa x 0.5 mm, on 1.4-7 mm; small cells).
-  static const std::vector<Extension> list = {
-      {"hertz", "hertz_overlap", {1e-3, 3e-3, 1e-2},
-       "initial stiffness that grows faster with confinement than the linear contacts give", false},
-      {"roughness", "roughness", {1e-3, 3e-3, 1e-2},
-       "soft initial response, most at low confinement; peak and residual hardly change"},
-      {"wear", "wear", {0.2, 0.4, 0.6}, "a residual strength that falls below the peak more than sliding alone explains"},
-      {"membrane", "membrane_kPa", {1e5, 3e5, 1e6},
-       "extra strength late in the test as the specimen bulges, largest relative to low sigma3"},
-  };
+  static const std::vector<Extension> list = [] {
+    std::vector<Extension> out;
+    for (const ModelKey& k : model_keys())
+      if (*k.extension)
+        out.push_back({k.extension, k.key, {k.strengths.begin(), k.strengths.end()}, k.signature, k.from_off});
+    return out;
+  }();
   return list;
 }
 

@@ -1,0 +1,54 @@
+#include "host/config/model_keys.hpp"
+
+#include <stdexcept>
+
+namespace dem {
+
+const std::vector<ModelKey>& model_keys() {
+  // Extension strengths span the physical range in equal ratios: Hertz reference overlaps of 0.1-1% of the radius
+  // (the overlaps of E* = 1e8 Pa beads at 100-300 kPa); combined roughness 0.1-1% of the radius (1-10 um on 2 mm
+  // beads; Table 2 gives Sq = 5-53 um, but over 1.3 mm areas that include the beads' waviness); 20-60% of the
+  // friction lost by wear; a membrane of 0.1-1 MPa over the specimen's radius (latex, 1.4 MPa x 0.5 mm, on 1.4-7 mm;
+  // small cells). Calibration ranges stay inside the config's where a smaller range is all a fit needs (roughness
+  // beyond 5% of the radius is no longer a surface's), and the membrane's reaches 3 MPa, above any latex.
+  using C = ContactParams;
+  static const std::vector<ModelKey> keys = {
+      {"mu_s", &C::mu_s, "-", 0, 10, false, 1, true, 0.02, 1.0, true, "", {}, "", true},
+      {"mu_r", &C::mu_r, "-", 0, 10, false, 1, true, 0.0, 0.2, false, "", {}, "", true},
+      {"emod_Pa", &C::emod, "Pa", 0, 1e13, true, 1, true, 1e6, 1e10, true, "", {}, "", true},
+      {"kratio", &C::kratio, "-", 0, 1e3, true, 1, true, 1.0, 4.0, false, "", {}, "", true},
+      {"beta_n", &C::beta_n, "-", 0, 1, false, 1, false, 0, 0, false, "", {}, "", true},
+      {"hertz_overlap", &C::hertz_overlap, "r", 0, 0.5, false, 1, true, 3e-4, 0.03, true, "hertz", {1e-3, 3e-3, 1e-2},
+       "initial stiffness that grows faster with confinement than the linear contacts give", false},
+      {"roughness", &C::roughness, "r", 0, 0.1, false, 1, true, 1e-4, 5e-2, true, "roughness", {1e-3, 3e-3, 1e-2},
+       "soft initial response, most at low confinement; peak and residual hardly change", true},
+      {"wear", &C::wear, "-", 0, 0.99, false, 1, true, 0.0, 0.9, false, "wear", {0.2, 0.4, 0.6},
+       "a residual strength that falls below the peak more than sliding alone explains", true},
+      {"wear_slip", &C::wear_slip, "r", 0, 10, true, 1, true, 0.005, 0.5, true, "", {}, "", true},
+      {"membrane_kPa", nullptr, "kPa", 0, 1e5, false, 1e3, true, 0.0, 3e6, false, "membrane", {1e5, 3e5, 1e6},
+       "extra strength late in the test as the specimen bulges, largest relative to low sigma3", true},
+  };
+  return keys;
+}
+
+const ModelKey& model_key(const std::string& key) {
+  for (const ModelKey& k : model_keys())
+    if (k.fit && key == k.key) return k;
+  throw std::invalid_argument("unknown free parameter '" + key + "' (allowed: " + free_key_names() + ")");
+}
+
+std::string extension_names() {
+  std::string names;
+  for (const ModelKey& k : model_keys())
+    if (*k.extension) names += (names.empty() ? "" : ", ") + std::string(k.extension);
+  return names;
+}
+
+std::string free_key_names() {
+  std::string names;
+  for (const ModelKey& k : model_keys())
+    if (k.fit) names += (names.empty() ? "" : ", ") + std::string(k.key);
+  return names;
+}
+
+}  // namespace dem
