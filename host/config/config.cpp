@@ -36,23 +36,19 @@ void check_memory(TableReader& t, const std::string& key, long balls) {
 
 Config load_config(const std::string& path) { return parse_config(file_text(path), path); }
 
-Config parse_config(const std::string& text, const std::string& path) {
-  Config c;
-  c.path = path;
-  toml::table root = parse_tables(text, path, {"run", "particles", "box", "material", "wall_material", "solver",
-                                                "specimen", "triaxial", "micro", "periodic", "calibrate"});
-  auto table = [&](const char* name) { return TableReader(path, name, root[name].as_table()); };
-  {
-    toml::table settings = root;
-    if (toml::table* run = settings["run"].as_table())
-      for (const char* free : {"steps", "name", "output", "stop_ratio", "checkpoint_every", "checkpoint_minutes"})
-        run->erase(free);
-    std::string text;
-    canonical_text(settings, text);
-    c.fingerprint = hex16(fnv1a(text.data(), text.size()));
-  }
+namespace {
 
-  TableReader run = table("run");
+/// The config's tables by name, each read through a TableReader that names the file and table in its errors.
+struct Tables {
+  const std::string& path;
+  toml::table& root;
+  TableReader operator()(const char* name) const { return TableReader(path, name, root[name].as_table()); }
+  bool present(const char* name) const { return root[name].as_table() != nullptr; }
+};
+
+/// [run]: names, steps, outputs, seed, checkpoints.
+void read_run(const Tables& read, Config& c) {
+  TableReader run = read("run");
   run.string("name", c.run.name);
   run.string("material", c.run.material);
   run.integer("steps", c.run.steps, 0, 1000000000L);
@@ -66,16 +62,22 @@ Config parse_config(const std::string& text, const std::string& path) {
   run.number("checkpoint_minutes", c.run.checkpoint_minutes, 0, 1e6);
   c.run.seed = static_cast<unsigned>(seed);
   run.finish();
+}
 
-  TableReader pt = table("particles");
+/// [particles], with the memory the count needs.
+void read_particles(const Tables& read, Config& c) {
+  TableReader pt = read("particles");
   pt.integer("count", c.particles.count, 1, 2000000000L);
   check_memory(pt, "count", c.particles.count);
   pt.number("diameter_mm", c.particles.diameter, 1e-6, 1e6, 1e-3, true);
   pt.number("diameter_ratio", c.particles.diameter_ratio, 1, 10);
   pt.number("density_kg_m3", c.particles.density, 0, 1e6, 1, true);
   pt.finish();
+}
 
-  TableReader box = table("box");
+/// [box].
+void read_box(const Tables& read, Config& c) {
+  TableReader box = read("box");
   // Up to a kilometre: cell and lattice counts are cast to int, and the memory check bounds the balls.
   box.number_triple("size_mm", c.box.size, 0, 1e6, 1e-3, true);
   box.boolean_triple("periodic", c.box.periodic);
@@ -83,14 +85,20 @@ Config parse_config(const std::string& text, const std::string& path) {
   box.string("fill", c.box.fill, {"random", "lattice"});
   box.number("lattice_spacing", c.box.lattice_spacing, 0.9, 2.0);
   box.finish();
+}
 
-  TableReader mat = table("material");
+/// [material] and [wall_material] (the walls follow the balls unless it says otherwise).
+void read_materials(const Tables& read, Config& c) {
+  TableReader mat = read("material");
   read_contact(mat, c.ball);
   c.wall = c.ball;
-  TableReader wmat = table("wall_material");
+  TableReader wmat = read("wall_material");
   read_contact(wmat, c.wall);
+}
 
-  TableReader sv = table("solver");
+/// [solver].
+void read_solver(const Tables& read, Config& c) {
+  TableReader sv = read("solver");
   sv.number("damping", c.solver.damping, 0, 0.99);
   sv.number_triple("gravity", c.solver.gravity, -1e4, 1e4);
   sv.number("dt_safety", c.solver.dt_safety, kMinDtFraction, 1);
@@ -99,9 +107,12 @@ Config parse_config(const std::string& text, const std::string& path) {
   sv.number("skin", c.solver.skin, 0, 2, 1, true);
   sv.number("overlap_limit", c.solver.overlap_limit, 0, 1, 1, true);
   sv.finish();
+}
 
-  TableReader sp = table("specimen");
-  c.has_specimen = root["specimen"].as_table() != nullptr;
+/// [specimen], with what its count or void ratio implies (a packing denser than random close packing, the memory, the width in diameters).
+void read_specimen(const Tables& read, Config& c) {
+  TableReader sp = read("specimen");
+  c.has_specimen = read.present("specimen");
   sp.number("diameter_mm", c.specimen.diameter, 0, 1e6, 1e-3, true);
   sp.number("height_mm", c.specimen.height, 0, 1e6, 1e-3, true);
   // Monodisperse spheres pack no denser than random close packing (solid fraction 0.64, e = 0.5625).
@@ -136,10 +147,13 @@ Config parse_config(const std::string& text, const std::string& path) {
                  static_cast<long>(std::min(balls, 4e18)));
   }
   if (c.has_specimen && c.specimen.diameter < 4 * c.particles.diameter)
-    throw ConfigError(path + ": [specimen] diameter_mm: must be at least 4 particle diameters (" +
+    throw ConfigError(c.path + ": [specimen] diameter_mm: must be at least 4 particle diameters (" +
                       std::to_string(4e3 * c.particles.diameter) + " mm)");
+}
 
-  TableReader tx = table("triaxial");
+/// [triaxial], with the membrane's memory and the record interval against the strain.
+void read_triaxial(const Tables& read, Config& c) {
+  TableReader tx = read("triaxial");
   tx.number("sigma3_kPa", c.triaxial.sigma3, 0, 1e6, 1e3, true);
   tx.number("axial_strain_end_pct", c.triaxial.axial_strain_end, 0, 50, 1e-2, true);
   tx.number("inertial_number", c.triaxial.inertial_number, 0, 1e-1, 1, true);
@@ -170,8 +184,13 @@ Config parse_config(const std::string& text, const std::string& path) {
   tx.number("membrane_density_kg_m3", c.triaxial.membrane_density, 0, 1e5, 1, true);
   tx.boolean("damping_about_flow", c.triaxial.damping_about_flow);
   tx.finish();
+  check_records(c.path, "triaxial", "record_every_pct", c.triaxial.record_every, "axial_strain_end_pct",
+                c.triaxial.axial_strain_end);
+}
 
-  TableReader mi = table("micro");
+/// [micro], with the cube inside the specimen.
+void read_micro(const Tables& read, Config& c) {
+  TableReader mi = read("micro");
   mi.boolean("enabled", c.micro.enabled);
   mi.number("rve_edge_mm", c.micro.rve_edge, 0, 1e6, 1e-3, true);
   long bins = c.micro.rose_bins;
@@ -188,9 +207,12 @@ Config parse_config(const std::string& text, const std::string& path) {
       mi.fail("rve_edge_mm", r.str());
     }
   }
+}
 
-  TableReader pr = table("periodic");
-  c.has_periodic = root["periodic"].as_table() != nullptr;
+/// [periodic], with the record interval against the strain.
+void read_periodic(const Tables& read, Config& c) {
+  TableReader pr = read("periodic");
+  c.has_periodic = read.present("periodic");
   PeriodicTriaxialParams& t = c.periodic.triax;
   pr.number("sigma3_kPa", t.sigma3, 0, 1e7, 1e3, true);
   pr.number("axial_rate_per_s", t.axial_rate, 0, 1e6);
@@ -217,12 +239,12 @@ Config parse_config(const std::string& text, const std::string& path) {
   pr.string("boundary", boundary, {"periodic", "walls"});
   c.periodic.boundary = boundary == "walls" ? CellBoundary::walls : CellBoundary::periodic;
   pr.finish();
+  check_records(c.path, "periodic", "record_strain_pct", t.record_strain, "target_axial_strain_pct", t.target_strain);
+}
 
-  check_records(path, "triaxial", "record_every_pct", c.triaxial.record_every, "axial_strain_end_pct",
-                c.triaxial.axial_strain_end);
-  check_records(path, "periodic", "record_strain_pct", t.record_strain, "target_axial_strain_pct", t.target_strain);
-
-  TableReader cal = table("calibrate");
+/// [calibrate].
+void read_calibrate(const Tables& read, Config& c) {
+  TableReader cal = read("calibrate");
   cal.strings("free", c.calibrate.free);  // names checked against the registry by the calibration job
   if (!cal.word("ensemble", "auto", c.calibrate.ensemble, kAutoEnsemble))
     cal.integer("ensemble", c.calibrate.ensemble, 1, 64);
@@ -233,7 +255,36 @@ Config parse_config(const std::string& text, const std::string& path) {
   cal.integer("predict_specimens", c.calibrate.predict_specimens, 1, 16);
   cal.string("reference_test", c.calibrate.reference_test, {"periodic", "walls", "two_fidelity"});
   cal.finish();
+}
 
+}  // namespace
+
+Config parse_config(const std::string& text, const std::string& path) {
+  Config c;
+  c.path = path;
+  toml::table root = parse_tables(text, path, {"run", "particles", "box", "material", "wall_material", "solver",
+                                                "specimen", "triaxial", "micro", "periodic", "calibrate"});
+  const Tables read{path, root};
+  {
+    toml::table settings = root;
+    if (toml::table* run = settings["run"].as_table())
+      for (const char* free : {"steps", "name", "output", "stop_ratio", "checkpoint_every", "checkpoint_minutes"})
+        run->erase(free);
+    std::string text;
+    canonical_text(settings, text);
+    c.fingerprint = hex16(fnv1a(text.data(), text.size()));
+  }
+
+  read_run(read, c);
+  read_particles(read, c);
+  read_box(read, c);
+  read_materials(read, c);
+  read_solver(read, c);
+  read_specimen(read, c);
+  read_triaxial(read, c);
+  read_micro(read, c);
+  read_periodic(read, c);
+  read_calibrate(read, c);
   for (int d = 0; d < 3; ++d)
     if (c.box.size[d] < 3 * c.particles.diameter)
       throw ConfigError(path + ": [box] size_mm: every side must be at least 3 diameters (" +

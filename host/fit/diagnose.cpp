@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <limits>
 #include <map>
 #include <random>
@@ -107,6 +108,155 @@ Real strength_at(const Extension& e, Real t) {
   return e.levels[k - 1] * std::pow(e.levels[k] / e.levels[k - 1], t - k);
 }
 
+/// What an extension's fit needs of the diagnosis: the base fit, its surfaces as a model of the residuals, the
+/// base model at unit coordinates, the simulator and the misfit.
+struct FitContext {
+  PeriodicLab& lab;
+  const CalibrationResult& base;
+  const std::function<std::vector<Real>(const std::vector<Real>&)>& base_model;
+  const std::function<Model(const std::vector<Real>&)>& base_at;
+  const std::vector<MeasuredTest>& measured;
+  const Misfit& misfit;
+  const std::function<void()>& report;  ///< a progress line after each batch of runs
+};
+
+/// One extension fitted jointly with the base parameters: its effect measured at the base optimum strength by
+/// strength, added to the base surfaces, and the joint optimum run twice (the surrogate corrected by each run).
+/// `base_runs` gets any run at strength 0 that beats it (a run of the base model).
+ExtensionFit fit_extension(const Extension& e, const FitContext& cx, Evaluation& base_runs) {
+  PeriodicLab& lab = cx.lab;
+  const std::vector<FreeParam>& free = cx.base.free;
+  const int d = static_cast<int>(free.size()), n = cx.base.data;
+  ExtensionFit f;
+  f.ext = e;
+  const long runs0 = lab.runs();
+  // The extension's effect at the base optimum, strength by strength.
+  std::vector<std::vector<Real>> effect{std::vector<Real>(cx.base.best.r.size(), 0.0)};
+  for (Real level : e.levels) {
+    Model m = cx.base.model;
+    set_param(m, e.param, level);
+    const std::vector<Real> r = cx.misfit.residuals(lab.run_ensemble(m, cx.measured));
+    cx.report();
+    std::vector<Real> diff(r.size());
+    for (std::size_t i = 0; i < r.size(); ++i) diff[i] = r[i] - cx.base.best.r[i];
+    effect.push_back(diff);
+  }
+  std::vector<Real> correction(cx.base.best.r.size(), 0.0);
+  auto joint = [&](const std::vector<Real>& u) {
+    const std::vector<Real> ub(u.begin(), u.begin() + d);
+    std::vector<Real> r = cx.base_model(ub);
+    const Real t = strength_coordinate(e, u[d]);
+    const int k = std::min(static_cast<int>(t), 2);
+    const Real w = t - k;
+    for (std::size_t i = 0; i < r.size(); ++i)
+      r[i] += (1 - w) * effect[k][i] + w * effect[k + 1][i] + correction[i];
+    return r;
+  };
+  auto model_at = [&](const std::vector<Real>& u) {
+    Model m = cx.base_at(u);
+    set_param(m, e.param, strength_at(e, strength_coordinate(e, u[d])));
+    return m;
+  };
+  // The base model is the extension at strength 0: its best run is the starting point, so an extended fit
+  // is never reported worse than the base.
+  f.best = cx.base.best;
+  std::vector<Real> best_u = cx.base.best.u;
+  best_u.push_back(0);
+  bool extended = false;  // a run of the extension beat the base
+  for (int round = 0; round < 2; ++round) {
+    const std::vector<Real> u = minimise_unit_box([&](const std::vector<Real>& x) { return sum_sq(joint(x)); },
+                                                  d + 1);
+    const std::vector<Real> predicted = joint(u);
+    Evaluation ev;
+    ev.u.assign(u.begin(), u.begin() + d);
+    const Ensemble ens = lab.run_ensemble(model_at(u), cx.measured);
+    for (const auto& members : ens) ev.sim.push_back(mean_curve(members));
+    ev.r = cx.misfit.residuals(ens);
+    ev.chi2 = sum_sq(ev.r);
+    cx.report();
+    if (strength_at(e, strength_coordinate(e, u[d])) == 0 && ev.chi2 < base_runs.chi2) base_runs = ev;
+    if (ev.chi2 < f.best.chi2) f.best = ev, best_u = u, extended = true;
+    for (std::size_t i = 0; i < correction.size(); ++i) correction[i] += ev.r[i] - predicted[i];
+  }
+  for (int k = 0; k < d; ++k) f.values.push_back(free[k].value(best_u[k]));
+  f.strength = extended ? strength_at(e, strength_coordinate(e, best_u[d])) : 0;
+  f.values.push_back(f.strength);
+  f.bic = bic(f.best.chi2, d + 1, n);
+  f.heldout = heldout_chi2(joint, d + 1, cx.measured, model_at, lab, cx.misfit);
+  f.runs = lab.runs() - runs0;
+  return f;
+}
+
+/// The verdict (see the top of diagnose.hpp): each extension weighed on both tests, the accepted one of lowest
+/// BIC named with its ties, and the explanation in words; n data, d base parameters.
+void give_verdict(Diagnosis& dg, int n, int d) {
+  // Verdict. The rule compares nested models (an extension at strength 0 is the base model) and weighs every
+  // extension on both tests: a drop of BIC by 6 (a likelihood-ratio test at about 0.3% for 15 data, more
+  // powerful than asking whether the base model alone fits within the noise) and a drop of the held-out chi2 by
+  // the same 6 (a likelihood ratio of e^3 = 20 on pressures the fit did not see, which guards against an
+  // extension that only fits the noise of the pressures it saw). Every extension that passes both is accepted;
+  // the verdict names the accepted one of lowest BIC, with the accepted ones within 2 of its BIC as ties.
+  const bool fits = dg.base.best.chi2 <= dg.chi2_limit;
+  char line[400];
+  for (ExtensionFit& f : dg.fits) {
+    const Real gain = dg.base_bic - f.bic, held = dg.base_heldout - f.heldout;
+    f.accepted = n >= d + 2 && gain >= kStrongEvidence && held >= kStrongEvidence;
+    std::snprintf(line, sizeof line, "BIC %s by %.1f (%s), held-out chi2 %.1f -> %.1f (%s)",
+                  gain >= 0 ? "lower" : "higher", std::fabs(gain), gain >= kStrongEvidence ? "passes" : "6 needed",
+                  dg.base_heldout, f.heldout, held >= kStrongEvidence ? "passes" : "a drop of 6 needed");
+    f.reason = std::string(f.accepted ? "accepted: " : "rejected: ") + line;
+  }
+  const ExtensionFit* top = nullptr;
+  for (const ExtensionFit& f : dg.fits)
+    if (f.accepted && (!top || f.bic < top->bic)) top = &f;
+  const ExtensionFit* best_bic = nullptr;  // the candidate a "none" names, to show what it would change
+  for (const ExtensionFit& f : dg.fits)
+    if (!best_bic || f.bic < best_bic->bic) best_bic = &f;
+  if (n < d + 2) {  // an extended model with as many parameters as data fits anything
+    dg.verdict = "none";
+    std::snprintf(line, sizeof line,
+                  "%d data cannot test an extension: the extended model has %d parameters and fits any %d numbers. "
+                  "The base model's chi2 is %.1f (99%% limit %.1f); the fits below show what each extension would "
+                  "need, not which is right. Curves, or more quantities per test, are needed to name a cause.",
+                  n, d + 1, n, dg.base.best.chi2, dg.chi2_limit);
+    dg.explanation = line;
+    return;
+  }
+  if (!top) {
+    dg.verdict = "none";
+    std::snprintf(line, sizeof line,
+                  fits ? "The calibrated base model fits within the data's noise (chi2 %.1f on %d data, below the "
+                         "99%% limit %.1f) and no extension passes both tests (the lowest BIC, %s, lowers it by %.1f "
+                         "and the held-out chi2 from %.1f to %.1f; a drop of 6 needed for each): no discrepancy "
+                         "beyond noise, and no extension is called for."
+                       : "The base model misses the data (chi2 %.1f on %d data, 99%% limit %.1f), but no extension "
+                         "explains it: none passes both tests (the lowest BIC, %s, lowers it by %.1f and the held-out "
+                         "chi2 from %.1f to %.1f; a drop of 6 needed for each).",
+                  dg.base.best.chi2, n, dg.chi2_limit, best_bic ? best_bic->ext.name.c_str() : "-",
+                  best_bic ? dg.base_bic - best_bic->bic : 0.0, dg.base_heldout, best_bic ? best_bic->heldout : 0.0);
+    dg.explanation = line;
+    return;
+  }
+  dg.verdict = top->ext.name;
+  std::string ties;
+  for (const ExtensionFit& f : dg.fits)
+    if (&f != top && f.accepted && f.bic - top->bic < kTieBIC) {
+      dg.verdict += " or " + f.ext.name;
+      ties += (ties.empty() ? "" : ", ") + f.ext.name;
+    }
+  std::snprintf(line, sizeof line,
+                "%s (chi2 %.1f on %d data, 99%% limit %.1f). %s (%s = %.3g) explains it: "
+                "chi2 %.1f, BIC lower by %.1f, held-out chi2 %.1f -> %.1f. Signature: %s.",
+                fits ? "The base model fits within the noise, but a model extension fits significantly better"
+                     : "The base model misses the data",
+                dg.base.best.chi2, n, dg.chi2_limit, top->ext.name.c_str(), top->ext.param.c_str(),
+                free_param(top->ext.param).shown * top->strength, top->best.chi2, dg.base_bic - top->bic,
+                dg.base_heldout, top->heldout, top->ext.signature.c_str());
+  dg.explanation = line;
+  if (!ties.empty())
+    dg.explanation += " These data cannot tell it from " + ties + " (both tests passed, BIC within 2).";
+}
+
 }  // namespace
 
 Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free0,
@@ -138,12 +288,12 @@ Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreePa
   // run becomes the base fit, below).
   std::vector<QuadraticSurface> surf = response_surfaces(dg.base.design, dg.base.best.u);
   std::vector<Real> at_best = evaluate_surfaces(surf, dg.base.best.u);
-  auto base_model = [&](const std::vector<Real>& u) {
+  const std::function<std::vector<Real>(const std::vector<Real>&)> base_model = [&](const std::vector<Real>& u) {
     std::vector<Real> r = evaluate_surfaces(surf, u);
     for (std::size_t i = 0; i < r.size(); ++i) r[i] += dg.base.best.r[i] - at_best[i];
     return r;
   };
-  auto base_at = [&](const std::vector<Real>& u) {
+  const std::function<Model(const std::vector<Real>&)> base_at = [&](const std::vector<Real>& u) {
     Model m = base;
     for (int k = 0; k < d; ++k) set_param(m, free[k].name, free[k].value(u[k]));
     return m;
@@ -153,67 +303,14 @@ Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreePa
       dg.base.best.chi2, n, dg.chi2_limit, dg.base_heldout);
 
   Evaluation base_runs = dg.base.best;  // the best run of the base model, also among the extension fits' runs
+  const std::function<void()> report_runs = [&] { report(best_chi2); };
+  const FitContext cx{lab, dg.base, base_model, base_at, measured, misfit, report_runs};
   for (const Extension& e : extensions()) {
-    ExtensionFit f;
-    f.ext = e;
-    const long runs0 = lab.runs();
-    // The extension's effect at the base optimum, strength by strength.
-    std::vector<std::vector<Real>> effect{std::vector<Real>(dg.base.best.r.size(), 0.0)};
-    for (Real level : e.levels) {
-      Model m = dg.base.model;
-      set_param(m, e.param, level);
-      const std::vector<Real> r = misfit.residuals(lab.run_ensemble(m, measured));
-      report(best_chi2);
-      std::vector<Real> diff(r.size());
-      for (std::size_t i = 0; i < r.size(); ++i) diff[i] = r[i] - dg.base.best.r[i];
-      effect.push_back(diff);
-    }
-    std::vector<Real> correction(dg.base.best.r.size(), 0.0);
-    auto joint = [&](const std::vector<Real>& u) {
-      const std::vector<Real> ub(u.begin(), u.begin() + d);
-      std::vector<Real> r = base_model(ub);
-      const Real t = strength_coordinate(e, u[d]);
-      const int k = std::min(static_cast<int>(t), 2);
-      const Real w = t - k;
-      for (std::size_t i = 0; i < r.size(); ++i)
-        r[i] += (1 - w) * effect[k][i] + w * effect[k + 1][i] + correction[i];
-      return r;
-    };
-    auto model_at = [&](const std::vector<Real>& u) {
-      Model m = base_at(u);
-      set_param(m, e.param, strength_at(e, strength_coordinate(e, u[d])));
-      return m;
-    };
-    // The base model is the extension at strength 0: its best run is the starting point, so an extended fit
-    // is never reported worse than the base.
-    f.best = dg.base.best;
-    std::vector<Real> best_u = dg.base.best.u;
-    best_u.push_back(0);
-    bool extended = false;  // a run of the extension beat the base
-    for (int round = 0; round < 2; ++round) {
-      const std::vector<Real> u = minimise_unit_box([&](const std::vector<Real>& x) { return sum_sq(joint(x)); },
-                                                    d + 1);
-      const std::vector<Real> predicted = joint(u);
-      Evaluation ev;
-      ev.u.assign(u.begin(), u.begin() + d);
-      const Ensemble ens = lab.run_ensemble(model_at(u), measured);
-      for (const auto& members : ens) ev.sim.push_back(mean_curve(members));
-      ev.r = misfit.residuals(ens);
-      ev.chi2 = sum_sq(ev.r);
-      report(best_chi2);
-      if (strength_at(e, strength_coordinate(e, u[d])) == 0 && ev.chi2 < base_runs.chi2) base_runs = ev;
-      if (ev.chi2 < f.best.chi2) f.best = ev, best_u = u, extended = true;
-      for (std::size_t i = 0; i < correction.size(); ++i) correction[i] += ev.r[i] - predicted[i];
-    }
-    for (int k = 0; k < d; ++k) f.values.push_back(free[k].value(best_u[k]));
-    f.strength = extended ? strength_at(e, strength_coordinate(e, best_u[d])) : 0;
-    f.values.push_back(f.strength);
-    f.bic = bic(f.best.chi2, d + 1, n);
-    f.heldout = heldout_chi2(joint, d + 1, measured, model_at, lab, misfit);
-    f.runs = lab.runs() - runs0;
+    dg.fits.push_back(fit_extension(e, cx, base_runs));
+    const ExtensionFit& f = dg.fits.back();
     say("diagnose: %-9s %s = %.3g: chi2 %.1f, BIC %.1f (base %.1f), held-out chi2 %.1f (base %.1f)\n",
-        e.name.c_str(), e.param.c_str(), free_param(e.param).shown * f.strength, f.best.chi2, f.bic, dg.base_bic, f.heldout, dg.base_heldout);
-    dg.fits.push_back(f);
+        e.name.c_str(), e.param.c_str(), free_param(e.param).shown * f.strength, f.best.chi2, f.bic, dg.base_bic,
+        f.heldout, dg.base_heldout);
   }
   // A run of an extension fit at strength 0 is a run of the base model: the base fit never ends worse than it.
   if (base_runs.chi2 < dg.base.best.chi2) {
@@ -239,71 +336,7 @@ Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreePa
   }
 
   if (verbose) progress.finish("");
-  // Verdict. The rule compares nested models (an extension at strength 0 is the base model) and weighs every
-  // extension on both tests: a drop of BIC by 6 (a likelihood-ratio test at about 0.3% for 15 data, more
-  // powerful than asking whether the base model alone fits within the noise) and a drop of the held-out chi2 by
-  // the same 6 (a likelihood ratio of e^3 = 20 on pressures the fit did not see, which guards against an
-  // extension that only fits the noise of the pressures it saw). Every extension that passes both is accepted;
-  // the verdict names the accepted one of lowest BIC, with the accepted ones within 2 of its BIC as ties.
-  const bool fits = dg.base.best.chi2 <= dg.chi2_limit;
-  char line[400];
-  for (ExtensionFit& f : dg.fits) {
-    const Real gain = dg.base_bic - f.bic, held = dg.base_heldout - f.heldout;
-    f.accepted = n >= d + 2 && gain >= kStrongEvidence && held >= kStrongEvidence;
-    std::snprintf(line, sizeof line, "BIC %s by %.1f (%s), held-out chi2 %.1f -> %.1f (%s)",
-                  gain >= 0 ? "lower" : "higher", std::fabs(gain), gain >= kStrongEvidence ? "passes" : "6 needed",
-                  dg.base_heldout, f.heldout, held >= kStrongEvidence ? "passes" : "a drop of 6 needed");
-    f.reason = std::string(f.accepted ? "accepted: " : "rejected: ") + line;
-  }
-  const ExtensionFit* top = nullptr;
-  for (const ExtensionFit& f : dg.fits)
-    if (f.accepted && (!top || f.bic < top->bic)) top = &f;
-  const ExtensionFit* best_bic = nullptr;  // the candidate a "none" names, to show what it would change
-  for (const ExtensionFit& f : dg.fits)
-    if (!best_bic || f.bic < best_bic->bic) best_bic = &f;
-  if (n < d + 2) {  // an extended model with as many parameters as data fits anything
-    dg.verdict = "none";
-    std::snprintf(line, sizeof line,
-                  "%d data cannot test an extension: the extended model has %d parameters and fits any %d numbers. "
-                  "The base model's chi2 is %.1f (99%% limit %.1f); the fits below show what each extension would "
-                  "need, not which is right. Curves, or more quantities per test, are needed to name a cause.",
-                  n, d + 1, n, dg.base.best.chi2, dg.chi2_limit);
-    dg.explanation = line;
-    return dg;
-  }
-  if (!top) {
-    dg.verdict = "none";
-    std::snprintf(line, sizeof line,
-                  fits ? "The calibrated base model fits within the data's noise (chi2 %.1f on %d data, below the "
-                         "99%% limit %.1f) and no extension passes both tests (the lowest BIC, %s, lowers it by %.1f "
-                         "and the held-out chi2 from %.1f to %.1f; a drop of 6 needed for each): no discrepancy "
-                         "beyond noise, and no extension is called for."
-                       : "The base model misses the data (chi2 %.1f on %d data, 99%% limit %.1f), but no extension "
-                         "explains it: none passes both tests (the lowest BIC, %s, lowers it by %.1f and the held-out "
-                         "chi2 from %.1f to %.1f; a drop of 6 needed for each).",
-                  dg.base.best.chi2, n, dg.chi2_limit, best_bic ? best_bic->ext.name.c_str() : "-",
-                  best_bic ? dg.base_bic - best_bic->bic : 0.0, dg.base_heldout, best_bic ? best_bic->heldout : 0.0);
-    dg.explanation = line;
-    return dg;
-  }
-  dg.verdict = top->ext.name;
-  std::string ties;
-  for (const ExtensionFit& f : dg.fits)
-    if (&f != top && f.accepted && f.bic - top->bic < kTieBIC) {
-      dg.verdict += " or " + f.ext.name;
-      ties += (ties.empty() ? "" : ", ") + f.ext.name;
-    }
-  std::snprintf(line, sizeof line,
-                "%s (chi2 %.1f on %d data, 99%% limit %.1f). %s (%s = %.3g) explains it: "
-                "chi2 %.1f, BIC lower by %.1f, held-out chi2 %.1f -> %.1f. Signature: %s.",
-                fits ? "The base model fits within the noise, but a model extension fits significantly better"
-                     : "The base model misses the data",
-                dg.base.best.chi2, n, dg.chi2_limit, top->ext.name.c_str(), top->ext.param.c_str(),
-                free_param(top->ext.param).shown * top->strength, top->best.chi2, dg.base_bic - top->bic,
-                dg.base_heldout, top->heldout, top->ext.signature.c_str());
-  dg.explanation = line;
-  if (!ties.empty())
-    dg.explanation += " These data cannot tell it from " + ties + " (both tests passed, BIC within 2).";
+  give_verdict(dg, n, d);
   return dg;
 }
 

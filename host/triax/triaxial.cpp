@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -136,6 +137,136 @@ void measure_stresses(const Cell& c, const TriaxialConfig& tc, const ContactSet&
   r.p_net = mean_stress(net);
 }
 
+/// Isotropic consolidation from the state in `st` (a resumed run's, or step 0): cell pressure on the membrane, stress
+/// servo on the top platen, until the platen's stress and the unbalanced ratio settle; then `st` moves to shear with
+/// the consolidated height, volumes and void ratio. `after_step` runs after each step (checkpoints and stops).
+void consolidate(const Config& cfg, const Specimen& sp, Cell& cell, Stage& st, bool verbose,
+                 const std::function<void(const Stage&)>& after_step) {
+  const TriaxialConfig& tc = cfg.triaxial;
+  Simulation& sim = *cell.sim;
+  const Real dt = sim.params().integ.dt;
+  // Isotropic consolidation: cell pressure on the membrane, stress servo on the top platen.
+  StressServo servo;
+  servo.target = tc.sigma3;
+  servo.area = cell.area;
+  servo.v_max = 0.05 * sp.height / (2000 * dt);  // at most 5% of the height in 2000 steps
+  long s = static_cast<long>(st.step);
+  Progress cons("consolidation (ETA to the step cap)", tc.max_consolidation_steps, s);
+  for (; s < tc.max_consolidation_steps; ++s) {
+    const auto [top, bottom] = platen_stresses(cell, sim.wall_forces());
+    const int n = sim.wall_contact_counts()[kTopPlaten];
+    set_top_velocity(cell, -servo.speed(top, n * cell.kn_wall, dt));
+    const bool check = (s + 1) % 200 == 0;
+    sim.step(check);
+    if (check) {
+      const Real ratio = sim.unbalanced_ratio();
+      // The servo holds the top platen; the bottom one differs by what the membrane carries through
+      // friction and its own axial stiffness, so only the controlled stress decides.
+      const Real err = std::fabs(top - tc.sigma3) / tc.sigma3;
+      if (verbose) {
+        char extra[96];
+        std::snprintf(extra, sizeof extra, "sigma_top %.1f kPa, sigma_bottom %.1f kPa, unbalanced %.1e",
+                      top / 1e3, bottom / 1e3, ratio);
+        cons.update(s + 1, extra);
+      }
+      if (err < tc.consolidation_tol && ratio < tc.stop_ratio) break;
+    }
+    st.step = static_cast<Real>(s + 1);
+    after_step(st);
+  }
+  if (s >= tc.max_consolidation_steps)
+    throw ConfigError(cfg.path + ": [triaxial] max_consolidation_steps: consolidation to " +
+                      std::to_string(tc.sigma3 / 1e3) + " kPa did not settle within " +
+                      std::to_string(tc.max_consolidation_steps) + " steps");
+  st.shear = 1;
+  st.step = 0;
+  st.consolidation_steps = static_cast<Real>(s + 1);
+  st.h0 = sim.wall_point(kTopPlaten).z;
+  st.v0 = specimen_volume(cell);
+  st.v0_envelope = envelope_volume(sim, st.h0, cell.mean_radius, tc.membrane_segments);
+  st.void_ratio = st.v0 / cell.solid_volume - 1;
+  if (verbose)
+    std::printf("\nconsolidated at %.0f kPa: e = %.4f, height %.3f mm after %ld steps\n", tc.sigma3 / 1e3,
+                st.void_ratio, st.h0 * 1e3, static_cast<long>(st.consolidation_steps));
+}
+
+/// What a blow-up leaves for inspection: the curve so far, a snapshot of balls, membrane and contacts, and the
+/// state (with a checkpoint plan) in blowup.h5.
+void save_blowup(Simulation& sim, const Cell& cell, io::Output& out, const Stage& st, const TriaxialResult& res,
+                 const CheckpointPlan* plan) {
+  out.flush_series();
+  const io::SurfaceSnapshot surface = membrane_surface(cell.membrane);
+  const io::ContactTable contacts = contact_table(contact_set(sim));
+  out.write_snapshot(take_snapshot(sim, "blow-up"), &surface, &contacts);
+  if (plan) save_triaxial(blowup_path(out.folder()), sim, &out, st, res, plan->config);
+  std::fprintf(stderr, "triaxdem: state at the blow-up saved in %s (snapshots.xdmf, last entry; %s)\n",
+               out.folder().c_str(), blowup_path(out.folder()).c_str());
+}
+
+/// What a shear stage's records need besides the step: the test, its state and result, the output, and the
+/// consolidated height and volumes the strains are taken from.
+struct ShearRecorder {
+  const Config& cfg;
+  const Cell& cell;
+  Stage& st;
+  TriaxialResult& res;
+  io::Output* out;
+  Real h0, v0, v0_envelope;
+  const std::array<Real, kSnapshotStrains>& snaps;  ///< the strains of the paper's points A-D
+  Progress& progress;
+  bool verbose;
+};
+
+/// One record of the shear stage at axial strain eps_a, step k: boundary stresses and strains, the stress measures,
+/// micromechanics where enabled (with their states at the snapshot strains and the peak), the series row.
+void take_record(const ShearRecorder& sh, Real eps_a, long k, const std::function<const ContactSet&()>& contacts_now) {
+  const TriaxialConfig& tc = sh.cfg.triaxial;
+  const MicroConfig& mc = sh.cfg.micro;
+  const Cell& cell = sh.cell;
+  Simulation& sim = *cell.sim;
+  const char* snap_labels[] = {"A", "B", "C", "D"};  // the paper's points A-D (Figure 8)
+  TriaxialRecord r;
+  const std::vector<Vec3> wall_f = sim.wall_forces();
+  const auto [top, bottom] = platen_stresses(cell, wall_f);
+  const Real top_z = sim.wall_point(kTopPlaten).z, volume = specimen_volume(cell);
+  r.eps_a = eps_a;
+  r.eps_v = (sh.v0 - volume) / sh.v0;
+  r.sigma1 = top;
+  r.sigma1_bottom = bottom;
+  r.q = top - tc.sigma3;
+  r.sigma3_balls = lateral_stress(sim, cell.membrane, wall_f);
+  r.eps_v_envelope =
+      (sh.v0_envelope - envelope_volume(sim, top_z, cell.mean_radius, tc.membrane_segments)) / sh.v0_envelope;
+  r.unbalanced = sim.unbalanced_ratio();
+  r.kinetic = sim.stats().kinetic;
+  measure_stresses(cell, tc, contacts_now(), volume, sh.v0 / sh.h0, r);
+  sh.res.records.push_back(r);
+  std::vector<double> row = series_row(r, tc.sigma3, sh.st.void_ratio);
+  const int next_snap = static_cast<int>(sh.st.next_snap);
+  if (mc.enabled) {
+    const ContactSet& cs = contacts_now();
+    const ContactSet rve = restrict_to_cube(cs, Vec3(0, 0, top_z / 2), mc.rve_edge);
+    const MicroRow m = micro_row(cs, volume);
+    sh.res.micro.push_back(m);
+    for (const MicroRow& x : {m, micro_row(rve, mc.rve_edge * mc.rve_edge * mc.rve_edge)})
+      for (double v : micro_values(x)) row.push_back(v);
+    const bool snap_due = next_snap < kSnapshotStrains && eps_a >= sh.snaps[next_snap] - 1e-12;
+    if (sh.out && snap_due) write_micro_state(sh.out->folder(), snap_labels[next_snap], cs, rve, mc.rose_bins);
+    if (sh.out && r.q > sh.st.q_max) write_micro_state(sh.out->folder(), "peak", cs, rve, mc.rose_bins);
+  }
+  sh.st.q_max = std::max(sh.st.q_max, r.q);
+  if (sh.out) {
+    sh.out->append_series(row);
+    if (sh.res.records.size() % 25 == 0) sh.out->flush_series();  // a crash keeps the curve so far
+  }
+  sh.st.next_record += tc.record_every;
+  if (sh.verbose) {
+    char extra[64];
+    std::snprintf(extra, sizeof extra, "eps_a %.2f%%, q %.1f kPa", 100 * eps_a, r.q / 1e3);
+    sh.progress.update(k, extra);
+  }
+}
+
 }  // namespace
 
 ShearPlan shear_plan(const Config& cfg, Real dt) {
@@ -207,55 +338,10 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
 
   // A blow-up saves the state it happened in (balls, membrane, contacts) and the curve so far, then stops.
   try {
-    if (st.shear == 0) {
-      // Isotropic consolidation: cell pressure on the membrane, stress servo on the top platen.
-      StressServo servo;
-      servo.target = tc.sigma3;
-      servo.area = cell.area;
-      servo.v_max = 0.05 * sp.height / (2000 * dt);  // at most 5% of the height in 2000 steps
-      long s = static_cast<long>(st.step);
-      Progress cons("consolidation (ETA to the step cap)", tc.max_consolidation_steps, s);
-      for (; s < tc.max_consolidation_steps; ++s) {
-        const auto [top, bottom] = platen_stresses(cell, sim.wall_forces());
-        const int n = sim.wall_contact_counts()[kTopPlaten];
-        set_top_velocity(cell, -servo.speed(top, n * cell.kn_wall, dt));
-        const bool check = (s + 1) % 200 == 0;
-        sim.step(check);
-        if (check) {
-          const Real ratio = sim.unbalanced_ratio();
-          // The servo holds the top platen; the bottom one differs by what the membrane carries through
-          // friction and its own axial stiffness, so only the controlled stress decides.
-          const Real err = std::fabs(top - tc.sigma3) / tc.sigma3;
-          if (verbose) {
-            char extra[96];
-            std::snprintf(extra, sizeof extra, "sigma_top %.1f kPa, sigma_bottom %.1f kPa, unbalanced %.1e",
-                          top / 1e3, bottom / 1e3, ratio);
-            cons.update(s + 1, extra);
-          }
-          if (err < tc.consolidation_tol && ratio < tc.stop_ratio) break;
-        }
-        st.step = static_cast<Real>(s + 1);
-        checkpoint(st);
-      }
-      if (s >= tc.max_consolidation_steps)
-        throw ConfigError(cfg.path + ": [triaxial] max_consolidation_steps: consolidation to " +
-                          std::to_string(tc.sigma3 / 1e3) + " kPa did not settle within " +
-                          std::to_string(tc.max_consolidation_steps) + " steps");
-      st.shear = 1;
-      st.step = 0;
-      st.consolidation_steps = static_cast<Real>(s + 1);
-      st.h0 = sim.wall_point(kTopPlaten).z;
-      st.v0 = specimen_volume(cell);
-      st.v0_envelope = envelope_volume(sim, st.h0, cell.mean_radius, tc.membrane_segments);
-      st.void_ratio = st.v0 / cell.solid_volume - 1;
-      if (verbose)
-        std::printf("\nconsolidated at %.0f kPa: e = %.4f, height %.3f mm after %ld steps\n", tc.sigma3 / 1e3,
-                    st.void_ratio, st.h0 * 1e3, static_cast<long>(st.consolidation_steps));
-    }
+    if (st.shear == 0) consolidate(cfg, sp, cell, st, verbose, checkpoint);
     res.consolidation_steps = static_cast<long>(st.consolidation_steps);
     res.void_ratio_consolidated = st.void_ratio;
     const Real h0 = st.h0, v0 = st.v0, v0_envelope = st.v0_envelope;
-    const int env_slabs = tc.membrane_segments;
 
     const ShearPlan plan_of_shear = shear_plan(cfg, dt);
     res.shear_rate = plan_of_shear.rate;
@@ -265,58 +351,18 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
       std::printf("shear: strain rate %.3g 1/s (inertial number %.1e%s), %ld steps to %.0f%%\n", res.shear_rate,
                   tc.inertial_number, cfg.solver.mass_scale != 1 ? ", with density scaling" : "", steps,
                   tc.axial_strain_end * 100);
-    const Real snaps[kSnapshotStrains] = {0.0, 0.01, 0.05, tc.axial_strain_end};
-    const char* snap_labels[] = {"A", "B", "C", "D"};  // the paper's points A-D (Figure 8)
+    const std::array<Real, kSnapshotStrains> snaps = {0.0, 0.01, 0.05, tc.axial_strain_end};
     Progress shear("shear", steps, static_cast<long>(st.step));
+    const ShearRecorder recorder{cfg, cell, st, res, out, h0, v0, v0_envelope, snaps, shear, verbose};
     for (long k = static_cast<long>(st.step); k <= steps; ++k) {
       const Real eps_a = (h0 - sim.wall_point(kTopPlaten).z) / h0;
       // The contacts are copied to the host at most once a step, for the record and the snapshot alike.
       std::optional<ContactSet> contacts;
-      auto contacts_now = [&]() -> const ContactSet& {
+      const std::function<const ContactSet&()> contacts_now = [&]() -> const ContactSet& {
         if (!contacts) contacts = contact_set(sim);
         return *contacts;
       };
-      if (eps_a >= st.next_record - 1e-12 || k == steps) {
-        TriaxialRecord r;
-        const std::vector<Vec3> wall_f = sim.wall_forces();
-        const auto [top, bottom] = platen_stresses(cell, wall_f);
-        const Real top_z = sim.wall_point(kTopPlaten).z, volume = specimen_volume(cell);
-        r.eps_a = eps_a;
-        r.eps_v = (v0 - volume) / v0;
-        r.sigma1 = top;
-        r.sigma1_bottom = bottom;
-        r.q = top - tc.sigma3;
-        r.sigma3_balls = lateral_stress(sim, cell.membrane, wall_f);
-        r.eps_v_envelope = (v0_envelope - envelope_volume(sim, top_z, cell.mean_radius, env_slabs)) / v0_envelope;
-        r.unbalanced = sim.unbalanced_ratio();
-        r.kinetic = sim.stats().kinetic;
-        measure_stresses(cell, tc, contacts_now(), volume, v0 / h0, r);
-        res.records.push_back(r);
-        std::vector<double> row = series_row(r, tc.sigma3, st.void_ratio);
-        const int next_snap = static_cast<int>(st.next_snap);
-        if (mc.enabled) {
-          const ContactSet& cs = contacts_now();
-          const ContactSet rve = restrict_to_cube(cs, Vec3(0, 0, top_z / 2), mc.rve_edge);
-          const MicroRow m = micro_row(cs, volume);
-          res.micro.push_back(m);
-          for (const MicroRow& x : {m, micro_row(rve, mc.rve_edge * mc.rve_edge * mc.rve_edge)})
-            for (double v : micro_values(x)) row.push_back(v);
-          const bool snap_due = next_snap < kSnapshotStrains && eps_a >= snaps[next_snap] - 1e-12;
-          if (out && snap_due) write_micro_state(out->folder(), snap_labels[next_snap], cs, rve, mc.rose_bins);
-          if (out && r.q > st.q_max) write_micro_state(out->folder(), "peak", cs, rve, mc.rose_bins);
-        }
-        st.q_max = std::max(st.q_max, r.q);
-        if (out) {
-          out->append_series(row);
-          if (res.records.size() % 25 == 0) out->flush_series();  // a crash keeps the curve so far
-        }
-        st.next_record += tc.record_every;
-        if (verbose) {
-          char extra[64];
-          std::snprintf(extra, sizeof extra, "eps_a %.2f%%, q %.1f kPa", 100 * eps_a, r.q / 1e3);
-          shear.update(k, extra);
-        }
-      }
+      if (eps_a >= st.next_record - 1e-12 || k == steps) take_record(recorder, eps_a, k, contacts_now);
       const int next_snap = static_cast<int>(st.next_snap);
       if (out && next_snap < kSnapshotStrains && eps_a >= snaps[next_snap] - 1e-12) {
         char label[48];
@@ -339,15 +385,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
       checkpoint(st);
     }
   } catch (const BlowUp&) {
-    if (out) {
-      out->flush_series();
-      const io::SurfaceSnapshot surface = membrane_surface(cell.membrane);
-      const io::ContactTable contacts = contact_table(contact_set(sim));
-      out->write_snapshot(take_snapshot(sim, "blow-up"), &surface, &contacts);
-      if (plan) save_triaxial(blowup_path(out->folder()), sim, out, st, res, plan->config);
-      std::fprintf(stderr, "triaxdem: state at the blow-up saved in %s (snapshots.xdmf, last entry; %s)\n",
-                   out->folder().c_str(), blowup_path(out->folder()).c_str());
-    }
+    if (out) save_blowup(sim, cell, *out, st, res, plan);
     throw;
   }
   if (out) out->flush_series();
