@@ -1,0 +1,237 @@
+#include "host/cli/calibration_session.hpp"
+
+#include <cstdio>
+
+#include "host/fit/calibration_report.hpp"
+#include "host/fit/diagnose.hpp"
+#include "host/fit/two_fidelity.hpp"
+#include "host/io/io_hdf5.hpp"
+#include "host/triax/summary.hpp"
+#include "host/util/text_format.hpp"
+
+namespace dem {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+/// A folder as a path without a trailing separator ("out/calibrate_x/" names calibrate_x).
+fs::path folder_path(const std::string& folder) {
+  fs::path p = fs::path(folder).lexically_normal();
+  return p.has_filename() ? p : p.parent_path();
+}
+
+/// The folder a resumed calibrate or diagnose continues in: one that a run of the same kind made.
+std::string resumed_folder(const std::string& folder, const std::string& kind) {
+  const std::string name = folder_path(folder).filename().string();
+  if (!fs::is_directory(folder) || name.rfind(kind + "_", 0) != 0)
+    throw std::invalid_argument("--resume " + folder + ": not a " + kind + "_<date> folder of an earlier " + kind +
+                                " (it gives the folder to continue in)");
+  return folder_path(folder).string();
+}
+
+/// The parent folder of a resumed folder: where its run left the specimens it shares with others.
+std::string resumed_parent(const std::string& folder) {
+  const fs::path parent = folder_path(folder).parent_path();
+  return parent.empty() ? "." : parent.string();
+}
+
+/// The free parameters: from the command line, else from the config's [calibrate] free.
+std::vector<FreeParam> free_params(const Config& cfg, const std::vector<std::string>& cli) {
+  std::vector<FreeParam> out;
+  for (const std::string& n : cli.empty() ? cfg.calibrate.free : cli) {
+    // A parameter twice would be two coordinates of one value: a singular fit.
+    for (const FreeParam& f : out)
+      if (f.name == n)
+        throw ConfigError((cli.empty() ? cfg.path + ": [calibrate] free" : std::string("--free")) + ": " + n +
+                          " given twice (each free parameter once)");
+    try {
+      out.push_back(free_param(n, model_of(cfg)));
+    } catch (const std::invalid_argument& e) {
+      if (!cli.empty()) throw;
+      throw ConfigError(cfg.path + ": [calibrate] free: " + e.what());
+    }
+  }
+  return out;
+}
+
+/// --predict walls, checked: the reference test must not be the walled cell already.
+bool walls_prediction_wanted(const Config& base, const CalibrationOptions& o) {
+  if (!predicts_walls(base, o.predict)) return false;
+  if (reference_cell(base, o.reference_test).periodic.boundary == CellBoundary::walls)
+    throw ConfigError((o.predict.empty() ? base.path + ": [calibrate] predict" : std::string("--predict")) +
+                      ": walls: the reference test is the cell between six walls already; predict a membrane test "
+                      "(a config of configs/small/) or none");
+  return true;
+}
+
+}  // namespace
+
+/// The tests of the data by material (sorted by name), filtered by `only` when it is set.
+std::map<std::string, std::vector<MeasuredTest>> by_material(const MeasuredData& d, const std::string& only) {
+  std::map<std::string, std::vector<MeasuredTest>> out;
+  for (const MeasuredTest& t : d.tests)
+    if (only.empty() || t.material == only) out[t.material].push_back(t);
+  if (out.empty()) throw DataError(d.path + ": no tests of material '" + only + "'");
+  return out;
+}
+
+Session::Session(const Config& base, const CalibrationOptions& o, const std::string& kind)
+    : data(load_measured(o.data)),
+      ref(o.reference.empty() ? ReferenceValues{}
+                              : load_reference(o.reference, [](const std::string& n) { free_param(n); })),
+      free(free_params(base, o.free)), predict_template(prediction_template(base, o.predict)),
+      walls_prediction(walls_prediction_wanted(base, o)), jobs(o.jobs),
+      two_fidelity(two_fidelity_wanted(base, o.reference_test, predict_template.has_value())),
+      lab(matched(reference_cell(base, o.reference_test), o.jobs), true, o.jobs),
+      folder(o.resume.empty() ? new_dated_folder(o.output, kind) : resumed_folder(o.resume, kind)),
+      output(o.resume.empty() ? o.output : resumed_parent(o.resume)) {
+  lab.set_run_store(folder + "/runs");
+  if (!o.resume.empty())
+    std::printf("%s: resuming in %s: the runs stored there are read, not run again\n", kind.c_str(), folder.c_str());
+  if (o.noise == "data" || o.noise == "lab") noise.mode = o.noise;
+  else noise = lab_noise_options(o.noise);
+  for (const std::string& n : data.notes) std::printf("%s: note: %s\n", kind.c_str(), n.c_str());
+}
+
+std::string Session::cell_text() const {
+  return lab.config().periodic.boundary == CellBoundary::walls
+             ? "the cell between six walls (stresses measured at the walls, as a walled test measures them)"
+             : "the periodic cell (stresses from its contacts: the specimen's interior, without a boundary)";
+}
+
+std::string Session::runs_text() const {
+  const long read = lab.stored_runs_read();
+  return std::to_string(lab.runs()) + " runs" +
+         (read > 0 ? " (" + std::to_string(read) + " of them read from the run store)" : "") +
+         (lab.failed_runs() > 0 ? "; WARNING: " + failed_text() : "");
+}
+
+std::string Session::failed_text() const {
+  return std::to_string(lab.failed_runs()) + " of the runs stopped at a blow-up" +
+         fmt(" (up to %g kPa)", 1e-3 * lab.highest_failed_sigma3()) +
+         ", their data counted as missing: where the overlaps are the contacts' physics (soft contacts at high "
+         "pressure), raise [solver] overlap_limit (docs/config.md)";
+}
+
+std::vector<std::string> Session::free_names() const {
+  std::vector<std::string> names;
+  for (const FreeParam& f : free) names.push_back(f.name);
+  return names;
+}
+
+std::vector<Prediction> Session::predict_at(const Config& base, const Model& model, const std::vector<MeasuredTest>& tests) const {
+  return predict(*predict_template, model, free_names(), tests, data.q_measure,
+                 static_cast<int>(base.calibrate.predict_specimens), output + "/.specimens", true);
+}
+
+Config Session::matched(const Config& base, int jobs) {
+  return matched_state(base, data.tests, state, true, match_plan(base, jobs));
+}
+
+std::string Session::state_text(const Misfit& m, const std::vector<MeasuredTest>& tests) const {
+  if (state.tests == 0)
+    return "The data give no void ratio: the simulator's specimens have the density their preparation gives (" +
+           fmt("e = %.3f", lab.prepared_void_ratio(0)) + " for the first), and the calibrated friction absorbs "
+           "any difference in density.\n";
+  std::string s = "The simulator's specimens were prepared to the data's void ratio " + fmt("%.4f", state.target) +
+                  " (preparation friction " + fmt("%.4g", state.prep_mu_s) + ", which packs " +
+                  fmt("%.4f", state.reached) +
+                  fmt(" on the mean of its first %.0f", static_cast<double>(state.specimens)) +
+                  "). At the start of shear, measured and simulated (mean of the scatter specimens at the base "
+                  "model):";
+  for (std::size_t k = 0; k < tests.size(); ++k)
+    s += fmt(" %g kPa", 1e-3 * tests[k].sigma3) + fmt(" %.4f", tests[k].void_ratio) +
+         fmt(" against %.4f;", m.reached_void_ratio(k));
+  return s + "\n";
+}
+
+Misfit Session::misfit_of(const Config& base, const std::string& material, const std::vector<MeasuredTest>& tests) {
+  std::printf("%s: %s: measuring the simulator's scatter: %d specimens of %zu balls at the base model\n",
+              folder.c_str(), material.c_str(), lab.specimens(), lab.balls());
+  lab.set_progress("  " + material + ": scatter");
+  Misfit m = measure_misfit(lab, model_of(base), tests, noise, true, &state);
+  lab.set_progress("");
+  for (const std::string& n : m.notes()) std::printf("  noise: %s\n", n.c_str());
+  const Real ratio = m.ensemble_ratio();
+  const bool chosen = base.calibrate.ensemble == kAutoEnsemble;
+  // An "auto" cell grows only with an "auto" ensemble: a fixed ensemble fixes the cost per point.
+  const bool cell_chosen = chosen && base.calibrate.cell_factor == kAutoCell;
+  std::printf("  cell: %zu balls, %d x the config's (%s)%s\n", lab.balls(), lab.cell_factor(),
+              base.calibrate.cell_factor != kAutoCell ? "[calibrate] cell_factor" : cell_chosen ? "chosen" : "kept",
+              lab.cell_factor() > 1 && cell_chosen ? ": all the scatter specimens of the config's cell fell short"
+                                                   : "");
+  std::printf("  ensemble: %d specimens per parameter point (%s); the simulator's standard error is %.2f of the "
+              "data's noise (median)%s\n", lab.members(), chosen ? "chosen" : "[calibrate] ensemble", ratio,
+              ratio > kEnsembleRatioGoal ? "" : ": below 1/2, enough");
+  if (ratio > kEnsembleRatioGoal) {
+    // The mean of K specimens of N balls scatters as 1 / sqrt(K N): where K runs out, N makes up the rest.
+    const int k = m.members_for(kEnsembleRatioGoal);
+    const Real grow = static_cast<Real>(k) / lab.specimens();
+    const Real factor = std::ceil(grow * lab.cell_factor());
+    const std::string beyond = cell_chosen && factor > kMaxCellFactor
+                                   ? ", beyond the " + std::to_string(kMaxCellFactor) + " x an \"auto\" cell grows to"
+                                   : "";
+    std::printf("  WARNING: above 1/2, and the misfit counts it. %d specimens would bring it to 1/2", k);
+    if (grow > 1)
+      std::printf(" (scatter_specimens = %d), or all %d in a cell of about %.0f balls (cell_factor = %.0f%s)", k,
+                  lab.specimens(), grow * static_cast<Real>(lab.balls()), factor, beyond.c_str());
+    std::printf("\n");
+  }
+  return m;
+}
+
+Real Session::reference(const std::string& material, const std::string& name) const {
+  auto m = ref.values.find(material);
+  if (m == ref.values.end()) return std::nan("");
+  auto v = m->second.find(name);
+  return v == m->second.end() ? std::nan("") : v->second;
+}
+
+std::string Session::predict_boundary(const Config& base, const std::map<std::string, Calibrated>& models) const {
+  if (!predict_template && !walls_prediction) {
+    std::printf("%s: no prediction ([calibrate] predict or --predict names a membrane test, or walls)\n",
+                folder.c_str());
+    return "";
+  }
+  std::optional<Config> walls;
+  if (walls_prediction) {
+    StateMatch walls_state;  // the walled cell's own preparation to the data's state
+    const Config cell = reference_cell(base, kPredictWalls);
+    walls = matched_state(cell, data.tests, walls_state, true, match_plan(cell, jobs));
+  }
+  const std::string test = walls ? walled_cell_text(*walls) : membrane_test_text(*predict_template);
+  const int specimens = static_cast<int>(base.calibrate.predict_specimens);
+  std::vector<Prediction> all;
+  std::vector<MeasuredTest> curves;
+  for (const auto& [material, cal] : models) {
+    const std::vector<MeasuredTest>& tests = cal.tests;
+    std::printf("%s: %s: predicting %s at the calibrated parameters: %zu pressures x %d specimens\n",
+                folder.c_str(), material.c_str(), walls ? "the walled cell" : predict_template->path.c_str(),
+                tests.size(), specimens);
+    std::vector<Prediction> p = walls ? predict_walls(*walls, cal.model, tests, specimens, jobs)
+                                      : predict_at(base, cal.model, tests);
+    for (std::size_t k = 0; k < p.size() && k < cal.sim.size(); ++k) p[k].periodic_q_peak = cal.sim[k].q_peak;
+    for (Prediction& x : p) {
+      curves.insert(curves.end(), x.members.begin(), x.members.end());
+      all.push_back(std::move(x));
+    }
+  }
+  const std::string md = prediction_markdown(all, data.q_measure);
+  io::write_text_atomic(folder + "/prediction.csv", prediction_csv(all, data.q_measure));
+  write_measured_curves(folder + "/prediction_curves.csv", curves, test + " at the calibrated parameters",
+                        name_of(data.q_measure));
+  std::printf("\nprediction (%s at the calibrated parameters):\n%s", test.c_str(), md.c_str());
+  run_plot_script("plot_prediction.py", {folder});
+  return prediction_section(test, specimens, data.q_measure, md, discrepancy);
+}
+
+void Session::finish(const std::vector<MeasuredTest>& meas, const std::vector<MeasuredTest>& sim,
+            const std::string& what) const {
+  io::write_text_atomic(folder + "/errors.csv", errors_csv(meas, sim));
+  write_measured_curves(folder + "/simulated_curves.csv", sim, "simulated by " + what);
+  if (data.curves) write_measured_curves(folder + "/measured_curves.csv", meas, "measured: " + data.path);
+  run_plot_script("plot_calibration.py", {folder});
+}
+
+}  // namespace dem

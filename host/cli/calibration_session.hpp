@@ -1,0 +1,83 @@
+#pragma once
+/// What `calibrate` and `diagnose` share (host/cli/calibration_jobs.cpp): the data, the free parameters, the
+/// reference test's simulator, the noise, the prediction that ends them, and a new result folder.
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include "host/cli/calibration_jobs.hpp"
+#include "host/fit/calibrate.hpp"
+#include "host/fit/misfit.hpp"
+#include "host/fit/prediction.hpp"
+#include "host/lab/periodic_lab.hpp"
+
+namespace dem {
+
+/// The data's tests by material: all of them, or those of `only` (DataError naming the file where it has none).
+std::map<std::string, std::vector<MeasuredTest>> by_material(const MeasuredData& d, const std::string& only);
+
+/// A material's calibration as the prediction needs it: its tests, the model, and the periodic cell's tests at it.
+struct Calibrated {
+  std::vector<MeasuredTest> tests;
+  Model model;
+  std::vector<MeasuredTest> sim;  ///< in the order of tests
+};
+
+/// Removes a result folder that is still empty when the job ends: a refusal after the folder was made.
+struct EmptyFolderRemover {
+  std::string path;
+  EmptyFolderRemover(const EmptyFolderRemover&) = delete;
+  EmptyFolderRemover& operator=(const EmptyFolderRemover&) = delete;
+  ~EmptyFolderRemover() {
+    std::error_code ec;
+    namespace fs = std::filesystem;
+    if (fs::is_directory(path, ec) && fs::is_empty(path, ec)) fs::remove(path, ec);
+  }
+};
+
+/// What calibrate and diagnose share: the data, the free parameters, the simulator and a new result folder.
+struct Session {
+  MeasuredData data;
+  ReferenceValues ref;
+  std::vector<FreeParam> free;
+  StateMatch state;  ///< the data's void ratio and the preparation that packs it
+  std::optional<Config> predict_template;
+  bool walls_prediction = false;  ///< the prediction is the reference cell between six walls (kPredictWalls)
+  int jobs = 1;
+  bool two_fidelity = false;  ///< the reference test: the periodic cell corrected by the membrane test
+  std::string discrepancy;    ///< what the two fidelities measured, for the report
+  PeriodicLab lab;
+  std::string folder, output;
+  EmptyFolderRemover remover{folder};
+  NoiseOptions noise;
+  Session(const Config& base, const CalibrationOptions& o, const std::string& kind);
+  /// The reference test's cell, for the report.
+  std::string cell_text() const;
+  /// "N runs", how many of them a resumed session read from its store, and how many a blow-up stopped: their data
+  /// count as missing (kMissingResidual), which pushes the fit away from where they happen.
+  std::string runs_text() const;
+  std::string failed_text() const;
+  std::vector<std::string> free_names() const;
+  /// The membrane test at `model` on every test of `tests`, q in the data's measure (a template must be set).
+  std::vector<Prediction> predict_at(const Config& base, const Model& model,
+                                     const std::vector<MeasuredTest>& tests) const;
+  Config matched(const Config& base, int jobs);
+  /// The report's line on the specimens' state.
+  std::string state_text(const Misfit& m, const std::vector<MeasuredTest>& tests) const;
+  /// The misfit of a material's tests: the ensemble run at the base model, its scatter beside the data's noise.
+  Misfit misfit_of(const Config& base, const std::string& material, const std::vector<MeasuredTest>& tests);
+  /// The reference value of a parameter for a material, in the key's unit; NaN when there is none.
+  Real reference(const std::string& material, const std::string& name) const;
+  /// The test with a boundary at each material's calibrated model (`models`, by material), beside the data: the
+  /// membrane test of the template or the walled cell. Writes prediction.csv, prediction_curves.csv and
+  /// prediction.png, prints the table, and returns it as Markdown ("" when there is no prediction).
+  std::string predict_boundary(const Config& base, const std::map<std::string, Calibrated>& models) const;
+  /// The errors table, the curves in the measured-data format and the figure.
+  void finish(const std::vector<MeasuredTest>& meas, const std::vector<MeasuredTest>& sim,
+              const std::string& what) const;
+};
+
+}  // namespace dem
