@@ -1,5 +1,5 @@
 #pragma once
-/// The command-line jobs of calibration and diagnosis (issue 5): `triaxdem calibrate`, `triaxdem diagnose` and
+/// The command-line jobs of calibration and diagnosis: `triaxdem calibrate`, `triaxdem diagnose` and
 /// `triaxdem synth` (synthetic measured data with a hidden effect, for tests and studies).
 #include <limits>
 #include <string>

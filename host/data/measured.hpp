@@ -1,5 +1,5 @@
 #pragma once
-/// Measured triaxial data (issue 5): a CSV of laboratory results per material and confining pressure,
+/// Measured triaxial data: a CSV of laboratory results per material and confining pressure,
 /// either curves (eps_a, q, eps_v against axial strain) or summary points (q_peak, eps_a at peak, q at the
 /// end, maximum dilatancy), with the unit in each column name. Parsed into SI; every error names the file,
 /// the line and the column.

@@ -1,5 +1,5 @@
 #pragma once
-/// Checkpoints (issue 7): a Simulation's state and what the job steering it needs to go on, in one HDF5 file
+/// Checkpoints: a Simulation's state and what the job steering it needs to go on, in one HDF5 file
 /// written through a temporary file and a rename, so that a run killed at any moment leaves the previous
 /// complete checkpoint in place.
 ///

@@ -1,5 +1,5 @@
 #pragma once
-/// Calibration against measured triaxial data (issue 5). The simulator, PeriodicLab, is in periodic_lab.cpp.
+/// Calibration against measured triaxial data. The simulator, PeriodicLab, is in periodic_lab.cpp.
 ///
 /// The simulator is the periodic-cell triaxial test (host/triax/periodic_triaxial.hpp) on one specimen prepared once
 /// from the base config, so that every run differs from the others only by its parameters (common random

@@ -1,5 +1,5 @@
 #pragma once
-/// Diagnosis (issue 5): what the calibrated base model gets wrong against measured data, which model extension
+/// Diagnosis: what the calibrated base model gets wrong against measured data, which model extension
 /// explains it, and by how much it helps.
 ///
 /// 1. The base model (free: mu_s, mu_r by default) is calibrated (host/fit/calibrate.hpp).

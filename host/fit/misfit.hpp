@@ -1,5 +1,5 @@
 #pragma once
-/// The misfit between measured tests and the simulator's ensemble (issue 26): what is compared, with which
+/// The misfit between measured tests and the simulator's ensemble: what is compared, with which
 /// noise, and the whitened residuals that calibration and diagnosis minimise.
 ///
 /// What is compared. Curve data: q and eps_v at the strains of kFeatureStrains (log-spaced, where the stiffness

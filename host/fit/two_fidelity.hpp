@@ -1,5 +1,5 @@
 #pragma once
-/// The two-fidelity calibration (issue 39): the periodic cell drives the search, and the membrane test, the test
+/// The two-fidelity calibration: the periodic cell drives the search, and the membrane test, the test
 /// the lab ran, corrects it. At the periodic optimum both run at every pressure of the data; their difference in
 /// each compared feature (the membrane test's specimens against the periodic ensemble, in the q the data report)
 /// is the discrepancy the boundary makes. The periodic cell is then calibrated again against the data less that

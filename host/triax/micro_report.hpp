@@ -1,5 +1,5 @@
 #pragma once
-/// The micromechanics a triaxial run records (issue 4): a row of scalars with every series record
+/// The micromechanics a triaxial run records: a row of scalars with every series record
 /// (coordination, strong/weak networks, anisotropy of the whole, strong and weak networks, Love-Weber
 /// stress), and at the paper's points A-D the distributions (O_n, roses) and the force chains of the
 /// representative volume. Column names carry units.

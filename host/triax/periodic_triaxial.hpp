@@ -1,5 +1,5 @@
 #pragma once
-/// Periodic-cell triaxial test (issue 3, item 7): no platens, no membrane. A fully periodic cell deforms
+/// Periodic-cell triaxial test: no platens, no membrane. A fully periodic cell deforms
 /// homogeneously (Simulation::set_strain_rate); the axial (z) strain rate is prescribed and the lateral
 /// (x, y) stresses, measured from the ball-ball contacts (Love-Weber, Simulation::contact_stress), are
 /// servo-controlled to sigma3. Fast constitutive runs for calibration, like YADE's PeriTriaxController.
