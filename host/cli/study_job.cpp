@@ -1,5 +1,5 @@
-/// The `study` command: each case a child process of this program, as many at once as the machine has cores to
-/// spare, and the table rewritten as each one ends.
+/// The `study` command: each case a child process of this program (the process pool, host/util/process_pool.hpp),
+/// as many at once as the machine has cores to spare, and the table rewritten as each one ends.
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -9,7 +9,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <map>
 #include <stdexcept>
 #include <thread>
 
@@ -17,6 +16,7 @@
 #include "host/engine/checkpoint.hpp"
 #include "host/io/io_hdf5.hpp"
 #include "host/study/study.hpp"
+#include "host/util/process_pool.hpp"
 #include "host/util/progress.hpp"
 
 namespace dem {
@@ -25,33 +25,22 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Running {
-  std::size_t index;
-  std::chrono::steady_clock::time_point start;
-};
-
-/// Starts `self job config -o folder` with its output in folder/log.txt and `threads` OpenMP threads.
-/// `resume`: the case continues from its checkpoint, and its log goes on.
-pid_t launch(const char* self, const StudyCase& c, const std::string& folder, int threads, bool resume) {
-  fs::create_directories(folder);
+/// In the child of piece `c`: `self job config -o folder` with its output in folder/log.txt and `threads` OpenMP
+/// threads. `resume`: the case continues from its checkpoint, and its log goes on.
+[[noreturn]] void exec_case(const char* self, const StudyCase& c, const std::string& folder, int threads, bool resume) {
   const std::string log = folder + "/log.txt";
-  const pid_t pid = fork();
-  if (pid < 0) throw std::runtime_error("study: cannot start a process for " + c.config);
-  if (pid == 0) {
-    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | (resume ? O_APPEND : O_TRUNC), 0644);
-    if (fd >= 0) {
-      dup2(fd, 1);
-      dup2(fd, 2);
-      close(fd);
-    }
-    setenv("OMP_NUM_THREADS", std::to_string(threads).c_str(), 1);
-    setenv("OMP_PROC_BIND", "false", 0);
-    execl(self, self, c.job.c_str(), c.config.c_str(), "-o", folder.c_str(), resume ? "--resume" : nullptr,
-          static_cast<char*>(nullptr));
-    std::perror("study: exec");
-    _exit(127);
+  const int fd = open(log.c_str(), O_WRONLY | O_CREAT | (resume ? O_APPEND : O_TRUNC), 0644);
+  if (fd >= 0) {
+    dup2(fd, 1);
+    dup2(fd, 2);
+    close(fd);
   }
-  return pid;
+  setenv("OMP_NUM_THREADS", std::to_string(threads).c_str(), 1);
+  setenv("OMP_PROC_BIND", "false", 0);
+  execl(self, self, c.job.c_str(), c.config.c_str(), "-o", folder.c_str(), resume ? "--resume" : nullptr,
+        static_cast<char*>(nullptr));
+  std::perror("study: exec");
+  _exit(127);
 }
 
 }  // namespace
@@ -67,8 +56,7 @@ int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, c
   std::printf("study: %zu cases, %d at a time with %d OpenMP threads each; logs in %s/<case>/log.txt\n",
               cases.size(), jobs, threads, opt.output.c_str());
   std::vector<int> status(cases.size(), -1);
-  std::map<pid_t, Running> running;
-  std::size_t next = 0, done = 0;
+  std::size_t done = 0;
   auto finished_before = [&](std::size_t k) {
     return opt.resume && fs::exists(opt.output + "/" + cases[k].name + "/summary.csv");
   };
@@ -76,40 +64,39 @@ int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, c
   for (std::size_t k = 0; k < cases.size(); ++k) kept += finished_before(k);
   // Kept cases took no time in this run: left out of the rate behind the ETA.
   Progress progress("study", static_cast<long>(cases.size()), kept);
-  while (done < cases.size()) {
-    while (next < cases.size() && static_cast<int>(running.size()) < jobs) {
-      const std::string folder = opt.output + "/" + cases[next].name;
-      if (finished_before(next)) {
-        std::printf("study: %s finished before (summary.csv): kept\n", cases[next].name.c_str());
-        status[next++] = 0;
-        ++done;
-        continue;
-      }
-      // Only the triaxial job checkpoints; a periodic case (minutes) starts again.
-      const bool go_on = opt.resume && cases[next].job == "triaxial" && fs::exists(checkpoint_path(folder));
-      const pid_t pid = launch(self_exe, cases[next], folder, threads, go_on);
-      running[pid] = {next, std::chrono::steady_clock::now()};
-      std::printf("study: %s %s (%s)\n", go_on ? "resumed" : "started", cases[next].name.c_str(),
-                  cases[next].config.c_str());
-      ++next;
+  std::vector<std::chrono::steady_clock::time_point> started(cases.size());
+  std::vector<char> go_on(cases.size(), 0);
+  auto folder = [&](std::size_t k) { return opt.output + "/" + cases[k].name; };
+  PoolWork w;
+  w.pieces = cases.size();
+  w.jobs = jobs;
+  w.before = [&](std::size_t k) {
+    if (finished_before(k)) {
+      std::printf("study: %s finished before (summary.csv): kept\n", cases[k].name.c_str());
+      status[k] = 0;
+      ++done;
+      return false;
     }
-    if (running.empty()) break;
-    int ws = 0;
-    const pid_t pid = waitpid(-1, &ws, 0);
-    if (pid < 0) throw std::runtime_error("study: lost track of the running cases");
-    auto it = running.find(pid);
-    if (it == running.end()) continue;
-    const std::size_t k = it->second.index;
-    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - it->second.start).count();
-    running.erase(it);
-    status[k] = WIFEXITED(ws) ? WEXITSTATUS(ws) : 128 + WTERMSIG(ws);
+    // Only the triaxial job checkpoints; a periodic case (minutes) starts again.
+    go_on[k] = opt.resume && cases[k].job == "triaxial" && fs::exists(checkpoint_path(folder(k)));
+    fs::create_directories(folder(k));
+    started[k] = std::chrono::steady_clock::now();
+    std::printf("study: %s %s (%s)\n", go_on[k] ? "resumed" : "started", cases[k].name.c_str(),
+                cases[k].config.c_str());
+    return true;
+  };
+  w.child = [&](std::size_t k, int) { exec_case(self_exe, cases[k], folder(k), threads, go_on[k] != 0); };
+  w.after = [&](std::size_t k, int st) {
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - started[k]).count();
+    status[k] = st;
     ++done;
     std::printf("study: %s %s after %s\n", cases[k].name.c_str(),
-                status[k] == 0 ? "finished" : ("FAILED (exit " + std::to_string(status[k]) + ", see its log.txt)").c_str(),
+                st == 0 ? "finished" : ("FAILED (exit " + std::to_string(st) + ", see its log.txt)").c_str(),
                 format_duration(secs).c_str());
     io::write_text_atomic(opt.output + "/study_summary.csv", study_table(cases, status, opt.output, compare).csv);
     progress.update(static_cast<long>(done));
-  }
+  };
+  run_pool(w, "study");
   progress.finish("");
 
   const StudyTable table = study_table(cases, status, opt.output, compare);

@@ -1,0 +1,67 @@
+#include "host/util/process_pool.hpp"
+
+#include <poll.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <iostream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace dem {
+
+void run_pool(const PoolWork& w, const char* what) {
+  std::cout.flush();
+  std::fflush(nullptr);  // a child must not write the parent's buffered output again
+  struct Child {
+    std::size_t j;
+    pid_t pid;
+    int fd;
+  };
+  std::vector<Child> running;
+  std::size_t next = 0;
+  for (;;) {
+    while (next < w.pieces && running.size() < static_cast<std::size_t>(w.jobs > 1 ? w.jobs : 1)) {
+      const std::size_t j = next++;
+      if (w.before && !w.before(j)) continue;
+      std::cout.flush();
+      std::fflush(nullptr);
+      int fd[2];
+      if (::pipe(fd) != 0) throw std::runtime_error(std::string(what) + ": cannot create a pipe for a child process");
+      const pid_t pid = ::fork();
+      if (pid < 0) throw std::runtime_error(std::string(what) + ": cannot start a child process (fork failed)");
+      if (pid == 0) {
+        ::close(fd[0]);
+        for (const Child& c : running) ::close(c.fd);  // the siblings' pipes are the parent's to read
+        w.child(j, fd[1]);
+        std::fflush(nullptr);
+        ::_exit(0);
+      }
+      ::close(fd[1]);
+      running.push_back({j, pid, fd[0]});
+    }
+    if (running.empty()) return;
+    std::vector<pollfd> polled;
+    for (const Child& c : running) polled.push_back({c.fd, POLLIN, 0});
+    if (::poll(polled.data(), polled.size(), -1) < 0) {
+      if (errno == EINTR) continue;
+      throw std::runtime_error(std::string(what) + ": cannot wait for the child processes (poll failed)");
+    }
+    std::size_t k = 0;
+    while (polled[k].revents == 0) ++k;
+    const Child c = running[k];
+    running.erase(running.begin() + static_cast<std::ptrdiff_t>(k));
+    const bool whole = !w.collect || w.collect(c.j, c.fd);
+    ::close(c.fd);
+    int ws = 0;
+    while (::waitpid(c.pid, &ws, 0) < 0 && errno == EINTR) {
+    }
+    const int status = WIFEXITED(ws) ? WEXITSTATUS(ws) : 128 + WTERMSIG(ws);
+    if (w.after) w.after(c.j, whole ? status : -1);
+  }
+}
+
+}  // namespace dem

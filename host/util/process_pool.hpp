@@ -1,0 +1,31 @@
+#pragma once
+/// The one process pool: pieces of work in child processes, up to `jobs` at once, the next starting as soon as any
+/// ends. Serves the calibration's parallel runs (forked_runs.hpp: results back through a pipe) and the study's
+/// cases (the program itself, exec'd, with its log in the case's folder). Each child holds the write end of a pipe
+/// until it ends (exec keeps it open), so the parent learns that a piece has ended, or has begun to send its
+/// result, from that pipe alone.
+#include <cstddef>
+#include <functional>
+
+namespace dem {
+
+struct PoolWork {
+  std::size_t pieces = 0;
+  int jobs = 1;
+  /// In the parent, before piece j starts: false leaves it out (finished before, or the pool is stopping).
+  std::function<bool(std::size_t)> before;
+  /// In the child: the piece, with `fd` the write end of its pipe. The child ends with exit status 0 when this
+  /// returns (no atexit handlers, no Kokkos finalize: the parent owns those), or exec's another program.
+  std::function<void(std::size_t, int)> child;
+  /// In the parent as piece j's pipe turns readable: reads its result (none: return true); false where it is cut
+  /// short. Results come in the order the children end: put result j in its place.
+  std::function<bool(std::size_t, int)> collect;
+  /// In the parent once piece j has ended: its exit status as a shell gives it (128 + the signal that ended it),
+  /// or -1 where collect found its result cut short.
+  std::function<void(std::size_t, int)> after;
+};
+
+/// Runs the pieces; `what` names them in the error when a pipe or a process cannot be made.
+void run_pool(const PoolWork& w, const char* what);
+
+}  // namespace dem
