@@ -88,127 +88,196 @@ std::string unknown_command(const CLI::App& app, const std::string& word) {
   return "'" + word + "' is no triaxdem command; the commands: " + names + " (triaxdem COMMAND --help for one)";
 }
 
+/// Everything the command line sets, filled by CLI11.
+struct Args {
+  std::string config_path, output;
+  long steps = -1;
+  bool resume = false, overwrite = false;
+  long stop_at = -1;
+  std::vector<std::string> study_inputs;
+  dem::StudyOptions study;
+  std::string micro_source, micro_out;
+  double micro_at = 0, micro_rve = 20;
+  int micro_bins = 18;
+  dem::CalibrationOptions cal;
+  std::string free_list;
+  dem::SynthOptions syn;
+  std::vector<double> syn_kpa;
+};
+
+/// The commands, to ask which one was given.
+struct Commands {
+  CLI::App *run, *specimen, *triaxial, *periodic, *study, *micro, *calibrate, *diagnose, *synth, *check, *info;
+};
+
+/// The commands that run one test or job from a config.
+void add_test_commands(CLI::App& app, Args& a, Commands& c) {
+  c.run = app.add_subcommand("run", "run the job a config describes");
+  c.run->add_option("config", a.config_path, "TOML config file")->required()->check(CLI::ExistingFile);
+  c.run->add_option("-o,--output", a.output, "output folder (overrides [run] output)");
+  c.run->add_option("-n,--steps", a.steps, "number of steps (overrides [run] steps)")->check(CLI::NonNegativeNumber);
+  c.run->add_flag("--resume", a.resume, "continue from the output folder's checkpoint.h5 to the step count");
+  const char* overwrite_help = "replace another run's outputs in the output folder (refused without it)";
+  c.run->add_flag("--overwrite", a.overwrite, overwrite_help)->excludes("--resume");
+  c.run->add_option("--stop-at-step", a.stop_at, "write a checkpoint after this step and stop (exit status 3)")
+      ->check(CLI::NonNegativeNumber);
+
+  c.specimen = app.add_subcommand("specimen", "build the [specimen] of a config by multilayer compaction");
+  c.specimen->add_option("config", a.config_path, "TOML config file")->required()->check(CLI::ExistingFile);
+  c.specimen->add_option("-o,--output", a.output, "output folder (overrides [run] output)");
+  c.specimen->add_flag("--overwrite", a.overwrite, overwrite_help);
+
+  c.triaxial = app.add_subcommand("triaxial", "specimen, membrane, consolidation and shear (drained triaxial test)");
+  c.triaxial->add_option("config", a.config_path, "TOML config file")->required()->check(CLI::ExistingFile);
+  c.triaxial->add_option("-o,--output", a.output, "output folder (overrides [run] output)");
+  auto* triaxial_resume = c.triaxial->add_flag("--resume", a.resume, "continue from the output folder's checkpoint.h5");
+  c.triaxial->add_flag("--overwrite", a.overwrite, overwrite_help)->excludes(triaxial_resume);
+  c.triaxial->add_option("--stop-at-step", a.stop_at, "write a checkpoint after this step and stop (exit status 3)")
+      ->check(CLI::NonNegativeNumber);
+
+  c.periodic = app.add_subcommand("periodic", "periodic-cell drained triaxial test (no platens, no membrane)");
+  c.periodic->add_option("config", a.config_path, "TOML config file")->required()->check(CLI::ExistingFile);
+  c.periodic->add_option("-o,--output", a.output, "output folder (overrides [run] output)");
+  c.periodic->add_flag("--overwrite", a.overwrite, overwrite_help);
+}
+
+/// The study and micro commands: a set of configs, and a saved state.
+void add_study_commands(CLI::App& app, Args& a, Commands& c) {
+  c.study = app.add_subcommand("study", "run a set of triaxial cases and write one summary table and figure");
+  c.study->add_option("configs", a.study_inputs, "config folders (every *.toml) or files")->required();
+  c.study->add_option("-o,--output", a.study.output, "output folder: summary, figure, one subfolder per case");
+  c.study->add_option("-j,--jobs", a.study.jobs, "cases run at once (default: one per two cores)")
+      ->check(count_on_this_machine(0));
+  c.study->add_option("-t,--threads", a.study.threads, "OpenMP threads per case (default: the cores shared out)")
+      ->check(count_on_this_machine(0));
+  c.study->add_flag("--resume", a.study.resume,
+                  "keep the cases that finished (summary.csv), continue the triaxial cases from their checkpoints");
+  c.study->add_option("--compare", a.study.compare,
+                    "measured data (docs/calibration.md: Measured data) whose q_peak goes beside each case's, matched "
+                    "by [run] material and sigma3; repeat for several files")
+      ->allow_extra_args(false)
+      ->check(CLI::ExistingFile);
+
+  c.micro = app.add_subcommand("micro", "micromechanics of a saved state (a run folder and a strain, or a snapshot)");
+  c.micro->add_option("source", a.micro_source, "run folder or snap_<step>.h5")->required();
+  c.micro->add_option("--at", a.micro_at, "axial strain of the saved state, % (with a run folder)");
+  c.micro->add_option("--rve", a.micro_rve, "edge of the central cube, mm (default 20)");
+  c.micro->add_option("--bins", a.micro_bins, "rose bins over 0-180 deg (default 18)")->check(CLI::Range(2, 3600));
+  c.micro->add_option("-o,--output", a.micro_out, "output folder (default: the run folder or the snapshot's)");
+}
+
+/// calibrate and diagnose (the same options) and synth.
+void add_calibration_commands(CLI::App& app, Args& a, Commands& c) {
+  auto add_calibration = [&](CLI::App* cmd) {
+    cmd->add_option("data", a.cal.data, "measured-data CSV (docs/calibration.md: Measured data)")->required()
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--config", a.config_path, "base config: a periodic cell ([box], [periodic], [material])")
+        ->required()->check(CLI::ExistingFile);
+    cmd->add_option("--free", a.free_list, "free parameters, comma-separated, of " + dem::free_key_names() +
+                  " (default: the config's [calibrate] free, else mu_s,mu_r)");
+    cmd->add_option("--material", a.cal.material, "only this material of the data");
+    cmd->add_option("--reference", a.cal.reference, "CSV of reference values (material, then one column per parameter) "
+                  "to set beside the calibrated ones")->check(CLI::ExistingFile);
+    cmd->add_option("-o,--output", a.cal.output, "parent folder of the dated result folder (default out)");
+    cmd->add_option("-j,--jobs", a.cal.jobs, "simulator runs at once, one thread each (default: one per core)")
+        ->check(count_on_this_machine(1));
+    cmd->add_option("--noise", a.cal.noise, "the data's noise: data (its standard-deviation columns, replicates, or "
+                  "its curves' own scatter), lab (a lab's fixed scatter) or a lab noise file like "
+                  "configs/calibration/lab_noise.toml; default data")
+        ->check(CLI::IsMember({"data", "lab"}) | CLI::ExistingFile);
+    cmd->add_option("--predict", a.cal.predict, "the test with a boundary to end with at the calibrated parameters: a "
+                  "membrane test's config with [specimen] and [triaxial] (configs/small/ by default through "
+                  "[calibrate] predict; configs/paper/ for full scale), walls (the config's cell between six walls: "
+                  "the boundary's share of a walled test), or none");
+    cmd->add_option("--resume", a.cal.resume, "continue in the result folder of an earlier run of this command on the "
+                  "same data and config: the runs it stored are read, not run again")->check(CLI::ExistingDirectory);
+    cmd->add_option("--reference-test", a.cal.reference_test, "what the calibration fits: periodic (the cell), walls "
+                  "(the cell between six servo-controlled walls, measured at the walls) or two_fidelity (the cell "
+                  "corrected by the --predict membrane test); default: [calibrate] reference_test")
+        ->check(CLI::IsMember({"periodic", "walls", "two_fidelity"}));
+  };
+  c.calibrate = app.add_subcommand("calibrate", "fit the free parameters to measured triaxial data");
+  add_calibration(c.calibrate);
+  c.diagnose = app.add_subcommand("diagnose", "calibrate, then find which model extension explains the misfit");
+  add_calibration(c.diagnose);
+  c.synth = app.add_subcommand("synth", "synthetic measured curves with a hidden model extension");
+  c.synth->add_option("--config", a.config_path, "base config (periodic cell)")->required()->check(CLI::ExistingFile);
+  c.synth->add_option("-o,--output", a.syn.output, "CSV to write")->required();
+  c.synth->add_flag("--overwrite", a.syn.overwrite, "replace an existing output file (never the config)");
+  c.synth->add_option("--extension", a.syn.extension, dem::extension_names() + " or none");
+  c.synth->add_option("--strength", a.syn.strength,
+                      "the extension's parameter in its config unit (default: drawn from the seed)");
+  c.synth->add_option("--seed", a.syn.seed, "noise and strength seed");
+  c.synth->add_option("--specimen-seed", a.syn.specimen_seed, "packing seed of the specimen (default: the config's "
+                      "[run] seed + 100000, a specimen no calibration ensemble of that config uses)");
+  c.synth->add_option("--pressures", a.syn_kpa, "confining pressures, kPa (default 100 200 300)")
+      ->check(pressure_kpa());
+  c.synth->add_option("--material", a.syn.material, "material name in the file");
+}
+
+/// check (a config and what its job would cost) and info (the Kokkos build).
+void add_check_commands(CLI::App& app, Args& a, Commands& c) {
+  c.check = app.add_subcommand("check", "validate a config and describe its job: balls, stages, time step, steps, "
+                               "a wall-time estimate");
+  c.check->add_option("config", a.config_path, "TOML config file")->required()->check(CLI::ExistingFile);
+  c.info = app.add_subcommand("info", "print the Kokkos build in use");
+}
+
+/// The command given, once parsed, with Kokkos running.
+int run_command(const Commands& c, Args& a) {
+  if (c.info->parsed()) {
+    Kokkos::print_configuration(std::cout, false);
+    return 0;
+  }
+  if (c.micro->parsed()) {
+    namespace fs = std::filesystem;
+    const std::string out = !a.micro_out.empty() ? a.micro_out
+                            : fs::is_directory(a.micro_source) ? a.micro_source
+                                                               : fs::path(a.micro_source).parent_path().string();
+    return dem::micro_job(a.micro_source, a.micro_at, a.micro_rve, a.micro_bins, out.empty() ? "." : out);
+  }
+  dem::Config cfg = dem::load_config(a.config_path);
+  if (!a.output.empty()) cfg.run.output = a.output;
+  if (a.steps >= 0) cfg.run.steps = a.steps;
+  if (c.check->parsed()) return dem::check_job(cfg);
+  // Held until the job returns: a second run into the folder is refused while this one writes there.
+  dem::io::FolderLock lock;
+  if (c.run->parsed() || c.triaxial->parsed() || c.periodic->parsed() || c.specimen->parsed())
+    lock = dem::io::claim_output_folder(cfg.run.output, a.resume, a.overwrite);
+  if (c.specimen->parsed()) return dem::specimen_job(cfg);
+  if (c.triaxial->parsed()) return dem::triaxial_job(cfg, a.resume, a.stop_at);
+  if (c.periodic->parsed()) return dem::run_periodic_job(cfg);
+  if (c.calibrate->parsed() || c.diagnose->parsed()) {
+    if (!a.free_list.empty()) {
+      a.cal.free.clear();
+      std::stringstream in(a.free_list);
+      for (std::string f; std::getline(in, f, ',');) a.cal.free.push_back(f);
+    }
+    return c.calibrate->parsed() ? dem::calibrate_job(cfg, a.cal) : dem::diagnose_job(cfg, a.cal);
+  }
+  if (c.synth->parsed()) {
+    if (!a.syn_kpa.empty()) {
+      a.syn.sigma3.clear();
+      for (double k : a.syn_kpa) a.syn.sigma3.push_back(1e3 * k);
+    }
+    return dem::synth_job(cfg, a.syn);
+  }
+  return dem::run_job(cfg, a.resume, a.stop_at);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"triaxdem: DEM laboratory for triaxial tests on granular materials"};
   app.set_version_flag("--version", dem::version_line());
   app.require_subcommand(1);
-  std::string config_path, output;
-  long steps = -1;
-
-  auto* run = app.add_subcommand("run", "run the job a config describes");
-  run->add_option("config", config_path, "TOML config file")->required()->check(CLI::ExistingFile);
-  run->add_option("-o,--output", output, "output folder (overrides [run] output)");
-  run->add_option("-n,--steps", steps, "number of steps (overrides [run] steps)")->check(CLI::NonNegativeNumber);
-  bool resume = false;
-  long stop_at = -1;
-  run->add_flag("--resume", resume, "continue from the output folder's checkpoint.h5 to the step count");
-  bool overwrite = false;
-  const char* overwrite_help = "replace another run's outputs in the output folder (refused without it)";
-  run->add_flag("--overwrite", overwrite, overwrite_help)->excludes("--resume");
-  run->add_option("--stop-at-step", stop_at, "write a checkpoint after this step and stop (exit status 3)")
-      ->check(CLI::NonNegativeNumber);
-
-  auto* specimen = app.add_subcommand("specimen", "build the [specimen] of a config by multilayer compaction");
-  specimen->add_option("config", config_path, "TOML config file")->required()->check(CLI::ExistingFile);
-  specimen->add_option("-o,--output", output, "output folder (overrides [run] output)");
-  specimen->add_flag("--overwrite", overwrite, overwrite_help);
-
-  auto* triaxial = app.add_subcommand("triaxial", "specimen, membrane, consolidation and shear (drained triaxial test)");
-  triaxial->add_option("config", config_path, "TOML config file")->required()->check(CLI::ExistingFile);
-  triaxial->add_option("-o,--output", output, "output folder (overrides [run] output)");
-  auto* triaxial_resume = triaxial->add_flag("--resume", resume, "continue from the output folder's checkpoint.h5");
-  triaxial->add_flag("--overwrite", overwrite, overwrite_help)->excludes(triaxial_resume);
-  triaxial->add_option("--stop-at-step", stop_at, "write a checkpoint after this step and stop (exit status 3)")
-      ->check(CLI::NonNegativeNumber);
-
-  auto* periodic = app.add_subcommand("periodic", "periodic-cell drained triaxial test (no platens, no membrane)");
-  periodic->add_option("config", config_path, "TOML config file")->required()->check(CLI::ExistingFile);
-  periodic->add_option("-o,--output", output, "output folder (overrides [run] output)");
-  periodic->add_flag("--overwrite", overwrite, overwrite_help);
-
-  std::vector<std::string> study_inputs;
-  dem::StudyOptions study_opt;
-  auto* study = app.add_subcommand("study", "run a set of triaxial cases and write one summary table and figure");
-  study->add_option("configs", study_inputs, "config folders (every *.toml) or files")->required();
-  study->add_option("-o,--output", study_opt.output, "output folder: summary, figure, one subfolder per case");
-  study->add_option("-j,--jobs", study_opt.jobs, "cases run at once (default: one per two cores)")
-      ->check(count_on_this_machine(0));
-  study->add_option("-t,--threads", study_opt.threads, "OpenMP threads per case (default: the cores shared out)")
-      ->check(count_on_this_machine(0));
-  study->add_flag("--resume", study_opt.resume,
-                  "keep the cases that finished (summary.csv), continue the triaxial cases from their checkpoints");
-  study->add_option("--compare", study_opt.compare,
-                    "measured data (docs/calibration.md: Measured data) whose q_peak goes beside each case's, matched by "
-                    "[run] material and sigma3; repeat for several files")
-      ->allow_extra_args(false)
-      ->check(CLI::ExistingFile);
-
-  std::string micro_source, micro_out;
-  double micro_at = 0, micro_rve = 20;
-  int micro_bins = 18;
-  auto* micro = app.add_subcommand("micro", "micromechanics of a saved state (a run folder and a strain, or a snapshot)");
-  micro->add_option("source", micro_source, "run folder or snap_<step>.h5")->required();
-  micro->add_option("--at", micro_at, "axial strain of the saved state, % (with a run folder)");
-  micro->add_option("--rve", micro_rve, "edge of the central cube, mm (default 20)");
-  micro->add_option("--bins", micro_bins, "rose bins over 0-180 deg (default 18)")->check(CLI::Range(2, 3600));
-  micro->add_option("-o,--output", micro_out, "output folder (default: the run folder or the snapshot's)");
-
-  dem::CalibrationOptions cal;
-  std::string free_list;
-  auto add_calibration = [&](CLI::App* c) {
-    c->add_option("data", cal.data, "measured-data CSV (docs/calibration.md: Measured data)")->required()
-        ->check(CLI::ExistingFile);
-    c->add_option("--config", config_path, "base config: a periodic cell ([box], [periodic], [material])")
-        ->required()->check(CLI::ExistingFile);
-    c->add_option("--free", free_list, "free parameters, comma-separated, of " + dem::free_key_names() +
-                  " (default: the config's [calibrate] free, else mu_s,mu_r)");
-    c->add_option("--material", cal.material, "only this material of the data");
-    c->add_option("--reference", cal.reference, "CSV of reference values (material, then one column per parameter) "
-                  "to set beside the calibrated ones")->check(CLI::ExistingFile);
-    c->add_option("-o,--output", cal.output, "parent folder of the dated result folder (default out)");
-    c->add_option("-j,--jobs", cal.jobs, "simulator runs at once, one thread each (default: one per core)")
-        ->check(count_on_this_machine(1));
-    c->add_option("--noise", cal.noise, "the data's noise: data (its standard-deviation columns, replicates, or its "
-                  "curves' own scatter), lab (a lab's fixed scatter) or a lab noise file like "
-                  "configs/calibration/lab_noise.toml; default data")
-        ->check(CLI::IsMember({"data", "lab"}) | CLI::ExistingFile);
-    c->add_option("--predict", cal.predict, "the test with a boundary to end with at the calibrated parameters: a "
-                  "membrane test's config with [specimen] and [triaxial] (configs/small/ by default through "
-                  "[calibrate] predict; configs/paper/ for full scale), walls (the config's cell between six walls: "
-                  "the boundary's share of a walled test), or none");
-    c->add_option("--resume", cal.resume, "continue in the result folder of an earlier run of this command on the "
-                  "same data and config: the runs it stored are read, not run again")->check(CLI::ExistingDirectory);
-    c->add_option("--reference-test", cal.reference_test, "what the calibration fits: periodic (the cell), walls "
-                  "(the cell between six servo-controlled walls, measured at the walls) or two_fidelity (the cell "
-                  "corrected by the --predict membrane test); default: [calibrate] reference_test")
-        ->check(CLI::IsMember({"periodic", "walls", "two_fidelity"}));
-  };
-  auto* calibrate = app.add_subcommand("calibrate", "fit the free parameters to measured triaxial data");
-  add_calibration(calibrate);
-  auto* diagnose = app.add_subcommand("diagnose", "calibrate, then find which model extension explains the misfit");
-  add_calibration(diagnose);
-  dem::SynthOptions syn;
-  std::vector<double> syn_kpa;
-  auto* synth = app.add_subcommand("synth", "synthetic measured curves with a hidden model extension");
-  synth->add_option("--config", config_path, "base config (periodic cell)")->required()->check(CLI::ExistingFile);
-  synth->add_option("-o,--output", syn.output, "CSV to write")->required();
-  synth->add_flag("--overwrite", syn.overwrite, "replace an existing output file (never the config)");
-  synth->add_option("--extension", syn.extension, dem::extension_names() + " or none");
-  synth->add_option("--strength", syn.strength, "the extension's parameter in its config unit (default: drawn from the seed)");
-  synth->add_option("--seed", syn.seed, "noise and strength seed");
-  synth->add_option("--specimen-seed", syn.specimen_seed, "packing seed of the specimen (default: the config's [run] "
-                    "seed + 100000, a specimen no calibration ensemble of that config uses)");
-  synth->add_option("--pressures", syn_kpa, "confining pressures, kPa (default 100 200 300)")->check(pressure_kpa());
-  synth->add_option("--material", syn.material, "material name in the file");
-
-  auto* check = app.add_subcommand("check", "validate a config and describe its job: balls, stages, time step, steps, a wall-time estimate");
-  check->add_option("config", config_path, "TOML config file")->required()->check(CLI::ExistingFile);
-
-  auto* info = app.add_subcommand("info", "print the Kokkos build in use");
-
-  cal.jobs = machine_cores();
+  Args a;
+  Commands c{};
+  add_test_commands(app, a, c);
+  add_study_commands(app, a, c);
+  add_calibration_commands(app, a, c);
+  add_check_commands(app, a, c);
+  a.cal.jobs = machine_cores();
   if (argc > 1 && argv[1][0] != '-') {
     if (const std::string problem = unknown_command(app, argv[1]); !problem.empty()) {
       std::fprintf(stderr, "triaxdem: %s\n", problem.c_str());
@@ -221,12 +290,12 @@ int main(int argc, char** argv) {
     return 1;
   }
   // Parallel calibration runs are child processes of one thread each (PeriodicLab::set_jobs).
-  if (calibrate->parsed() || diagnose->parsed()) dem::prepare_parallel_runs(cal.jobs);
+  if (c.calibrate->parsed() || c.diagnose->parsed()) dem::prepare_parallel_runs(a.cal.jobs);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // progress reaches a log file as it happens
-  if (study->parsed()) {  // the study only starts child processes: no Kokkos of its own
+  if (c.study->parsed()) {  // the study only starts child processes: no Kokkos of its own
     try {
-      const dem::io::FolderLock lock(study_opt.output);  // two studies into one folder would mix their cases
-      return dem::study_job(study_inputs, study_opt, "/proc/self/exe");
+      const dem::io::FolderLock lock(a.study.output);  // two studies into one folder would mix their cases
+      return dem::study_job(a.study_inputs, a.study, "/proc/self/exe");
     } catch (const std::exception& e) {
       std::fprintf(stderr, "triaxdem: %s\n", e.what());
       return 1;
@@ -234,44 +303,7 @@ int main(int argc, char** argv) {
   }
   Kokkos::ScopeGuard guard(argc, argv);
   try {
-    if (info->parsed()) {
-      Kokkos::print_configuration(std::cout, false);
-      return 0;
-    }
-    if (micro->parsed()) {
-      namespace fs = std::filesystem;
-      const std::string out = !micro_out.empty() ? micro_out
-                              : fs::is_directory(micro_source) ? micro_source
-                                                               : fs::path(micro_source).parent_path().string();
-      return dem::micro_job(micro_source, micro_at, micro_rve, micro_bins, out.empty() ? "." : out);
-    }
-    dem::Config cfg = dem::load_config(config_path);
-    if (!output.empty()) cfg.run.output = output;
-    if (steps >= 0) cfg.run.steps = steps;
-    if (check->parsed()) return dem::check_job(cfg);
-    // Held until the job returns: a second run into the folder is refused while this one writes there.
-    dem::io::FolderLock lock;
-    if (run->parsed() || triaxial->parsed() || periodic->parsed() || specimen->parsed())
-      lock = dem::io::claim_output_folder(cfg.run.output, resume, overwrite);
-    if (specimen->parsed()) return dem::specimen_job(cfg);
-    if (triaxial->parsed()) return dem::triaxial_job(cfg, resume, stop_at);
-    if (periodic->parsed()) return dem::run_periodic_job(cfg);
-    if (calibrate->parsed() || diagnose->parsed()) {
-      if (!free_list.empty()) {
-        cal.free.clear();
-        std::stringstream in(free_list);
-        for (std::string f; std::getline(in, f, ',');) cal.free.push_back(f);
-      }
-      return calibrate->parsed() ? dem::calibrate_job(cfg, cal) : dem::diagnose_job(cfg, cal);
-    }
-    if (synth->parsed()) {
-      if (!syn_kpa.empty()) {
-        syn.sigma3.clear();
-        for (double k : syn_kpa) syn.sigma3.push_back(1e3 * k);
-      }
-      return dem::synth_job(cfg, syn);
-    }
-    return dem::run_job(cfg, resume, stop_at);
+    return run_command(c, a);
   } catch (const dem::DataError& e) {
     std::fprintf(stderr, "triaxdem: data error: %s\n", e.what());
     return 1;
