@@ -49,6 +49,73 @@ const ExtensionFit* top_fit(const Diagnosis& dg) {
   return top;
 }
 
+/// The diagnosis report's opening: the simulator, the free parameters, the misfit and noise, the reference values
+/// and the notes on the data.
+std::string diagnosis_intro(const Session& ss, const Config& base, const CalibrationOptions& o) {
+  std::ostringstream md;
+  md << "# Diagnosis of " << o.data << "\n\n"
+     << "Simulator: the cell triaxial test in " << ss.cell_text() << ", an ensemble of " << ss.lab.members()
+     << " specimens of " << ss.lab.balls() << " balls (packing seeds from " << base.run.seed
+     << "), each prepared once; every parameter point runs them all and compares their mean. Free base parameters:";
+  for (const FreeParam& f : ss.free) md << " " << f.name;
+  md << ". Misfit: chi2 over " << (ss.data.curves ? "q and eps_v at fixed axial strains (0.02% to 15%)"
+                                                  : "the summary quantities given")
+     << ", with the data's noise, the measured specimen's own scatter and the simulator's standard error "
+        "(host/fit/misfit.hpp); noise: " << (ss.noise.mode == "lab" ? ss.noise.lab_name : "the data's") << ".\n\n";
+  if (!ss.ref.values.empty())
+    md << "Reference values: " << ss.ref.path << (ss.ref.comment.empty() ? "" : ": " + ss.ref.comment)
+       << " The calibrated values belong to this simulator (its cell, density and boundary), the reference values to "
+          "the model they were calibrated with: a difference between them measures the two simulators as much as "
+          "the data.\n\n";
+  for (const std::string& n : ss.data.notes) md << "Note on the data: " << n << "\n\n";
+  return md.str();
+}
+
+/// The table of the base model and each extension fit (parameters, chi2, BIC, held-out chi2, runs), into the report
+/// and as rows of models.csv.
+void write_models(const Session& ss, const std::string& material, const Diagnosis& dg, std::size_t tests,
+                  std::ostream& md, std::ostream& csv) {
+  md << "| model | parameters | chi2 | BIC | held-out chi2 | runs |\n|---|---|---|---|---|---|\n| base | ";
+  for (std::size_t k = 0; k < ss.free.size(); ++k) {
+    md << ss.free[k].name << " = " << fmt("%.4g", ss.free[k].shown * dg.base.values[k]) << " ";
+    csv << material << ",base," << ss.free[k].name << "," << fmt("%.6g", ss.free[k].shown * dg.base.values[k]) << ","
+        << fmt("%.3f", dg.base.best.chi2) << "," << fmt("%.3f", dg.base_bic) << "," << fmt("%.3f", dg.base_heldout)
+        << "," << dg.base.design.size() * tests << "\n";
+  }
+  md << "| " << fmt("%.1f", dg.base.best.chi2) << " | " << fmt("%.1f", dg.base_bic) << " | "
+     << fmt("%.1f", dg.base_heldout) << " | " << dg.base.design.size() * tests * ss.lab.members() << " |\n";
+  for (const ExtensionFit& f : dg.fits) {
+    md << "| " << f.ext.name << " | ";
+    for (std::size_t k = 0; k < ss.free.size(); ++k)
+      md << ss.free[k].name << " = " << fmt("%.4g", ss.free[k].shown * f.values[k]) << " ";
+    const Real shown = free_param(f.ext.param).shown;
+    md << f.ext.param << " = " << fmt("%.3g", shown * f.strength) << " | " << fmt("%.1f", f.best.chi2) << " | "
+       << fmt("%.1f", f.bic) << " | " << fmt("%.1f", f.heldout) << " | " << f.runs << " |\n";
+    csv << material << "," << f.ext.name << "," << f.ext.param << "," << fmt("%.6g", shown * f.strength) << ","
+        << fmt("%.3f", f.best.chi2) << "," << fmt("%.3f", f.bic) << "," << fmt("%.3f", f.heldout) << "," << f.runs
+        << "\n";
+  }
+}
+
+/// The calibrated values beside the reference values, for the base model and the extension the verdict names.
+std::string reference_table(const Session& ss, const std::string& material, const Diagnosis& dg) {
+  if (ss.ref.values.empty()) return "";
+  std::ostringstream md;
+  const ExtensionFit* named = nullptr;  // the extension the verdict names first, if any
+  for (const ExtensionFit& f : dg.fits)
+    if (dg.verdict.rfind(f.ext.name, 0) == 0) named = &f;
+  md << "\nCalibrated values beside the reference (" << ss.ref.path << "):\n\n| parameter | base model | "
+     << (named ? "base + " + named->ext.name + " | " : "") << "reference |\n|---|---|" << (named ? "---|" : "")
+     << "---|\n";
+  for (std::size_t k = 0; k < ss.free.size(); ++k) {
+    const Real ref = ss.reference(material, ss.free[k].name);
+    md << "| " << ss.free[k].name << " | " << fmt("%.4g", ss.free[k].shown * dg.base.values[k]) << " | "
+       << (named ? fmt("%.4g", ss.free[k].shown * named->values[k]) + " | " : "")
+       << (std::isfinite(ref) ? fmt("%g", ref) : std::string("-")) << " |\n";
+  }
+  return md.str();
+}
+
 }  // namespace
 
 int calibrate_job(const Config& base, const CalibrationOptions& o) {
@@ -134,21 +201,7 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
     std::printf("diagnose: note: the diagnosis fits the periodic cell; two fidelities apply to calibrate (the "
                 "membrane prediction at the end shows what the boundary adds)\n");
   std::ostringstream md, csv;
-  md << "# Diagnosis of " << o.data << "\n\n"
-     << "Simulator: the cell triaxial test in " << ss.cell_text() << ", an ensemble of " << ss.lab.members()
-     << " specimens of " << ss.lab.balls() << " balls (packing seeds from " << base.run.seed
-     << "), each prepared once; every parameter point runs them all and compares their mean. Free base parameters:";
-  for (const FreeParam& f : ss.free) md << " " << f.name;
-  md << ". Misfit: chi2 over " << (ss.data.curves ? "q and eps_v at fixed axial strains (0.02% to 15%)"
-                                                  : "the summary quantities given")
-     << ", with the data's noise, the measured specimen's own scatter and the simulator's standard error "
-        "(host/fit/misfit.hpp); noise: " << (ss.noise.mode == "lab" ? ss.noise.lab_name : "the data's") << ".\n\n";
-  if (!ss.ref.values.empty())
-    md << "Reference values: " << ss.ref.path << (ss.ref.comment.empty() ? "" : ": " + ss.ref.comment)
-       << " The calibrated values belong to this simulator (its cell, density and boundary), the reference values to "
-          "the model they were calibrated with: a difference between them measures the two simulators as much as "
-          "the data.\n\n";
-  for (const std::string& n : ss.data.notes) md << "Note on the data: " << n << "\n\n";
+  md << diagnosis_intro(ss, base, o);
   csv << "material,model,parameter,value,chi2,bic,heldout_chi2,runs\n";
   std::vector<MeasuredTest> all_meas, all_sim, all_ext;
   std::map<std::string, Calibrated> models;
@@ -171,41 +224,9 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
        << noise_table(misfit, tests)
        << (widened.empty() ? "" : "Search ranges: " + widened + ".\n\n")
        << (edge.empty() ? "" : "**Warning:** the base model's " + edge + " lies at the edge of its search range: the "
-                               "optimum may lie outside, and part of the misfit may be the range's, not the model's.\n\n")
-       << "| model | parameters | chi2 | BIC | held-out chi2 | runs |\n|---|---|---|---|---|---|\n| base | ";
-    for (std::size_t k = 0; k < ss.free.size(); ++k) {
-      md << ss.free[k].name << " = " << fmt("%.4g", ss.free[k].shown * dg.base.values[k]) << " ";
-      csv << material << ",base," << ss.free[k].name << "," << fmt("%.6g", ss.free[k].shown * dg.base.values[k]) << ","
-          << fmt("%.3f", dg.base.best.chi2) << "," << fmt("%.3f", dg.base_bic) << "," << fmt("%.3f", dg.base_heldout)
-          << "," << dg.base.design.size() * tests.size() << "\n";
-    }
-    md << "| " << fmt("%.1f", dg.base.best.chi2) << " | " << fmt("%.1f", dg.base_bic) << " | "
-       << fmt("%.1f", dg.base_heldout) << " | " << dg.base.design.size() * tests.size() * ss.lab.members() << " |\n";
-    for (const ExtensionFit& f : dg.fits) {
-      md << "| " << f.ext.name << " | ";
-      for (std::size_t k = 0; k < ss.free.size(); ++k)
-        md << ss.free[k].name << " = " << fmt("%.4g", ss.free[k].shown * f.values[k]) << " ";
-      const Real shown = free_param(f.ext.param).shown;
-      md << f.ext.param << " = " << fmt("%.3g", shown * f.strength) << " | " << fmt("%.1f", f.best.chi2) << " | "
-         << fmt("%.1f", f.bic) << " | " << fmt("%.1f", f.heldout) << " | " << f.runs << " |\n";
-      csv << material << "," << f.ext.name << "," << f.ext.param << "," << fmt("%.6g", shown * f.strength) << ","
-          << fmt("%.3f", f.best.chi2) << "," << fmt("%.3f", f.bic) << "," << fmt("%.3f", f.heldout) << "," << f.runs
-          << "\n";
-    }
-    if (!ss.ref.values.empty()) {
-      const ExtensionFit* named = nullptr;  // the extension the verdict names first, if any
-      for (const ExtensionFit& f : dg.fits)
-        if (dg.verdict.rfind(f.ext.name, 0) == 0) named = &f;
-      md << "\nCalibrated values beside the reference (" << ss.ref.path << "):\n\n| parameter | base model | "
-         << (named ? "base + " + named->ext.name + " | " : "") << "reference |\n|---|---|" << (named ? "---|" : "")
-         << "---|\n";
-      for (std::size_t k = 0; k < ss.free.size(); ++k) {
-        const Real ref = ss.reference(material, ss.free[k].name);
-        md << "| " << ss.free[k].name << " | " << fmt("%.4g", ss.free[k].shown * dg.base.values[k]) << " | "
-           << (named ? fmt("%.4g", ss.free[k].shown * named->values[k]) + " | " : "")
-           << (std::isfinite(ref) ? fmt("%g", ref) : std::string("-")) << " |\n";
-      }
-    }
+                               "optimum may lie outside, and part of the misfit may be the range's, not the model's.\n\n");
+    write_models(ss, material, dg, tests.size(), md, csv);
+    md << reference_table(ss, material, dg);
     md << "\nEach extension against the base model:\n\n";
     for (const ExtensionFit& f : dg.fits) md << "- **" << f.ext.name << "**: " << f.reason << "\n";
     for (const std::string& n : dg.notes) md << "- " << n << "\n";

@@ -43,6 +43,45 @@ namespace {
   _exit(127);
 }
 
+/// The study's table on the terminal: each case's headline numbers and its errors against each compared file, then
+/// each file's mean and largest error. Returns the number of failed cases.
+int print_study_table(const std::vector<StudyCase>& cases, const StudyTable& table, const StudyOptions& opt) {
+  const std::vector<PeakComparison>& cmp = table.cmp;
+  int failed = 0;
+  std::printf("\n%-14s %8s %6s %6s %10s %9s %10s %10s %8s", "case", "s3 kPa", "mu_s", "mu_r", "q_peak kPa",
+              "phi deg", "eps_pk %", "q_end kPa", "max dil");
+  for (std::size_t j = 0; j < cmp.size(); ++j) std::printf(" %7s%zu %6s%zu", "ref kPa ", j + 1, "err % ", j + 1);
+  std::printf("\n");
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    const StudyCase& c = cases[k];
+    if (!table.ok[k]) {
+      ++failed;
+      std::printf("%-14s FAILED: see %s/%s/log.txt\n", c.name.c_str(), opt.output.c_str(), c.name.c_str());
+      continue;
+    }
+    const TestSummary& s = table.summaries[k];
+    std::printf("%-14s %8.0f %6.3f %6.3f %10.1f %9.2f %10.2f %10.1f %8.3f", c.name.c_str(), s.sigma3 / 1e3, s.mu_s,
+                s.mu_r, s.q_peak / 1e3, s.phi_peak_deg, 100 * s.eps_a_peak, s.q_end / 1e3, s.max_dilatancy);
+    for (const PeakComparison& p : cmp) {
+      if (std::isfinite(p.error[k])) std::printf(" %9.1f %8.1f", p.measured[k] / 1e3, 100 * p.error[k]);
+      else std::printf(" %9s %8s", "-", "-");
+    }
+    std::printf("\n");
+  }
+  for (std::size_t j = 0; j < cmp.size(); ++j) {
+    const PeakComparison& p = cmp[j];
+    if (p.matched == 0) {
+      std::printf("ref %zu, %s: no case matched (a case needs [run] material and its sigma3 in the file)\n", j + 1,
+                  p.source.c_str());
+      continue;
+    }
+    std::printf("ref %zu, %s (q %s): %d of %zu cases matched; q_peak off by %.1f%% on average (|error|), %.1f%% "
+                "at most (%s)\n", j + 1, p.source.c_str(), name_of(p.measure), p.matched, cases.size(),
+                100 * p.mean_abs_error, 100 * p.max_abs_error, cases[p.worst].name.c_str());
+  }
+  return failed;
+}
+
 }  // namespace
 
 int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, const char* self_exe) {
@@ -100,39 +139,7 @@ int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, c
   progress.finish("");
 
   const StudyTable table = study_table(cases, status, opt.output, compare);
-  const std::vector<PeakComparison>& cmp = table.cmp;
-  int failed = 0;
-  std::printf("\n%-14s %8s %6s %6s %10s %9s %10s %10s %8s", "case", "s3 kPa", "mu_s", "mu_r", "q_peak kPa",
-              "phi deg", "eps_pk %", "q_end kPa", "max dil");
-  for (std::size_t j = 0; j < cmp.size(); ++j) std::printf(" %7s%zu %6s%zu", "ref kPa ", j + 1, "err % ", j + 1);
-  std::printf("\n");
-  for (std::size_t k = 0; k < cases.size(); ++k) {
-    const StudyCase& c = cases[k];
-    if (!table.ok[k]) {
-      ++failed;
-      std::printf("%-14s FAILED: see %s/%s/log.txt\n", c.name.c_str(), opt.output.c_str(), c.name.c_str());
-      continue;
-    }
-    const TestSummary& s = table.summaries[k];
-    std::printf("%-14s %8.0f %6.3f %6.3f %10.1f %9.2f %10.2f %10.1f %8.3f", c.name.c_str(), s.sigma3 / 1e3, s.mu_s,
-                s.mu_r, s.q_peak / 1e3, s.phi_peak_deg, 100 * s.eps_a_peak, s.q_end / 1e3, s.max_dilatancy);
-    for (const PeakComparison& p : cmp) {
-      if (std::isfinite(p.error[k])) std::printf(" %9.1f %8.1f", p.measured[k] / 1e3, 100 * p.error[k]);
-      else std::printf(" %9s %8s", "-", "-");
-    }
-    std::printf("\n");
-  }
-  for (std::size_t j = 0; j < cmp.size(); ++j) {
-    const PeakComparison& p = cmp[j];
-    if (p.matched == 0) {
-      std::printf("ref %zu, %s: no case matched (a case needs [run] material and its sigma3 in the file)\n", j + 1,
-                  p.source.c_str());
-      continue;
-    }
-    std::printf("ref %zu, %s (q %s): %d of %zu cases matched; q_peak off by %.1f%% on average (|error|), %.1f%% "
-                "at most (%s)\n", j + 1, p.source.c_str(), name_of(p.measure), p.matched, cases.size(),
-                100 * p.mean_abs_error, 100 * p.max_abs_error, cases[p.worst].name.c_str());
-  }
+  const int failed = print_study_table(cases, table, opt);
   io::write_text_atomic(opt.output + "/study_summary.csv", table.csv);
   std::printf("\nstudy: summary in %s/study_summary.csv\n", opt.output.c_str());
   if (run_plot_script("plot_study.py", {opt.output}))
