@@ -190,69 +190,48 @@ bool recentre(FreeParam& f, Real v) {
 
 namespace {
 
-CalibrationResult search(const Simulator& simulate, const Model& base, const std::vector<FreeParam>& free, int data,
-                         int rounds, int widen) {
-  const int d = static_cast<int>(free.size());
-  CalibrationResult res;
-  res.free = free;
-  res.data = data;
-  auto model_at = [&](const std::vector<Real>& u) {
-    Model m = base;
-    for (int k = 0; k < d; ++k) set_param(m, free[k].name, free[k].value(u[k]));
+/// One search over fixed ranges: every point run is kept in `res.design`, the best in `res.best`.
+class Search {
+ public:
+  Search(const Simulator& simulate, const Model& base, const std::vector<FreeParam>& free, int data)
+      : simulate_(simulate), base_(base), free_(free), d_(static_cast<int>(free.size())) {
+    res.free = free;
+    res.data = data;
+  }
+  Model model_at(const std::vector<Real>& u) const {
+    Model m = base_;
+    for (int k = 0; k < d_; ++k) set_param(m, free_[k].name, free_[k].value(u[k]));
     return m;
-  };
-  auto run_before = [&](const std::vector<Real>& u) {
-    for (const Evaluation& e : res.design) {
-      Real d2 = 0;
-      for (int k = 0; k < d; ++k) d2 += (e.u[k] - u[k]) * (e.u[k] - u[k]);
-      if (d2 < 1e-6) return true;
+  }
+  /// The 3^d design: each parameter at the ends and the middle of its range.
+  void design() {
+    long points = 1;
+    for (int k = 0; k < d_; ++k) points *= 3;
+    for (long p = 0; p < points; ++p) {
+      std::vector<Real> u(d_);
+      long c = p;
+      for (int k = 0; k < d_; ++k, c /= 3) u[k] = 0.5 * static_cast<Real>(c % 3);
+      evaluate(u);
     }
-    return false;
-  };
-  auto evaluate = [&](const std::vector<Real>& u) {
-    Evaluation e;
-    e.u = u;
-    SimulatedPoint s = simulate(model_at(u));
-    e.sim = std::move(s.sim);
-    e.r = std::move(s.r);
-    e.chi2 = chi2_of(e.r);
-    res.design.push_back(e);
-    const bool better = res.design.size() == 1 || e.chi2 < res.best.chi2;
-    if (better) res.best = e;
-    return better;
-  };
-  // Runs the surrogate's optimum, the surfaces centred on the best run; false when that point was run before.
-  auto surrogate_step = [&]() {
-    const std::vector<QuadraticSurface> s = response_surfaces(res.design, res.best.u);
-    const std::vector<Real> u = minimise_unit_box([&](const std::vector<Real>& x) {
-      Real c = 0;
-      for (const QuadraticSurface& q : s) c += q(x) * q(x);
-      return c;
-    }, d);
-    if (run_before(u)) return false;
-    evaluate(u);
-    return true;
-  };
-  long design_points = 1;
-  for (int k = 0; k < d; ++k) design_points *= 3;
-  for (long p = 0; p < design_points; ++p) {
-    std::vector<Real> u(d);
-    long c = p;
-    for (int k = 0; k < d; ++k, c /= 3) u[k] = 0.5 * static_cast<Real>(c % 3);
-    evaluate(u);
   }
-  for (int round = 0; round < rounds && d > 0; ++round) {
-    const Real before = res.best.chi2;
-    if (!surrogate_step()) break;  // the surface points at a point already run: converged
-    if (round > 0 && res.best.chi2 > 0.98 * before) break;  // stopped improving
+  /// Up to `rounds` surrogate steps, until one points at a point already run or stops improving by 2%.
+  void surrogate_rounds(int rounds) {
+    for (int round = 0; round < rounds && d_ > 0; ++round) {
+      const Real before = res.best.chi2;
+      if (!surrogate_step()) break;  // the surface points at a point already run: converged
+      if (round > 0 && res.best.chi2 > 0.98 * before) break;  // stopped improving
+    }
   }
-  if (d > 0) {
+  /// A compass search around the best point in steps of 1/4, then 1/8, of each range (a valley the quadratic
+  /// surfaces miss), and a last surrogate step where it moved.
+  void compass() {
+    if (d_ == 0) return;
     bool moved = false;
     for (Real step : {0.25, 0.125}) {
       for (bool better = true; better;) {
         better = false;
         const std::vector<Real> from = res.best.u;
-        for (int k = 0; k < d && !better; ++k)
+        for (int k = 0; k < d_ && !better; ++k)
           for (Real sign : {-1.0, 1.0}) {
             std::vector<Real> u = from;
             u[k] += sign * step;
@@ -266,9 +245,60 @@ CalibrationResult search(const Simulator& simulate, const Model& base, const std
     }
     if (moved) surrogate_step();
   }
-  res.model = model_at(res.best.u);
+  CalibrationResult res;
+
+ private:
+  bool run_before(const std::vector<Real>& u) const {
+    for (const Evaluation& e : res.design) {
+      Real d2 = 0;
+      for (int k = 0; k < d_; ++k) d2 += (e.u[k] - u[k]) * (e.u[k] - u[k]);
+      if (d2 < 1e-6) return true;
+    }
+    return false;
+  }
+  /// Runs u; true where it beats the best so far.
+  bool evaluate(const std::vector<Real>& u) {
+    Evaluation e;
+    e.u = u;
+    SimulatedPoint s = simulate_(model_at(u));
+    e.sim = std::move(s.sim);
+    e.r = std::move(s.r);
+    e.chi2 = chi2_of(e.r);
+    res.design.push_back(e);
+    const bool better = res.design.size() == 1 || e.chi2 < res.best.chi2;
+    if (better) res.best = e;
+    return better;
+  }
+  /// Runs the surrogate's optimum, the surfaces centred on the best run; false when that point was run before.
+  bool surrogate_step() {
+    const std::vector<QuadraticSurface> s = response_surfaces(res.design, res.best.u);
+    const std::vector<Real> u = minimise_unit_box([&](const std::vector<Real>& x) {
+      Real c = 0;
+      for (const QuadraticSurface& q : s) c += q(x) * q(x);
+      return c;
+    }, d_);
+    if (run_before(u)) return false;
+    evaluate(u);
+    return true;
+  }
+  const Simulator& simulate_;
+  const Model& base_;
+  const std::vector<FreeParam>& free_;
+  int d_;
+};
+
+CalibrationResult search(const Simulator& simulate, const Model& base, const std::vector<FreeParam>& free, int data,
+                         int rounds, int widen) {
+  const int d = static_cast<int>(free.size());
+  Search sr(simulate, base, free, data);
+  sr.design();
+  sr.surrogate_rounds(rounds);
+  sr.compass();
+  CalibrationResult res = std::move(sr.res);
+  res.model = sr.model_at(res.best.u);
   for (int k = 0; k < d; ++k) res.values.push_back(free[k].value(res.best.u[k]));
   if (widen <= 0) return res;
+  // A best value on an edge of its range: the range moved to centre it, and searched again.
   std::vector<FreeParam> moved = free;
   std::vector<std::string> notes;
   for (int k = 0; k < d; ++k) {
