@@ -125,6 +125,46 @@ PooledVariance replicate_scatter(const std::vector<std::vector<Feature>>& featur
   return p;
 }
 
+/// A test's own noise of each feature (variances, in `data_var`), from its standard-deviation columns or the scatter
+/// of its rows; false where it has too few rows for either and no replicates: the lab model is used instead.
+/// `notes` gets what was done, `where` naming the test.
+bool data_noise(const MeasuredTest& t, const std::vector<Feature>& fs, bool have_replicates, const std::string& where,
+                std::vector<Real>& data_var, std::vector<std::string>& notes) {
+  const int n = static_cast<int>(fs.size());
+  bool use_lab = false;
+  const RowNoise qn = row_noise(t.eps_a, t.q), vn = row_noise(t.eps_a, t.eps_v);
+  const bool rows_given = !t.q_sd.empty();
+  if (!rows_given && !std::isfinite(qn.sd)) {
+    use_lab = !have_replicates;
+    notes.push_back(where + ": " + std::to_string(t.q.size()) + " rows, fewer than " +
+                    std::to_string(kMinNoiseRows) + " to estimate noise from: " +
+                    (use_lab ? "the lab model is used" : "replicates alone give it"));
+  } else if (rows_given) {
+    notes.push_back(where + ": noise from the standard-deviation columns");
+  } else {
+    notes.push_back(where + ": noise estimated from the rows' scatter: q " + fmt("%.3g kPa", 1e-3 * qn.sd) +
+                    fmt(" (lag-1 correlation %.2f)", qn.rho) +
+                    (t.eps_v.empty() ? std::string() : ", eps_v " + fmt("%.3g%%", 100 * vn.sd) +
+                                                           fmt(" (%.2f)", vn.rho)));
+  }
+  for (int i = 0; i < n && !use_lab; ++i) {
+    const Feature& f = fs[i];
+    const std::vector<Real>& sdv = f.quantity == 0 ? t.q_sd : t.eps_v_sd;
+    const Real h = feature_window(f.strain);
+    const auto rows = std::upper_bound(t.eps_a.begin(), t.eps_a.end(), f.strain + h) -
+                      std::lower_bound(t.eps_a.begin(), t.eps_a.end(), f.strain - h);
+    const Real nw = std::max<Real>(1, static_cast<Real>(rows));
+    if (!sdv.empty()) {
+      const Real sd = curve_value(t.eps_a, sdv, f.strain);
+      data_var[i] = sd * sd / nw;  // rows given with their own errors: independent
+    } else if (std::isfinite(qn.sd)) {
+      const RowNoise& rn = f.quantity == 0 ? qn : vn;
+      data_var[i] = rn.sd * rn.sd * std::min<Real>(1, (1 + rn.rho) / ((1 - rn.rho) * nw));
+    }
+  }
+  return !use_lab;
+}
+
 }  // namespace
 
 void Misfit::build_curve_noise(const std::vector<MeasuredTest>& measured, const NoiseOptions& noise,
@@ -153,40 +193,8 @@ void Misfit::build_curve_noise(const std::vector<MeasuredTest>& measured, const 
     const int n = static_cast<int>(fs.size());
     const std::string where = t.material + " at " + fmt("%g kPa", 1e-3 * t.sigma3);
     // The data's own noise of each feature (variance), and whether this test falls back to the lab model.
-    bool use_lab = lab;
     std::vector<Real> data_var(n, 0);
-    if (!lab) {
-      const RowNoise qn = row_noise(t.eps_a, t.q), vn = row_noise(t.eps_a, t.eps_v);
-      const bool rows_given = !t.q_sd.empty();
-      if (!rows_given && !std::isfinite(qn.sd)) {
-        use_lab = rep.var.empty();
-        notes_.push_back(where + ": " + std::to_string(t.q.size()) + " rows, fewer than " +
-                         std::to_string(kMinNoiseRows) + " to estimate noise from: " +
-                         (use_lab ? "the lab model is used" : "replicates alone give it"));
-      } else if (rows_given) {
-        notes_.push_back(where + ": noise from the standard-deviation columns");
-      } else {
-        notes_.push_back(where + ": noise estimated from the rows' scatter: q " + fmt("%.3g kPa", 1e-3 * qn.sd) +
-                         fmt(" (lag-1 correlation %.2f)", qn.rho) +
-                         (t.eps_v.empty() ? std::string() : ", eps_v " + fmt("%.3g%%", 100 * vn.sd) +
-                                                                fmt(" (%.2f)", vn.rho)));
-      }
-      for (int i = 0; i < n && !use_lab; ++i) {
-        const Feature& f = fs[i];
-        const std::vector<Real>& sdv = f.quantity == 0 ? t.q_sd : t.eps_v_sd;
-        const Real h = feature_window(f.strain);
-        const auto rows = std::upper_bound(t.eps_a.begin(), t.eps_a.end(), f.strain + h) -
-                          std::lower_bound(t.eps_a.begin(), t.eps_a.end(), f.strain - h);
-        const Real nw = std::max<Real>(1, static_cast<Real>(rows));
-        if (!sdv.empty()) {
-          const Real sd = curve_value(t.eps_a, sdv, f.strain);
-          data_var[i] = sd * sd / nw;  // rows given with their own errors: independent
-        } else if (std::isfinite(qn.sd)) {
-          const RowNoise& rn = f.quantity == 0 ? qn : vn;
-          data_var[i] = rn.sd * rn.sd * std::min<Real>(1, (1 + rn.rho) / ((1 - rn.rho) * nw));
-        }
-      }
-    }
+    const bool use_lab = lab || !data_noise(t, fs, !rep.var.empty(), where, data_var, notes_);
     Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(n, n);
     for (int i = 0; i < n; ++i) {
       Feature& f = fs[i];
