@@ -243,6 +243,39 @@ long consolidate_isotropic(Simulation& sim, const PeriodicTriaxialParams& prm_in
   throw std::runtime_error(msg.str());
 }
 
+namespace {
+
+/// The result's curve values and checks (the lateral stress's largest error, the largest kinetic energy), and the
+/// closing lines when verbose; `wall_seconds` is set.
+void finish_result(const Simulation& sim, PeriodicTriaxialResult& res, Progress& progress, double wall_seconds) {
+  const PeriodicTriaxialParams& prm = res.params;
+  take_curve_values(res, summarised(res.series, prm.sigma3));
+  for (const PeriodicTriaxialRecord& r : res.series) {
+    // The membrane's share is the same on both axes to rounding (they stretch alike on average); its
+    // mean is recorded.
+    const Real target = prm.sigma3 + r.membrane;
+    res.max_lateral_error = std::max({res.max_lateral_error, std::fabs(r.sigma2 - target) / target,
+                                      std::fabs(r.sigma3 - target) / target});
+    res.max_kinetic = std::max(res.max_kinetic, r.kinetic);
+  }
+  res.wall_seconds = wall_seconds;
+  if (prm.verbose) {
+    const PeriodicTriaxialRecord& f = res.series.back();
+    progress.finish("");
+    std::printf("periodic triaxial: consolidated in %ld steps to void ratio %.4f (Z = %.2f); sheared to eps_a = %.2f%% "
+                "in %ld steps\n", res.consolidation_steps, res.void_ratio0, res.series.front().coordination,
+                100 * f.eps_a, sim.step_count() - res.series.front().step);
+    std::printf("peak q = %.2f kPa at eps_a = %.2f%% (moving mean over +-%.2f%% strain); peak friction angle "
+                "phi = asin((s1-s3)/(s1+s3)) = %.2f deg\n",
+                1e-3 * res.q_peak, 100 * res.eps_a_peak, 100 * kSmoothHalfWidth, res.phi_peak_deg);
+    std::printf("end: q = %.2f kPa, eps_v = %.2f%%, void ratio %.4f; lateral stress within %.2f%% of sigma3; "
+                "wall time %s\n", 1e-3 * f.q, 100 * f.eps_v, f.void_ratio, 100 * res.max_lateral_error,
+                format_duration(res.wall_seconds).c_str());
+  }
+}
+
+}  // namespace
+
 PeriodicTriaxialResult run_periodic_triaxial(Simulation& sim, const PeriodicTriaxialParams& prm_in, io::Output* out) {
   const auto t0 = std::chrono::steady_clock::now();
   PeriodicTriaxialResult res;
@@ -320,29 +353,7 @@ PeriodicTriaxialResult run_periodic_triaxial(Simulation& sim, const PeriodicTria
   set_cell_rates(sim, Vec3());
   if (out) out->flush_series();
 
-  take_curve_values(res, summarised(res.series, prm.sigma3));
-  for (const PeriodicTriaxialRecord& r : res.series) {
-    // The membrane's share is the same on both axes to rounding (they stretch alike on average); its
-    // mean is recorded.
-    const Real target = prm.sigma3 + r.membrane;
-    res.max_lateral_error = std::max({res.max_lateral_error, std::fabs(r.sigma2 - target) / target,
-                                      std::fabs(r.sigma3 - target) / target});
-    res.max_kinetic = std::max(res.max_kinetic, r.kinetic);
-  }
-  res.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  if (prm.verbose) {
-    const PeriodicTriaxialRecord& f = res.series.back();
-    progress.finish("");
-    std::printf("periodic triaxial: consolidated in %ld steps to void ratio %.4f (Z = %.2f); sheared to eps_a = %.2f%% "
-                "in %ld steps\n", res.consolidation_steps, res.void_ratio0, res.series.front().coordination,
-                100 * f.eps_a, sim.step_count() - res.series.front().step);
-    std::printf("peak q = %.2f kPa at eps_a = %.2f%% (moving mean over +-%.2f%% strain); peak friction angle "
-                "phi = asin((s1-s3)/(s1+s3)) = %.2f deg\n",
-                1e-3 * res.q_peak, 100 * res.eps_a_peak, 100 * kSmoothHalfWidth, res.phi_peak_deg);
-    std::printf("end: q = %.2f kPa, eps_v = %.2f%%, void ratio %.4f; lateral stress within %.2f%% of sigma3; "
-                "wall time %s\n", 1e-3 * f.q, 100 * f.eps_v, f.void_ratio, 100 * res.max_lateral_error,
-                format_duration(res.wall_seconds).c_str());
-  }
+  finish_result(sim, res, progress, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   return res;
 }
 
