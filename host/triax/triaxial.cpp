@@ -267,6 +267,33 @@ void take_record(const ShearRecorder& sh, Real eps_a, long k, const std::functio
   }
 }
 
+/// The series' columns: the boundary's, then the micromechanics' of the specimen and of its central cube where enabled.
+std::vector<std::string> series_columns(const MicroConfig& mc) {
+  std::vector<std::string> columns = kSeriesColumns;
+  if (mc.enabled)
+    for (const std::string& prefix : {std::string(), std::string("rve_")})
+      for (const std::string& c : micro_columns(prefix)) columns.push_back(c);
+  return columns;
+}
+
+/// The result's curve values from its records, its highest record, the balls that left the membrane, and the
+/// run's times and counts.
+void finish_result(const Cell& cell, Real sigma3, double wall_seconds, TriaxialResult& res) {
+  Simulation& sim = *cell.sim;
+  if (!res.records.empty()) {
+    take_curve_values(res, summarised(res.records, sigma3));
+    res.highest_record = static_cast<std::size_t>(
+        std::max_element(res.records.begin(), res.records.end(),
+                         [](const TriaxialRecord& a, const TriaxialRecord& b) { return a.q < b.q; }) -
+        res.records.begin());
+  }
+  res.escaped = count_escaped(sim, cell.membrane, sim.wall_point(kTopPlaten).z);
+  res.wall_seconds = wall_seconds;
+  res.times = sim.times();
+  res.steps = sim.step_count();
+  res.balls = sim.particles().n;
+}
+
 }  // namespace
 
 ShearPlan shear_plan(const Config& cfg, Real dt) {
@@ -310,11 +337,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
   const Real dt = sim.params().integ.dt;
   TriaxialResult res;
   const MicroConfig& mc = cfg.micro;
-  std::vector<std::string> columns = kSeriesColumns;
-  if (mc.enabled)
-    for (const std::string& prefix : {std::string(), std::string("rve_")})
-      for (const std::string& c : micro_columns(prefix)) columns.push_back(c);
-  if (out) out->set_series_columns(columns);
+  if (out) out->set_series_columns(series_columns(mc));
   Stage st;
   // Wall time of the whole test: a resumed run adds what the segments before it took.
   double wall_before = 0;
@@ -389,18 +412,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
     throw;
   }
   if (out) out->flush_series();
-  if (!res.records.empty()) {
-    take_curve_values(res, summarised(res.records, tc.sigma3));
-    res.highest_record = static_cast<std::size_t>(
-        std::max_element(res.records.begin(), res.records.end(),
-                         [](const TriaxialRecord& a, const TriaxialRecord& b) { return a.q < b.q; }) -
-        res.records.begin());
-  }
-  res.escaped = count_escaped(sim, cell.membrane, sim.wall_point(kTopPlaten).z);
-  res.wall_seconds = elapsed();
-  res.times = sim.times();
-  res.steps = sim.step_count();
-  res.balls = sim.particles().n;
+  finish_result(cell, tc.sigma3, elapsed(), res);
   return res;
 }
 
