@@ -110,11 +110,16 @@ struct Commands {
   CLI::App *run, *specimen, *triaxial, *periodic, *study, *micro, *calibrate, *diagnose, *synth, *check, *info;
 };
 
+/// The config file and the output folder, which every command that runs one config takes.
+void add_config_and_output(CLI::App* cmd, Args& a) {
+  cmd->add_option("config", a.config_path, "TOML config file")->required()->check(CLI::ExistingFile);
+  cmd->add_option("-o,--output", a.output, "output folder (overrides [run] output)");
+}
+
 /// The commands that run one test or job from a config.
 void add_test_commands(CLI::App& app, Args& a, Commands& c) {
   c.run = app.add_subcommand("run", "run the job a config describes");
-  c.run->add_option("config", a.config_path, "TOML config file")->required()->check(CLI::ExistingFile);
-  c.run->add_option("-o,--output", a.output, "output folder (overrides [run] output)");
+  add_config_and_output(c.run, a);
   c.run->add_option("-n,--steps", a.steps, "number of steps (overrides [run] steps)")->check(CLI::NonNegativeNumber);
   c.run->add_flag("--resume", a.resume, "continue from the output folder's checkpoint.h5 to the step count");
   const char* overwrite_help = "replace another run's outputs in the output folder (refused without it)";
@@ -123,21 +128,18 @@ void add_test_commands(CLI::App& app, Args& a, Commands& c) {
       ->check(CLI::NonNegativeNumber);
 
   c.specimen = app.add_subcommand("specimen", "build the [specimen] of a config by multilayer compaction");
-  c.specimen->add_option("config", a.config_path, "TOML config file")->required()->check(CLI::ExistingFile);
-  c.specimen->add_option("-o,--output", a.output, "output folder (overrides [run] output)");
+  add_config_and_output(c.specimen, a);
   c.specimen->add_flag("--overwrite", a.overwrite, overwrite_help);
 
   c.triaxial = app.add_subcommand("triaxial", "specimen, membrane, consolidation and shear (drained triaxial test)");
-  c.triaxial->add_option("config", a.config_path, "TOML config file")->required()->check(CLI::ExistingFile);
-  c.triaxial->add_option("-o,--output", a.output, "output folder (overrides [run] output)");
+  add_config_and_output(c.triaxial, a);
   auto* triaxial_resume = c.triaxial->add_flag("--resume", a.resume, "continue from the output folder's checkpoint.h5");
   c.triaxial->add_flag("--overwrite", a.overwrite, overwrite_help)->excludes(triaxial_resume);
   c.triaxial->add_option("--stop-at-step", a.stop_at, "write a checkpoint after this step and stop (exit status 3)")
       ->check(CLI::NonNegativeNumber);
 
   c.periodic = app.add_subcommand("periodic", "periodic-cell drained triaxial test (no platens, no membrane)");
-  c.periodic->add_option("config", a.config_path, "TOML config file")->required()->check(CLI::ExistingFile);
-  c.periodic->add_option("-o,--output", a.output, "output folder (overrides [run] output)");
+  add_config_and_output(c.periodic, a);
   c.periodic->add_flag("--overwrite", a.overwrite, overwrite_help);
 }
 
