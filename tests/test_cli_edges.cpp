@@ -73,6 +73,12 @@ fs::path tiny_triaxial_file(const fs::path& dir, const std::string& specimen_ext
   return file;
 }
 
+/// One test of four points, material A at 100 kPa: data that a calibration reads before it refuses something else.
+void write_four_point_curve(const fs::path& path) {
+  std::ofstream(path) << "material,sigma3_kPa,eps_a_pct,q_kPa,eps_v_pct\n"
+                         "A,100,0,0,0\nA,100,1,60,0.1\nA,100,2,70,-0.1\nA,100,3,65,-0.3\n";
+}
+
 }  // namespace
 
 // Two runs started at once into one folder both went on and left a mixture of their files: a run locks its folder
@@ -330,8 +336,7 @@ TEST(CliEdges, MicroOnAFolderThatIsNoRunSaysSo) {
 // A calibration refused after it had made its dated result folder left the folder behind, empty.
 TEST(CliEdges, ARefusedCalibrationLeavesNoFolder) {
   const fs::path dir = dem::test::scratch_dir("cli_refused_folder");
-  std::ofstream(dir / "d.csv") << "material,sigma3_kPa,eps_a_pct,q_kPa,eps_v_pct\n"
-                                  "A,100,0,0,0\nA,100,1,60,0.1\nA,100,2,70,-0.1\nA,100,3,65,-0.3\n";
+  write_four_point_curve(dir / "d.csv");
   const Outcome o = triaxdem("calibrate " + (dir / "d.csv").string() + " --config tests/data/hidden_effects.toml "
                              "--predict none --material nosuch -j 1 -o " + (dir / "out").string(), dir);
   EXPECT_EQ(o.code, 1) << o.output;
@@ -344,8 +349,7 @@ TEST(CliEdges, ARefusedCalibrationLeavesNoFolder) {
 // run or folder, naming the option and what to give instead.
 TEST(CliEdges, AWalledPredictionOfAWalledCalibrationIsRefused) {
   const fs::path dir = dem::test::scratch_dir("cli_predict_walls");
-  std::ofstream(dir / "d.csv") << "material,sigma3_kPa,eps_a_pct,q_kPa,eps_v_pct\n"
-                                  "A,100,0,0,0\nA,100,1,60,0.1\nA,100,2,70,-0.1\nA,100,3,65,-0.3\n";
+  write_four_point_curve(dir / "d.csv");
   const Outcome o = triaxdem("calibrate " + (dir / "d.csv").string() + " --config tests/data/hidden_effects.toml "
                              "--reference-test walls --predict walls -j 1 -o " + (dir / "out").string(), dir);
   EXPECT_EQ(o.code, 1) << o.output;

@@ -203,6 +203,20 @@ void save_blowup(Simulation& sim, const Cell& cell, io::Output& out, const Stage
                out.folder().c_str(), blowup_path(out.folder()).c_str());
 }
 
+/// The contacts of the current step, copied to the host at most once a step, for the record and the snapshot alike.
+class LazyContacts {
+ public:
+  explicit LazyContacts(Simulation& sim) : sim_(sim) {}
+  const ContactSet& get() {
+    if (!set_) set_ = contact_set(sim_);
+    return *set_;
+  }
+
+ private:
+  Simulation& sim_;
+  std::optional<ContactSet> set_;
+};
+
 /// What a shear stage's records need besides the step: the test, its state and result, the output, and the
 /// consolidated height and volumes the strains are taken from.
 struct ShearRecorder {
@@ -219,7 +233,7 @@ struct ShearRecorder {
 
 /// One record of the shear stage at axial strain eps_a, step k: boundary stresses and strains, the stress measures,
 /// micromechanics where enabled (with their states at the snapshot strains and the peak), the series row.
-void take_record(const ShearRecorder& sh, Real eps_a, long k, const std::function<const ContactSet&()>& contacts_now) {
+void take_record(const ShearRecorder& sh, Real eps_a, long k, LazyContacts& contacts) {
   const TriaxialConfig& tc = sh.cfg.triaxial;
   const MicroConfig& mc = sh.cfg.micro;
   const Cell& cell = sh.cell;
@@ -239,12 +253,12 @@ void take_record(const ShearRecorder& sh, Real eps_a, long k, const std::functio
       (sh.v0_envelope - envelope_volume(sim, top_z, cell.mean_radius, tc.membrane_segments)) / sh.v0_envelope;
   r.unbalanced = sim.unbalanced_ratio();
   r.kinetic = sim.stats().kinetic;
-  measure_stresses(cell, tc, contacts_now(), volume, sh.v0 / sh.h0, r);
+  measure_stresses(cell, tc, contacts.get(), volume, sh.v0 / sh.h0, r);
   sh.res.records.push_back(r);
   std::vector<double> row = series_row(r, tc.sigma3, sh.st.void_ratio);
   const int next_snap = static_cast<int>(sh.st.next_snap);
   if (mc.enabled) {
-    const ContactSet& cs = contacts_now();
+    const ContactSet& cs = contacts.get();
     const ContactSet rve = restrict_to_cube(cs, Vec3(0, 0, top_z / 2), mc.rve_edge);
     const MicroRow m = micro_row(cs, volume);
     sh.res.micro.push_back(m);
@@ -379,19 +393,14 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
     const ShearRecorder recorder{cfg, cell, st, res, out, h0, v0, v0_envelope, snaps, shear, verbose};
     for (long k = static_cast<long>(st.step); k <= steps; ++k) {
       const Real eps_a = (h0 - sim.wall_point(kTopPlaten).z) / h0;
-      // The contacts are copied to the host at most once a step, for the record and the snapshot alike.
-      std::optional<ContactSet> contacts;
-      const std::function<const ContactSet&()> contacts_now = [&]() -> const ContactSet& {
-        if (!contacts) contacts = contact_set(sim);
-        return *contacts;
-      };
-      if (eps_a >= st.next_record - 1e-12 || k == steps) take_record(recorder, eps_a, k, contacts_now);
+      LazyContacts contacts{sim};
+      if (eps_a >= st.next_record - 1e-12 || k == steps) take_record(recorder, eps_a, k, contacts);
       const int next_snap = static_cast<int>(st.next_snap);
       if (out && next_snap < kSnapshotStrains && eps_a >= snaps[next_snap] - 1e-12) {
         char label[48];
         std::snprintf(label, sizeof label, "shear eps_a=%.0f%%", 100 * snaps[next_snap]);
         const io::SurfaceSnapshot surface = membrane_surface(cell.membrane);
-        const io::ContactTable table = mc.enabled ? contact_table(contacts_now()) : io::ContactTable();
+        const io::ContactTable table = mc.enabled ? contact_table(contacts.get()) : io::ContactTable();
         out->write_snapshot(take_snapshot(sim, label), &surface, mc.enabled ? &table : nullptr);
         st.next_snap += 1;
       }
