@@ -80,14 +80,15 @@ struct BallForce : MaxOverlap {
     const bool full = lanes == W;
     h.fs = load_lanes<T>(c.fs, s0, cs, full);
     h.mr = load_lanes<T>(c.mr, s0, cs, full);
-    // Only slip weakening reads or changes the sliding distance: without it in the pack, it stays as stored.
-    const bool worn = any(prm.wear != T(0));
-    if (worn) h.slip = from_lanes<T>([&](int k) { return c.slip(cs[k]); });
+    // Only the slots the pack's parameters use are read or changed: the others stay as stored.
+    const unsigned slots = RRLinear::slots(prm);
+    for (int q = 0; q < kHistorySlots; ++q)
+      if (slots & (1u << q)) h.slot[q] = from_lanes<T>([&](int k) { return c.slot[q](cs[k]); });
     const ContactOutputT<T> out = RRLinear::eval(prm, kin, h);
     const Vec3T<T> nxf = cross(kin.n, out.force);
     const Vec3T<T> mt = b * nxf - out.moment, mo = a * nxf + out.moment;
     const auto store_results = [&](auto at) {
-      store_law(c, at, h, out, worn);
+      store_law(c, at, h, out, slots);
       put(c.mo, at, mo);
       put(c.mt, at, mt);
     };

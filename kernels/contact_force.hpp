@@ -26,14 +26,15 @@ OverlapStat compute_wall_forces(const Particles& p, ContactList& c, const Adjace
                                 const FacetMesh& mesh, const ParamTableView& params, Real dt);
 
 /// Stores a touching contact's updated history and the law's output (force on particle 1, elastic normal force)
-/// at `at`; both kernels. The sliding distance only where `slip` holds: only slip weakening changes it.
+/// at `at`; both kernels. Of the history slots only those in `slots` (ContactLaw::slots): no other can change.
 template <class T, class At>
 KOKKOS_INLINE_FUNCTION void store_law(const ContactList& c, At at, const ContactHistoryT<T>& h,
-                                      const ContactOutputT<T>& out, bool slip) {
+                                      const ContactOutputT<T>& out, unsigned slots) {
   put(c.fs, at, h.fs);
   put(c.mr, at, h.mr);
   put_scalar(c.flags, at, h.flags);
-  if (slip) put_scalar(c.slip, at, h.slip);
+  for (int s = 0; s < kHistorySlots; ++s)
+    if (slots & (1u << s)) put_scalar(c.slot[s], at, h.slot[s]);
   put(c.fc, at, out.force);
   put_scalar(c.fn, at, out.fn);
 }
@@ -41,9 +42,12 @@ KOKKOS_INLINE_FUNCTION void store_law(const ContactList& c, At at, const Contact
 /// Applies the law to kinematics k of contact slot `s`, stores its history and output, and returns the output.
 KOKKOS_FORCEINLINE_FUNCTION ContactOutput apply_law(const ContactList& c, int s, const ContactParams& prm,
                                                const ContactKinematics& k) {
-  ContactHistory h{load(c.fs, s), load(c.mr, s), c.flags(s), c.slip(s)};
+  ContactHistory h{load(c.fs, s), load(c.mr, s), c.flags(s)};
+  const unsigned slots = RRLinear::slots(prm);
+  for (int q = 0; q < kHistorySlots; ++q)
+    if (slots & (1u << q)) h.slot[q] = c.slot[q](s);
   const ContactOutput out = RRLinear::eval(prm, k, h);
-  store_law(c, LaneRow{s, 0}, h, out, true);
+  store_law(c, LaneRow{s, 0}, h, out, slots);
   return out;
 }
 
@@ -55,7 +59,7 @@ KOKKOS_INLINE_FUNCTION void open_contact(const ContactList& c, int s) {
   store(c.fs, s, Vec3());
   store(c.mr, s, Vec3());
   c.flags(s) = 0;
-  c.slip(s) = 0;
+  for (int q = 0; q < kHistorySlots; ++q) c.slot[q](s) = 0;
   store(c.fc, s, Vec3());
   store(c.mo, s, Vec3());
   store(c.mt, s, Vec3());

@@ -1,7 +1,9 @@
 #pragma once
 /// Contact laws composed from a normal, a tangential and a rolling part (the LIGGGHTS idea): each part
-/// is a small device struct, and ContactLaw<N, T, R> calls them in a fixed order (normal first, since
-/// the others are capped by the normal force and scaled by its tangent stiffness).
+/// is a small device struct, and ContactLaw<N, T, R, S> calls them in a fixed order (normal first, since
+/// the others are capped by the normal force and scaled by its tangent stiffness). A part that keeps history
+/// beyond the shear force and rolling moment keeps it in named slots (contact_params.hpp, HistorySlot) and says
+/// which ones its parameters use (`slots`), so the kernels load and store only those.
 ///
 /// The default law is PFC's rolling resistance linear model `rrlinear` with the deformability method
 /// (../shared/notes/physics_reference.md sections 1.1-1.2):
@@ -29,6 +31,11 @@
 ///     with s the sliding distance accumulated by the contact (reset when it opens): asperities worn by
 ///     sliding, a lower residual strength after the peak. The default s_c is half a radius: much shorter,
 ///     the contacts wear before the peak and the effect is a lower mu_s (diagnose cannot tell them apart).
+///   Twisting resistance (twist > 0): a spring on the relative spin about n, k_tw = ks Rbar^2 (the rolling
+///     spring's stiffness), capped at twist Rbar Fn: YADE's form with one coefficient, like mu_r for bending.
+///     LAMMPS `twisting marshall` ties both to the contact radius a instead (k_tw = ks a^2 / 2, cap 2/3 a mu_s
+///     Fn), which makes it negligible for stiff spheres; a free coefficient stands for rough or flattened
+///     contacts. The moment is a scalar about n (slot kTwistSlot), so a turning contact plane carries it as is.
 #include "kernels/contact_params.hpp"
 #include "kernels/vec3.hpp"
 
@@ -45,7 +52,7 @@ using Arg = typename Same<T>::type;
 /// The parameters of W material pairs as lanes: pair(k) gives lane k's.
 template <class T, class Pair>
 KOKKOS_INLINE_FUNCTION ContactParamsT<T> params_of_lanes(const Pair& pair) {
-  static_assert(sizeof(ContactParams) == 9 * sizeof(Real), "a new ContactParams field must be copied here");
+  static_assert(sizeof(ContactParams) == 10 * sizeof(Real), "a new ContactParams field must be copied here");
   const auto field = [&](Real ContactParams::*m) { return from_lanes<T>([&](int k) { return pair(k).*m; }); };
   ContactParamsT<T> P;
   P.emod = field(&ContactParams::emod);
@@ -57,6 +64,7 @@ KOKKOS_INLINE_FUNCTION ContactParamsT<T> params_of_lanes(const Pair& pair) {
   P.roughness = field(&ContactParams::roughness);
   P.wear = field(&ContactParams::wear);
   P.wear_slip = field(&ContactParams::wear_slip);
+  P.twist = field(&ContactParams::twist);
   return P;
 }
 
@@ -82,7 +90,7 @@ struct ContactHistoryT {
   Vec3T<T> fs;                          ///< shear force on particle 1 (N)
   Vec3T<T> mr;                          ///< rolling moment on particle 1 (N m)
   typename LaneFlags<T>::type flags{};  ///< ContactFlag bits
-  T slip = 0;                           ///< sliding distance accumulated while touching (m), for slip-weakening friction
+  T slot[kHistorySlots] = {};           ///< the extensions' scalar history, by HistorySlot
 };
 using ContactHistory = ContactHistoryT<Real>;
 
@@ -166,6 +174,10 @@ struct NormalElastic {
 /// coefficient weakens with the contact's sliding distance when wear > 0.
 struct TangentialCoulomb {
   template <class T>
+  KOKKOS_INLINE_FUNCTION static unsigned slots(const ContactParamsT<T>& p) {
+    return any(p.wear != T(0)) ? 1u << kSlipSlot : 0u;
+  }
+  template <class T>
   KOKKOS_INLINE_FUNCTION static T friction(const ContactParamsT<T>& p, const Arg<T>& r, const Arg<T>& slip) {
     const auto worn = p.wear != T(0);
     if (!any(worn)) return p.mu_s;
@@ -182,10 +194,11 @@ struct TangentialCoulomb {
     } else {
       // The slip of this step is the trial force beyond the cap over the spring stiffness.
       const T trial = norm(fs);
-      const T cap = friction(p, contact_radius(k.r1, k.r2), h.slip) * nr.fn;
+      T& slip = h.slot[kSlipSlot];
+      const T cap = friction(p, contact_radius(k.r1, k.r2), slip) * nr.fn;
       const auto capped = cap_to(fs, cap);
       set_flag(h.flags, capped, kSliding);
-      h.slip = select(worn & capped & (ks > T(0)), h.slip + (trial - cap) / ks, h.slip);
+      slip = select(worn & capped & (ks > T(0)), slip + (trial - cap) / ks, slip);
     }
     h.fs = fs;
     return fs;
@@ -211,8 +224,32 @@ struct RollingLinear {
   }
 };
 
-template <class Normal, class Tangential, class Rolling>
+/// Twisting resistance, off where twist = 0 (see the top of the file): the spin moment on particle 1 about n.
+struct TwistingLinear {
+  template <class T>
+  KOKKOS_INLINE_FUNCTION static unsigned slots(const ContactParamsT<T>& p) {
+    return any(p.twist != T(0)) ? 1u << kTwistSlot : 0u;
+  }
+  template <class T>
+  KOKKOS_INLINE_FUNCTION static Vec3T<T> update(const ContactParamsT<T>& p, const ContactKinematicsT<T>& k,
+                                                const NormalResponseT<T>& nr, ContactHistoryT<T>& h) {
+    const T rb = RollingLinear::rbar(k.r1, k.r2);
+    const T cap = p.twist * rb * nr.fn;
+    const T trial = h.slot[kTwistSlot] + nr.k / p.kratio * rb * rb * dot(k.dtheta, k.n);
+    const auto capped = trial * trial > cap * cap;
+    const T mt = select(capped, select(trial > T(0), cap, -cap), trial);
+    h.slot[kTwistSlot] = select(p.twist != T(0), mt, h.slot[kTwistSlot]);  // a lane without it keeps its history
+    return mt * k.n;
+  }
+};
+
+template <class Normal, class Tangential, class Rolling, class Twisting>
 struct ContactLaw {
+  /// The history slots that parameters p use (bits 1 << HistorySlot): the kernels load and store only these.
+  template <class T>
+  KOKKOS_INLINE_FUNCTION static unsigned slots(const ContactParamsT<T>& p) {
+    return Tangential::slots(p) | Twisting::slots(p);
+  }
   /// Normal stiffness scale kn of a pair, to be stored in ContactKinematics::kn before eval.
   template <class T>
   KOKKOS_INLINE_FUNCTION static T stiffness(const ContactParamsT<T>& p, const Arg<T>& r1, const Arg<T>& r2) {
@@ -228,12 +265,17 @@ struct ContactLaw {
     const Vec3T<T> fs = Tangential::update(p, k, nr, h);
     out.force = fs - fn_total * k.n;
     out.moment = Rolling::update(p, k, nr, h);
+    if (Twisting::slots(p)) {
+      // Lanes without it keep the rolling moment's bits (adding a zero would turn a -0 into +0).
+      const auto on = p.twist != T(0);
+      out.moment = select(on, out.moment + Twisting::update(p, k, nr, h), out.moment);
+    }
     out.fn = nr.fn;
     set_flag(h.flags, true, kTouching);
     return out;
   }
 };
 
-using RRLinear = ContactLaw<NormalElastic, TangentialCoulomb, RollingLinear>;
+using RRLinear = ContactLaw<NormalElastic, TangentialCoulomb, RollingLinear, TwistingLinear>;
 
 }  // namespace dem

@@ -45,7 +45,7 @@ struct ContactList {
   Vec3View fs;            ///< shear force on particle 1 (N)
   Vec3View mr;            ///< rolling moment on particle 1 (N m)
   FlagView flags;
-  ScalarView slip;        ///< sliding distance accumulated while touching (m)
+  ScalarView slot[kHistorySlots];  ///< the extensions' scalar history (contact_params.hpp, HistorySlot)
   // results of the current step
   Vec3View fc;            ///< total contact force on particle 1 (N)
   Vec3View mo;            ///< moment on particle 1 (N m), ball-ball: the owner's side, summed in its gather

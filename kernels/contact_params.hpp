@@ -18,14 +18,21 @@ struct ContactParamsT {
   T roughness = 0.0;      ///< rough-surface compliance: combined rms roughness / r
   T wear = 0.0;           ///< slip weakening: fraction of mu_s lost after long sliding
   T wear_slip = 0.5;      ///< slip weakening: sliding distance / r over which friction decays by 1/e
+  T twist = 0.0;          ///< twisting resistance: the spin moment's cap over Rbar Fn (the spin analogue of mu_r)
 
   /// The same pair without the extensions (specimen preparation, which must not depend on them).
   ContactParamsT base() const {
     ContactParamsT b = *this;
-    b.hertz_overlap = b.roughness = b.wear = 0;
+    b.hertz_overlap = b.roughness = b.wear = b.twist = 0;
     return b;
   }
 };
 using ContactParams = ContactParamsT<Real>;
+
+/// The scalar history the extensions keep per contact, by name (units: slip m, twist N m). Storage
+/// (ContactList::slot), the rebuild's remap, the saved state and the checkpoint loop over this list, so an
+/// extension's history is one line here and its use in the law.
+enum HistorySlot : int { kSlipSlot, kTwistSlot, kHistorySlots };
+inline constexpr const char* kHistorySlotNames[kHistorySlots] = {"slip", "twist"};
 
 }  // namespace dem

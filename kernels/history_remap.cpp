@@ -19,7 +19,6 @@ ContactList remap_history(const PairKeyView& keys, const ContactList& old, const
   auto okey = old.key;
   auto ofs = old.fs, omr = old.mr;
   auto oflags = old.flags;
-  auto oslip = old.slip;
   Kokkos::parallel_for("dem::remap::history", RangePolicy(0, n), KOKKOS_LAMBDA(const int k) {
     const std::uint64_t key = keys(k);
     if (ball_ball) {
@@ -36,7 +35,7 @@ ContactList remap_history(const PairKeyView& keys, const ContactList& old, const
       c.mr(k, d) = o >= 0 ? omr(o, d) : Real(0);
     }
     c.flags(k) = o >= 0 ? oflags(o) : std::uint8_t(0);
-    c.slip(k) = o >= 0 ? oslip(o) : Real(0);
+    for (int s = 0; s < kHistorySlots; ++s) c.slot[s](k) = o >= 0 ? old.slot[s](o) : Real(0);
   });
   return c;
 }

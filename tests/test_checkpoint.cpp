@@ -7,6 +7,7 @@
 #include <spawn.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <filesystem>
@@ -31,13 +32,15 @@ namespace {
 fs::path scratch(const std::string& name) { return dem::test::scratch_dir("checkpoint/" + name); }
 
 /// 300 beads poured into a box under a strong gravity (200 g, so that they land within a few thousand
-/// steps) with sliding and rolling friction: by step 4000 the contacts carry shear and rolling history.
+/// steps) with sliding, rolling and twisting friction and slip weakening: by step 4000 the contacts carry shear and
+/// rolling history and every history slot (contact_params.hpp).
 Config pour(const fs::path& dir, long steps, long checkpoint_every = 0) {
   const fs::path file = dir / "pour.toml";
   std::ofstream(file) << "[run]\nname = \"pour\"\nseries_every = 100\nsnapshot_every = 1000\n"
                          "[particles]\ncount = 300\ndiameter_mm = 2.0\n"
                          "[box]\nsize_mm = [14.0, 14.0, 24.0]\nwalls = true\nfill = \"random\"\n"
                          "[material]\nemod_Pa = 1.0e8\nkratio = 1.5\nmu_s = 0.3\nmu_r = 0.05\n"
+                         "wear = 0.3\ntwist = 0.1\n"
                          "[solver]\ndamping = 0.3\ngravity = [0.0, 0.0, -2000.0]\ndt_safety = 0.2\n";
   Config c = load_config(file.string());
   c.run.steps = steps;
@@ -59,7 +62,7 @@ void expect_same(const SimState& a, const SimState& b) {
     EXPECT_EQ(p->key, q->key);
     EXPECT_EQ(p->fs, q->fs);
     EXPECT_EQ(p->mr, q->mr);
-    EXPECT_EQ(p->slip, q->slip);
+    EXPECT_EQ(p->slot, q->slot);
     EXPECT_EQ(p->flags, q->flags);
   }
   EXPECT_EQ(a.wall_point, b.wall_point);
@@ -131,6 +134,9 @@ TEST(Checkpoint, FileHoldsTheStateExactly) {
   c.numbers["series"] = {1.5, -2, 1e-300};
   c.texts["index"] = "line one\nline two\n";
   ASSERT_GT(with_history(c.sim.balls), 10);
+  for (int s = 0; s < kHistorySlots; ++s)
+    ASSERT_GT(std::count_if(c.sim.balls.slot[s].begin(), c.sim.balls.slot[s].end(), [](double v) { return v != 0; }), 10)
+        << "test set-up: history in slot " << kHistorySlotNames[s];
   write_checkpoint(checkpoint_path(dir.string()), c);
   const Checkpoint r = read_checkpoint(checkpoint_path(dir.string()));
   EXPECT_EQ(r.job, "test");

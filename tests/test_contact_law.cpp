@@ -209,7 +209,7 @@ TEST(ContactLaw, RollingMomentCapBallBall) {
 
 TEST(ContactLaw, RollingMomentCapWall) { check_rolling(1e-3, 0, 1e-3); }  // Rbar = R1 at walls
 
-// Twist (relative rotation about n) is not resisted: no moment however long it lasts, and no shear.
+// Without twisting resistance (twist = 0, the default) a twist (relative rotation about n) is not resisted: no moment however long it lasts, and no shear.
 TEST(ContactLaw, TwistProducesNoMoment) {
   const ContactParams p = test::law(1e8, 1.5, 0.5, 0.5);
   const Vec3 n = unit(Vec3(0.1, 0.2, -1));
@@ -226,6 +226,40 @@ TEST(ContactLaw, TwistProducesNoMoment) {
     EXPECT_FALSE(h.flags & kRolling);
   }
 }
+
+// Twisting resistance (twist > 0): a steady spin of 2 relative to 1 about n builds a moment on 1 along the spin at
+// k_tw = ks Rbar^2 per radian, held at twist Rbar Fn once it gets there, with no bending moment and no shear; a
+// spin back unloads it elastically by the same stiffness. Ball-ball (Rbar = R1 R2 / (R1 + R2)) and at a wall (R1).
+namespace {
+void check_twisting(double R1, double R2, double rbar_expect) {
+  ContactParams p = test::law(1e8, 1.5, 0.5, 0.3);
+  p.twist = 0.2;
+  const double dt = 1e-7, d = 2e-6, spin = 30.0;  // rad/s
+  const Vec3 n = unit(Vec3(0.3, -0.4, 1.0));
+  const double kn = kn_formula(p.emod, R1, R2), ktw = kn / p.kratio * rbar_expect * rbar_expect;
+  const double cap = p.twist * rbar_expect * kn * d, inc = ktw * spin * dt;
+  const int nsat = static_cast<int>(std::ceil(cap / inc));
+  ASSERT_GT(nsat, 20);  // set-up: an elastic stretch of several steps before the cap
+  ContactKinematics k = kin(p, n, d, R1, R2, dt);
+  k.dtheta = dt * spin * n;
+  ContactHistory h;
+  for (int s = 1; s <= nsat + 30; ++s) {
+    const ContactOutput out = RRLinear::eval(p, k, h);
+    // The increments are summed one step at a time: rounding of 1e-12 of the moment covers a few hundred steps.
+    const double want = std::min(s * inc, cap);
+    EXPECT_NEAR(dot(out.moment, n), want, 1e-12 * cap) << "step " << s;
+    EXPECT_LT(norm(tangential(out.moment, n)), 1e-12 * cap) << "no bending moment from a spin";
+    EXPECT_NEAR(h.slot[kTwistSlot], want, 1e-12 * cap);
+    EXPECT_FALSE(h.flags & (kSliding | kRolling));
+  }
+  k.dtheta = -1.0 * k.dtheta;
+  const ContactOutput back = RRLinear::eval(p, k, h);
+  EXPECT_NEAR(dot(back.moment, n), cap - inc, 1e-12 * cap) << "a reversal unloads elastically";
+}
+}  // namespace
+
+TEST(ContactLaw, TwistingResistanceBallBall) { check_twisting(0.8e-3, 1.2e-3, 0.8e-3 * 1.2e-3 / 2.0e-3); }
+TEST(ContactLaw, TwistingResistanceWall) { check_twisting(1e-3, 0, 1e-3); }
 
 // ---------------------------------------------------------------------------------------------------
 // No tension. (a) With beta_n > 0, a fast separation makes kn d - 2 beta sqrt(mc kn) vn negative: the
@@ -445,14 +479,14 @@ TEST(ContactLaw, FrictionWeakensWithAccumulatedSlip) {
   ContactHistory h;
   double travel = 0;
   for (int s = 0; s < 3000; ++s) {
-    const double slip_before = h.slip;
+    const double slip_before = h.slot[kSlipSlot];
     RRLinear::eval(p, k, h);
     travel += v * dt;
     const double fs = norm(h.fs);
-    EXPECT_NEAR(h.slip, std::max(0.0, travel - fs / ks), 1e-9 * travel) << "step " << s;
+    EXPECT_NEAR(h.slot[kSlipSlot], std::max(0.0, travel - fs / ks), 1e-9 * travel) << "step " << s;
     if (h.flags & kSliding) {
       const double mu_before = 0.5 * (1 - 0.4 * (1 - std::exp(-slip_before / sc)));
-      const double mu_after = 0.5 * (1 - 0.4 * (1 - std::exp(-h.slip / sc)));
+      const double mu_after = 0.5 * (1 - 0.4 * (1 - std::exp(-h.slot[kSlipSlot] / sc)));
       EXPECT_LE(fs, mu_before * fn * (1 + 1e-12));
       EXPECT_GE(fs, mu_after * fn * (1 - 1e-12));
     }
@@ -465,7 +499,7 @@ TEST(ContactLaw, FrictionWeakensWithAccumulatedSlip) {
   p.wear = 0;
   ContactHistory h0;
   for (int s = 0; s < 3000; ++s) RRLinear::eval(p, k, h0);
-  EXPECT_EQ(h0.slip, 0.0);
+  EXPECT_EQ(h0.slot[kSlipSlot], 0.0);
   EXPECT_NEAR(norm(h0.fs), 0.5 * fn, 1e-12 * fn);
 }
 

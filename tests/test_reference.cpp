@@ -55,7 +55,7 @@ test::CaseResults periodic_cell(unsigned seed) {
   add_curves(v, base, {0.1, 1, 2, 5, 8});
   v["void_ratio_sheared"] = base.void_ratio;
   const std::map<std::string, Real> strength{
-      {"hertz", 3e-3}, {"roughness", 1e-2}, {"wear", 0.6}, {"membrane", 300e3}};
+      {"hertz", 3e-3}, {"roughness", 1e-2}, {"wear", 0.6}, {"twist", 0.2}, {"membrane", 300e3}};
   test::CaseResults out{{"periodic_cell", v}};
   std::map<std::string, double> ext;
   for (const Extension& e : extensions()) {
@@ -126,13 +126,15 @@ test::CaseResults contact_laws(unsigned) {
   };
   ContactParams linear = test::law(1e8, 1.5, 0.3, 0.05, 0.2);
   std::vector<Law> laws{{"linear", linear}};
-  ContactParams hertz = linear, rough = linear, wear = linear;
+  ContactParams hertz = linear, rough = linear, wear = linear, twist = linear;
   hertz.hertz_overlap = 3e-3;
   rough.roughness = 1e-2;
   wear.wear = 0.6;
+  twist.twist = 0.2;
   laws.push_back({"hertz", hertz});
   laws.push_back({"roughness", rough});
   laws.push_back({"wear", wear});
+  laws.push_back({"twist", twist});
   std::map<std::string, double> v;
   for (const Law& law : laws) {
     const Real R = 1e-3;
@@ -171,7 +173,7 @@ TEST(Reference, PeriodicCell) {
                            "void_ratio_sheared"}},
                          {"periodic_extensions",
                           {"hertz_q_peak_over_sigma3", "roughness_q_peak_over_sigma3", "wear_q_end_over_sigma3",
-                           "membrane_q_end_over_sigma3"}}});
+                           "twist_q_peak_over_sigma3", "membrane_q_end_over_sigma3"}}});
 }
 
 TEST(Reference, MembraneTriaxial) {

@@ -29,17 +29,18 @@ struct LawCase {
   ContactHistory h;
 };
 
-/// A random touching contact; every fourth uses one extension or the dashpot, every seventh is a wall, every
+/// A random touching contact; five in six use one extension or the dashpot, every seventh is a wall, every
 /// third starts with no history and some have history along n (it must vanish) or loads past the caps.
 LawCase random_case(std::mt19937_64& rng, int t) {
   std::uniform_real_distribution<double> u(-1, 1);
   LawCase c;
   c.p = test::law(1e8, 1.5, 0.3, 0.02);
-  switch (t % 5) {
+  switch (t % 6) {
     case 1: c.p.wear = 0.6; break;
     case 2: c.p.hertz_overlap = 3e-3; break;
     case 3: c.p.roughness = 1e-2; break;
     case 4: c.p.beta_n = 0.2; break;
+    case 5: c.p.twist = 0.1; break;
     default: break;
   }
   Vec3 n(u(rng), u(rng), u(rng));
@@ -57,7 +58,8 @@ LawCase random_case(std::mt19937_64& rng, int t) {
   c.h.fs = scale * Vec3(u(rng), u(rng), u(rng));
   c.h.mr = 1e-3 * scale * Vec3(u(rng), u(rng), u(rng));
   if (t % 11 == 0) c.h.fs = scale * c.k.n;
-  c.h.slip = 1e-5 * (1 + u(rng));
+  c.h.slot[kSlipSlot] = 1e-5 * (1 + u(rng));
+  c.h.slot[kTwistSlot] = 1e-3 * scale * u(rng);
   return c;
 }
 
@@ -85,7 +87,7 @@ TEST(SimdLanes, EachLaneGivesTheScalarLawsBits) {
     ContactHistoryT<T> H;
     H.fs = vlanes([](const LawCase& q) { return q.h.fs; });
     H.mr = vlanes([](const LawCase& q) { return q.h.mr; });
-    H.slip = lanes([](const LawCase& q) { return q.h.slip; });
+    for (int s = 0; s < kHistorySlots; ++s) H.slot[s] = lanes([s](const LawCase& q) { return q.h.slot[s]; });
     const ContactOutputT<T> out = RRLinear::eval(P, K, H);
     for (int k = 0; k < kContactLanes; ++k) {
       ContactHistory h = c[k].h;
@@ -96,7 +98,8 @@ TEST(SimdLanes, EachLaneGivesTheScalarLawsBits) {
       ASSERT_TRUE(same_bits(lane(out.fn, k), ref.fn)) << "contact " << t0 + k;
       ASSERT_TRUE(same_bits(at(H.fs), h.fs)) << "contact " << t0 + k;
       ASSERT_TRUE(same_bits(at(H.mr), h.mr)) << "contact " << t0 + k;
-      ASSERT_TRUE(same_bits(lane(H.slip, k), h.slip)) << "contact " << t0 + k;
+      for (int s = 0; s < kHistorySlots; ++s)
+        ASSERT_TRUE(same_bits(lane(H.slot[s], k), h.slot[s])) << "contact " << t0 + k << ", " << kHistorySlotNames[s];
       ASSERT_EQ(lane(H.flags, k), h.flags) << "contact " << t0 + k;
     }
   }
@@ -149,7 +152,8 @@ TEST(SimdLanes, RowsAndMinimumImageMatchTheScalarPath) {
 /// Results of the kernel for every contact of a list, by key.
 struct KernelResult {
   std::vector<Vec3> fs, mr, fc, mo, mt;
-  std::vector<double> fn, slip;
+  std::vector<double> fn;
+  std::vector<double> slot[kHistorySlots];
   std::vector<int> flags;
 };
 
@@ -183,12 +187,14 @@ KernelResult run_kernel(const Particles& p, const std::vector<std::uint64_t>& ke
   };
   KernelResult r{v3(c.fs), v3(c.mr), v3(c.fc), v3(c.mo), v3(c.mt), {}, {}, {}};
   auto fn = Kokkos::create_mirror_view_and_copy(HostSpace(), c.fn);
-  auto slip = Kokkos::create_mirror_view_and_copy(HostSpace(), c.slip);
   auto fl = Kokkos::create_mirror_view_and_copy(HostSpace(), c.flags);
   for (std::size_t s = 0; s < keys.size(); ++s) {
     r.fn.push_back(fn(s));
-    r.slip.push_back(slip(s));
     r.flags.push_back(fl(s));
+  }
+  for (int q = 0; q < kHistorySlots; ++q) {
+    auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), c.slot[q]);
+    r.slot[q].assign(h.data(), h.data() + keys.size());
   }
   return r;
 }
@@ -198,7 +204,9 @@ void expect_same_contact(const KernelResult& r, std::size_t q, const KernelResul
   ASSERT_TRUE(same_bits(r.fc[q], ref.fc[s]) && same_bits(r.mo[q], ref.mo[s]) && same_bits(r.mt[q], ref.mt[s]))
       << run << ": contact " << s;
   ASSERT_TRUE(same_bits(r.fs[q], ref.fs[s]) && same_bits(r.mr[q], ref.mr[s])) << run << ": contact " << s;
-  ASSERT_TRUE(same_bits(r.fn[q], ref.fn[s]) && same_bits(r.slip[q], ref.slip[s])) << run << ": contact " << s;
+  ASSERT_TRUE(same_bits(r.fn[q], ref.fn[s])) << run << ": contact " << s;
+  for (int k = 0; k < kHistorySlots; ++k)
+    ASSERT_TRUE(same_bits(r.slot[k][q], ref.slot[k][s])) << run << ": contact " << s << ", " << kHistorySlotNames[k];
   ASSERT_EQ(r.flags[q], ref.flags[s]) << run << ": contact " << s;
 }
 
@@ -224,6 +232,7 @@ TEST(SimdLanes, KernelResultDoesNotDependOnLaneOrPackMates) {
   ht(0, 0) = ht(1, 1) = test::law(1e8, 1.5, 0.3, 0.02);
   ht(0, 1) = ht(1, 0) = test::law(1e8, 1.5, 0.3, 0.02);
   ht(0, 1).wear = ht(1, 0).wear = 0.5;  // a second pair in some packs: lanes with other parameters
+  ht(0, 1).twist = ht(1, 0).twist = 0.2;
   Kokkos::deep_copy(table, ht);
   std::vector<std::uint64_t> keys, touching;
   std::vector<std::size_t> touching_at;  // position of each touching pair in keys

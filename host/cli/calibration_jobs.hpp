@@ -35,7 +35,7 @@ int diagnose_job(const Config& base, const CalibrationOptions& o);
 
 struct SynthOptions {
   std::string output;                     ///< CSV to write
-  std::string extension = "none";         ///< hertz, roughness, wear, membrane or none
+  std::string extension = "none";         ///< an extension's name (model_keys.hpp) or none
   /// The extension parameter in its key's unit, within its range (free_param); NaN: drawn from the seed.
   Real strength = std::numeric_limits<Real>::quiet_NaN();
   bool overwrite = false;                 ///< replace an existing output file (never the config)

@@ -8,9 +8,10 @@ const std::vector<ModelKey>& model_keys() {
   // Extension strengths span the physical range in equal ratios: Hertz reference overlaps of 0.1-1% of the radius
   // (the overlaps of E* = 1e8 Pa beads at 100-300 kPa); combined roughness 0.1-1% of the radius (1-10 um on 2 mm
   // beads; Table 2 gives Sq = 5-53 um, but over 1.3 mm areas that include the beads' waviness); 20-60% of the
-  // friction lost by wear; a membrane of 0.1-1 MPa over the specimen's radius (latex, 1.4 MPa x 0.5 mm, on 1.4-7 mm;
-  // small cells). Calibration ranges stay inside the config's where a smaller range is all a fit needs (roughness
-  // beyond 5% of the radius is no longer a surface's), and the membrane's reaches 3 MPa, above any latex.
+  // friction lost by wear; a twisting cap of 5-20% of Rbar Fn (a quarter to all of a rough bead's mu_r); a membrane
+  // of 0.1-1 MPa over the specimen's radius (latex, 1.4 MPa x 0.5 mm, on 1.4-7 mm; small cells). Calibration ranges
+  // stay inside the config's where a smaller range is all a fit needs (roughness beyond 5% of the radius is no longer
+  // a surface's), and the membrane's reaches 3 MPa, above any latex.
   using C = ContactParams;
   static const std::vector<ModelKey> keys = {
       {"mu_s", &C::mu_s, "-", 0, 10, false, 1, true, 0.02, 1.0, true, "", {}, "", true},
@@ -25,6 +26,9 @@ const std::vector<ModelKey>& model_keys() {
       {"wear", &C::wear, "-", 0, 0.99, false, 1, true, 0.0, 0.9, false, "wear", {0.2, 0.4, 0.6},
        "a residual strength that falls below the peak more than sliding alone explains", true},
       {"wear_slip", &C::wear_slip, "r", 0, 10, true, 1, true, 0.005, 0.5, true, "", {}, "", true},
+      {"twist", &C::twist, "-", 0, 10, false, 1, true, 0.0, 0.5, false, "twist", {0.05, 0.1, 0.2},
+       "more strength and dilatancy at every confinement, as a larger mu_r gives; spin in the shear band held back",
+       true},
       {"membrane_kPa", nullptr, "kPa", 0, 1e5, false, 1e3, true, 0.0, 3e6, false, "membrane", {1e5, 3e5, 1e6},
        "extra strength late in the test as the specimen bulges, largest relative to low sigma3", true},
   };

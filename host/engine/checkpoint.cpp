@@ -72,7 +72,7 @@ void put_history(SealedWriter& f, const std::string& prefix, const SavedContacts
   f.put(prefix + "j", H5T_NATIVE_INT, h.j);
   f.put(prefix + "fs", H5T_NATIVE_DOUBLE, h.fs, 3);
   f.put(prefix + "mr", H5T_NATIVE_DOUBLE, h.mr, 3);
-  f.put(prefix + "slip", H5T_NATIVE_DOUBLE, h.slip);
+  for (int s = 0; s < kHistorySlots; ++s) f.put(prefix + kHistorySlotNames[s], H5T_NATIVE_DOUBLE, h.slot[s]);
   f.put(prefix + "flags", H5T_NATIVE_UINT8, h.flags);
   f.put(prefix + "fc", H5T_NATIVE_DOUBLE, h.fc, 3);
   f.put(prefix + "mt", H5T_NATIVE_DOUBLE, h.mt, 3);
@@ -100,7 +100,7 @@ SavedContacts get_history(SealedReader& f, const std::string& prefix) {
   h.j = f.read<int>(prefix + "j", H5T_NATIVE_INT);
   h.fs = f.read<double>(prefix + "fs", H5T_NATIVE_DOUBLE, 3);
   h.mr = f.read<double>(prefix + "mr", H5T_NATIVE_DOUBLE, 3);
-  h.slip = f.read<double>(prefix + "slip", H5T_NATIVE_DOUBLE);
+  for (int s = 0; s < kHistorySlots; ++s) h.slot[s] = f.read<double>(prefix + kHistorySlotNames[s], H5T_NATIVE_DOUBLE);
   h.flags = f.read<std::uint8_t>(prefix + "flags", H5T_NATIVE_UINT8);
   h.fc = f.read<double>(prefix + "fc", H5T_NATIVE_DOUBLE, 3);
   h.mt = f.read<double>(prefix + "mt", H5T_NATIVE_DOUBLE, 3);

@@ -6,7 +6,8 @@
 /// Layout (every dataset at the root): step (int64), time_s, dt_s, cell_pressure_Pa, wall_disp_m,
 /// stats (unbalanced, kinetic, max_disp2, max_move2), flags (fresh, bad), domain (lo, hi, strain rate: 3 x 3), periodic
 /// (3); per ball (local order) x, v, w, f, m, x_ref (n x 3), radius, mass, inertia, gid, specimen, material;
-/// per contact list (balls_*, walls_*): key, i, j, fs, mr, slip, flags, fc, mt, fn; wall_point, wall_velocity,
+/// per contact list (balls_*, walls_*): key, i, j, fs, mr, the history slots (slip, twist: kHistorySlotNames), flags,
+/// fc, mt, fn; wall_point, wall_velocity,
 /// node_x, node_v; the job's arrays as number_<name> (double) and text_<name> (bytes), their names in the
 /// root attributes `numbers` and `texts`; counts (balls, ball-ball and ball-wall contacts, walls, mesh nodes); the
 /// root attributes `format` ("triaxdem checkpoint 2"), `job`, `config` (the config's fingerprint) and `checksum`

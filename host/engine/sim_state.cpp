@@ -48,7 +48,7 @@ SavedContacts history_out(const ContactList& c) {
   h.j = scalar_out<int>(c.j, c.n);
   h.fs = vec3_out(c.fs, c.n);
   h.mr = vec3_out(c.mr, c.n);
-  h.slip = scalar_out<double>(c.slip, c.n);
+  for (int s = 0; s < kHistorySlots; ++s) h.slot[s] = scalar_out<double>(c.slot[s], c.n);
   h.flags = scalar_out<std::uint8_t>(c.flags, c.n);
   h.fc = vec3_out(c.fc, c.n);
   h.mt = vec3_out(c.mt, c.n);
@@ -58,16 +58,18 @@ SavedContacts history_out(const ContactList& c) {
 
 ContactList history_in(const SavedContacts& h, const char* which) {
   const std::size_t n = h.key.size();
-  if (h.i.size() != n || h.j.size() != n || h.fs.size() != 3 * n || h.mr.size() != 3 * n || h.slip.size() != n ||
+  if (h.i.size() != n || h.j.size() != n || h.fs.size() != 3 * n || h.mr.size() != 3 * n ||
       h.flags.size() != n || h.fc.size() != 3 * n || h.mt.size() != 3 * n || h.fn.size() != n)
     throw std::runtime_error(std::string("state: the ") + which + " contact list has arrays of unequal length");
+  for (const auto& v : h.slot)
+    if (v.size() != n) throw std::runtime_error(std::string("state: the ") + which + " contact list has arrays of unequal length");
   ContactList c(static_cast<int>(n));
   scalar_in(c.key, h.key, c.n);
   scalar_in(c.i, h.i, c.n);
   scalar_in(c.j, h.j, c.n);
   vec3_in(c.fs, h.fs, c.n);
   vec3_in(c.mr, h.mr, c.n);
-  scalar_in(c.slip, h.slip, c.n);
+  for (int s = 0; s < kHistorySlots; ++s) scalar_in(c.slot[s], h.slot[s], c.n);
   scalar_in(c.flags, h.flags, c.n);
   vec3_in(c.fc, h.fc, c.n);
   vec3_in(c.mt, h.mt, c.n);
@@ -123,7 +125,8 @@ void check_contacts(const SavedContacts& h, const char* which, bool ball_ball, c
                                      std::to_string(want_i) + ", " + std::to_string(want_j) + ")");
   }
   for (const auto* v : {&h.fs, &h.mr, &h.fc, &h.mt}) check_finite(list + " history", *v, 3);
-  for (const auto* v : {&h.slip, &h.fn}) check_finite(list + " history", *v);
+  check_finite(list + " history", h.fn);
+  for (int s = 0; s < kHistorySlots; ++s) check_finite(list + " history " + kHistorySlotNames[s], h.slot[s]);
 }
 
 }  // namespace

@@ -1,8 +1,9 @@
 #pragma once
 /// A Simulation's whole dynamic state as host vectors: what a checkpoint holds so that a resumed run goes on
 /// bit for bit. The particles are kept in their current local order and both contact lists as they are
-/// (history, flags, slip), with the rebuild bookkeeping, so that the resumed run rebuilds its neighbour lists
+/// (history, flags, the extensions' slots), with the rebuild bookkeeping, so that the resumed run rebuilds its neighbour lists
 /// at the same steps and gathers forces in the same order as the run it continues.
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -16,7 +17,8 @@ namespace dem {
 struct SavedContacts {
   std::vector<std::uint64_t> key;
   std::vector<int> i, j;
-  std::vector<double> fs, mr, slip;   ///< history: N, N m, m
+  std::vector<double> fs, mr;         ///< history: N, N m
+  std::array<std::vector<double>, kHistorySlots> slot;  ///< the extensions' history (HistorySlot)
   std::vector<std::uint8_t> flags;
   std::vector<double> fc, mt, fn;     ///< the last step's forces (N, N m, N): what wall forces and records read
 };

@@ -32,7 +32,7 @@ constexpr Real kStrongEvidence = 6;
 /// A model extension the diagnosis tries: its parameter, three strengths within a physical range, and the
 /// signature it leaves in triaxial data (for the report).
 struct Extension {
-  std::string name;       ///< short name: hertz, roughness, wear, membrane
+  std::string name;       ///< short name (ModelKey::extension: hertz, roughness, ...)
   std::string param;      ///< its free parameter (host/fit/calibrate.hpp)
   std::vector<Real> levels;
   std::string signature;

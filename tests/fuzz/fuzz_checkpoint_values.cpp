@@ -26,7 +26,8 @@ dem::SavedContacts contacts(FuzzedDataProvider& in, int balls) {
   c.i = indices<int>(in, n, balls);
   c.j = indices<int>(in, n, balls);
   c.fs = values(in, 3 * n), c.mr = values(in, 3 * n), c.fc = values(in, 3 * n), c.mt = values(in, 3 * n);
-  c.slip = values(in, n), c.fn = values(in, n);
+  for (auto& s : c.slot) s = values(in, n);
+  c.fn = values(in, n);
   c.flags = indices<std::uint8_t>(in, n, 255);
   return c;
 }

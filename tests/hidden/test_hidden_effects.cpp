@@ -2,7 +2,8 @@
 /// specimen per pressure that the diagnosis never runs (packing seeds 100000 above the config's, cells of four
 /// times the balls; the file gives their void ratio and particle count, as a user would), adds lab-like
 /// noise (host/fit/diagnose.hpp, synthetic_tests) and writes only a measured-data file. The diagnosis reads that file,
-/// calibrates the base model on its own ensemble and must name the hidden effect, or none for the null case;
+/// calibrates the base model on its own ensemble and must name the hidden effect, or none for the null case and
+/// for an effect the data cannot show;
 /// where an effect was hidden, the extended model must lower the held-out misfit by the strong-evidence margin
 /// (kStrongEvidence). A case per extension (hertz among the long cases) and a null case, on the cheap simulator of
 /// tests/data/hidden_effects.toml (120 balls, an ensemble of two, the scatter measured on eight; about 500 runs a
@@ -33,6 +34,7 @@ struct HiddenCase {
   unsigned ensemble = 1;  ///< the diagnosis's first packing seed ([run] seed)
   bool auto_ensemble = false;  ///< the diagnosis chooses its ensemble and cell (the default of a user's config)
   Real noise = 1;              ///< the data's lab-like noise times this (0: as precise as a simulation)
+  std::string verdict = extension;  ///< the verdict the data allow: "none" where they cannot show the effect
 };
 
 void PrintTo(const HiddenCase& c, std::ostream* os) {
@@ -66,16 +68,16 @@ TEST_P(HiddenEffect, DiagnosisNamesIt) {
   std::printf("hidden %s (ensemble seed %u): verdict %s. %s\n", c.extension.c_str(), c.ensemble, dg.verdict.c_str(),
               dg.explanation.c_str());
   for (const ExtensionFit& f : dg.fits) std::printf("  %s: %s\n", f.ext.name.c_str(), f.reason.c_str());
-  EXPECT_EQ(dg.verdict, c.extension) << dg.explanation;
+  EXPECT_EQ(dg.verdict, c.verdict) << dg.explanation;
   // What the report claims, asserted: the named extension lowers both BIC and the held-out chi2 by the strong-
   // evidence margin; with none named, no extension does both.
   for (const ExtensionFit& f : dg.fits) {
     const Real bic_gain = dg.base_bic - f.bic, heldout_gain = dg.base_heldout - f.heldout;
-    if (f.ext.name == c.extension) {
+    if (f.ext.name == c.verdict) {
       EXPECT_GE(bic_gain, kStrongEvidence) << f.ext.name << ": BIC " << dg.base_bic << " -> " << f.bic;
       EXPECT_GE(heldout_gain, kStrongEvidence) << f.ext.name << ": held-out chi2 " << dg.base_heldout << " -> "
                                                << f.heldout;
-    } else if (c.extension == "none") {
+    } else if (c.verdict == "none") {
       EXPECT_FALSE(bic_gain >= kStrongEvidence && heldout_gain >= kStrongEvidence)
           << f.ext.name << " passes both tests on null data: BIC gain " << bic_gain
           << ", held-out gain " << heldout_gain;
@@ -98,6 +100,19 @@ INSTANTIATE_TEST_SUITE_P(OneCasePerExtension, HiddenEffect, ::testing::Values(Hi
 INSTANTIATE_TEST_SUITE_P(LongOneCasePerExtension, HiddenEffect,
                          ::testing::Values(HiddenCase{"hertz", 3e-3, 1}, HiddenCase{"none", 0, 1}),
                          [](const ::testing::TestParamInfo<HiddenCase>& i) { return i.param.extension; });
+
+// Twisting resistance at the top of its range (a spin moment capped at 0.2 Rbar Fn: q_peak 32% above the base law's
+// in the reference cell, tests/reference/periodic_extensions.csv) cannot be shown by triaxial curves: a slightly
+// larger mu_r gives the same curves, so the base calibration fits its data within noise (chi2 16.8 on 60 data with
+// lab-like noise, 10.2 with none), and the fit with twist freed ends at the base point. The data allow no name, and
+// the diagnosis must give none: neither twist nor a wrong extension. Both noise levels; long cases (about 5 minutes
+// each on 2 cores).
+INSTANTIATE_TEST_SUITE_P(LongNotIdentifiable, HiddenEffect,
+                         ::testing::Values(HiddenCase{"twist", 0.2, 1, 1, false, 1, "none"},
+                                           HiddenCase{"twist", 0.2, 1, 1, false, 0, "none"}),
+                         [](const ::testing::TestParamInfo<HiddenCase>& i) {
+                           return i.param.extension + (i.param.noise == 0 ? "_precise" : "_lab");
+                         });
 
 // The verdict must not hinge on the ensemble: the same data, diagnosed by an ensemble of other specimens
 // (packing seeds 11, 12, ... instead of 1, 2, ...), give the same verdict. A long case (ctest -L long, about 2
