@@ -1,7 +1,7 @@
 #!/usr/bin/python3
-"""Layers.IncludesGoOnlyDownward: every project include in kernels/ and host/<layer>/ names a file of its own
+"""Layers.IncludesGoOnlyDownward: every project include in kernels/<layer>/ and host/<layer>/ names a file of its own
 layer or of one below it, in the order CMake builds them (BUILD/layers.txt, from TRIAXDEM_LAYERS in
-CMakeLists.txt), and spells it from the source root ("host/<layer>/<file>" or "kernels/<file>"); a header the
+CMakeLists.txt), and spells it from the source root ("host/<layer>/<file>" or "kernels/<layer>/<file>"); a header the
 build generates is left alone. Prints each
 offending include with its file and line, and the layer order.
 
@@ -17,8 +17,8 @@ INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"')
 
 def layer_of(path):
     parts = path.split("/")
-    if parts[0] == "kernels":
-        return "kernels"
+    if parts[0] == "kernels" and len(parts) == 3:
+        return "kernels/" + parts[1]
     if parts[0] == "host" and len(parts) == 3:
         return parts[1]
     return None
@@ -32,9 +32,10 @@ def main():
         order = [line.strip() for line in f if line.strip()]
     rank = {name: k for k, name in enumerate(order)}
     bad = []
-    stray = sorted(os.path.relpath(p, src) for p in glob.glob(os.path.join(src, "host", "*.[ch]pp")))
-    bad += [f"{p}: outside every layer (host/<layer>/)" for p in stray]
-    files = glob.glob(os.path.join(src, "kernels", "*.[ch]pp")) + glob.glob(os.path.join(src, "host", "*", "*.[ch]pp"))
+    stray = sorted(os.path.relpath(p, src) for top in ("host", "kernels")
+                   for p in glob.glob(os.path.join(src, top, "*.[ch]pp")))
+    bad += [f"{p}: outside every layer ({p.split('/')[0]}/<layer>/)" for p in stray]
+    files = glob.glob(os.path.join(src, "kernels", "*", "*.[ch]pp")) + glob.glob(os.path.join(src, "host", "*", "*.[ch]pp"))
     ours = {os.path.basename(p) for p in files}
     for path in sorted(files):
         rel = os.path.relpath(path, src)
@@ -53,7 +54,7 @@ def main():
                 theirs = layer_of(name)
                 if theirs is None or not os.path.exists(os.path.join(src, name)):
                     bad.append(f"{rel}:{n}: \"{name}\" is not spelled from the source root (host/<layer>/<file> or "
-                               "kernels/<file>)")
+                               "kernels/<layer>/<file>)")
                 elif rank.get(theirs, len(order)) > rank[mine]:
                     bad.append(f"{rel}:{n}: includes {name}: layer {theirs} lies above {mine}")
     if bad:

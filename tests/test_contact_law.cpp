@@ -1,4 +1,4 @@
-/// Unit tests of the rrlinear contact law parts (kernels/contact_law.hpp), evaluated on the host as
+/// Unit tests of the rrlinear contact law parts (kernels/contact/contact_law.hpp), evaluated on the host as
 /// plain structs: no Simulation, no time loop. Expected values come from the PFC formulas
 /// (kn = pi r^2 E*/L, ks = kn/kratio, |Fs| <= mu_s Fn, kr = ks Rbar^2, |Mr| <= mu_r Rbar Fn), written
 /// out independently here.
@@ -13,10 +13,10 @@
 
 #include "host/engine/builder.hpp"
 #include "test_util.hpp"
-#include "kernels/contact_force.hpp"
-#include "kernels/contact_law.hpp"
-#include "kernels/det_math.hpp"
-#include "kernels/vec3.hpp"
+#include "kernels/contact/contact_force.hpp"
+#include "kernels/contact/contact_law.hpp"
+#include "kernels/core/det_math.hpp"
+#include "kernels/core/vec3.hpp"
 
 using namespace dem;
 

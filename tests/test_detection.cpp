@@ -13,9 +13,9 @@
 
 #include "host/engine/builder.hpp"
 #include "host/engine/simulation.hpp"
-#include "kernels/binning.hpp"
-#include "kernels/contact_detect.hpp"
-#include "kernels/history_remap.hpp"
+#include "kernels/neighbor/binning.hpp"
+#include "kernels/neighbor/contact_detect.hpp"
+#include "kernels/neighbor/history_remap.hpp"
 
 using namespace dem;
 

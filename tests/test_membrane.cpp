@@ -14,7 +14,7 @@
 
 #include "host/engine/builder.hpp"
 #include "host/engine/membrane_mesh.hpp"
-#include "kernels/accumulate.hpp"
+#include "kernels/contact/accumulate.hpp"
 
 using namespace dem;
 
@@ -495,7 +495,7 @@ TEST(MembraneIntegrate, InflatedTubeRelaxesToHoopEquilibrium) {
 // shared memory concurrently (an atomic add would make the sums' order, and so their bits, depend on timing).
 TEST(MembraneDeterminism, KernelsGatherWithoutAtomics) {
   // The kernels gather; nothing in them may add into shared memory concurrently.
-  for (const char* file : {"/kernels/membrane.cpp", "/kernels/membrane.hpp"}) {
+  for (const char* file : {"/kernels/motion/membrane.cpp", "/kernels/motion/membrane.hpp"}) {
     std::ifstream in(std::string(TRIAXDEM_SOURCE_DIR) + file);
     ASSERT_TRUE(in.good()) << file;
     std::stringstream ss;

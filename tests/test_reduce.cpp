@@ -1,4 +1,4 @@
-/// The deterministic reductions (kernels/reduce.hpp): the documented tree to the bit, on every level count, with
+/// The deterministic reductions (kernels/core/reduce.hpp): the documented tree to the bit, on every level count, with
 /// maxima alongside, and the W-lane item functions giving what one item at a time gives.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-/// The ball-ball force kernel evaluates kContactLanes contacts side by side (kernels/simd.hpp). These tests hold it
+/// The ball-ball force kernel evaluates kContactLanes contacts side by side (kernels/core/simd.hpp). These tests hold it
 /// to what makes that safe: a lane gives the bits of the scalar law (the build fuses no multiply-add, so both round
 /// every operation alike), whatever its neighbours in the pack are doing, and the kernel's result for a contact does
 /// not depend on which lane or pack it falls in. Comparisons are exact: any difference is a lane mixed up or a
@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "host/engine/builder.hpp"
-#include "kernels/contact_force.hpp"
-#include "kernels/integrate.hpp"
+#include "kernels/contact/contact_force.hpp"
+#include "kernels/motion/integrate.hpp"
 #include "test_util.hpp"
 #include "tree_sum.hpp"
 
@@ -261,7 +261,7 @@ TEST(SimdLanes, KernelResultDoesNotDependOnLaneOrPackMates) {
   for (std::size_t q = 0; q < touching.size(); ++q) expect_same_contact(r, q, ref, touching_at[q], "touching only");
 }
 
-/// The leapfrog of one particle as the scalar code spells it (kernels/integrate.hpp before the lanes), for the
+/// The leapfrog of one particle as the scalar code spells it (kernels/motion/integrate.hpp before the lanes), for the
 /// reference of the test below. The forces are summed as the gather sums them: the owner's side of its contacts in
 /// key order, then the reactions of the others in contact order.
 struct ScalarStep {

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "host/config/config.hpp"
-#include "kernels/contact_law.hpp"
+#include "kernels/contact/contact_law.hpp"
 
 namespace dem::test {
 

@@ -31,7 +31,7 @@ PeriodicTriaxialParams quiet() {
 
 // A simple cubic lattice of n^3 balls of radius r between the walls, compressed isotropically: every column of n
 // balls carries F = sigma3 L^2 / n^2 through n - 1 ball-ball springs of kn = pi r E / 2 and two ball-wall springs of
-// pi r E (kernels/contact_law.hpp: pi r^2 E / (r1 + r2), r1 at a wall), so L = 2 n r - F ((n - 1) / kn + 2 / kw),
+// pi r E (kernels/contact/contact_law.hpp: pi r^2 E / (r1 + r2), r1 at a wall), so L = 2 n r - F ((n - 1) / kn + 2 / kw),
 // solved with F by fixed-point iteration. The servo stops within stress_tolerance (0.5%) of sigma3, so each side
 // lies within 0.5% of the lattice's compression of the analytic length (0.6% allowed for the last step's drift).
 // The servo's stiffness is the walls' exactly: n^2 kw on a wall, K = n^2 kw L / (2 L^2). Rates set are rates read,

@@ -1,9 +1,9 @@
 #pragma once
-/// The deterministic reductions' tree (kernels/reduce.hpp) written out plainly on the host, from its description
+/// The deterministic reductions' tree (kernels/core/reduce.hpp) written out plainly on the host, from its description
 /// alone: what a device reduction must give to the bit.
 #include <vector>
 
-#include "kernels/reduce.hpp"
+#include "kernels/core/reduce.hpp"
 
 namespace dem::test {
 

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "kernels/contact_params.hpp"
+#include "kernels/core/contact_params.hpp"
 
 namespace dem {
 

@@ -3,12 +3,12 @@
 /// diagnosis tries, described once: its key, unit, the config's allowed range, the range a calibration searches,
 /// and for a model extension what the diagnosis needs (its name, the strengths it tries, its signature in words).
 /// The config reader, `--free`, the diagnosis and the help all read this table, so a new parameter or extension is
-/// one row here (and its physics in kernels/contact_law.hpp).
+/// one row here (and its physics in kernels/contact/contact_law.hpp).
 #include <array>
 #include <string>
 #include <vector>
 
-#include "kernels/contact_params.hpp"
+#include "kernels/core/contact_params.hpp"
 
 namespace dem {
 

@@ -5,7 +5,7 @@
 #include <array>
 #include <string>
 
-#include "kernels/real.hpp"
+#include "kernels/core/real.hpp"
 
 namespace dem {
 

@@ -32,7 +32,7 @@
 #include <string>
 #include <vector>
 
-#include "kernels/vec3.hpp"
+#include "kernels/core/vec3.hpp"
 
 namespace dem {
 

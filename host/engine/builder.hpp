@@ -2,8 +2,8 @@
 /// Host-side construction of device state: particles, walls and facet meshes from plain vectors.
 #include <vector>
 
-#include "kernels/particles.hpp"
-#include "kernels/walls.hpp"
+#include "kernels/core/particles.hpp"
+#include "kernels/core/walls.hpp"
 
 namespace dem {
 

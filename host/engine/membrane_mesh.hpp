@@ -3,7 +3,7 @@
 /// 20 segments in height), and its device state.
 #include <vector>
 
-#include "kernels/membrane.hpp"
+#include "kernels/motion/membrane.hpp"
 
 namespace dem {
 

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "host/io/io_hdf5.hpp"
-#include "kernels/vec3.hpp"
+#include "kernels/core/vec3.hpp"
 
 namespace dem {
 

@@ -4,7 +4,7 @@
 /// stiffness of the contacts it pushes on:
 ///   v = G (sigma_target - sigma),   G = relax * A / (k_n N_c dt),   |v| <= v_max
 /// (positive v moves the wall into the specimen). With no contacts the wall approaches at v_max.
-#include "kernels/vec3.hpp"
+#include "kernels/core/vec3.hpp"
 
 namespace dem {
 

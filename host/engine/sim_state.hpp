@@ -8,8 +8,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "kernels/domain.hpp"
-#include "kernels/integrate.hpp"
+#include "kernels/core/domain.hpp"
+#include "kernels/motion/integrate.hpp"
 
 namespace dem {
 

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <sstream>
 
-#include "kernels/history_remap.hpp"
-#include "kernels/reduce.hpp"
+#include "kernels/neighbor/history_remap.hpp"
+#include "kernels/core/reduce.hpp"
 
 namespace dem {
 

@@ -6,12 +6,12 @@
 #include <string>
 #include <vector>
 
-#include "kernels/accumulate.hpp"
-#include "kernels/binning.hpp"
-#include "kernels/contact_detect.hpp"
-#include "kernels/contact_force.hpp"
-#include "kernels/integrate.hpp"
-#include "kernels/membrane.hpp"
+#include "kernels/contact/accumulate.hpp"
+#include "kernels/neighbor/binning.hpp"
+#include "kernels/neighbor/contact_detect.hpp"
+#include "kernels/contact/contact_force.hpp"
+#include "kernels/motion/integrate.hpp"
+#include "kernels/motion/membrane.hpp"
 #include "host/engine/sim_state.hpp"
 
 namespace dem {

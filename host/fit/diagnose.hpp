@@ -4,7 +4,7 @@
 ///
 /// 1. The base model (free: mu_s, mu_r by default) is calibrated (host/fit/calibrate.hpp).
 /// 2. Each extension (Hertz-Mindlin stiffness, rough-surface compliance, slip-weakening friction, membrane
-///    confinement; kernels/contact_law.hpp, host/triax/periodic_triaxial.hpp) is run at the base optimum at three
+///    confinement; kernels/contact/contact_law.hpp, host/triax/periodic_triaxial.hpp) is run at the base optimum at three
 ///    strengths within its physical range. Its residuals are modelled as the base model's response surface
 ///    plus the extension's effect there, interpolated between the strengths (off, 1, 2, 3); the joint optimum
 ///    over the base parameters and the strength is run, the surrogate corrected by what the run shows, and

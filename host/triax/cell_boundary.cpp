@@ -1,6 +1,6 @@
 #include "host/triax/cell_boundary.hpp"
 
-#include "kernels/reduce.hpp"
+#include "kernels/core/reduce.hpp"
 #include "host/engine/packing.hpp"
 #include "host/triax/periodic_triaxial.hpp"
 #include "host/engine/simulation.hpp"

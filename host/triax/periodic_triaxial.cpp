@@ -13,7 +13,7 @@
 
 #include "host/triax/cell_boundary.hpp"
 #include "host/data/measured.hpp"
-#include "kernels/reduce.hpp"
+#include "kernels/core/reduce.hpp"
 #include "host/engine/setup.hpp"
 #include "host/util/progress.hpp"
 

@@ -7,7 +7,7 @@
 
 #include "host/io/io_hdf5.hpp"
 #include "host/engine/micro.hpp"
-#include "kernels/membrane.hpp"
+#include "kernels/motion/membrane.hpp"
 
 namespace dem {
 

@@ -30,7 +30,7 @@ this installation):
       R = r1 r2/(r1+r2), Fn = kno un^1.5 with kno = 4/3 E* sqrt(R), ks = kso sqrt(un), kso = 2 sqrt(4R) G/(2-v),
       kr = krot (constant), maxBendPl = eta * (r1+r2)/2, Law2_ScGeom_MindlinPhys_Mindlin(includeMoment)
       caps |M_bend| <= maxBendPl |Fn|.
-triaxdem (kernels/contact_law.hpp): kn = pi r^2 E / (r1+r2), ks = kn/1.5, kr = ks Rbar^2, Rbar = r1 r2/(r1+r2),
+triaxdem (kernels/contact/contact_law.hpp): kn = pi r^2 E / (r1+r2), ks = kn/1.5, kr = ks Rbar^2, Rbar = r1 r2/(r1+r2),
 |M| <= mu_r Rbar Fn.  Hence for equal spheres (r = 1 mm, Rbar = r/2):
   linear: young = pi E / 2 (E = 1e8), poisson = 1/1.5, alphaKr = 1/4 (kr identical), etaRoll = mu_r / 2.
   hertz:  mu_r(triaxdem) = eta * r / Rbar = 2 eta; ks/kt = 2(1-v)/(2-v) equals triaxdem's 1/1.5 for v = 0.5.

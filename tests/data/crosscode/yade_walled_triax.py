@@ -45,7 +45,7 @@ POISSON = 1.0 / KRATIO
 ALPHA_KR = RBAR ** 2 / (R * R)
 ETA_ROLL = MU_R * RBAR / R
 # YADE's ball-wall kn = 2 Ew E r / (Ew + E) (measured: E r with Ew = E); triaxdem's is pi E_triax r = 2 E r (a wall
-# counts as a ball of the same radius against a flat, kernels/contact_law.hpp): stiff walls take YADE to 0.9999 of it.
+# counts as a ball of the same radius against a flat, kernels/contact/contact_law.hpp): stiff walls take YADE to 0.9999 of it.
 WALL_YOUNG = 1e4 * YOUNG
 
 from yade import pack, utils

@@ -5,9 +5,9 @@
 #include <cstring>
 #include <type_traits>
 
-#include "kernels/det_math.hpp"
-#include "kernels/simd.hpp"
-#include "kernels/types.hpp"
+#include "kernels/core/det_math.hpp"
+#include "kernels/core/simd.hpp"
+#include "kernels/core/types.hpp"
 
 namespace dem {
 namespace kc {

@@ -1,4 +1,4 @@
-#include "kernels/history_remap.hpp"
+#include "kernels/neighbor/history_remap.hpp"
 
 namespace dem {
 

@@ -7,8 +7,8 @@
 /// halving tree, past-the-end items as zeros); the block results are items of the next level, until one is left.
 /// A GPU reduces a block with a team of B threads in shared memory, a CPU with one thread in a loop: the same
 /// operations on the same operands, so the same bits, and every item is computed by its own thread on a GPU.
-#include "kernels/simd.hpp"
-#include "kernels/types.hpp"
+#include "kernels/core/simd.hpp"
+#include "kernels/core/types.hpp"
 
 namespace dem {
 

@@ -1,4 +1,4 @@
-#include "kernels/binning.hpp"
+#include "kernels/neighbor/binning.hpp"
 
 #include <cmath>
 #include <stdexcept>

@@ -1,7 +1,7 @@
 #pragma once
 /// The parameters of a material pair's contact law (contact_law.hpp). Free of Kokkos, so that the config reader,
 /// which a CUDA build compiles with the host compiler (CMakeLists.txt), can fill them.
-#include "kernels/real.hpp"
+#include "kernels/core/real.hpp"
 
 namespace dem {
 

@@ -2,7 +2,7 @@
 /// Rigid analytic walls (planes, discs, the inner face of a cylinder) and triangle facets (membrane).
 /// Every wall answers one question for a ball centre x: the closest point of its surface on the
 /// ball's side, from which the contact normal and overlap follow exactly as for two balls.
-#include "kernels/vec3.hpp"
+#include "kernels/core/vec3.hpp"
 
 namespace dem {
 

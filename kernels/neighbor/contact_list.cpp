@@ -1,4 +1,4 @@
-#include "kernels/contact_list.hpp"
+#include "kernels/neighbor/contact_list.hpp"
 
 #include <Kokkos_Sort.hpp>
 

@@ -9,9 +9,9 @@
 /// never changes), so node forces are bit-for-bit the same for any thread count.
 #include <vector>
 
-#include "kernels/contact_list.hpp"
-#include "kernels/vec3.hpp"
-#include "kernels/walls.hpp"
+#include "kernels/neighbor/contact_list.hpp"
+#include "kernels/core/vec3.hpp"
+#include "kernels/core/walls.hpp"
 
 namespace dem {
 
@@ -72,7 +72,7 @@ void membrane_contact_forces(const Membrane& m, const FacetContacts& fc, Vec3Vie
 /// minus their sum is what the platens carry through the tied rings (for the axial force balance).
 void membrane_forces(const Membrane& m, Real p, const FacetContacts& fc, Vec3View& out);
 
-/// Node integration parameters (same scheme as kernels/integrate.hpp).
+/// Node integration parameters (same scheme as kernels/motion/integrate.hpp).
 struct MembraneIntegrateParams {
   Vec3 gravity;            ///< m/s^2 (usually zero: the membrane's weight is negligible)
   Real alpha = 0.7;        ///< local damping coefficient

@@ -1,10 +1,10 @@
-#include "kernels/membrane.hpp"
+#include "kernels/motion/membrane.hpp"
 
 #include <stdexcept>
 #include <string>
 
-#include "kernels/integrate.hpp"  // damped: the same damping law as the balls
-#include "kernels/reduce.hpp"
+#include "kernels/motion/integrate.hpp"  // damped: the same damping law as the balls
+#include "kernels/core/reduce.hpp"
 
 // Elasticity choice: total Lagrangian CST with the Green-Lagrange strain and a St. Venant-Kirchhoff
 // plane-stress law, rather than a co-rotational small-strain CST, because

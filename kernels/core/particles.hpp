@@ -1,7 +1,7 @@
 #pragma once
 /// Particle state in structure-of-arrays Views. Everything that moves with a particle when the
 /// particles are re-sorted by cell lives here, so a permutation touches one place.
-#include "kernels/types.hpp"
+#include "kernels/core/types.hpp"
 
 namespace dem {
 

@@ -2,8 +2,8 @@
 /// Carries contact history across a rebuild: each new key looks itself up among the previous sorted
 /// keys (binary search) and takes that contact's shear force, rolling moment and flags; new contacts
 /// start from zero. Keys are global ids, so re-sorting particles never loses history.
-#include "kernels/contact_list.hpp"
-#include "kernels/particles.hpp"
+#include "kernels/neighbor/contact_list.hpp"
+#include "kernels/core/particles.hpp"
 
 namespace dem {
 

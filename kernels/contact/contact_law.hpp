@@ -36,8 +36,8 @@
 ///     LAMMPS `twisting marshall` ties both to the contact radius a instead (k_tw = ks a^2 / 2, cap 2/3 a mu_s
 ///     Fn), which makes it negligible for stiff spheres; a free coefficient stands for rough or flattened
 ///     contacts. The moment is a scalar about n (slot kTwistSlot), so a turning contact plane carries it as is.
-#include "kernels/contact_params.hpp"
-#include "kernels/vec3.hpp"
+#include "kernels/core/contact_params.hpp"
+#include "kernels/core/vec3.hpp"
 
 namespace dem {
 

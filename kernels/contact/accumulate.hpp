@@ -6,9 +6,9 @@
 ///  - every particle then sums, inside integration (Gather), the owner's side of the contacts it owns in key
 ///    order, the reactions of the contacts it does not own and its wall contacts, through particle -> contact
 ///    lists sorted by contact index.
-#include "kernels/contact_list.hpp"
-#include "kernels/particles.hpp"
-#include "kernels/vec3.hpp"
+#include "kernels/neighbor/contact_list.hpp"
+#include "kernels/core/particles.hpp"
+#include "kernels/core/vec3.hpp"
 
 namespace dem {
 

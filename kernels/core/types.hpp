@@ -4,7 +4,7 @@
 #include <Kokkos_Core.hpp>
 #include <cstdint>
 
-#include "kernels/contact_params.hpp"
+#include "kernels/core/contact_params.hpp"
 
 namespace dem {
 

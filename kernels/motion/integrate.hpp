@@ -4,9 +4,9 @@
 ///   taken about a mean flow, IntegrateParams::about_flow),
 ///   v(t + dt/2) = v(t - dt/2) + (F + F_d) / m dt,   x(t + dt) = x(t) + v(t + dt/2) dt.
 /// Density scaling multiplies inertial mass and moment of inertia (not weight) by `mass_scale`.
-#include "kernels/accumulate.hpp"
-#include "kernels/particles.hpp"
-#include "kernels/vec3.hpp"
+#include "kernels/contact/accumulate.hpp"
+#include "kernels/core/particles.hpp"
+#include "kernels/core/vec3.hpp"
 
 namespace dem {
 

@@ -1,6 +1,6 @@
-#include "kernels/contact_force.hpp"
+#include "kernels/contact/contact_force.hpp"
 
-#include "kernels/contact_detect.hpp"
+#include "kernels/neighbor/contact_detect.hpp"
 
 namespace dem {
 

@@ -3,7 +3,7 @@
 /// contact, sorted by key. Ball-ball key: min_gid << 32 | max_gid. Ball-wall key: object << 32 | gid,
 /// where object numbers the analytic walls first, then the facets; sorting by it groups each wall's
 /// contacts, so wall forces are summed in a fixed order.
-#include "kernels/types.hpp"
+#include "kernels/core/types.hpp"
 
 namespace dem {
 

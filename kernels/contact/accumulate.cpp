@@ -1,4 +1,4 @@
-#include "kernels/accumulate.hpp"
+#include "kernels/contact/accumulate.hpp"
 
 namespace dem {
 

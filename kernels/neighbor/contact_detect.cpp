@@ -1,4 +1,4 @@
-#include "kernels/contact_detect.hpp"
+#include "kernels/neighbor/contact_detect.hpp"
 
 #include <algorithm>
 #include <vector>

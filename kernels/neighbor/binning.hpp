@@ -1,8 +1,8 @@
 #pragma once
 /// Cell list by counting sort. Particles are re-sorted by cell (memory locality), ties broken by
 /// global id so that the order, and everything computed from it, is the same for any thread count.
-#include "kernels/domain.hpp"
-#include "kernels/particles.hpp"
+#include "kernels/core/domain.hpp"
+#include "kernels/core/particles.hpp"
 
 namespace dem {
 

@@ -6,8 +6,8 @@
 /// result is bit for bit the Real one, given that the build fuses no multiply-add (tests/test_simd_lanes.cpp checks it).
 ///
 /// GPUs take one contact per thread (kContactLanes = 1): T is then Real and nothing here is used.
-#include "kernels/det_math.hpp"
-#include "kernels/types.hpp"
+#include "kernels/core/det_math.hpp"
+#include "kernels/core/types.hpp"
 
 #include <type_traits>
 

@@ -1,6 +1,6 @@
-#include "kernels/integrate.hpp"
+#include "kernels/motion/integrate.hpp"
 
-#include "kernels/reduce.hpp"
+#include "kernels/core/reduce.hpp"
 
 namespace dem {
 

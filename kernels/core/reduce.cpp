@@ -1,4 +1,4 @@
-#include "kernels/reduce.hpp"
+#include "kernels/core/reduce.hpp"
 
 namespace dem {
 

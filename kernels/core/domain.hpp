@@ -1,6 +1,6 @@
 #pragma once
 /// The simulation box: bounds and which axes are periodic. Non-periodic axes are open (walls confine).
-#include "kernels/vec3.hpp"
+#include "kernels/core/vec3.hpp"
 
 namespace dem {
 

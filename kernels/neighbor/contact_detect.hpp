@@ -1,9 +1,9 @@
 #pragma once
 /// Candidate contacts by count -> exclusive scan -> fill -> sort: no guessed capacity, no retry loop,
 /// and the sorted keys make the order independent of threads.
-#include "kernels/binning.hpp"
-#include "kernels/contact_list.hpp"
-#include "kernels/walls.hpp"
+#include "kernels/neighbor/binning.hpp"
+#include "kernels/neighbor/contact_list.hpp"
+#include "kernels/core/walls.hpp"
 
 namespace dem {
 

@@ -1,4 +1,4 @@
-#include "kernels/particles.hpp"
+#include "kernels/core/particles.hpp"
 
 namespace dem {
 

@@ -1,10 +1,10 @@
 #pragma once
 /// Contact force kernels: geometry and kinematics of each candidate contact, then the contact law.
 /// Candidates that do not touch get zero force and lose their history (the contact opened).
-#include "kernels/accumulate.hpp"
-#include "kernels/contact_law.hpp"
-#include "kernels/domain.hpp"
-#include "kernels/walls.hpp"
+#include "kernels/contact/accumulate.hpp"
+#include "kernels/contact/contact_law.hpp"
+#include "kernels/core/domain.hpp"
+#include "kernels/core/walls.hpp"
 
 namespace dem {
 
