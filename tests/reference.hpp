@@ -9,8 +9,8 @@
 /// When a deliberate change moves the bits (another summation order, a new kernel), the bits rows are rewritten
 /// and the scatter rows stay: the new code must still give, on a specimen it was not fitted to, what the old
 /// code's population gave. Regenerating:
-///   TRIAXDEM_WRITE_REFERENCE=bits build/tests/triaxdem_tests --gtest_filter='Reference.*'   (bits rows only)
-///   TRIAXDEM_WRITE_REFERENCE=all  build/tests/triaxdem_tests --gtest_filter='Reference.*'   (also the scatter)
+///   TRIAXDEM_WRITE_REFERENCE=bits build/tests/triaxdem_tests_fit --gtest_filter='Reference.*'   (bits rows only)
+///   TRIAXDEM_WRITE_REFERENCE=all  build/tests/triaxdem_tests_fit --gtest_filter='Reference.*'   (also the scatter)
 /// Without the variable a missing file, a missing or extra key, or a value beyond its tolerance fails the test,
 /// naming the file and the key; nothing is ever rewritten then.
 #include <gtest/gtest.h>
@@ -85,7 +85,7 @@ inline void write_rows(const std::string& path, const std::string& stem, const s
     out << "# triaxdem reference results: " << stem << " (tests/reference.hpp, docs/testing.md).\n"
         << "# bits: the value at packing seed 1, reproduced exactly. scatterN: the mean over seeds 2..N+1, and a 99%\n"
         << "# prediction interval for one more specimen, checked on seed 1.\n"
-        << "# Regenerate: TRIAXDEM_WRITE_REFERENCE=bits|all build/tests/triaxdem_tests --gtest_filter='Reference.*'\n"
+        << "# Regenerate: TRIAXDEM_WRITE_REFERENCE=bits|all build/tests/triaxdem_tests_fit --gtest_filter='Reference.*'\n"
         << "quantity,basis,value,tolerance\n";
     char buf[96];
     for (const Row& r : rows) {
@@ -143,7 +143,7 @@ inline void check_reference(const ReferenceCase& run, const std::map<std::string
     }
     const std::vector<Row> rows = read_rows(path);
     ASSERT_FALSE(rows.empty()) << path << ": missing or empty; make it with TRIAXDEM_WRITE_REFERENCE=all "
-                               << "build/tests/triaxdem_tests --gtest_filter='Reference.*' (docs/testing.md)";
+                               << "build/tests/triaxdem_tests_fit --gtest_filter='Reference.*' (docs/testing.md)";
     std::set<std::string> bits_keys, scatter_keys;
     for (const Row& r : rows) {
       if (r.basis == scatter_basis) scatter_keys.insert(r.quantity);
