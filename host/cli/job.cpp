@@ -10,6 +10,7 @@
 #include "host/engine/checkpoint.hpp"
 #include "host/engine/packing.hpp"
 #include "host/engine/setup.hpp"
+#include "host/engine/stage_loop.hpp"
 #include "host/triax/specimen.hpp"
 #include "host/util/progress.hpp"
 #include "host/triax/triaxial.hpp"
@@ -47,42 +48,45 @@ int run_job(const Config& cfg, bool resume, long stop_at_step) {
   CheckpointPlan plan{ckpt, CheckpointClock(cfg.run.checkpoint_every, cfg.run.checkpoint_minutes), nullptr,
                       stop_at_step, cfg.fingerprint};
   StopSignals signals;
-  try {
-    for (long s = sim->step_count() + 1; s <= cfg.run.steps; ++s) {
-      const bool record_now = s % cfg.run.series_every == 0;
-      sim->step(record_now);
-      if (record_now) {
-        const auto [ratio, ball_contacts] = record();
-        char extra[96];
-        std::snprintf(extra, sizeof extra, "KE %.3e J, unbalanced %.2e", sim->stats().kinetic, ratio);
-        progress.update(s, extra);
-        if (ratio < cfg.run.stop_ratio && ball_contacts > 0) {
-          std::printf("\nunbalanced-force ratio below %g at step %ld: equilibrium reached\n", cfg.run.stop_ratio, s);
-          break;
-        }
-      }
-      if (cfg.run.snapshot_every > 0 && s % cfg.run.snapshot_every == 0 && s != cfg.run.steps)
-        out.write_snapshot(take_snapshot(*sim, "step " + std::to_string(s)));
-      // The series is flushed with every checkpoint, so that a killed run's files agree with its checkpoint.
-      if (plan.due(s)) {
-        out.flush_series();
-        write_checkpoint(ckpt, checkpoint_of("run", *sim, &out, cfg.fingerprint));
-        plan.clock.written();
-      }
-      if (plan.stop(s)) {
-        const RunStopped stopped = run_stopped(plan, s);
-        std::printf("\ntriaxdem: %s\n", stopped.what());
-        return stopped.code;
+  StageSteps run;
+  run.first = sim->step_count() + 1;
+  run.last = cfg.run.steps;
+  run.before = [&](long s) { return StepPlan{false, s % cfg.run.series_every == 0}; };
+  run.after = [&](long s) {
+    if (s % cfg.run.series_every == 0) {
+      const auto [ratio, ball_contacts] = record();
+      char extra[96];
+      std::snprintf(extra, sizeof extra, "KE %.3e J, unbalanced %.2e", sim->stats().kinetic, ratio);
+      progress.update(s, extra);
+      if (ratio < cfg.run.stop_ratio && ball_contacts > 0) {
+        std::printf("\nunbalanced-force ratio below %g at step %ld: equilibrium reached\n", cfg.run.stop_ratio, s);
+        return true;
       }
     }
-  } catch (const BlowUp& e) {
+    if (cfg.run.snapshot_every > 0 && s % cfg.run.snapshot_every == 0 && s != cfg.run.steps)
+      out.write_snapshot(take_snapshot(*sim, "step " + std::to_string(s)));
+    return false;
+  };
+  // The series is flushed with every checkpoint, so that a killed run's files agree with its checkpoint.
+  run.checkpoint = [&](long) {
+    out.flush_series();
+    write_checkpoint(ckpt, checkpoint_of("run", *sim, &out, cfg.fingerprint));
+  };
+  run.save_blowup = [&] {
     out.flush_series();
     out.write_snapshot(take_snapshot(*sim, "blow-up"));
     write_checkpoint(blowup_path(out.folder()), checkpoint_of("run", *sim, &out, cfg.fingerprint));
+  };
+  try {
+    run_stage(*sim, run, &plan);
+  } catch (const BlowUp& e) {
     std::fprintf(stderr, "\ntriaxdem: %s\n  state at the blow-up saved in %s (snapshot) and %s (for inspection); "
                  "the last good checkpoint, %s, continues with --resume once the cause is fixed\n",
                  e.what(), out.folder().c_str(), blowup_path(out.folder()).c_str(), ckpt.c_str());
     return 2;
+  } catch (const RunStopped& stopped) {
+    std::printf("\ntriaxdem: %s\n", stopped.what());
+    return stopped.code;
   }
   out.flush_series();
   out.write_snapshot(take_snapshot(*sim, "final"));

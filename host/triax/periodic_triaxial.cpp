@@ -1,7 +1,5 @@
 #include "host/triax/periodic_triaxial.hpp"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -15,6 +13,7 @@
 #include "host/data/measured.hpp"
 #include "kernels/core/reduce.hpp"
 #include "host/engine/setup.hpp"
+#include "host/engine/stage_loop.hpp"
 #include "host/util/progress.hpp"
 
 namespace dem {
@@ -201,15 +200,15 @@ long consolidate_isotropic(Simulation& sim, const PeriodicTriaxialParams& prm_in
   Progress progress(prm.name + " consolidation (ETA to the step cap)", prm.max_consolidation_steps);
   Real err = 0, ratio = 1;
   std::array<Real, 3> s{};
-  const auto t0 = std::chrono::steady_clock::now();
-  const bool tty = isatty(fileno(stdout)) != 0;
-  double next_log = 10;
-  for (long n = 1; n <= prm.max_consolidation_steps; ++n) {
+  StageSteps stage;
+  stage.last = prm.max_consolidation_steps;
+  stage.before = [&](long n) {
     const Real target[3] = {prm.sigma3, prm.sigma3, prm.sigma3};
     servo.update(sim, all, none, target);
-    const bool check = n % prm.check_every == 0;
-    sim.step(check);
-    if (!check) continue;
+    return StepPlan{false, n % prm.check_every == 0};
+  };
+  stage.after = [&](long n) {
+    if (n % prm.check_every != 0) return false;
     s = cell_stress(sim);
     err = 0;
     for (int d = 0; d < 3; ++d) err = std::max(err, std::fabs(s[d] - prm.sigma3) / prm.sigma3);
@@ -219,21 +218,15 @@ long consolidate_isotropic(Simulation& sim, const PeriodicTriaxialParams& prm_in
       std::snprintf(extra, sizeof extra, "p %.1f kPa, stress error %.2e, unbalanced %.2e",
                     1e-3 * (s[0] + s[1] + s[2]) / 3, err, ratio);
       progress.update(n, extra);
-      // The end of consolidation is not known in advance: logs get a line every 10 s besides the deciles.
-      const double now = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      if (!tty && now >= next_log) {
-        std::printf("%s consolidation: step %ld, %s\n", prm.name.c_str(), n, extra);
-        std::fflush(stdout);
-        next_log = now + 10;
-      }
     }
-    if (err < prm.stress_tolerance && ratio < prm.unbalanced_tolerance) {
-      set_cell_rates(sim, Vec3());
-      if (prm.verbose) progress.finish("(converged after " + std::to_string(n) + " steps)");
-      return n;
-    }
-  }
+    return err < prm.stress_tolerance && ratio < prm.unbalanced_tolerance;
+  };
+  const StageEnd end = run_stage(sim, stage, nullptr);
   set_cell_rates(sim, Vec3());
+  if (end.done) {
+    if (prm.verbose) progress.finish("(converged after " + std::to_string(end.step) + " steps)");
+    return end.step;
+  }
   std::ostringstream msg;
   msg << "periodic triaxial: isotropic consolidation to sigma3 = " << 1e-3 * prm.sigma3 << " kPa did not converge in "
       << prm.max_consolidation_steps << " steps: stresses (xx, yy, zz) = (" << 1e-3 * s[0] << ", " << 1e-3 * s[1]
@@ -326,15 +319,20 @@ PeriodicTriaxialResult run_periodic_triaxial(Simulation& sim, const PeriodicTria
   const long total = static_cast<long>(std::ceil(-std::log(1 - prm.target_strain) / (prm.axial_rate * dt)));
   Progress progress(prm.name + " shear", total);
   Real next_record = prm.record_strain;
-  for (long n = 1;; ++n) {
+  bool last = false, due = false;  // the step ends the test; the step is recorded
+  StageSteps stage;
+  stage.last = std::numeric_limits<long>::max();  // until the target strain
+  stage.before = [&](long) {
     const std::array<Real, 3> lengths = cell_lengths(sim);
     const std::array<Real, 3> target = lateral_targets(lengths, prm, L0);
     servo.update(sim, lateral, axial, target.data());
     const Real h = lengths[2];
     const Real eps_next = (res.h0 - h * (1 - prm.axial_rate * dt)) / res.h0;
-    const bool last = eps_next >= prm.target_strain;
-    const bool due = last || eps_next >= next_record - 1e-12;
-    sim.step(due);
+    last = eps_next >= prm.target_strain;
+    due = last || eps_next >= next_record - 1e-12;
+    return StepPlan{false, due};
+  };
+  stage.after = [&](long n) {
     if (due) {
       record();
       while (next_record <= res.series.back().eps_a + 1e-12) next_record += prm.record_strain;
@@ -348,8 +346,9 @@ PeriodicTriaxialResult run_periodic_triaxial(Simulation& sim, const PeriodicTria
       if (out && res.series.size() % 50 == 0) out->flush_series();
     }
     snapshot_due((res.h0 - cell_lengths(sim)[2]) / res.h0);
-    if (last) break;
-  }
+    return last;
+  };
+  run_stage(sim, stage, nullptr);
   set_cell_rates(sim, Vec3());
   if (out) out->flush_series();
 

@@ -16,6 +16,7 @@
 #include "host/util/progress.hpp"
 #include "host/engine/setup.hpp"
 #include "host/engine/simulation.hpp"
+#include "host/engine/stage_loop.hpp"
 
 namespace dem {
 
@@ -55,51 +56,53 @@ std::pair<long, Real> compact(Simulation& sim, Real z_target, const SpecimenConf
                               Progress* progress, const std::vector<ContactParams>* settle) {
   const long check_every = 200;
   const Real z_start = sim.wall_point(kTop).z;
-  long s = 0;
   Real ratio = 1, load = 0;  // load: mean platen contact force / f_limit
-  while (s < sc.max_steps_per_layer) {
-    const Real z = sim.wall_point(kTop).z;
+  Real z = z_start;          // the platen's height before the step
+  StageSteps layer;
+  layer.last = sc.max_steps_per_layer;
+  layer.before = [&](long n) {
+    z = sim.wall_point(kTop).z;
     const Real dt = sim.params().integ.dt;
-    if (s % 5 == 0) {
-      const int n = sim.wall_contact_counts()[kTop];
-      load = n > 0 ? std::fabs(sim.wall_forces()[kTop].z) / (n * f_limit) : 0;
+    if ((n - 1) % 5 == 0) {
+      const int touching = sim.wall_contact_counts()[kTop];
+      load = touching > 0 ? std::fabs(sim.wall_forces()[kTop].z) / (touching * f_limit) : 0;
     }
     const Real v = std::min(sc.platen_speed * std::clamp(1 - load, Real(0), Real(1)), (z - z_target) / dt);
     sim.set_wall_velocity(kTop, Vec3(0, 0, -std::max(v, Real(0))));
-    const bool measure = (s + 1) % check_every == 0;
-    sim.step(measure);
-    ++s;
-    if (measure) {
-      // A stop asked for here has no checkpoint to write: a half-built specimen is no state to resume.
-      if (StopSignals::requested())
-        throw RunStopped(std::string(StopSignals::name()) + " during the specimen build: nothing was stored, and "
-                         "the next run builds the specimen again", 128 + StopSignals::signal());
-      ratio = sim.unbalanced_ratio();
-      if (progress) {
-        // At its height the platen has no travel left to report, and the unbalanced ratio does not fall steadily
-        // enough to extrapolate: the line says what the layer waits for and the step cap that bounds it.
-        char extra[160];
-        if (z - z_target < 1e-9) {
-          std::snprintf(extra, sizeof extra, "platen at its height, settling until the unbalanced ratio is below "
-                        "%.0e (now %.1e), at most %ld steps more (the layer's step cap)", sc.stop_ratio, ratio,
-                        sc.max_steps_per_layer - s);
-          progress->settling(extra);
-        } else {
-          std::snprintf(extra, sizeof extra, "(um of platen travel), unbalanced ratio %.1e (stop at %.0e)", ratio,
-                        sc.stop_ratio);
-          progress->update(std::lround((z_start - z) * 1e6), extra);
-        }
+    return StepPlan{false, n % check_every == 0};
+  };
+  layer.after = [&](long n) {
+    if (n % check_every != 0) return false;
+    // A stop asked for here has no checkpoint to write: a half-built specimen is no state to resume.
+    if (StopSignals::requested())
+      throw RunStopped(std::string(StopSignals::name()) + " during the specimen build: nothing was stored, and "
+                       "the next run builds the specimen again", 128 + StopSignals::signal());
+    ratio = sim.unbalanced_ratio();
+    if (progress) {
+      // At its height the platen has no travel left to report, and the unbalanced ratio does not fall steadily
+      // enough to extrapolate: the line says what the layer waits for and the step cap that bounds it.
+      char extra[160];
+      if (z - z_target < 1e-9) {
+        std::snprintf(extra, sizeof extra, "platen at its height, settling until the unbalanced ratio is below "
+                      "%.0e (now %.1e), at most %ld steps more (the layer's step cap)", sc.stop_ratio, ratio,
+                      sc.max_steps_per_layer - n);
+        progress->settling(extra);
+      } else {
+        std::snprintf(extra, sizeof extra, "(um of platen travel), unbalanced ratio %.1e (stop at %.0e)", ratio,
+                      sc.stop_ratio);
+        progress->update(std::lround((z_start - z) * 1e6), extra);
       }
-      const bool blocked = load > 0.9;
-      // Pressed to its height (or as far as it goes, nearly at rest): friction now only helps the layer come
-      // to rest; switched on earlier, it would lock the packing before the platen gets there.
-      if (settle && (z - z_target < 1e-9 || (blocked && ratio < 10 * sc.stop_ratio))) {
-        sim.set_contact_params(*settle);
-        settle = nullptr;
-      }
-      if ((z - z_target < 1e-9 || blocked) && ratio < sc.stop_ratio) break;
     }
-  }
+    const bool blocked = load > 0.9;
+    // Pressed to its height (or as far as it goes, nearly at rest): friction now only helps the layer come
+    // to rest; switched on earlier, it would lock the packing before the platen gets there.
+    if (settle && (z - z_target < 1e-9 || (blocked && ratio < 10 * sc.stop_ratio))) {
+      sim.set_contact_params(*settle);
+      settle = nullptr;
+    }
+    return (z - z_target < 1e-9 || blocked) && ratio < sc.stop_ratio;
+  };
+  const long s = run_stage(sim, layer, nullptr).step;
   sim.set_wall_velocity(kTop, Vec3());
   return {s, ratio};
 }

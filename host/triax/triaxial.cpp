@@ -5,12 +5,13 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <functional>
 #include <optional>
 #include <string>
+#include <tuple>
 
 #include "host/engine/membrane_mesh.hpp"
 #include "host/engine/setup.hpp"
+#include "host/engine/stage_loop.hpp"
 #include "host/data/measured.hpp"
 #include "host/triax/micro_report.hpp"
 #include "host/util/progress.hpp"
@@ -139,9 +140,10 @@ void measure_stresses(const Cell& c, const TriaxialConfig& tc, const ContactSet&
 
 /// Isotropic consolidation from the state in `st` (a resumed run's, or step 0): cell pressure on the membrane, stress
 /// servo on the top platen, until the platen's stress and the unbalanced ratio settle; then `st` moves to shear with
-/// the consolidated height, volumes and void ratio. `after_step` runs after each step (checkpoints and stops).
-void consolidate(const Config& cfg, const Specimen& sp, Cell& cell, Stage& st, bool verbose,
-                 const std::function<void(const Stage&)>& after_step) {
+/// the consolidated height, volumes and void ratio. `stage` comes with what both stages of the test do alike
+/// (checkpoints, the blow-up's save); `plan` may be null.
+void consolidate(const Config& cfg, const Specimen& sp, Cell& cell, Stage& st, bool verbose, StageSteps stage,
+                 CheckpointPlan* plan) {
   const TriaxialConfig& tc = cfg.triaxial;
   Simulation& sim = *cell.sim;
   const Real dt = sim.params().integ.dt;
@@ -150,15 +152,18 @@ void consolidate(const Config& cfg, const Specimen& sp, Cell& cell, Stage& st, b
   servo.target = tc.sigma3;
   servo.area = cell.area;
   servo.v_max = 0.05 * sp.height / (2000 * dt);  // at most 5% of the height in 2000 steps
-  long s = static_cast<long>(st.step);
-  Progress cons("consolidation (ETA to the step cap)", tc.max_consolidation_steps, s);
-  for (; s < tc.max_consolidation_steps; ++s) {
-    const auto [top, bottom] = platen_stresses(cell, sim.wall_forces());
-    const int n = sim.wall_contact_counts()[kTopPlaten];
-    set_top_velocity(cell, -servo.speed(top, n * cell.kn_wall, dt));
-    const bool check = (s + 1) % 200 == 0;
-    sim.step(check);
-    if (check) {
+  Progress cons("consolidation (ETA to the step cap)", tc.max_consolidation_steps, static_cast<long>(st.step));
+  Real top = 0, bottom = 0;  // the platens' stresses before the step
+  stage.first = static_cast<long>(st.step) + 1;
+  stage.last = tc.max_consolidation_steps;
+  stage.before = [&](long n) {
+    std::tie(top, bottom) = platen_stresses(cell, sim.wall_forces());
+    const int touching = sim.wall_contact_counts()[kTopPlaten];
+    set_top_velocity(cell, -servo.speed(top, touching * cell.kn_wall, dt));
+    return StepPlan{false, n % 200 == 0};
+  };
+  stage.after = [&](long n) {
+    if (n % 200 == 0) {
       const Real ratio = sim.unbalanced_ratio();
       // The servo holds the top platen; the bottom one differs by what the membrane carries through
       // friction and its own axial stiffness, so only the controlled stress decides.
@@ -167,20 +172,21 @@ void consolidate(const Config& cfg, const Specimen& sp, Cell& cell, Stage& st, b
         char extra[96];
         std::snprintf(extra, sizeof extra, "sigma_top %.1f kPa, sigma_bottom %.1f kPa, unbalanced %.1e",
                       top / 1e3, bottom / 1e3, ratio);
-        cons.update(s + 1, extra);
+        cons.update(n, extra);
       }
-      if (err < tc.consolidation_tol && ratio < tc.stop_ratio) break;
+      if (err < tc.consolidation_tol && ratio < tc.stop_ratio) return true;
     }
-    st.step = static_cast<Real>(s + 1);
-    after_step(st);
-  }
-  if (s >= tc.max_consolidation_steps)
+    st.step = static_cast<Real>(n);
+    return false;
+  };
+  const StageEnd end = run_stage(sim, stage, plan);
+  if (!end.done)
     throw ConfigError(cfg.path + ": [triaxial] max_consolidation_steps: consolidation to " +
                       std::to_string(tc.sigma3 / 1e3) + " kPa did not settle within " +
                       std::to_string(tc.max_consolidation_steps) + " steps");
   st.shear = 1;
   st.step = 0;
-  st.consolidation_steps = static_cast<Real>(s + 1);
+  st.consolidation_steps = static_cast<Real>(end.step);
   st.h0 = sim.wall_point(kTopPlaten).z;
   st.v0 = specimen_volume(cell);
   st.v0_envelope = envelope_volume(sim, st.h0, cell.mean_radius, tc.membrane_segments);
@@ -363,63 +369,66 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
       std::printf("triaxial: resuming %s at step %ld (%s)\n", plan->path.c_str(), sim.step_count(),
                   st.shear != 0 ? "shear" : "consolidation");
   }
-  // After each loop step: a checkpoint when due, and a stop when asked for.
-  auto checkpoint = [&](const Stage& now) {
-    if (!plan || !plan->due(sim.step_count())) return;
+  // What both stages do alike: a checkpoint of the test's stage and curve when due; on a blow-up, the state it
+  // happened in (balls, membrane, contacts) and the curve so far.
+  StageSteps shared;
+  shared.checkpoint = [&](long) {
     if (out) out->flush_series();
     res.wall_seconds = elapsed();
-    save_triaxial(plan->path, sim, out, now, res, plan->config);
-    plan->clock.written();
-    if (plan->stop(sim.step_count())) throw run_stopped(*plan, sim.step_count());
+    save_triaxial(plan->path, sim, out, st, res, plan->config);
   };
+  if (out) shared.save_blowup = [&] { save_blowup(sim, cell, *out, st, res, plan); };
+  if (st.shear == 0) consolidate(cfg, sp, cell, st, verbose, shared, plan);
+  res.consolidation_steps = static_cast<long>(st.consolidation_steps);
+  res.void_ratio_consolidated = st.void_ratio;
+  const Real h0 = st.h0, v0 = st.v0, v0_envelope = st.v0_envelope;
 
-  // A blow-up saves the state it happened in (balls, membrane, contacts) and the curve so far, then stops.
-  try {
-    if (st.shear == 0) consolidate(cfg, sp, cell, st, verbose, checkpoint);
-    res.consolidation_steps = static_cast<long>(st.consolidation_steps);
-    res.void_ratio_consolidated = st.void_ratio;
-    const Real h0 = st.h0, v0 = st.v0, v0_envelope = st.v0_envelope;
-
-    const ShearPlan plan_of_shear = shear_plan(cfg, dt);
-    res.shear_rate = plan_of_shear.rate;
-    res.inertial_number = tc.inertial_number;
-    const long ramp = plan_of_shear.ramp, steps = plan_of_shear.steps;
-    if (verbose && st.step == 0)
-      std::printf("shear: strain rate %.3g 1/s (inertial number %.1e%s), %ld steps to %.0f%%\n", res.shear_rate,
-                  tc.inertial_number, cfg.solver.mass_scale != 1 ? ", with density scaling" : "", steps,
-                  tc.axial_strain_end * 100);
-    const std::array<Real, kSnapshotStrains> snaps = {0.0, 0.01, 0.05, tc.axial_strain_end};
-    Progress shear("shear", steps, static_cast<long>(st.step));
-    const ShearRecorder recorder{cfg, cell, st, res, out, h0, v0, v0_envelope, snaps, shear, verbose};
-    for (long k = static_cast<long>(st.step); k <= steps; ++k) {
-      const Real eps_a = (h0 - sim.wall_point(kTopPlaten).z) / h0;
-      LazyContacts contacts{sim};
-      if (eps_a >= st.next_record - 1e-12 || k == steps) take_record(recorder, eps_a, k, contacts);
-      const int next_snap = static_cast<int>(st.next_snap);
-      if (out && next_snap < kSnapshotStrains && eps_a >= snaps[next_snap] - 1e-12) {
-        char label[48];
-        std::snprintf(label, sizeof label, "shear eps_a=%.0f%%", 100 * snaps[next_snap]);
-        const io::SurfaceSnapshot surface = membrane_surface(cell.membrane);
-        const io::ContactTable table = mc.enabled ? contact_table(contacts.get()) : io::ContactTable();
-        out->write_snapshot(take_snapshot(sim, label), &surface, mc.enabled ? &table : nullptr);
-        st.next_snap += 1;
-      }
-      if (k == steps) break;
-      if (k < ramp) set_top_velocity(cell, -res.shear_rate * h0 * static_cast<Real>(k + 1) / ramp);
-      if (tc.damping_about_flow) {  // the bottom platen rests at z = 0: the flow is v_z = v_top z / h
-        const Real h = sim.wall_point(kTopPlaten).z;
-        sim.set_damping_flow(Vec3(0, 0, sim.wall_velocity(kTopPlaten).z / h), Vec3());
-      }
-      // The unbalanced ratio and kinetic energy cost a pass: measured on the steps before a record only.
-      sim.step((h0 - sim.wall_point(kTopPlaten).z) / h0 + res.shear_rate * dt >= st.next_record - 1e-12 ||
-               k + 1 == steps);
-      st.step = static_cast<Real>(k + 1);
-      checkpoint(st);
+  const ShearPlan plan_of_shear = shear_plan(cfg, dt);
+  res.shear_rate = plan_of_shear.rate;
+  res.inertial_number = tc.inertial_number;
+  const long ramp = plan_of_shear.ramp, steps = plan_of_shear.steps;
+  if (verbose && st.step == 0)
+    std::printf("shear: strain rate %.3g 1/s (inertial number %.1e%s), %ld steps to %.0f%%\n", res.shear_rate,
+                tc.inertial_number, cfg.solver.mass_scale != 1 ? ", with density scaling" : "", steps,
+                tc.axial_strain_end * 100);
+  const std::array<Real, kSnapshotStrains> snaps = {0.0, 0.01, 0.05, tc.axial_strain_end};
+  Progress shear("shear", steps, static_cast<long>(st.step));
+  const ShearRecorder recorder{cfg, cell, st, res, out, h0, v0, v0_envelope, snaps, shear, verbose};
+  // Before step k + 1, the state step k left: its record and snapshot where due (the last state's too), then the
+  // platen's control. A checkpoint follows each step, before the record of the state it left (a resumed run
+  // takes that record).
+  StageSteps shear_stage = shared;
+  shear_stage.first = static_cast<long>(st.step) + 1;
+  shear_stage.last = steps + 1;
+  shear_stage.before = [&](long n) {
+    const long k = n - 1;
+    const Real eps_a = (h0 - sim.wall_point(kTopPlaten).z) / h0;
+    LazyContacts contacts{sim};
+    if (eps_a >= st.next_record - 1e-12 || k == steps) take_record(recorder, eps_a, k, contacts);
+    const int next_snap = static_cast<int>(st.next_snap);
+    if (out && next_snap < kSnapshotStrains && eps_a >= snaps[next_snap] - 1e-12) {
+      char label[48];
+      std::snprintf(label, sizeof label, "shear eps_a=%.0f%%", 100 * snaps[next_snap]);
+      const io::SurfaceSnapshot surface = membrane_surface(cell.membrane);
+      const io::ContactTable table = mc.enabled ? contact_table(contacts.get()) : io::ContactTable();
+      out->write_snapshot(take_snapshot(sim, label), &surface, mc.enabled ? &table : nullptr);
+      st.next_snap += 1;
     }
-  } catch (const BlowUp&) {
-    if (out) save_blowup(sim, cell, *out, st, res, plan);
-    throw;
-  }
+    if (k == steps) return StepPlan{true, false};
+    if (k < ramp) set_top_velocity(cell, -res.shear_rate * h0 * static_cast<Real>(k + 1) / ramp);
+    if (tc.damping_about_flow) {  // the bottom platen rests at z = 0: the flow is v_z = v_top z / h
+      const Real h = sim.wall_point(kTopPlaten).z;
+      sim.set_damping_flow(Vec3(0, 0, sim.wall_velocity(kTopPlaten).z / h), Vec3());
+    }
+    // The unbalanced ratio and kinetic energy cost a pass: measured on the steps before a record only.
+    const Real eps_next = (h0 - sim.wall_point(kTopPlaten).z) / h0 + res.shear_rate * dt;
+    return StepPlan{false, eps_next >= st.next_record - 1e-12 || k + 1 == steps};
+  };
+  shear_stage.after = [&](long n) {
+    st.step = static_cast<Real>(n);
+    return false;
+  };
+  run_stage(sim, shear_stage, plan);
   if (out) out->flush_series();
   finish_result(cell, tc.sigma3, elapsed(), res);
   return res;

@@ -1,0 +1,44 @@
+#pragma once
+/// The one time loop of every stage of a test: the run job, a specimen layer's compaction, the membrane test's
+/// consolidation and shear, the periodic cell's consolidation and shear. A stage says what is its own: its control
+/// before a step and whether the step measures, what it records after it, and when it is done. The loop does what
+/// they share, in one order: the step, the checkpoint when due and the stop when asked, and on a blow-up the
+/// stage's state saved for inspection before the error goes on.
+#include <functional>
+
+#include "host/engine/checkpoint.hpp"
+#include "host/engine/simulation.hpp"
+
+namespace dem {
+
+/// What a stage does before a step: whether it is done before taking it (its end was seen in the state the last
+/// step left), and whether the step measures the unbalanced force and kinetic energy (when the stage reads them).
+struct StepPlan {
+  bool done = false;
+  bool measure = false;
+};
+
+struct StageSteps {
+  long first = 1;  ///< the number of the stage's first step
+  long last = 0;   ///< its cap: the stage takes no step beyond it
+  /// Before step n: the stage's control (servo, boundary speeds), and what the step is to be.
+  std::function<StepPlan(long n)> before;
+  /// After step n: records, snapshots, progress. True when the stage is done; then no checkpoint follows.
+  std::function<bool(long n)> after;
+  /// Writes the stage's checkpoint after step n; unset: the stage keeps none.
+  std::function<void(long n)> checkpoint;
+  /// Saves the state a blow-up left, for inspection; unset: the error goes on as it is.
+  std::function<void()> save_blowup;
+};
+
+/// How a stage ended: the number of its last step, and whether it was done (else it reached its cap).
+struct StageEnd {
+  long step = 0;
+  bool done = false;
+};
+
+/// Runs the stage's steps. `plan` (may be null) decides when a checkpoint is due, by the simulation's step count,
+/// and when the job stops after one (RunStopped thrown).
+StageEnd run_stage(Simulation& sim, const StageSteps& stage, CheckpointPlan* plan);
+
+}  // namespace dem
