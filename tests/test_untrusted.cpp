@@ -335,7 +335,7 @@ TEST_F(Untrusted, EditedSnapshotsAreRefusedBeforeMicroUsesThem) {
 TEST_F(Untrusted, TriaxialStageValuesAreCheckedBeforeTheRunChanges) {
   sim_ = settled_box();
   Stage st;
-  st.shear = 1;
+  st.shear = true;
   st.step = 10;
   st.h0 = st.v0 = st.v0_envelope = 1e-6;
   st.void_ratio = 0.7;

@@ -152,9 +152,9 @@ void consolidate(const Config& cfg, const Specimen& sp, Cell& cell, Stage& st, b
   servo.target = tc.sigma3;
   servo.area = cell.area;
   servo.v_max = 0.05 * sp.height / (2000 * dt);  // at most 5% of the height in 2000 steps
-  Progress cons("consolidation (ETA to the step cap)", tc.max_consolidation_steps, static_cast<long>(st.step));
+  Progress cons("consolidation (ETA to the step cap)", tc.max_consolidation_steps, st.step);
   Real top = 0, bottom = 0;  // the platens' stresses before the step
-  stage.first = static_cast<long>(st.step) + 1;
+  stage.first = st.step + 1;
   stage.last = tc.max_consolidation_steps;
   stage.before = [&](long n) {
     std::tie(top, bottom) = platen_stresses(cell, sim.wall_forces());
@@ -176,7 +176,7 @@ void consolidate(const Config& cfg, const Specimen& sp, Cell& cell, Stage& st, b
       }
       if (err < tc.consolidation_tol && ratio < tc.stop_ratio) return true;
     }
-    st.step = static_cast<Real>(n);
+    st.step = n;
     return false;
   };
   const StageEnd end = run_stage(sim, stage, plan);
@@ -184,16 +184,16 @@ void consolidate(const Config& cfg, const Specimen& sp, Cell& cell, Stage& st, b
     throw ConfigError(cfg.path + ": [triaxial] max_consolidation_steps: consolidation to " +
                       std::to_string(tc.sigma3 / 1e3) + " kPa did not settle within " +
                       std::to_string(tc.max_consolidation_steps) + " steps");
-  st.shear = 1;
+  st.shear = true;
   st.step = 0;
-  st.consolidation_steps = static_cast<Real>(end.step);
+  st.consolidation_steps = end.step;
   st.h0 = sim.wall_point(kTopPlaten).z;
   st.v0 = specimen_volume(cell);
   st.v0_envelope = envelope_volume(sim, st.h0, cell.mean_radius, tc.membrane_segments);
   st.void_ratio = st.v0 / cell.solid_volume - 1;
   if (verbose)
     std::printf("\nconsolidated at %.0f kPa: e = %.4f, height %.3f mm after %ld steps\n", tc.sigma3 / 1e3,
-                st.void_ratio, st.h0 * 1e3, static_cast<long>(st.consolidation_steps));
+                st.void_ratio, st.h0 * 1e3, st.consolidation_steps);
 }
 
 /// What a blow-up leaves for inspection: the curve so far, a snapshot of balls, membrane and contacts, and the
@@ -262,7 +262,7 @@ void take_record(const ShearRecorder& sh, Real eps_a, long k, LazyContacts& cont
   measure_stresses(cell, tc, contacts.get(), volume, sh.v0 / sh.h0, r);
   sh.res.records.push_back(r);
   std::vector<double> row = series_row(r, tc.sigma3, sh.st.void_ratio);
-  const int next_snap = static_cast<int>(sh.st.next_snap);
+  const int next_snap = sh.st.next_snap;
   if (mc.enabled) {
     const ContactSet& cs = contacts.get();
     const ContactSet rve = restrict_to_cube(cs, Vec3(0, 0, top_z / 2), mc.rve_edge);
@@ -367,7 +367,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
     wall_before = res.wall_seconds;
     if (verbose)
       std::printf("triaxial: resuming %s at step %ld (%s)\n", plan->path.c_str(), sim.step_count(),
-                  st.shear != 0 ? "shear" : "consolidation");
+                  st.shear ? "shear" : "consolidation");
   }
   // What both stages do alike: a checkpoint of the test's stage and curve when due; on a blow-up, the state it
   // happened in (balls, membrane, contacts) and the curve so far.
@@ -378,8 +378,8 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
     save_triaxial(plan->path, sim, out, st, res, plan->config);
   };
   if (out) shared.save_blowup = [&] { save_blowup(sim, cell, *out, st, res, plan); };
-  if (st.shear == 0) consolidate(cfg, sp, cell, st, verbose, shared, plan);
-  res.consolidation_steps = static_cast<long>(st.consolidation_steps);
+  if (!st.shear) consolidate(cfg, sp, cell, st, verbose, shared, plan);
+  res.consolidation_steps = st.consolidation_steps;
   res.void_ratio_consolidated = st.void_ratio;
   const Real h0 = st.h0, v0 = st.v0, v0_envelope = st.v0_envelope;
 
@@ -392,20 +392,20 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
                 tc.inertial_number, cfg.solver.mass_scale != 1 ? ", with density scaling" : "", steps,
                 tc.axial_strain_end * 100);
   const std::array<Real, kSnapshotStrains> snaps = {0.0, 0.01, 0.05, tc.axial_strain_end};
-  Progress shear("shear", steps, static_cast<long>(st.step));
+  Progress shear("shear", steps, st.step);
   const ShearRecorder recorder{cfg, cell, st, res, out, h0, v0, v0_envelope, snaps, shear, verbose};
   // Before step k + 1, the state step k left: its record and snapshot where due (the last state's too), then the
   // platen's control. A checkpoint follows each step, before the record of the state it left (a resumed run
   // takes that record).
   StageSteps shear_stage = shared;
-  shear_stage.first = static_cast<long>(st.step) + 1;
+  shear_stage.first = st.step + 1;
   shear_stage.last = steps + 1;
   shear_stage.before = [&](long n) {
     const long k = n - 1;
     const Real eps_a = (h0 - sim.wall_point(kTopPlaten).z) / h0;
     LazyContacts contacts{sim};
     if (eps_a >= st.next_record - 1e-12 || k == steps) take_record(recorder, eps_a, k, contacts);
-    const int next_snap = static_cast<int>(st.next_snap);
+    const int next_snap = st.next_snap;
     if (out && next_snap < kSnapshotStrains && eps_a >= snaps[next_snap] - 1e-12) {
       char label[48];
       std::snprintf(label, sizeof label, "shear eps_a=%.0f%%", 100 * snaps[next_snap]);
@@ -425,7 +425,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
     return StepPlan{false, eps_next >= st.next_record - 1e-12 || k + 1 == steps};
   };
   shear_stage.after = [&](long n) {
-    st.step = static_cast<Real>(n);
+    st.step = n;
     return false;
   };
   run_stage(sim, shear_stage, plan);

@@ -12,7 +12,15 @@ namespace dem {
 namespace {
 
 std::vector<double> stage_numbers(const Stage& s) {
-  return {s.shear, s.step, s.h0, s.v0, s.v0_envelope, s.void_ratio, s.consolidation_steps, s.q_max, s.next_snap,
+  return {s.shear ? 1.0 : 0.0,
+          static_cast<double>(s.step),
+          s.h0,
+          s.v0,
+          s.v0_envelope,
+          s.void_ratio,
+          static_cast<double>(s.consolidation_steps),
+          s.q_max,
+          static_cast<double>(s.next_snap),
           s.next_record};
 }
 /// The stage as the file gives it, each value checked against what the loops do with it: the stage and the
@@ -39,7 +47,8 @@ Stage stage_of(const std::vector<double>& v, const std::string& path) {
   if (std::isnan(v[7]) || v[7] == INFINITY) refuse(7, "a finite number, or -inf before the first record");
   whole(8, kSnapshotStrains);
   if (!(std::isfinite(v[9]) && v[9] >= 0)) refuse(9, "a finite strain of 0 or more");
-  return Stage{v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9]};
+  return Stage{v[0] != 0, static_cast<long>(v[1]), v[2], v[3], v[4], v[5], static_cast<long>(v[6]), v[7],
+               static_cast<int>(v[8]), v[9]};
 }
 
 /// A record's fields in the file's order: one list for the writer (const records) and the reader.

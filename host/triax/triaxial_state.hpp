@@ -17,10 +17,13 @@ inline constexpr double kMaxStageSteps = 1e15;
 
 /// Where a triaxial run stands. Numbers only (counters as Real), so that the stage is one array of the file.
 struct Stage {
-  Real shear = 0;            ///< 0 consolidation, 1 shear
-  Real step = 0;             ///< the next loop step of the stage
-  Real h0 = 0, v0 = 0, v0_envelope = 0, void_ratio = 0, consolidation_steps = 0;  ///< m, m^3, m^3, -, steps
-  Real q_max = -INFINITY, next_snap = 0, next_record = 0;                         ///< Pa, index, strain
+  bool shear = false;             ///< false: consolidation
+  long step = 0;                  ///< the steps the stage has taken
+  Real h0 = 0, v0 = 0, v0_envelope = 0, void_ratio = 0;  ///< m, m^3, m^3, -: at the end of consolidation
+  long consolidation_steps = 0;
+  Real q_max = -INFINITY;         ///< Pa, the highest record so far
+  int next_snap = 0;              ///< index of the next snapshot strain
+  Real next_record = 0;           ///< strain
 };
 
 /// Writes the checkpoint of a triaxial run to `path`.
