@@ -267,6 +267,41 @@ void finish_result(const Simulation& sim, PeriodicTriaxialResult& res, Progress&
   }
 }
 
+/// The test's first line: pressure, rate, inertial number (flagged above the quasi-static limit), step, servo.
+void announce(const PeriodicTriaxialParams& prm, Real inertial, Real dt) {
+  std::printf("periodic triaxial: sigma3 %.1f kPa, axial rate %.4g /s (I = %.2e at p = sigma3%s), dt %.3e s, "
+              "servo alpha %.2f, lateral rate clamp %.4g /s\n",
+              1e-3 * prm.sigma3, prm.axial_rate, inertial,
+              inertial > prm.max_inertial ? ", ABOVE the quasi-static limit: allowed by the config" : "", dt,
+              prm.servo_alpha, prm.max_lateral_rate);
+}
+
+/// Snapshots at the configured axial strains within the test, each written once, when the strain first reaches it
+/// (several passed in one step give one snapshot, labelled with the largest).
+class SnapshotSchedule {
+ public:
+  SnapshotSchedule(const PeriodicTriaxialParams& prm, Simulation& sim, io::Output* out) : sim_(sim), out_(out) {
+    for (Real e : prm.snapshot_strains)
+      if (e >= 0 && e <= prm.target_strain + 1e-12) strains_.push_back(e);
+    std::sort(strains_.begin(), strains_.end());
+  }
+  /// The cell is at axial strain eps.
+  void at(Real eps) {
+    Real nominal = -1;
+    while (next_ < strains_.size() && eps >= strains_[next_] - 1e-9) nominal = strains_[next_++];
+    if (nominal >= 0 && out_) {
+      out_->flush_series();
+      out_->write_snapshot(take_snapshot(sim_, pct_label(nominal)));
+    }
+  }
+
+ private:
+  Simulation& sim_;
+  io::Output* out_;
+  std::vector<Real> strains_;
+  std::size_t next_ = 0;
+};
+
 }  // namespace
 
 PeriodicTriaxialResult run_periodic_triaxial(Simulation& sim, const PeriodicTriaxialParams& prm_in, io::Output* out) {
@@ -279,12 +314,7 @@ PeriodicTriaxialResult run_periodic_triaxial(Simulation& sim, const PeriodicTria
   res.density_eff = g.rho_eff;
   res.inertial = prm.axial_rate * g.d * std::sqrt(g.rho_eff / prm.sigma3);
   const Real dt = sim.params().integ.dt;
-  if (prm.verbose)
-    std::printf("periodic triaxial: sigma3 %.1f kPa, axial rate %.4g /s (I = %.2e at p = sigma3%s), dt %.3e s, "
-                "servo alpha %.2f, lateral rate clamp %.4g /s\n",
-                1e-3 * prm.sigma3, prm.axial_rate, res.inertial,
-                res.inertial > prm.max_inertial ? ", ABOVE the quasi-static limit: allowed by the config" : "", dt,
-                prm.servo_alpha, prm.max_lateral_rate);
+  if (prm.verbose) announce(prm, res.inertial, dt);
 
   res.consolidation_steps = consolidate_isotropic(sim, prm);
 
@@ -297,21 +327,9 @@ PeriodicTriaxialResult run_periodic_triaxial(Simulation& sim, const PeriodicTria
     res.series.push_back(measure_row(sim, prm, g, res.h0, res.V0, L0));
     if (out) out->append_series(series_row(res.series.back()));
   };
-  std::vector<Real> snaps;
-  for (Real e : prm.snapshot_strains)
-    if (e >= 0 && e <= prm.target_strain + 1e-12) snaps.push_back(e);
-  std::sort(snaps.begin(), snaps.end());
-  std::size_t next_snap = 0;
-  auto snapshot_due = [&](Real eps) {
-    Real nominal = -1;
-    while (next_snap < snaps.size() && eps >= snaps[next_snap] - 1e-9) nominal = snaps[next_snap++];
-    if (nominal >= 0 && out) {
-      out->flush_series();
-      out->write_snapshot(take_snapshot(sim, pct_label(nominal)));
-    }
-  };
+  SnapshotSchedule snapshots(prm, sim, out);
   record();
-  snapshot_due(0);
+  snapshots.at(0);
 
   CellServo servo(prm, prm.max_lateral_rate);
   const bool lateral[3] = {true, true, false};
@@ -345,7 +363,7 @@ PeriodicTriaxialResult run_periodic_triaxial(Simulation& sim, const PeriodicTria
       }
       if (out && res.series.size() % 50 == 0) out->flush_series();
     }
-    snapshot_due((res.h0 - cell_lengths(sim)[2]) / res.h0);
+    snapshots.at((res.h0 - cell_lengths(sim)[2]) / res.h0);
     return last;
   };
   run_stage(sim, stage, nullptr);
