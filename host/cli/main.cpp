@@ -24,6 +24,7 @@
 #include "host/config/provenance.hpp"
 #include "host/study/study.hpp"
 #include "host/triax/triaxial.hpp"
+#include "host/util/text_format.hpp"
 
 namespace {
 
@@ -251,9 +252,7 @@ int run_command(const Commands& c, Args& a) {
   if (c.periodic->parsed()) return dem::run_periodic_job(cfg);
   if (c.calibrate->parsed() || c.diagnose->parsed()) {
     if (!a.free_list.empty()) {
-      a.cal.free.clear();
-      std::stringstream in(a.free_list);
-      for (std::string f; std::getline(in, f, ',');) a.cal.free.push_back(f);
+      a.cal.free = dem::split_fields(a.free_list);
     }
     return c.calibrate->parsed() ? dem::calibrate_job(cfg, a.cal) : dem::diagnose_job(cfg, a.cal);
   }

@@ -1,4 +1,5 @@
 #include "host/data/measured.hpp"
+#include "host/util/text_format.hpp"
 
 #include <algorithm>
 #include <cerrno>
@@ -50,18 +51,10 @@ const std::vector<std::string> kCurveSd = {"q", "eps_v"};
 const std::vector<std::string> kSummarySd = {"q_peak", "eps_a_peak", "q_end",  "max_dilatancy",
                                               "e_ini",  "q_1pct",     "q_3pct"};
 
-std::string trim(const std::string& s) {
-  const auto a = s.find_first_not_of(" \t\r");
-  if (a == std::string::npos) return "";
-  return s.substr(a, s.find_last_not_of(" \t\r") - a + 1);
-}
-
+/// A CSV line's cells, trimmed.
 std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> out;
-  std::stringstream s(line);
-  std::string cell;
-  while (std::getline(s, cell, ',')) out.push_back(trim(cell));
-  if (!line.empty() && line.back() == ',') out.emplace_back();
+  std::vector<std::string> out = split_fields(line);
+  for (std::string& c : out) c = trim(c);
   return out;
 }
 

@@ -4,20 +4,9 @@
 
 #include "host/io/h5_file.hpp"
 #include "host/data/measured.hpp"
+#include "host/util/text_format.hpp"
 
 namespace dem {
-
-namespace {
-
-std::vector<std::string> split_names(const std::string& s) {
-  std::vector<std::string> out;
-  std::size_t at = 0;
-  for (std::size_t comma; (comma = s.find(',', at)) != std::string::npos; at = comma + 1) out.push_back(s.substr(at, comma - at));
-  out.push_back(s.substr(at));
-  return out;
-}
-
-}  // namespace
 
 MeasuredTextTable read_measured_h5(const std::string& path) {
   try {
@@ -29,7 +18,7 @@ MeasuredTextTable read_measured_h5(const std::string& path) {
       if (!f.exists(table) || names.empty())
         throw DataError(path + ":/" + material + ": no dataset 'table' with a string attribute 'columns'");
       std::vector<std::string> header{"material"};
-      for (const std::string& c : split_names(names)) header.push_back(c);
+      for (const std::string& c : split_fields(names)) header.push_back(c);
       if (t.header_at.empty()) {
         t.header = header;
         t.header_at = path + ":" + table + " columns";

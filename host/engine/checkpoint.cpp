@@ -8,6 +8,7 @@
 
 #include "host/util/fnv1a.hpp"
 #include "host/io/h5_file.hpp"
+#include "host/util/text_format.hpp"
 
 namespace dem {
 
@@ -87,8 +88,7 @@ std::string join_names(const std::vector<std::string>& names) {
 
 std::vector<std::string> split_names(const std::string& s) {
   std::vector<std::string> out;
-  std::stringstream in(s);
-  for (std::string n; std::getline(in, n, ',');)
+  for (const std::string& n : split_fields(s))
     if (!n.empty()) out.push_back(n);
   return out;
 }

@@ -52,9 +52,7 @@ void print_errors(const std::vector<MeasuredTest>& meas, const std::vector<Measu
   std::string line;
   std::getline(in, line);
   while (std::getline(in, line)) {
-    std::vector<std::string> c;
-    std::stringstream ls(line);
-    for (std::string x; std::getline(ls, x, ',');) c.push_back(x);
+    const std::vector<std::string> c = split_fields(line);
     std::printf("%-10s %7s %-14s %12s %12s %8s\n", c[0].c_str(), c[1].c_str(), (c[2] + " " + c[3]).c_str(),
                 c[4].c_str(), c[5].c_str(), c[6].c_str());
   }

@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "host/io/io_hdf5.hpp"
+#include "host/util/text_format.hpp"
 
 namespace dem {
 
@@ -46,14 +47,6 @@ const std::pair<const char*, Real TestSummary::*> kMeasurePeaks[] = {{"q_area_kP
                                                                      {"q_parabolic_kPa", &TestSummary::q_peak_parabolic},
                                                                      {"q_membrane_kPa", &TestSummary::q_peak_membrane},
                                                                      {"q_lw_kPa", &TestSummary::q_peak_lw}};
-
-std::vector<std::string> split_csv(const std::string& line) {
-  std::vector<std::string> out;
-  std::stringstream s(line);
-  std::string cell;
-  while (std::getline(s, cell, ',')) out.push_back(cell);
-  return out;
-}
 
 // Provenance, after the numbers: text columns, optional for the reader (older summaries lack them).
 const std::pair<const char*, std::string Provenance::*> kProvenanceColumns[] = {
@@ -109,7 +102,7 @@ TestSummary read_summary(const std::string& path) {
   std::string h, v;
   std::getline(f, h);
   std::getline(f, v);
-  const std::vector<std::string> names = split_csv(h), values = split_csv(v);
+  const std::vector<std::string> names = split_fields(h), values = split_fields(v);
   if (names.size() != values.size()) throw std::runtime_error(path + ": line 2 has " + std::to_string(values.size()) +
                                                               " cells, the header " + std::to_string(names.size()));
   std::map<std::string, std::string> m;

@@ -1,8 +1,10 @@
 #pragma once
-/// One number through a printf format, as a string: the cells of the reports' tables.
+/// Text in and out of tables: one number through a printf format (the cells of the reports' tables), and the
+/// fields of a comma-separated line (every CSV and name list triaxdem reads).
 #include <cstdio>
 #include <string>
 #include <type_traits>
+#include <vector>
 
 namespace dem {
 
@@ -15,5 +17,11 @@ inline std::string fmt(const char* format, double v) {
 /// so that counts are written with std::to_string and a number meant as a double is converted where it is passed.
 template <class T, std::enable_if_t<std::is_integral_v<T>, int> = 0>
 std::string fmt(const char* format, T v) = delete;
+
+/// The fields of a line separated by `sep`, each as written: "a,,b," gives "a", "", "b", "" (an empty last field
+/// after a trailing separator, which a row's cell count must see), and "" gives one empty field.
+std::vector<std::string> split_fields(const std::string& line, char sep = ',');
+/// s without its leading and trailing blanks (spaces, tabs, a carriage return).
+std::string trim(const std::string& s);
 
 }  // namespace dem
