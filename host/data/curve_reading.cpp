@@ -8,10 +8,6 @@
 
 namespace dem {
 
-namespace {
-constexpr Real kNaN = std::numeric_limits<Real>::quiet_NaN();
-}  // namespace
-
 Real feature_window(Real e) { return std::min(0.3 * e, 0.0025); }
 
 Real curve_value(const std::vector<Real>& eps_a, const std::vector<Real>& v, Real e) {

@@ -18,7 +18,6 @@ namespace dem {
 
 namespace {
 
-constexpr Real kNaN = std::numeric_limits<Real>::quiet_NaN();
 /// Sands stay below e ~ 1.2 and soft clays below ~ 4: a larger value is something else (a porosity in percent).
 constexpr Real kMaxVoidRatio = 5;
 // A curve of one or two rows has no shape: its peak, stiffness and dilatancy would be read off single points (a file

@@ -9,7 +9,6 @@
 namespace dem {
 
 namespace {
-constexpr Real kNaN = std::numeric_limits<Real>::quiet_NaN();
 
 /// Mean of v over the rows whose axial strain lies within +-h of eps_a[i], h = min(half, distance to either end
 /// of the curve): a window in strain, so that uneven row spacing does not change the smoothing, and symmetric,

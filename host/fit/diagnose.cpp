@@ -38,23 +38,10 @@ const Extension& extension(const std::string& name) {
   throw std::invalid_argument("unknown extension '" + name + "' (allowed: " + names + ")");
 }
 
-Real chi2_quantile(Real nu, Real z) {
-  const Real a = 2 / (9 * nu);
-  return nu * std::pow(1 - a + z * std::sqrt(a), 3);
-}
-
 namespace {
 
 constexpr Real kZ99 = 2.326;   // standard normal score of the 99% quantile
 constexpr Real kTieBIC = 2;     // ... below 2, not worth more than a bare mention
-
-/// Sum of squares of r[from, to).
-Real sum_sq(const std::vector<Real>& r, std::size_t from, std::size_t to) {
-  Real s = 0;
-  for (std::size_t i = from; i < to; ++i) s += r[i] * r[i];
-  return s;
-}
-Real sum_sq(const std::vector<Real>& r) { return sum_sq(r, 0, r.size()); }
 
 /// Residual index range [first, last) of each test.
 std::vector<std::pair<std::size_t, std::size_t>> test_ranges(const Misfit& misfit) {

@@ -63,8 +63,6 @@ struct Diagnosis {
   std::vector<std::string> notes;   ///< what the search did beyond the plan (a better base run found late)
 };
 
-/// The upper quantile of chi2 with nu degrees of freedom at standard normal score z (Wilson-Hilferty).
-Real chi2_quantile(Real nu, Real z);
 
 /// Runs the diagnosis of `measured` (one material) from `base` with base parameters `free`.
 Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,

@@ -12,10 +12,6 @@
 
 namespace dem {
 
-namespace {
-constexpr Real kNaN = std::numeric_limits<Real>::quiet_NaN();
-}  // namespace
-
 std::array<Real, kQuantities> quantities(const MeasuredTest& t) {
   return {t.e_ini, t.q_1pct, t.q_3pct, t.q_peak, t.eps_a_peak, t.q_end, t.max_dilatancy};
 }
@@ -203,6 +199,18 @@ Real Misfit::ensemble_ratio() const {
 int Misfit::members_for(Real target) const {
   const Real r = ensemble_ratio() / target;
   return std::max(1, static_cast<int>(std::ceil(members_ * r * r - 1e-9)));
+}
+
+Real sum_sq(const std::vector<Real>& r, std::size_t from, std::size_t to) {
+  Real s = 0;
+  for (std::size_t i = from; i < to; ++i) s += r[i] * r[i];
+  return s;
+}
+Real sum_sq(const std::vector<Real>& r) { return sum_sq(r, 0, r.size()); }
+
+Real chi2_quantile(Real nu, Real z) {
+  const Real a = 2 / (9 * nu);
+  return nu * std::pow(1 - a + z * std::sqrt(a), 3);
 }
 
 Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<MeasuredTest>& measured,

@@ -167,4 +167,11 @@ class Misfit {
 Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<MeasuredTest>& measured,
                       const NoiseOptions& noise, bool cell_bias = true, StateMatch* state = nullptr);
 
+/// The chi2 of whitened residuals: the sum of their squares, of r[from, to) where given.
+Real sum_sq(const std::vector<Real>& r, std::size_t from, std::size_t to);
+Real sum_sq(const std::vector<Real>& r);
+/// The quantile of chi2 with nu degrees of freedom at the standard normal score z (Wilson-Hilferty: within 3% of
+/// the exact quantile at nu = 1, 95%, and closer as nu grows).
+Real chi2_quantile(Real nu, Real z);
+
 }  // namespace dem

@@ -27,12 +27,6 @@ namespace dem {
 
 namespace fs = std::filesystem;
 
-namespace {
-
-constexpr Real kNaN = std::numeric_limits<Real>::quiet_NaN();
-
-}  // namespace
-
 std::vector<StudyCase> study_cases(const std::vector<std::string>& inputs) {
   std::vector<std::string> files;
   for (const std::string& in : inputs) {

@@ -21,8 +21,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr Real kNaN = std::numeric_limits<Real>::quiet_NaN();
-
 // Column names and scales of summary.csv: one place for the writer and the reader.
 struct Column {
   const char* name;
