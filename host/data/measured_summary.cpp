@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "host/data/curve_reading.hpp"
+
 /// A curve's summary quantities (summarise, measured.hpp), for measured and simulated curves alike.
 
 namespace dem {
@@ -42,13 +44,7 @@ void summarise(MeasuredTest& t) {
   const auto k = std::max_element(q.begin() + lo, q.begin() + hi) - q.begin();
   t.q_peak = q[k];
   t.eps_a_peak = t.eps_a[k];
-  auto q_at = [&](Real e) {
-    if (e < t.eps_a.front() || e > t.eps_a.back()) return kNaN;
-    const auto j = std::lower_bound(t.eps_a.begin(), t.eps_a.end(), e) - t.eps_a.begin();
-    if (j == 0) return q[0];
-    const Real w = (e - t.eps_a[j - 1]) / (t.eps_a[j] - t.eps_a[j - 1]);
-    return (1 - w) * q[j - 1] + w * q[j];
-  };
+  auto q_at = [&](Real e) { return e < t.eps_a.front() || e > t.eps_a.back() ? kNaN : interpolate(t.eps_a, q, e); };
   t.q_1pct = q_at(kEarlyStrain);
   t.q_3pct = q_at(kMidStrain);
   // q at the end: the mean over the last strain window (one raw row carries the full scatter).

@@ -107,20 +107,32 @@ Real QuadraticSurface::operator()(const std::vector<Real>& u) const {
   return v;
 }
 
+namespace {
+
+/// Calls f(u) at every point of the grid of n points per axis over the unit box [0, 1]^d, the first axis fastest.
+void for_each_grid_point(int d, int n, const std::function<void(const std::vector<Real>&)>& f) {
+  std::vector<int> idx(d, 0);
+  std::vector<Real> u(d);
+  for (;;) {
+    for (int k = 0; k < d; ++k) u[k] = static_cast<Real>(idx[k]) / (n - 1);
+    f(u);
+    int k = 0;
+    while (k < d && ++idx[k] == n) idx[k++] = 0;
+    if (k == d) return;
+  }
+}
+
+}  // namespace
+
 std::vector<Real> minimise_unit_box(const std::function<Real(const std::vector<Real>&)>& f, int d, int per_axis) {
   if (d == 0) return {};
   const int n = d <= 3 ? per_axis : 7;
   std::vector<Real> best(d, 0.5), u(d);
   Real fbest = std::numeric_limits<Real>::infinity();
-  std::vector<int> idx(d, 0);
-  for (;;) {
-    for (int k = 0; k < d; ++k) u[k] = static_cast<Real>(idx[k]) / (n - 1);
-    const Real v = f(u);
-    if (v < fbest) fbest = v, best = u;
-    int k = 0;
-    while (k < d && ++idx[k] == n) idx[k++] = 0;
-    if (k == d) break;
-  }
+  for_each_grid_point(d, n, [&](const std::vector<Real>& x) {
+    const Real v = f(x);
+    if (v < fbest) fbest = v, best = x;
+  });
   for (Real step = 0.5 / (n - 1); step > 1e-4; step /= 2) {
     for (bool moved = true; moved;) {
       moved = false;
@@ -394,16 +406,10 @@ Real CalibrationResult::flat_share() const {
   const int n = d <= 3 ? 21 : 7;
   const Real limit = surrogate_chi2(best.u) + chi2_95(d) * scale;
   long inside = 0, all = 0;
-  std::vector<int> idx(d, 0);
-  std::vector<Real> u(d);
-  for (;;) {
-    for (int k = 0; k < d; ++k) u[k] = static_cast<Real>(idx[k]) / (n - 1);
+  for_each_grid_point(d, n, [&](const std::vector<Real>& u) {
     inside += surrogate_chi2(u) <= limit;
     ++all;
-    int k = 0;
-    while (k < d && ++idx[k] == n) idx[k++] = 0;
-    if (k == d) break;
-  }
+  });
   return static_cast<Real>(inside) / all;
 }
 
