@@ -23,11 +23,6 @@ constexpr Real kMaxVoidRatio = 5;
 // A curve of one or two rows has no shape: its peak, stiffness and dilatancy would be read off single points (a file
 // with one point per test started a calibration). Three rows are the fewest with a peak between them.
 constexpr std::size_t kMinCurveRows = 3;
-// The curve's smoothing and noise estimate read a window of rows around each row, so their cost grows with the
-// square of the rows per strain: 10^5 rows of a test take about a second, 10^6 minutes. A curve shows nothing at
-// 10^5 rows that it does not at 10^4. A file beyond the total is refused while it is read, before it fills memory.
-constexpr std::size_t kMaxCurveRows = 100000;
-constexpr std::size_t kMaxFileRows = 2000000;
 
 /// A column's quantity and the factor that turns the file's unit into SI.
 struct ColumnSpec {
@@ -50,12 +45,6 @@ const std::vector<std::string> kCurveSd = {"q", "eps_v"};
 const std::vector<std::string> kSummarySd = {"q_peak", "eps_a_peak", "q_end",  "max_dilatancy",
                                               "e_ini",  "q_1pct",     "q_3pct"};
 
-/// A CSV line's cells, trimmed.
-std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> out = split_fields(line);
-  for (std::string& c : out) c = trim(c);
-  return out;
-}
 
 std::string str(Real v) {
   std::ostringstream s;
@@ -67,9 +56,8 @@ bool is_sd(const std::string& quantity) {
   return quantity.size() > 3 && quantity.compare(quantity.size() - 3, 3, "_sd") == 0;
 }
 
-/// `at` is where in the file: "<path>:<line>" in a CSV, "<path>:/<material>/table row <k>" in HDF5.
 [[noreturn]] void fail(const std::string& at, const std::string& column, const std::string& what) {
-  throw DataError(at + (column.empty() ? "" : ":" + column) + ": " + what);
+  throw DataError(at, column, what);
 }
 
 Real unit_scale(const std::string& at, const std::string& name, const std::string& quantity,
@@ -321,33 +309,6 @@ void note_replicates(MeasuredData& d) {
 
 }  // namespace
 
-MeasuredTextTable read_csv_table(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
-    throw DataError(path + ": not a regular file (measured data are a CSV or HDF5 file)");
-  std::ifstream f(path);
-  if (!f) throw DataError(path + ": cannot be read");
-  MeasuredTextTable t;
-  std::string line;
-  for (long n = 1; std::getline(f, line); ++n) {
-    // A spreadsheet's UTF-8 byte order mark is no part of the first column's name.
-    if (n == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
-    const std::string s = trim(line);
-    if (s.empty() || s[0] == '#') continue;
-    if (t.header.empty() && t.header_at.empty()) {
-      t.header = split(s);
-      t.header_at = path + ":" + std::to_string(n);
-    } else {
-      if (t.rows.size() == kMaxFileRows)
-        throw DataError(path + ":" + std::to_string(n) + ": more than " + std::to_string(kMaxFileRows) +
-                        " data rows (allowed: at most " + std::to_string(kMaxFileRows) + " in a file, " +
-                        std::to_string(kMaxCurveRows) + " per test; thin the curves, e.g. every 10th row)");
-      t.rows.push_back({path + ":" + std::to_string(n), split(s)});
-    }
-  }
-  return t;
-}
-
 bool is_hdf5_path(const std::string& path) {
   const auto dot = path.rfind('.');
   const std::string ext = dot == std::string::npos ? "" : path.substr(dot);
@@ -413,50 +374,6 @@ MeasuredData load_measured(const std::string& path) {
     d.notes.push_back(path + ": no q_measure column: q taken as fixed_area (platen force over the cross-section "
                              "after consolidation, as Tang et al. 2025 report it)");
   return d;
-}
-
-ReferenceValues load_reference(const std::string& path, const std::function<void(const std::string&)>& known) {
-  std::ifstream f(path);
-  if (!f) throw DataError(path + ": cannot be read");
-  ReferenceValues ref;
-  ref.path = path;
-  std::string line;
-  for (long n = 1; std::getline(f, line); ++n) {
-    const std::string t = trim(line);
-    if (t.empty()) continue;
-    if (t[0] == '#') {
-      ref.comment += (ref.comment.empty() ? "" : " ") + trim(t.substr(1));
-      continue;
-    }
-    const std::vector<std::string> cells = split(t);
-    if (ref.parameters.empty()) {
-      if (cells.empty() || cells[0] != "material") fail(path + ":" + std::to_string(n), cells.empty() ? "" : cells[0], "the first column must be 'material'");
-      if (cells.size() < 2) fail(path + ":" + std::to_string(n), "", "no parameter columns");
-      for (std::size_t c = 1; c < cells.size(); ++c) {
-        try {
-          known(cells[c]);
-        } catch (const std::invalid_argument& e) {
-          fail(path + ":" + std::to_string(n), cells[c], e.what());
-        }
-        ref.parameters.push_back(cells[c]);
-      }
-      continue;
-    }
-    if (cells.size() != ref.parameters.size() + 1)
-      fail(path + ":" + std::to_string(n), "", "has " + std::to_string(cells.size()) + " cells, the header " +
-                            std::to_string(ref.parameters.size() + 1));
-    if (cells[0].empty()) fail(path + ":" + std::to_string(n), "material", "empty");
-    for (std::size_t c = 0; c < ref.parameters.size(); ++c) {
-      const std::string& v = cells[c + 1];
-      char* end = nullptr;
-      const double x = std::strtod(v.c_str(), &end);
-      if (v.empty() || end != v.c_str() + v.size() || !std::isfinite(x))
-        fail(path + ":" + std::to_string(n), ref.parameters[c], "'" + v + "' is not a number");
-      ref.values[cells[0]][ref.parameters[c]] = x;
-    }
-  }
-  if (ref.parameters.empty()) throw DataError(path + ": no header line");
-  return ref;
 }
 
 void check_pressures(const MeasuredData& d, const std::vector<Real>& sigma3) {

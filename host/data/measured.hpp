@@ -36,9 +36,19 @@
 
 namespace dem {
 
+/// The most rows a test's curve and a file may have. The curve's smoothing and noise estimate read a window of rows
+/// around each row, so their cost grows with the square of the rows per strain: 10^5 rows of a test take about a
+/// second, 10^6 minutes. A curve shows nothing at 10^5 rows that it does not at 10^4. A file beyond the total is
+/// refused while it is read, before it fills memory.
+constexpr std::size_t kMaxCurveRows = 100000;
+constexpr std::size_t kMaxFileRows = 2000000;
+
 /// A measured-data error: what() reads "<file>:<line>:<column name>: problem".
 struct DataError : std::runtime_error {
   using std::runtime_error::runtime_error;
+  /// `at` is where in the file: "<path>:<line>" in a CSV, "<path>:/<material>/table row <k>" in HDF5.
+  DataError(const std::string& at, const std::string& column, const std::string& what)
+      : std::runtime_error(at + (column.empty() ? "" : ":" + column) + ": " + what) {}
 };
 
 /// Which deviator q a lab reports (docs/running.md, "Which q"): the platen force over the cross-section after

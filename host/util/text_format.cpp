@@ -11,6 +11,12 @@ std::vector<std::string> split_fields(const std::string& line, char sep) {
   return out;
 }
 
+std::vector<std::string> split_cells(const std::string& line) {
+  std::vector<std::string> out = split_fields(line);
+  for (std::string& c : out) c = trim(c);
+  return out;
+}
+
 std::string trim(const std::string& s) {
   const auto a = s.find_first_not_of(" \t\r");
   if (a == std::string::npos) return "";

@@ -23,5 +23,7 @@ std::string fmt(const char* format, T v) = delete;
 std::vector<std::string> split_fields(const std::string& line, char sep = ',');
 /// s without its leading and trailing blanks (spaces, tabs, a carriage return).
 std::string trim(const std::string& s);
+/// The fields of a comma-separated line, each trimmed: a CSV row's cells.
+std::vector<std::string> split_cells(const std::string& line);
 
 }  // namespace dem
