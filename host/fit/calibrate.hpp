@@ -160,6 +160,9 @@ long planned_points(int d, int rounds = 4);
 /// One response surface per residual of the evaluations, weighted towards `centre` (unit coordinates).
 std::vector<QuadraticSurface> response_surfaces(const std::vector<Evaluation>& pts, const std::vector<Real>& centre);
 
+/// Calls f(u) at every point of the grid of n points per axis over the unit box [0, 1]^d, the first axis fastest.
+void for_each_grid_point(int d, int n, const std::function<void(const std::vector<Real>&)>& f);
+
 /// Minimises f over [0, 1]^d: a grid of `per_axis` points per axis (fewer for d > 3), then coordinate steps
 /// that halve down to 1e-4.
 std::vector<Real> minimise_unit_box(const std::function<Real(const std::vector<Real>&)>& f, int d, int per_axis = 21);
