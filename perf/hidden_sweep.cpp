@@ -32,13 +32,13 @@ int main(int argc, char** argv) {
   std::string out = "hidden_sweep.csv";
   unsigned first = 1, last = 4;
   std::vector<unsigned> listed;
-  int jobs = 2;
+  int workers = 2;
   app.add_option("--config", config, "base config of the simulator")->check(CLI::ExistingFile);
   app.add_option("--first-seed", first, "first seed");
   app.add_option("--last-seed", last, "last seed");
   app.add_option("--seeds", listed, "these seeds instead of first..last (e.g. the upper quantiles: seed 6 "
                                     "draws 0.90 of each range, 9: 0.71, 10: 0.96, 12: 0.75)")->delimiter(',');
-  app.add_option("-j,--jobs", jobs, "simulator runs at once, one thread each");
+  app.add_option("-j,--jobs", workers, "simulator runs at once, one thread each");
   app.add_option("-o,--output", out, "CSV of the cases");
   bool own = false;
   double noise = 1;
@@ -62,7 +62,7 @@ int main(int argc, char** argv) {
                  "(default " + std::to_string(kGeneratorCellFactor) + ")")->check(CLI::Range(1, 64));
   app.add_flag("--own-specimen", own, "generate the data on the diagnosis's own first specimen (the old, easier test)");
   CLI11_PARSE(app, argc, argv);
-  prepare_parallel_runs(jobs);
+  prepare_parallel_runs(workers);
   Kokkos::ScopeGuard guard(argc, argv);
   Config cfg = load_config(config);
   if (ensemble == "auto") cfg.calibrate.ensemble = kAutoEnsemble;
@@ -109,10 +109,10 @@ int main(int argc, char** argv) {
       if (h != "none") set_param(truth, extension(h).param, strength = draw_strength(extension(h), seed));
       // The data come from a specimen per pressure that the diagnosis never runs (own: its first member, as before).
       PeriodicLab generator(own ? cfg : larger_cell(cfg, data_cell), false, own ? 1 : 3,
-                            own ? cfg.run.seed : cfg.run.seed + kForeignSeedOffset + 3 * seed, 0, jobs);
+                            own ? cfg.run.seed : cfg.run.seed + kForeignSeedOffset + 3 * seed, 0, workers);
       const std::vector<MeasuredTest> data = synthetic_tests(generator, truth, {100e3, 200e3, 300e3}, "hidden", seed, noise);
       StateMatch state;  // the data's void ratio sets the preparation, as triaxdem diagnose does
-      PeriodicLab matched(matched_state(cfg, data, state, false, match_plan(cfg, jobs)), false, jobs);
+      PeriodicLab matched(matched_state(cfg, data, state, false, match_plan(cfg, workers)), false, workers);
       const Diagnosis dg = diagnose(matched, base, free, data, measure_misfit(matched, base, data, NoiseOptions()), false);
       Real true_heldout = dg.base_heldout;
       bool data_show = false;

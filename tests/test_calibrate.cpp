@@ -183,7 +183,7 @@ TEST(Calibrate, MeasuredCurvesRoundTrip) {
 // Parallel runs (child processes) give the same tests as runs one at a time, bit for bit: each child runs the
 // same specimen and law as the parent would, for each member of a two-specimen ensemble; and specimens packed in
 // children are those the parent would pack.
-// It runs at one thread only (tests/CMakeLists.txt): with two, set_jobs refuses (forking a multithreaded OpenMP
+// It runs at one thread only (tests/CMakeLists.txt): with two, set_workers refuses (forking a multithreaded OpenMP
 // process is unsafe) and both paths would be the in-process one.
 TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
   const Config cfg = test::tiny_cell_config();
@@ -193,7 +193,7 @@ TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
   std::vector<MeasuredTest> like(3);
   for (int k = 0; k < 3; ++k) like[k].sigma3 = 100e3 * (k + 1);
   const Ensemble one = lab.run_ensemble(m, like);
-  ASSERT_EQ(lab.set_jobs(2), 2) << "the runs fork only from a one-thread process (ctest runs this test so)";
+  ASSERT_EQ(lab.set_workers(2), 2) << "the runs fork only from a one-thread process (ctest runs this test so)";
   // The scatter measurement printed nothing for minutes: a labelled batch reports its runs as they come back.
   lab.set_progress("scatter");
   testing::internal::CaptureStdout();
@@ -217,7 +217,7 @@ TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
   EXPECT_EQ(lab.runs(), 12);
   // Specimens packed side by side are those packed one at a time; run_each runs test k on member k % 2.
   PeriodicLab packed_apart(cfg, false, 2, 1, 0, 2);
-  ASSERT_EQ(packed_apart.jobs(), 2);
+  ASSERT_EQ(packed_apart.workers(), 2);
   for (int j = 0; j < 2; ++j) EXPECT_EQ(packed_apart.prepared_void_ratio(j), lab.prepared_void_ratio(j));
   const std::vector<MeasuredTest> each = packed_apart.run_each(m, like);
   ASSERT_EQ(each.size(), 3u);
@@ -290,7 +290,7 @@ TEST(Calibrate, StateIsMatchedOnTheMeanOfTheLabsFirstSpecimens) {
   if (runs_at_once(2) == 2) {
     StateMatch side;
     MatchPlan two = plan;
-    two.jobs = 2;
+    two.workers = 2;
     EXPECT_EQ(matched_state(cfg, data, side, false, two).periodic.prep_mu_s, m.prep_mu_s);
     EXPECT_EQ(side.reached, m.reached);
   }

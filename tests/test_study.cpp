@@ -90,7 +90,7 @@ TEST(Study, ResumeKeepsFinishedCasesAndRunsTheRest) {
                                dir / "configs" / (std::string(name) + ".toml"));
   StudyOptions opt;
   opt.output = (dir / "out").string();
-  opt.jobs = 1;
+  opt.workers = 1;
   opt.threads = 1;
   opt.resume = true;
   TestSummary done;

@@ -14,7 +14,7 @@ struct CalibrationOptions {
   std::string output = "out";             ///< parent of the dated result folder
   std::vector<std::string> free;          ///< empty: the config's [calibrate] free
   std::string material;                   ///< empty: every material of the file
-  int jobs = 1;                           ///< simulator runs at once (PeriodicLab::set_jobs)
+  int workers = 1;                           ///< simulator runs at once (PeriodicLab::set_workers)
   std::string reference;                  ///< optional reference values (load_reference) to set beside the fit
   std::string noise = "data";             ///< the data's noise: data, lab or a lab noise file
   /// The membrane test to predict with (host/fit/prediction.hpp): a config path, "none" for no prediction, or ""

@@ -81,9 +81,9 @@ Session::Session(const Config& base, const CalibrationOptions& o, const std::str
       ref(o.reference.empty() ? ReferenceValues{}
                               : load_reference(o.reference, [](const std::string& n) { free_param(n); })),
       free(free_params(base, o.free)), predict_template(prediction_template(base, o.predict)),
-      walls_prediction(walls_prediction_wanted(base, o)), jobs(o.jobs),
+      walls_prediction(walls_prediction_wanted(base, o)), workers(o.workers),
       two_fidelity(two_fidelity_wanted(base, o.reference_test, predict_template.has_value())),
-      lab(matched(reference_cell(base, o.reference_test), o.jobs), true, o.jobs),
+      lab(matched(reference_cell(base, o.reference_test), o.workers), true, o.workers),
       folder(o.resume.empty() ? new_dated_folder(o.output, kind) : resumed_folder(o.resume, kind)),
       output(o.resume.empty() ? o.output : resumed_parent(o.resume)) {
   lab.set_run_store(folder + "/runs");
@@ -125,8 +125,8 @@ std::vector<Prediction> Session::predict_at(const Config& base, const Model& mod
                  static_cast<int>(base.calibrate.predict_specimens), output + "/.specimens", true);
 }
 
-Config Session::matched(const Config& base, int jobs) {
-  return matched_state(base, data.tests, state, true, match_plan(base, jobs));
+Config Session::matched(const Config& base, int workers) {
+  return matched_state(base, data.tests, state, true, match_plan(base, workers));
 }
 
 std::string Session::state_text(const Misfit& m, const std::vector<MeasuredTest>& tests) const {
@@ -198,7 +198,7 @@ std::string Session::predict_boundary(const Config& base, const std::map<std::st
   if (walls_prediction) {
     StateMatch walls_state;  // the walled cell's own preparation to the data's state
     const Config cell = reference_cell(base, kPredictWalls);
-    walls = matched_state(cell, data.tests, walls_state, true, match_plan(cell, jobs));
+    walls = matched_state(cell, data.tests, walls_state, true, match_plan(cell, workers));
   }
   const std::string test = walls ? walled_cell_text(*walls) : membrane_test_text(*predict_template);
   const int specimens = static_cast<int>(base.calibrate.predict_specimens);
@@ -209,7 +209,7 @@ std::string Session::predict_boundary(const Config& base, const std::map<std::st
     std::printf("%s: %s: predicting %s at the calibrated parameters: %zu pressures x %d specimens\n",
                 folder.c_str(), material.c_str(), walls ? "the walled cell" : predict_template->path.c_str(),
                 tests.size(), specimens);
-    std::vector<Prediction> p = walls ? predict_walls(*walls, cal.model, tests, specimens, jobs)
+    std::vector<Prediction> p = walls ? predict_walls(*walls, cal.model, tests, specimens, workers)
                                       : predict_at(base, cal.model, tests);
     for (std::size_t k = 0; k < p.size() && k < cal.sim.size(); ++k) p[k].periodic_q_peak = cal.sim[k].q_peak;
     for (Prediction& x : p) {

@@ -46,7 +46,7 @@ struct Session {
   StateMatch state;  ///< the data's void ratio and the preparation that packs it
   std::optional<Config> predict_template;
   bool walls_prediction = false;  ///< the prediction is the reference cell between six walls (kPredictWalls)
-  int jobs = 1;
+  int workers = 1;
   bool two_fidelity = false;  ///< the reference test: the periodic cell corrected by the membrane test
   std::string discrepancy;    ///< what the two fidelities measured, for the report
   PeriodicLab lab;
@@ -64,7 +64,7 @@ struct Session {
   /// The membrane test at `model` on every test of `tests`, q in the data's measure (a template must be set).
   std::vector<Prediction> predict_at(const Config& base, const Model& model,
                                      const std::vector<MeasuredTest>& tests) const;
-  Config matched(const Config& base, int jobs);
+  Config matched(const Config& base, int workers);
   /// The report's line on the specimens' state.
   std::string state_text(const Misfit& m, const std::vector<MeasuredTest>& tests) const;
   /// The misfit of a material's tests: the ensemble run at the base model, its scatter beside the data's noise.

@@ -149,7 +149,7 @@ void add_study_commands(CLI::App& app, Args& a, Commands& c) {
   c.study = app.add_subcommand("study", "run a set of triaxial cases and write one summary table and figure");
   c.study->add_option("configs", a.study_inputs, "config folders (every *.toml) or files")->required();
   c.study->add_option("-o,--output", a.study.output, "output folder: summary, figure, one subfolder per case");
-  c.study->add_option("-j,--jobs", a.study.jobs, "cases run at once (default: one per two cores)")
+  c.study->add_option("-j,--jobs", a.study.workers, "cases run at once (default: one per two cores)")
       ->check(count_on_this_machine(0));
   c.study->add_option("-t,--threads", a.study.threads, "OpenMP threads per case (default: the cores shared out)")
       ->check(count_on_this_machine(0));
@@ -182,7 +182,7 @@ void add_calibration_commands(CLI::App& app, Args& a, Commands& c) {
     cmd->add_option("--reference", a.cal.reference, "CSV of reference values (material, then one column per parameter) "
                   "to set beside the calibrated ones")->check(CLI::ExistingFile);
     cmd->add_option("-o,--output", a.cal.output, "parent folder of the dated result folder (default out)");
-    cmd->add_option("-j,--jobs", a.cal.jobs, "simulator runs at once, one thread each (default: one per core)")
+    cmd->add_option("-j,--jobs", a.cal.workers, "simulator runs at once, one thread each (default: one per core)")
         ->check(count_on_this_machine(1));
     cmd->add_option("--noise", a.cal.noise, "the data's noise: data (its standard-deviation columns, replicates, or "
                   "its curves' own scatter), lab (a lab's fixed scatter) or a lab noise file like "
@@ -278,7 +278,7 @@ int main(int argc, char** argv) {
   add_study_commands(app, a, c);
   add_calibration_commands(app, a, c);
   add_check_commands(app, a, c);
-  a.cal.jobs = machine_cores();
+  a.cal.workers = machine_cores();
   if (argc > 1 && argv[1][0] != '-') {
     if (const std::string problem = unknown_command(app, argv[1]); !problem.empty()) {
       std::fprintf(stderr, "triaxdem: %s\n", problem.c_str());
@@ -290,8 +290,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "triaxdem: %s\n", problem.c_str());
     return 1;
   }
-  // Parallel calibration runs are child processes of one thread each (PeriodicLab::set_jobs).
-  if (c.calibrate->parsed() || c.diagnose->parsed()) dem::prepare_parallel_runs(a.cal.jobs);
+  // Parallel calibration runs are child processes of one thread each (PeriodicLab::set_workers).
+  if (c.calibrate->parsed() || c.diagnose->parsed()) dem::prepare_parallel_runs(a.cal.workers);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // progress reaches a log file as it happens
   if (c.study->parsed()) {  // the study only starts child processes: no Kokkos of its own
     try {

@@ -89,11 +89,11 @@ int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, c
   std::vector<MeasuredData> compare;  // read before anything runs: a bad file stops the study at once
   for (const std::string& f : opt.compare) compare.push_back(load_measured(f));
   const int cores = std::max(1u, std::thread::hardware_concurrency());
-  const int jobs = std::clamp(opt.jobs > 0 ? opt.jobs : cores / 2, 1, static_cast<int>(cases.size()));
-  const int threads = opt.threads > 0 ? opt.threads : std::max(1, cores / jobs);
+  const int workers = std::clamp(opt.workers > 0 ? opt.workers : cores / 2, 1, static_cast<int>(cases.size()));
+  const int threads = opt.threads > 0 ? opt.threads : std::max(1, cores / workers);
   fs::create_directories(opt.output);
   std::printf("study: %zu cases, %d at a time with %d OpenMP threads each; logs in %s/<case>/log.txt\n",
-              cases.size(), jobs, threads, opt.output.c_str());
+              cases.size(), workers, threads, opt.output.c_str());
   std::vector<int> status(cases.size(), -1);
   std::size_t done = 0;
   auto finished_before = [&](std::size_t k) {
@@ -108,7 +108,7 @@ int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, c
   auto folder = [&](std::size_t k) { return opt.output + "/" + cases[k].name; };
   PoolWork w;
   w.pieces = cases.size();
-  w.jobs = jobs;
+  w.workers = workers;
   w.before = [&](std::size_t k) {
     if (finished_before(k)) {
       std::printf("study: %s finished before (summary.csv): kept\n", cases[k].name.c_str());

@@ -27,12 +27,12 @@ void measure_cell_bias(PeriodicLab& lab, const Model& base, const std::vector<Me
   MatchPlan plan;
   plan.first_seed = lab.config().run.seed + kCellCheckSeedOffset;
   plan.steps = kCellCheckPrepSteps;
-  plan.jobs = lab.jobs();
+  plan.workers = lab.workers();
   // The lab's cell was matched to the same data: the larger one's friction lies near its own.
   plan.around = std::sqrt(lab.config().periodic.prep_mu_s);
   plan.store = lab.run_store();
   const Config cfg = matched_state(larger_cell(lab.config(), kCellCheckFactor), measured, state, false, plan);
-  PeriodicLab check(cfg, false, kCellCheckSpecimens, plan.first_seed, kCellCheckSpecimens, lab.jobs());
+  PeriodicLab check(cfg, false, kCellCheckSpecimens, plan.first_seed, kCellCheckSpecimens, lab.workers());
   check.set_run_store(lab.run_store());  // its own specimens: their runs have their own names there
   const Ensemble larger = check.run_ensemble(base, measured, true);
   const Real n = static_cast<Real>(lab.balls()), factor = static_cast<Real>(check.balls()) / n;

@@ -113,8 +113,8 @@ std::vector<Prediction> predictions_of(const std::vector<MeasuredTest>& tests, E
 }
 
 std::vector<Prediction> predict_walls(const Config& walls, const Model& calibrated,
-                                      const std::vector<MeasuredTest>& tests, int specimens, int jobs) {
-  PeriodicLab lab(walls, false, specimens, walls.run.seed, specimens, jobs);
+                                      const std::vector<MeasuredTest>& tests, int specimens, int workers) {
+  PeriodicLab lab(walls, false, specimens, walls.run.seed, specimens, workers);
   lab.set_progress("prediction: walled cells");
   Ensemble runs = lab.run_ensemble(calibrated, tests);
   for (std::size_t j = 0; j < tests.size(); ++j)

@@ -65,9 +65,9 @@ std::vector<Prediction> predict(const Config& membrane, const Model& calibrated,
 
 /// The cell between six walls of `walls` (a walled config: reference_cell(base, "walls"), its preparation matched)
 /// at `calibrated` for every test of `tests`, on its first `specimens` specimens (packing seeds from [run] seed),
-/// `jobs` runs at once, with a progress line.
+/// `workers` runs at once, with a progress line.
 std::vector<Prediction> predict_walls(const Config& walls, const Model& calibrated,
-                                      const std::vector<MeasuredTest>& tests, int specimens, int jobs);
+                                      const std::vector<MeasuredTest>& tests, int specimens, int workers);
 
 /// The predictions as a Markdown table (material, sigma3, measured and predicted q_peak with the members' scatter,
 /// error; the periodic cell's q_peak and the boundary's share (predicted - periodic) / predicted where given) with

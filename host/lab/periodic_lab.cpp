@@ -58,32 +58,32 @@ Config larger_cell(const Config& base, int factor) {
   return c;
 }
 
-PeriodicLab::PeriodicLab(const Config& base, bool verbose, int members, unsigned first_seed, int specimens, int jobs)
+PeriodicLab::PeriodicLab(const Config& base, bool verbose, int members, unsigned first_seed, int specimens, int workers)
     : cfg_(base), members_(std::max(members, 1)), first_seed_(first_seed) {
-  set_jobs(jobs);
+  set_workers(workers);
   pack(std::max(members_, specimens), verbose);
 }
 
 void PeriodicLab::pack(int count, bool verbose) {
-  specimens_.assign(static_cast<std::size_t>(count), Specimen{});
+  specimens_.assign(static_cast<std::size_t>(count), PackedCell{});
   auto prepare = [&](std::size_t k) {
     Config c = cfg_;
     c.run.seed = first_seed_ + static_cast<unsigned>(k);
-    Specimen& s = specimens_[k];
+    PackedCell& s = specimens_[k];
     prepare_periodic_specimen(c, s.balls, s.cell, verbose && k == 0);
     s.void_ratio = void_ratio_of(s.balls, s.cell);
   };
-  if (jobs_ <= 1 || count <= 1) {
+  if (workers_ <= 1 || count <= 1) {
     for (std::size_t k = 0; k < specimens_.size(); ++k) prepare(k);
     return;
   }
   // Each specimen in a child, sent back as its ball count, balls (plain data), cell and void ratio.
   static_assert(std::is_trivially_copyable<BallSpec>::value, "BallSpec goes through a pipe as bytes");
   forked_runs(
-      specimens_.size(), jobs_,
+      specimens_.size(), workers_,
       [&](std::size_t k, int fd) {
         prepare(k);
-        const Specimen& s = specimens_[k];
+        const PackedCell& s = specimens_[k];
         const std::size_t n = s.balls.size();
         put_bytes(fd, &n, sizeof n);
         put_bytes(fd, s.balls.data(), n * sizeof(BallSpec));
@@ -91,7 +91,7 @@ void PeriodicLab::pack(int count, bool verbose) {
         put_bytes(fd, &s.void_ratio, sizeof s.void_ratio);
       },
       [&](std::size_t k, int fd) {
-        Specimen& s = specimens_[k];
+        PackedCell& s = specimens_[k];
         std::size_t n = 0;
         if (!get_bytes(fd, &n, sizeof n)) return false;
         s.balls.resize(n);
@@ -110,25 +110,25 @@ void PeriodicLab::grow_cell(int factor, StateMatch* state) {
     MatchPlan plan;
     plan.first_seed = first_seed_;
     plan.specimens = state->specimens;
-    plan.jobs = jobs_;
+    plan.workers = workers_;
     cfg_.periodic.prep_mu_s = state->prep_mu_s = prep_friction_for(cfg_, state->target, state->reached, false, plan);
   }
   pack(specimens(), false);
 }
 
-MatchPlan match_plan(const Config& base, int jobs) {
+MatchPlan match_plan(const Config& base, int workers) {
   MatchPlan p;
   p.first_seed = base.run.seed;
   p.cell_factor = fixed_cell_factor(base);
-  p.jobs = runs_at_once(jobs);
+  p.workers = runs_at_once(workers);
   return p;
 }
 
-PeriodicLab::PeriodicLab(const Config& base, bool verbose, int jobs)
+PeriodicLab::PeriodicLab(const Config& base, bool verbose, int workers)
     : PeriodicLab(larger_cell(base, fixed_cell_factor(base)), verbose,
                   static_cast<int>(base.calibrate.ensemble == kAutoEnsemble ? base.calibrate.scatter_specimens
                                                                             : base.calibrate.ensemble),
-                  base.run.seed, static_cast<int>(base.calibrate.scatter_specimens), jobs) {
+                  base.run.seed, static_cast<int>(base.calibrate.scatter_specimens), workers) {
   cell_factor_ = fixed_cell_factor(base);
 }
 
@@ -141,7 +141,7 @@ void PeriodicLab::set_members(int k) {
 
 MeasuredTest PeriodicLab::run(const Model& m, Real sigma3, const std::string& material, int member) {
   const auto t0 = std::chrono::steady_clock::now();
-  const Specimen& sp = specimens_.at(static_cast<std::size_t>(member));
+  const PackedCell& sp = specimens_.at(static_cast<std::size_t>(member));
   MeasuredTest t;
   PeriodicTriaxialParams p = cfg_.periodic.triax;
   p.sigma3 = sigma3;
@@ -163,20 +163,20 @@ MeasuredTest PeriodicLab::run(const Model& m, Real sigma3, const std::string& ma
   return t;
 }
 
-void prepare_parallel_runs(int jobs) {
+void prepare_parallel_runs(int workers) {
 #if defined(KOKKOS_ENABLE_OPENMP)
-  if (jobs > 1) omp_set_num_threads(1);
+  if (workers > 1) omp_set_num_threads(1);
 #else
-  (void)jobs;
+  (void)workers;
 #endif
 }
 
-int runs_at_once(int jobs) {
+int runs_at_once(int workers) {
   constexpr bool host = std::is_same<ExecSpace::memory_space, Kokkos::HostSpace>::value;
-  return host && ExecSpace().concurrency() == 1 ? std::max(jobs, 1) : 1;
+  return host && ExecSpace().concurrency() == 1 ? std::max(workers, 1) : 1;
 }
 
-int PeriodicLab::set_jobs(int jobs) { return jobs_ = runs_at_once(jobs); }
+int PeriodicLab::set_workers(int workers) { return workers_ = runs_at_once(workers); }
 
 namespace {
 
@@ -220,7 +220,7 @@ std::string PeriodicLab::stored_path(const Model& m, const Case& c) const {
   h = fnv1a(&m.law, sizeof m.law, h);  // Reals only: no padding
   h = fnv1a(&m.membrane, sizeof m.membrane, h);
   h = fnv1a(&c.sigma3, sizeof c.sigma3, h);
-  const Specimen& sp = specimens_.at(static_cast<std::size_t>(c.member));
+  const PackedCell& sp = specimens_.at(static_cast<std::size_t>(c.member));
   for (const BallSpec& b : sp.balls) {
     const Real v[] = {b.x.x, b.x.y, b.x.z, b.v.x, b.v.y, b.v.z, b.w.x, b.w.y, b.w.z, b.radius, b.density};
     h = fnv1a(v, sizeof v, h);
@@ -270,7 +270,7 @@ std::vector<MeasuredTest> PeriodicLab::run_or_read(const Model& m, const std::ve
       todo.push_back(j);
     }
   }
-  if (jobs_ <= 1 || todo.size() <= 1) {
+  if (workers_ <= 1 || todo.size() <= 1) {
     for (const std::size_t j : todo) {
       out[j] = run(m, cases[j].sigma3, cases[j].material, cases[j].member);
       store_run(paths[j], out[j]);
@@ -280,7 +280,7 @@ std::vector<MeasuredTest> PeriodicLab::run_or_read(const Model& m, const std::ve
   }
   const auto t0 = std::chrono::steady_clock::now();
   forked_runs(
-      todo.size(), jobs_,
+      todo.size(), workers_,
       [&](std::size_t k, int fd) {
         const Case& c = cases[todo[k]];
         send_curves(fd, run(m, c.sigma3, c.material, c.member));

@@ -40,28 +40,28 @@ struct StateMatch;
 class PeriodicLab {
  public:
   /// `specimens` specimens with packing seeds first_seed, first_seed + 1, ..., of which the first `members`
-  /// (at most all) form the ensemble that run_ensemble runs. They are packed up to `jobs` at once (set_jobs).
-  PeriodicLab(const Config& base, bool verbose, int members, unsigned first_seed, int specimens = 0, int jobs = 1);
+  /// (at most all) form the ensemble that run_ensemble runs. They are packed up to `workers` at once (set_workers).
+  PeriodicLab(const Config& base, bool verbose, int members, unsigned first_seed, int specimens = 0, int workers = 1);
   /// The config's ensemble ([calibrate] ensemble, scatter_specimens), cell ([calibrate] cell_factor) and seed
   /// ([run] seed); an "auto" ensemble starts as all the scatter specimens and an "auto" cell as the config's,
   /// until measure_misfit chooses.
-  PeriodicLab(const Config& base, bool verbose, int jobs = 1);
+  PeriodicLab(const Config& base, bool verbose, int workers = 1);
   /// One simulated test (curves, summarised; its void ratio at the start of shear) of one member at sigma3 (Pa).
   MeasuredTest run(const Model& m, Real sigma3, const std::string& material = "sim", int member = 0);
   /// Every test of `like` (its materials and pressures) on every member (on every specimen with `all`); up to
-  /// jobs() runs at once.
+  /// workers() runs at once.
   Ensemble run_ensemble(const Model& m, const std::vector<MeasuredTest>& like, bool all = false);
   /// Test j of `like` (its material and pressure) on member j % members(): data made on a specimen per test.
   std::vector<MeasuredTest> run_each(const Model& m, const std::vector<MeasuredTest>& like);
   /// Runs at once: each in a child process (fork) with the same specimens; the results are the same as one at a
   /// time, bit for bit. Only where that is safe: a host backend on one thread (OMP_NUM_THREADS=1); otherwise
   /// the runs go one at a time with all threads. Returns the value in effect.
-  int set_jobs(int jobs);
-  int jobs() const { return jobs_; }
+  int set_workers(int workers);
+  int workers() const { return workers_; }
   int members() const { return members_; }
   /// Makes the first k specimens the ensemble (1 <= k <= specimens()).
   void set_members(int k);
-  /// Packs every specimen again (same seeds) in a cell of `factor` times the balls (larger_cell), jobs() at once.
+  /// Packs every specimen again (same seeds) in a cell of `factor` times the balls (larger_cell), workers() at once.
   /// Where `state` holds a match to the data's void ratio, the preparation friction is matched again, on the larger
   /// cell's first specimens (prep_friction_for), and `state` gets what it reaches.
   void grow_cell(int factor, StateMatch* state = nullptr);
@@ -90,13 +90,14 @@ class PeriodicLab {
   Real prepared_void_ratio(int k) const { return specimens_[static_cast<std::size_t>(k)].void_ratio; }
 
  private:
-  struct Specimen {
+  /// A member's specimen: its balls packed in their periodic cell.
+  struct PackedCell {
     std::vector<BallSpec> balls;
     std::array<Real, 3> cell{};
     Real void_ratio = 0;
   };
   Config cfg_;
-  std::vector<Specimen> specimens_;
+  std::vector<PackedCell> specimens_;
   long runs_ = 0;
   long failed_ = 0;
   Real failed_sigma3_ = 0;
@@ -104,7 +105,7 @@ class PeriodicLab {
   std::string progress_label_;
   std::string store_;
   long stored_read_ = 0;
-  int jobs_ = 1;
+  int workers_ = 1;
   int members_ = 1;
   int cell_factor_ = 1;
   unsigned first_seed_ = 0;
@@ -117,29 +118,29 @@ class PeriodicLab {
   };
   /// run_or_read, then the blown-up runs among them counted (failed_runs), whichever way each test came.
   std::vector<MeasuredTest> run_cases(const Model& m, const std::vector<Case>& cases);
-  /// The cases in order, up to jobs() at once; those in the run store are read.
+  /// The cases in order, up to workers() at once; those in the run store are read.
   std::vector<MeasuredTest> run_or_read(const Model& m, const std::vector<Case>& cases);
   /// The run store's file of a case ("" without a store).
   std::string stored_path(const Model& m, const Case& c) const;
 };
 
-/// Runs at once that `jobs` asks for, where that is safe (PeriodicLab::set_jobs); otherwise 1.
-int runs_at_once(int jobs);
+/// Runs at once that `workers` asks for, where that is safe (PeriodicLab::set_workers); otherwise 1.
+int runs_at_once(int workers);
 
 /// Specimens whose mean void ratio the preparation friction is matched on. One specimen of 120 balls scatters by
 /// about 0.011 in void ratio at one friction (perf/specimen_scatter.sh), and a void ratio 0.001 lower adds about
 /// 0.01-0.02 to q/sigma3 (docs/calibration.md): a match on one specimen leaves that scatter as an offset of every
-/// specimen packed with its friction. The mean of two, packed side by side with 2 jobs, costs no more time.
+/// specimen packed with its friction. The mean of two, packed side by side with 2 workers, costs no more time.
 constexpr int kStateMatchSpecimens = 2;
 
 /// How the preparation friction is looked for: `steps` halvings, each packing the specimens of packing seeds
-/// first_seed, first_seed + 1, ... (`specimens` of them, up to `jobs` at once: the answer is the same for any
-/// jobs).
+/// first_seed, first_seed + 1, ... (`specimens` of them, up to `workers` at once: the answer is the same for any
+/// number of workers).
 struct MatchPlan {
   unsigned first_seed = 0;
   int specimens = kStateMatchSpecimens;
   int steps = 8;
-  int jobs = 1;
+  int workers = 1;
   int cell_factor = 1;  ///< the specimens are packed in cells of this many times the base config's balls
   /// Where the answer is expected (sqrt(prep_mu_s), from a smaller cell's match; negative: nowhere): the halvings
   /// start from the bracket of +-kMatchBracket around it, and from [0, 1] only where the target lies outside.
@@ -152,8 +153,8 @@ struct MatchPlan {
 /// Its two ends and two halvings reach the 1/32 of five halvings of [0, 1] with four packings instead of seven.
 constexpr Real kMatchBracket = 1.0 / 16;
 /// The plan for a lab's specimens: its first seeds ([run] seed on), in the cell it runs ([calibrate] cell_factor,
-/// the config's own where "auto"), 8 halvings, `jobs` at once.
-MatchPlan match_plan(const Config& base, int jobs);
+/// the config's own where "auto"), 8 halvings, `workers` at once.
+MatchPlan match_plan(const Config& base, int workers);
 
 /// How far (in void ratio) a data state may lie outside what a cell's preparation reaches and still be matched
 /// by the nearest end. Table 6's glass beads (e 0.60-0.61) lie 0.01-0.02 from the densest packing of the shipped
@@ -187,9 +188,9 @@ struct StateMatch {
 Config matched_state(const Config& base, const std::vector<MeasuredTest>& tests, StateMatch& m, bool verbose,
                      const MatchPlan& plan);
 
-/// Before Kokkos starts, in a program that will run `jobs` > 1 simulator runs at once: sets OpenMP to one
+/// Before Kokkos starts, in a program that will run `workers` > 1 simulator runs at once: sets OpenMP to one
 /// thread (its runtime read OMP_NUM_THREADS when it was loaded, before main, so through its API), as
-/// PeriodicLab::set_jobs requires.
-void prepare_parallel_runs(int jobs);
+/// PeriodicLab::set_workers requires.
+void prepare_parallel_runs(int workers);
 
 }  // namespace dem

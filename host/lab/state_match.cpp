@@ -19,7 +19,7 @@ namespace {
 /// its specimens, so that the mean matched is the mean of a lab's first specimens, bit for bit.
 Real prepared_void_ratio(const Config& cfg, const MatchPlan& plan) {
   const int n = std::max(plan.specimens, 1);
-  const PeriodicLab lab(larger_cell(cfg, plan.cell_factor), false, n, plan.first_seed, n, plan.jobs);
+  const PeriodicLab lab(larger_cell(cfg, plan.cell_factor), false, n, plan.first_seed, n, plan.workers);
   Real sum = 0;
   for (int k = 0; k < n; ++k) sum += lab.prepared_void_ratio(k);
   return sum / static_cast<Real>(n);

@@ -26,8 +26,8 @@ std::vector<StudyCase> study_cases(const std::vector<std::string>& inputs);
 
 struct StudyOptions {
   std::string output = "out/study";  ///< the summary and one subfolder per case
-  int jobs = 0;                      ///< cases run at once; 0: one per two cores (at least one)
-  int threads = 0;                   ///< OpenMP threads per case; 0: the cores shared out among the jobs
+  int workers = 0;                   ///< cases run at once; 0: one per two cores (at least one)
+  int threads = 0;                   ///< OpenMP threads per case; 0: the cores shared out among the workers
   bool resume = false;               ///< skip the cases with a summary.csv; continue those with a checkpoint.h5
   std::vector<std::string> compare;  ///< measured-data files whose peaks are set beside the cases'
 };

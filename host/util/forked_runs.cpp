@@ -27,13 +27,13 @@ bool get_bytes(int fd, void* p, std::size_t n) {
   return true;
 }
 
-void forked_runs(std::size_t n, int jobs, const std::function<void(std::size_t, int)>& task,
+void forked_runs(std::size_t n, int workers, const std::function<void(std::size_t, int)>& task,
                  const std::function<bool(std::size_t, int)>& collect, const char* what) {
-  if (jobs <= 1) return;
+  if (workers <= 1) return;
   bool ok = true;
   PoolWork w;
   w.pieces = n;
-  w.jobs = jobs;
+  w.workers = workers;
   w.before = [&](std::size_t) { return ok; };  // a failed run stops new ones; those running end first
   w.child = task;
   w.collect = collect;

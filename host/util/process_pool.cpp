@@ -24,7 +24,7 @@ void run_pool(const PoolWork& w, const char* what) {
   std::vector<Child> running;
   std::size_t next = 0;
   for (;;) {
-    while (next < w.pieces && running.size() < static_cast<std::size_t>(w.jobs > 1 ? w.jobs : 1)) {
+    while (next < w.pieces && running.size() < static_cast<std::size_t>(w.workers > 1 ? w.workers : 1)) {
       const std::size_t j = next++;
       if (w.before && !w.before(j)) continue;
       std::cout.flush();

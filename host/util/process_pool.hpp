@@ -1,5 +1,5 @@
 #pragma once
-/// The one process pool: pieces of work in child processes, up to `jobs` at once, the next starting as soon as any
+/// The one process pool: pieces of work in child processes, up to `workers` at once, the next starting as soon as any
 /// ends. Serves the calibration's parallel runs (forked_runs.hpp: results back through a pipe) and the study's
 /// cases (the program itself, exec'd, with its log in the case's folder). Each child holds the write end of a pipe
 /// until it ends (exec keeps it open), so the parent learns that a piece has ended, or has begun to send its
@@ -11,7 +11,7 @@ namespace dem {
 
 struct PoolWork {
   std::size_t pieces = 0;
-  int jobs = 1;
+  int workers = 1;
   /// In the parent, before piece j starts: false leaves it out (finished before, or the pool is stopping).
   std::function<bool(std::size_t)> before;
   /// In the child: the piece, with `fd` the write end of its pipe. The child ends with exit status 0 when this
