@@ -110,7 +110,7 @@ int main(int argc, char** argv) {
       // The data come from a specimen per pressure that the diagnosis never runs (own: its first member, as before).
       PeriodicLab generator(own ? cfg : larger_cell(cfg, data_cell), false, own ? 1 : 3,
                             own ? cfg.run.seed : cfg.run.seed + kForeignSeedOffset + 3 * seed, 0, workers);
-      const std::vector<MeasuredTest> data = synthetic_tests(generator, truth, {100e3, 200e3, 300e3}, "hidden", seed, noise);
+      const std::vector<TriaxialTest> data = synthetic_tests(generator, truth, {100e3, 200e3, 300e3}, "hidden", seed, noise);
       StateMatch state;  // the data's void ratio sets the preparation, as triaxdem diagnose does
       PeriodicLab matched(matched_state(cfg, data, state, false, match_plan(cfg, workers)), false, workers);
       const Diagnosis dg = diagnose(matched, base, free, data, measure_misfit(matched, base, data, NoiseOptions()), false);

@@ -57,7 +57,7 @@ TEST(Calibrate, MinimiserFindsInteriorAndBoundaryMinima) {
 // skipped and a missing simulated value counts ten standard deviations. One stress alone is not whitened by
 // anything (its residual is the plain one), and the strain at peak shares no specimen factor.
 TEST(Calibrate, ResidualsUseTheNoiseModel) {
-  MeasuredTest m, s;
+  TriaxialTest m, s;
   m.q_peak = 100e3;
   m.eps_a_peak = 0.05;
   m.e_ini = m.q_1pct = m.q_3pct = m.q_end = m.max_dilatancy = std::nan("");
@@ -81,7 +81,7 @@ TEST(Calibrate, ResidualsUseTheNoiseModel) {
 // sum (d / r_q)^2, growing with every stress (1.01 against 1.51 here). The analytic value is checked to 1e-9
 // (rounding only). With specimen = 0 the whitened residuals are the plain ones.
 TEST(Calibrate, ResidualsCountASharedSpecimenFactorOnce) {
-  MeasuredTest m;
+  TriaxialTest m;
   m.e_ini = 50e6;
   m.q_1pct = 150e3;
   m.q_3pct = 200e3;
@@ -89,7 +89,7 @@ TEST(Calibrate, ResidualsCountASharedSpecimenFactorOnce) {
   m.eps_a_peak = 0.04;
   m.q_end = 180e3;
   m.max_dilatancy = 0.3;
-  MeasuredTest s = m;
+  TriaxialTest s = m;
   const Real d = 0.03;
   for (Real* v : {&s.e_ini, &s.q_1pct, &s.q_3pct, &s.q_peak, &s.q_end}) *v *= 1 + d;
   const NoiseModel noise;
@@ -158,7 +158,7 @@ TEST(Calibrate, DatedFoldersAreNeverReused) {
 
 // Curves written by the synthetic generator's writer read back as the same tests (kPa and % in the file).
 TEST(Calibrate, MeasuredCurvesRoundTrip) {
-  MeasuredTest t;
+  TriaxialTest t;
   t.material = "X";
   t.sigma3 = 200e3;
   for (int i = 0; i <= 100; ++i) {
@@ -190,7 +190,7 @@ TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
   PeriodicLab lab(cfg, false, 2, 1);
   Model m;
   m.law = cfg.ball;
-  std::vector<MeasuredTest> like(3);
+  std::vector<TriaxialTest> like(3);
   for (int k = 0; k < 3; ++k) like[k].sigma3 = 100e3 * (k + 1);
   const Ensemble one = lab.run_ensemble(m, like);
   ASSERT_EQ(lab.set_workers(2), 2) << "the runs fork only from a one-thread process (ctest runs this test so)";
@@ -219,7 +219,7 @@ TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
   PeriodicLab packed_apart(cfg, false, 2, 1, 0, 2);
   ASSERT_EQ(packed_apart.workers(), 2);
   for (int j = 0; j < 2; ++j) EXPECT_EQ(packed_apart.prepared_void_ratio(j), lab.prepared_void_ratio(j));
-  const std::vector<MeasuredTest> each = packed_apart.run_each(m, like);
+  const std::vector<TriaxialTest> each = packed_apart.run_each(m, like);
   ASSERT_EQ(each.size(), 3u);
   for (int k = 0; k < 3; ++k) EXPECT_EQ(each[k].q, one[k][k % 2].q) << "sigma3 " << like[k].sigma3;
 }
@@ -234,7 +234,7 @@ TEST(Calibrate, BlownUpRunsAreCountedWithTheirPressure) {
   Model soft;
   soft.law = cfg.ball;
   soft.law.emod = 1e-5 * cfg.ball.emod;
-  std::vector<MeasuredTest> like(2);
+  std::vector<TriaxialTest> like(2);
   like[0].sigma3 = 100e3;
   like[1].sigma3 = 200e3;
   const Ensemble out = lab.run_ensemble(soft, like);
@@ -268,7 +268,7 @@ TEST(Calibrate, StateIsMatchedOnTheMeanOfTheLabsFirstSpecimens) {
   EXPECT_EQ(reached, e1);
   EXPECT_THROW(prep_friction_for(cfg, -1, reached, false, plan), DataError);
   EXPECT_THROW(prep_friction_for(cfg, 10, reached, false, plan), DataError);
-  std::vector<MeasuredTest> data(2);
+  std::vector<TriaxialTest> data(2);
   data[0].void_ratio = e0 + 0.3 * (e1 - e0);
   data[1].void_ratio = e0 + 0.5 * (e1 - e0);
   const Real target = e0 + 0.4 * (e1 - e0);
@@ -363,7 +363,7 @@ TEST(Calibrate, AutoCellGrowsWhereAllScatterSpecimensFallShort) {
   Model m;
   m.law = cfg.ball;
   PeriodicLab foreign(cfg, false, 1, 1000);  // the "measured" test: a specimen no lab below runs
-  const std::vector<MeasuredTest> data{foreign.run(m, 100e3)};
+  const std::vector<TriaxialTest> data{foreign.run(m, 100e3)};
 
   cfg.calibrate.cell_factor = 1;
   PeriodicLab kept(cfg, false);
@@ -413,7 +413,7 @@ TEST(Calibrate, MeasureMisfitCountsTheCellsBias) {
   Model m;
   m.law = cfg.ball;
   PeriodicLab foreign(cfg, false, 1, 1000);
-  std::vector<MeasuredTest> data{foreign.run(m, 100e3)};
+  std::vector<TriaxialTest> data{foreign.run(m, 100e3)};
   data[0].specimen_balls = 100;
   data[0].void_ratio = std::numeric_limits<Real>::quiet_NaN();  // no state to match: the check packs 4 cells, not 11
   PeriodicLab lab(cfg, false);

@@ -55,7 +55,7 @@ TEST(Measured, AnEndRecordIsNotTakenForThePeak) {
   std::ostringstream f;
   f << "material,sigma3_kPa,eps_a_pct,q_kPa\n";
   for (int i = 0; i <= 50; ++i) f << "A,100," << 0.1 * i << "," << (i == 50 ? 120.0 : 100.0 + (i % 2 ? 3 : -3)) << "\n";
-  const MeasuredTest t = load_measured(write("spike.csv", f.str())).tests[0];
+  const TriaxialTest t = load_measured(write("spike.csv", f.str())).tests[0];
   EXPECT_LT(t.q_peak, 102e3);  // 100 kPa and the mean of the +-3 kPa scatter over 5 or 6 rows
   EXPECT_GT(t.q_peak, 99e3);
   EXPECT_LE(t.eps_a_peak, 0.0475 + 1e-12);
@@ -68,7 +68,7 @@ TEST(Measured, CurvesInOtherUnitsAreSummarised) {
                                              "A,0.1,0.03,140,-0.3\n"));
   ASSERT_TRUE(d.curves);
   ASSERT_EQ(d.tests.size(), 1u);
-  const MeasuredTest& t = d.tests[0];
+  const TriaxialTest& t = d.tests[0];
   EXPECT_DOUBLE_EQ(t.sigma3, 100e3);
   EXPECT_DOUBLE_EQ(t.q_peak, 150e3);
   EXPECT_DOUBLE_EQ(t.eps_a_peak, 0.02);
@@ -93,7 +93,7 @@ TEST(Measured, NoisyCurvesAreSmoothedBeforeTheyAreSummarised) {
     const double q = 100 * (1 - std::exp(-e)) + (i % 2 ? 5.0 : -5.0);
     f << "A,100," << e << "," << q << "," << -0.2 * e << "\n";
   }
-  const MeasuredTest t = load_measured(write("noisy.csv", f.str())).tests[0];
+  const TriaxialTest t = load_measured(write("noisy.csv", f.str())).tests[0];
   // The clean curve rises to the end; the peak is sought where the window is whole, up to 9.75%, where it is
   // 100 (1 - e^-9.75) = 99.994 kPa; the window's mean carries at most one unpaired row: 5/51 ~ 0.1 kPa; the
   // mean of the scatter over the last 1% likewise.
@@ -170,7 +170,7 @@ TEST(Measured, ReferenceValuesLoadAndBadOnesAreRefused) {
 // The HDF5 form holds the same data as the CSV: curves written both ways read back to the same tests (the CSV
 // keeps 6 digits, hence the tolerance of 1e-5 relative); an HDF5 error names the group, the row and the column.
 TEST(Measured, Hdf5FormReadsLikeTheCsv) {
-  MeasuredTest a;
+  TriaxialTest a;
   a.material = "S-1";
   a.sigma3 = 100e3;
   for (int i = 0; i <= 400; ++i) {
@@ -178,7 +178,7 @@ TEST(Measured, Hdf5FormReadsLikeTheCsv) {
     a.q.push_back(150e3 * (1 - std::exp(-40.0 * a.eps_a.back())));
     a.eps_v.push_back(0.3 * a.eps_a.back() * (a.eps_a.back() - 0.02));
   }
-  MeasuredTest b = a;
+  TriaxialTest b = a;
   b.material = "S-2";
   b.sigma3 = 200e3;
   const std::string csv = write("curves.csv", ""), h5 = write("curves.h5", "");
@@ -221,7 +221,7 @@ TEST(Measured, StandardDeviationColumnsAreReadInSI) {
                                              "material,sigma3_kPa,q_peak_kPa,q_peak_sd_MPa,eps_a_peak_pct,eps_a_peak_sd_pct,"
                                              "max_dilatancy,max_dilatancy_sd,e_ini_MPa,e_ini_sd_kPa\n"
                                              "A,100,300,0.01,4,0.5,0.3,0.05,50,2000\n"));
-  const MeasuredTest& t = s.tests[0];
+  const TriaxialTest& t = s.tests[0];
   EXPECT_DOUBLE_EQ(t.summary_sd.at("q_peak"), 1e4);
   EXPECT_DOUBLE_EQ(t.summary_sd.at("eps_a_peak"), 0.005);
   EXPECT_DOUBLE_EQ(t.summary_sd.at("max_dilatancy"), 0.05);
@@ -353,7 +353,7 @@ TEST(Measured, ImplausibleValuesAreRefusedWithLineAndColumn) {
   EXPECT_NE(e.find("bad.csv:3:eps_a_pct: 150% is implausible (allowed: |eps_a| <= 100%)"), std::string::npos) << e;
   e = error_of(curve + "A,100,1,50,-101\n");
   EXPECT_NE(e.find("bad.csv:3:eps_v_pct: -101% is implausible (allowed: |eps_v| <= 100%)"), std::string::npos) << e;
-  const MeasuredTest edge =
+  const TriaxialTest edge =
       load_measured(write("edge.csv", curve + "A,100,50,5000,-50\nA,100,100,10000,-100\n")).tests[0];
   EXPECT_DOUBLE_EQ(edge.q.back(), 100 * 100e3);
   const std::string summary =
@@ -380,12 +380,12 @@ TEST(Measured, ImplausibleValuesAreRefusedWithLineAndColumn) {
 // their first test; the reader says so when they are not exactly equal.
 TEST(Measured, NearEqualPressuresAreGroupedAsReplicates) {
   auto test = [](const std::string& m, Real s) {
-    MeasuredTest t;
+    TriaxialTest t;
     t.material = m;
     t.sigma3 = s;
     return t;
   };
-  const std::vector<MeasuredTest> tests = {test("A", 100e3), test("B", 100e3), test("A", 200e3), test("A", 101e3),
+  const std::vector<TriaxialTest> tests = {test("A", 100e3), test("B", 100e3), test("A", 200e3), test("A", 101e3),
                                            test("A", 102.5e3), test("B", 99e3), test("A", 100e3)};
   // 102.5 is within 2% of 101 but not of 100, the group's first: it stands alone.
   EXPECT_EQ(replicate_groups(tests), (std::vector<std::vector<std::size_t>>{{0, 3, 6}, {1, 5}, {2}, {4}}));

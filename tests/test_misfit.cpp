@@ -19,8 +19,8 @@ namespace {
 
 /// A drained-test-like curve: q rising hyperbolically to a plateau, eps_v contracting then dilating; rows every
 /// 0.02% to 1%, then every `late` to 10% (0.1%: the spacing of the cross-code data).
-MeasuredTest smooth_test(Real sigma3, Real contraction = 0, Real late = 1e-3) {
-  MeasuredTest t;
+TriaxialTest smooth_test(Real sigma3, Real contraction = 0, Real late = 1e-3) {
+  TriaxialTest t;
   t.material = "A";
   t.sigma3 = sigma3;
   for (Real e = 0; e <= 0.1 + 1e-12; e += e < 0.01 - 1e-12 ? 2e-4 : late) {
@@ -36,10 +36,10 @@ MeasuredTest smooth_test(Real sigma3, Real contraction = 0, Real late = 1e-3) {
 }
 
 /// An ensemble of n members: the curve with its q scaled by 1 + s_k, s_k alternating +-spread.
-std::vector<MeasuredTest> members_of(const MeasuredTest& t, int n, Real spread) {
-  std::vector<MeasuredTest> out;
+std::vector<TriaxialTest> members_of(const TriaxialTest& t, int n, Real spread) {
+  std::vector<TriaxialTest> out;
   for (int k = 0; k < n; ++k) {
-    MeasuredTest m = t;
+    TriaxialTest m = t;
     for (Real& q : m.q) q *= 1 + (k % 2 ? spread : -spread);
     summarise(m);
     out.push_back(m);
@@ -72,7 +72,7 @@ TEST(Misfit, CurveValueReadsLinesExactlyAndStaysInside) {
 // The estimate reads low (0.37 here): a parabola through 21 rows takes up part of a correlated noise as trend,
 // so strongly correlated noise is understated; the specimen term covers the slow part (host/fit/misfit.hpp).
 TEST(Misfit, RowNoiseRecoversTheScatterAndItsCorrelation) {
-  MeasuredTest t = smooth_test(100e3, 0, 2e-4);
+  TriaxialTest t = smooth_test(100e3, 0, 2e-4);
   std::mt19937_64 rng(7);
   std::normal_distribution<Real> g(0, 1);
   std::vector<Real> white = t.q, ar = t.q;
@@ -93,7 +93,7 @@ TEST(Misfit, RowNoiseRecoversTheScatterAndItsCorrelation) {
 // The simulator's scatter: members whose q differ by +-2% of itself give a pooled variance of (0.02 q)^2 n / (n - 1)
 // per feature, inflated by Student's nu / (nu - 2), nu = n - 1; the mean's standard error divides it by K.
 TEST(Misfit, EnsembleScatterIsPooledAndInflated) {
-  const MeasuredTest t = smooth_test(100e3);
+  const TriaxialTest t = smooth_test(100e3);
   const int n = 8;
   const Ensemble ref{members_of(t, n, 0.02)};
   const Misfit m({t}, NoiseOptions(), ref, 4, 0.1);
@@ -111,7 +111,7 @@ TEST(Misfit, EnsembleScatterIsPooledAndInflated) {
 // specimens of perf/specimen_scatter.sh scatter (host/fit/misfit.hpp). A member scatter of 20% keeps the lab floor (2%
 // of q) out of the way: 20% / 4 is 5%.
 TEST(Misfit, ADataSpecimensScatterFallsAsTheSquareRootOfItsSize) {
-  MeasuredTest t = smooth_test(100e3);
+  TriaxialTest t = smooth_test(100e3);
   t.specimen_balls = 1920;
   const Misfit m({t}, NoiseOptions(), Ensemble{members_of(t, 8, 0.2)}, 2, 0.1, 120);
   int checked = 0;
@@ -128,9 +128,9 @@ TEST(Misfit, ADataSpecimensScatterFallsAsTheSquareRootOfItsSize) {
 // dilatancy's slope is the same after 1%), but the whole-curve misfit counts it: 0.2% is four of a lab's 0.05%
 // floor on the specimen's eps_v, over a decade of strain.
 TEST(Misfit, ADifferenceInTheEarlyVolumetricCurveIsSeen) {
-  const MeasuredTest data = smooth_test(100e3), bumped = smooth_test(100e3, 2e-3);
+  const TriaxialTest data = smooth_test(100e3), bumped = smooth_test(100e3, 2e-3);
   Ensemble ref{members_of(data, 8, 0.01)};
-  for (MeasuredTest& m : ref[0])  // the members' volume scatters by 2e-5: a precise simulator
+  for (TriaxialTest& m : ref[0])  // the members' volume scatters by 2e-5: a precise simulator
     for (std::size_t i = 0; i < m.eps_v.size(); ++i) m.eps_v[i] += (&m - ref[0].data()) % 2 ? 2e-5 : -2e-5;
   const Misfit m({data}, NoiseOptions(), ref, 4, 0.1);
   const Real same = chi2(m.test_residuals(0, {data})), early = chi2(m.test_residuals(0, {bumped}));
@@ -146,7 +146,7 @@ TEST(Misfit, ADifferenceInTheEarlyVolumetricCurveIsSeen) {
 // Replicates hold the data and the specimen noise: the scatter between two tests of one material and pressure
 // replaces the ensemble's stand-in, and the row noise is not counted again.
 TEST(Misfit, ReplicatesGiveTheSpecimenScatter) {
-  MeasuredTest a = smooth_test(100e3), b = a;
+  TriaxialTest a = smooth_test(100e3), b = a;
   a.replicate = "1";
   b.replicate = "2";
   for (Real& q : b.q) q *= 1.04;
@@ -183,7 +183,7 @@ TEST(Misfit, LabNoiseFileSetsTheLabModel) {
   const std::string path = (test::scratch_dir("lab_noise") / "mine.toml").string();
   std::ofstream(path) << "[curve]\nq_rel = 0.08\nq_shared = 0.03\neps_v_rel = 0.2\neps_v_abs_pct = 0.1\n";
   const NoiseOptions o = lab_noise_options(path);
-  const MeasuredTest t = smooth_test(100e3);
+  const TriaxialTest t = smooth_test(100e3);
   const Misfit m({t}, o, Ensemble{members_of(t, 1, 0)}, 1, 0.1);
   int q_data = 0, ev_data = 0;
   for (const Feature& f : m.features(0)) {
@@ -233,7 +233,7 @@ TEST(Misfit, BadLabNoiseFilesAreRefused) {
 // most half the data's noise. Members scattering by 4% of q against a lab's 5% (with floors) need several; the
 // answer K must reach the goal and K - 1 must not.
 TEST(Misfit, EnsembleSizeForTheGoalIsTheFewestThatReachIt) {
-  const MeasuredTest t = smooth_test(100e3);
+  const TriaxialTest t = smooth_test(100e3);
   const Ensemble ref{members_of(t, 16, 0.04)};
   NoiseOptions lab;
   lab.mode = "lab";
@@ -277,12 +277,12 @@ TEST(CellBias, CountsOnlyTheDifferenceBeyondItsOwnScatter) {
 // allowing for the curve's shape, 1.1 q is not exactly the correlated pattern). A difference in eps_v, which the
 // bias does not cover, is still seen in full.
 TEST(CellBias, ACountedBiasTakesUpTheShiftItMeasuredAndNothingElse) {
-  const MeasuredTest data = smooth_test(100e3);
+  const TriaxialTest data = smooth_test(100e3);
   Misfit m({data}, NoiseOptions(), Ensemble{members_of(data, 8, 0.01)}, 8, 0.1);
-  MeasuredTest shifted = data;
+  TriaxialTest shifted = data;
   for (Real& q : shifted.q) q *= 1.1;
   summarise(shifted);
-  MeasuredTest contracts = data;
+  TriaxialTest contracts = data;
   for (Real& v : contracts.eps_v) v += 2e-3;
   summarise(contracts);
   const Real before = chi2(m.test_residuals(0, {shifted})), volume_before = chi2(m.test_residuals(0, {contracts}));
@@ -304,8 +304,8 @@ TEST(CellBias, ACountedBiasTakesUpTheShiftItMeasuredAndNothingElse) {
 // specimens at +-2% of q, four periodic ones at +-1%: the ratio's relative error is sqrt(2%^2 + 1%^2 / 3), and
 // delta = (1 - 1/1.3) of the datum, which is 0.3 of the cell's value, with that relative error on the cell's value.
 TEST(TwoFidelity, TheDataLessTheMeasuredExcessFitAndItsErrorIsCounted) {
-  const MeasuredTest lab = smooth_test(100e3);
-  MeasuredTest cell = lab;
+  const TriaxialTest lab = smooth_test(100e3);
+  TriaxialTest cell = lab;
   for (Real& q : cell.q) q /= 1.3;
   summarise(cell);
   Misfit m({lab}, NoiseOptions(), Ensemble{members_of(cell, 8, 0.01)}, 8, 0.1);

@@ -73,7 +73,7 @@ TEST(Prediction, EachPressureIsTheMembraneTestAtTheCalibratedParameters) {
   const Config t = test::tiny_triaxial_config(0.15, 0.015);
   Model m{t.ball, 0};
   set_param(m, "mu_s", 0.3);
-  std::vector<MeasuredTest> data(2);
+  std::vector<TriaxialTest> data(2);
   data[0].material = data[1].material = "S-x";
   data[0].sigma3 = 100e3;
   data[1].sigma3 = 200e3;
@@ -104,7 +104,7 @@ TEST(Prediction, EachPressureIsTheMembraneTestAtTheCalibratedParameters) {
   EXPECT_NE(md.find("q as the data report it: area_corrected"), std::string::npos) << md;
   // The files a calibration writes, and the figure tools/plot_prediction.py draws from them.
   io::write_text_atomic((dir / "prediction.csv").string(), prediction_csv(p, QMeasure::kAreaCorrected));
-  std::vector<MeasuredTest> curves;
+  std::vector<TriaxialTest> curves;
   for (const Prediction& x : p) curves.insert(curves.end(), x.members.begin(), x.members.end());
   write_measured_curves((dir / "prediction_curves.csv").string(), curves, "test", "area_corrected");
   const MeasuredData back = load_measured((dir / "prediction_curves.csv").string());
@@ -126,7 +126,7 @@ TEST(Prediction, TheWalledPredictionIsTheWalledCellsRunsAtTheCalibratedPoint) {
   ASSERT_EQ(walls.periodic.boundary, CellBoundary::walls);
   Model m{walls.ball, 0};
   set_param(m, "mu_s", 0.4);
-  std::vector<MeasuredTest> data(2);
+  std::vector<TriaxialTest> data(2);
   for (int k = 0; k < 2; ++k) {
     data[k].material = "W";
     data[k].sigma3 = 100e3 * (k + 1);
@@ -137,7 +137,7 @@ TEST(Prediction, TheWalledPredictionIsTheWalledCellsRunsAtTheCalibratedPoint) {
   PeriodicLab lab(walls, false, 2, walls.run.seed, 2, 1);
   for (int k = 0; k < 2; ++k) {
     ASSERT_EQ(p[k].members.size(), 2u);
-    const MeasuredTest a = lab.run(m, data[k].sigma3, "W", 0), b = lab.run(m, data[k].sigma3, "W", 1);
+    const TriaxialTest a = lab.run(m, data[k].sigma3, "W", 0), b = lab.run(m, data[k].sigma3, "W", 1);
     ASSERT_GT(a.q.size(), 5u);
     EXPECT_EQ(p[k].members[0].q, a.q);
     EXPECT_EQ(p[k].members[1].q, b.q);

@@ -34,7 +34,7 @@ std::string at(const std::string& what, Real strain_pct) {
 }
 
 /// The curves and summary of a simulated test, q in units of sigma3.
-void add_curves(std::map<std::string, double>& v, const MeasuredTest& t, const std::vector<Real>& strains_pct) {
+void add_curves(std::map<std::string, double>& v, const TriaxialTest& t, const std::vector<Real>& strains_pct) {
   for (Real e : strains_pct) {
     v[at("q_over_sigma3", e)] = curve_value(t.eps_a, t.q, e / 100) / t.sigma3;
     v[at("eps_v_pct", e)] = 100 * curve_value(t.eps_a, t.eps_v, e / 100);
@@ -51,7 +51,7 @@ test::CaseResults periodic_cell(unsigned seed) {
   const Config cfg = load_config(std::string(TRIAXDEM_SOURCE_DIR) + "/tests/data/hidden_effects.toml");
   PeriodicLab lab(cfg, false, 1, seed);
   std::map<std::string, double> v;
-  const MeasuredTest base = lab.run(model_of(cfg), 100e3);
+  const TriaxialTest base = lab.run(model_of(cfg), 100e3);
   add_curves(v, base, {0.1, 1, 2, 5, 8});
   v["void_ratio_sheared"] = base.void_ratio;
   const std::map<std::string, Real> strength{
@@ -61,7 +61,7 @@ test::CaseResults periodic_cell(unsigned seed) {
   for (const Extension& e : extensions()) {
     Model m = model_of(cfg);
     set_param(m, e.param, strength.at(e.name));
-    const MeasuredTest t = lab.run(m, 100e3);
+    const TriaxialTest t = lab.run(m, 100e3);
     ext[e.name + "_" + at("q_over_sigma3", 1)] = curve_value(t.eps_a, t.q, 0.01) / t.sigma3;
     ext[e.name + "_q_peak_over_sigma3"] = t.q_peak / t.sigma3;
     ext[e.name + "_q_end_over_sigma3"] = t.q_end / t.sigma3;
@@ -86,7 +86,7 @@ test::CaseResults membrane_triaxial(unsigned seed) {
   layers["balls"] = static_cast<double>(sp.balls.size());
 
   const TriaxialResult r = run_triaxial(c, sp, nullptr, false);
-  MeasuredTest t;
+  TriaxialTest t;
   t.sigma3 = c.triaxial.sigma3;
   for (const TriaxialRecord& x : r.records) {
     t.eps_a.push_back(x.eps_a);

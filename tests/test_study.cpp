@@ -128,7 +128,7 @@ TEST(Study, TableMarksPendingAndFailedCases) {
   write_summary((dir / "done").string(), done);
   MeasuredData lab;
   lab.path = "lab.csv";
-  MeasuredTest t;
+  TriaxialTest t;
   t.material = "S-1";
   t.sigma3 = 100e3;
   t.q_peak = 120e3;
@@ -152,7 +152,7 @@ TEST(Study, PeaksAreComparedByMaterialAndPressure) {
   d.path = "lab.csv";
   for (const auto& [material, sigma3, q] : std::vector<std::tuple<std::string, Real, Real>>{
            {"S-1", 100e3, 140e3}, {"S-1", 200e3, 250e3}, {"S-2", 100e3, 200e3}}) {
-    MeasuredTest t;
+    TriaxialTest t;
     t.material = material;
     t.sigma3 = sigma3;
     t.q_peak = q;
@@ -190,7 +190,7 @@ TEST(Study, PeaksAreComparedInTheMeasureTheDataReport) {
   MeasuredData d;
   d.path = "lab.csv";
   d.q_measure = QMeasure::kAreaCorrected;
-  MeasuredTest t;
+  TriaxialTest t;
   t.material = "S-1";
   t.sigma3 = 100e3;
   t.q_peak = 120e3;

@@ -122,12 +122,12 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
   Session ss(base, o, "calibrate");
   std::ostringstream table;
   table << "material,parameter,value,low95,high95,reference,chi2,data,runs\n";
-  std::vector<MeasuredTest> all_meas, all_sim;
+  std::vector<TriaxialTest> all_meas, all_sim;
   std::map<std::string, Calibrated> models;
   for (const auto& by : by_material(ss.data, o.material)) {
     // Named, not structured, bindings: a lambda below captures them (C++17 cannot capture a structured binding).
     const std::string& material = by.first;
-    const std::vector<MeasuredTest>& tests = by.second;
+    const std::vector<TriaxialTest>& tests = by.second;
     std::printf("calibrate: %s, %zu tests, free %zu parameters, %zu balls in %s\n", material.c_str(), tests.size(),
                 ss.free.size(), ss.lab.balls(), ss.cell_text().c_str());
     const long runs0 = ss.lab.runs();
@@ -203,7 +203,7 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
   std::ostringstream md, csv;
   md << diagnosis_intro(ss, base, o);
   csv << "material,model,parameter,value,chi2,bic,heldout_chi2,runs\n";
-  std::vector<MeasuredTest> all_meas, all_sim, all_ext;
+  std::vector<TriaxialTest> all_meas, all_sim, all_ext;
   std::map<std::string, Calibrated> models;
   for (const auto& [material, tests] : by_material(ss.data, o.material)) {
     std::printf("diagnose: %s, %zu tests, %zu balls in %s\n", material.c_str(), tests.size(), ss.lab.balls(),

@@ -68,9 +68,9 @@ bool walls_prediction_wanted(const Config& base, const CalibrationOptions& o) {
 }  // namespace
 
 /// The tests of the data by material (sorted by name), filtered by `only` when it is set.
-std::map<std::string, std::vector<MeasuredTest>> by_material(const MeasuredData& d, const std::string& only) {
-  std::map<std::string, std::vector<MeasuredTest>> out;
-  for (const MeasuredTest& t : d.tests)
+std::map<std::string, std::vector<TriaxialTest>> by_material(const MeasuredData& d, const std::string& only) {
+  std::map<std::string, std::vector<TriaxialTest>> out;
+  for (const TriaxialTest& t : d.tests)
     if (only.empty() || t.material == only) out[t.material].push_back(t);
   if (out.empty()) throw DataError(d.path + ": no tests of material '" + only + "'");
   return out;
@@ -120,7 +120,7 @@ std::vector<std::string> Session::free_names() const {
   return names;
 }
 
-std::vector<Prediction> Session::predict_at(const Config& base, const Model& model, const std::vector<MeasuredTest>& tests) const {
+std::vector<Prediction> Session::predict_at(const Config& base, const Model& model, const std::vector<TriaxialTest>& tests) const {
   return predict(*predict_template, model, free_names(), tests, data.q_measure,
                  static_cast<int>(base.calibrate.predict_specimens), output + "/.specimens", true);
 }
@@ -129,7 +129,7 @@ Config Session::matched(const Config& base, int workers) {
   return matched_state(base, data.tests, state, true, match_plan(base, workers));
 }
 
-std::string Session::state_text(const Misfit& m, const std::vector<MeasuredTest>& tests) const {
+std::string Session::state_text(const Misfit& m, const std::vector<TriaxialTest>& tests) const {
   if (state.tests == 0)
     return "The data give no void ratio: the simulator's specimens have the density their preparation gives (" +
            fmt("e = %.3f", lab.prepared_void_ratio(0)) + " for the first), and the calibrated friction absorbs "
@@ -146,7 +146,7 @@ std::string Session::state_text(const Misfit& m, const std::vector<MeasuredTest>
   return s + "\n";
 }
 
-Misfit Session::misfit_of(const Config& base, const std::string& material, const std::vector<MeasuredTest>& tests) {
+Misfit Session::misfit_of(const Config& base, const std::string& material, const std::vector<TriaxialTest>& tests) {
   std::printf("%s: %s: measuring the simulator's scatter: %d specimens of %zu balls at the base model\n",
               folder.c_str(), material.c_str(), lab.specimens(), lab.balls());
   lab.set_progress("  " + material + ": scatter");
@@ -203,9 +203,9 @@ std::string Session::predict_boundary(const Config& base, const std::map<std::st
   const std::string test = walls ? walled_cell_text(*walls) : membrane_test_text(*predict_template);
   const int specimens = static_cast<int>(base.calibrate.predict_specimens);
   std::vector<Prediction> all;
-  std::vector<MeasuredTest> curves;
+  std::vector<TriaxialTest> curves;
   for (const auto& [material, cal] : models) {
-    const std::vector<MeasuredTest>& tests = cal.tests;
+    const std::vector<TriaxialTest>& tests = cal.tests;
     std::printf("%s: %s: predicting %s at the calibrated parameters: %zu pressures x %d specimens\n",
                 folder.c_str(), material.c_str(), walls ? "the walled cell" : predict_template->path.c_str(),
                 tests.size(), specimens);
@@ -226,7 +226,7 @@ std::string Session::predict_boundary(const Config& base, const std::map<std::st
   return prediction_section(test, specimens, data.q_measure, md, discrepancy);
 }
 
-void Session::finish(const std::vector<MeasuredTest>& meas, const std::vector<MeasuredTest>& sim,
+void Session::finish(const std::vector<TriaxialTest>& meas, const std::vector<TriaxialTest>& sim,
             const std::string& what) const {
   io::write_text_atomic(folder + "/errors.csv", errors_csv(meas, sim));
   write_measured_curves(folder + "/simulated_curves.csv", sim, "simulated by " + what);

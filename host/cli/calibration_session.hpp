@@ -17,13 +17,13 @@
 namespace dem {
 
 /// The data's tests by material: all of them, or those of `only` (DataError naming the file where it has none).
-std::map<std::string, std::vector<MeasuredTest>> by_material(const MeasuredData& d, const std::string& only);
+std::map<std::string, std::vector<TriaxialTest>> by_material(const MeasuredData& d, const std::string& only);
 
 /// A material's calibration as the prediction needs it: its tests, the model, and the periodic cell's tests at it.
 struct Calibrated {
-  std::vector<MeasuredTest> tests;
+  std::vector<TriaxialTest> tests;
   Model model;
-  std::vector<MeasuredTest> sim;  ///< in the order of tests
+  std::vector<TriaxialTest> sim;  ///< in the order of tests
 };
 
 /// Removes a result folder that is still empty when the job ends: a refusal after the folder was made.
@@ -63,12 +63,12 @@ struct Session {
   std::vector<std::string> free_names() const;
   /// The membrane test at `model` on every test of `tests`, q in the data's measure (a template must be set).
   std::vector<Prediction> predict_at(const Config& base, const Model& model,
-                                     const std::vector<MeasuredTest>& tests) const;
+                                     const std::vector<TriaxialTest>& tests) const;
   Config matched(const Config& base, int workers);
   /// The report's line on the specimens' state.
-  std::string state_text(const Misfit& m, const std::vector<MeasuredTest>& tests) const;
+  std::string state_text(const Misfit& m, const std::vector<TriaxialTest>& tests) const;
   /// The misfit of a material's tests: the ensemble run at the base model, its scatter beside the data's noise.
-  Misfit misfit_of(const Config& base, const std::string& material, const std::vector<MeasuredTest>& tests);
+  Misfit misfit_of(const Config& base, const std::string& material, const std::vector<TriaxialTest>& tests);
   /// The reference value of a parameter for a material, in the key's unit; NaN when there is none.
   Real reference(const std::string& material, const std::string& name) const;
   /// The test with a boundary at each material's calibrated model (`models`, by material), beside the data: the
@@ -76,7 +76,7 @@ struct Session {
   /// prediction.png, prints the table, and returns it as Markdown ("" when there is no prediction).
   std::string predict_boundary(const Config& base, const std::map<std::string, Calibrated>& models) const;
   /// The errors table, the curves in the measured-data format and the figure.
-  void finish(const std::vector<MeasuredTest>& meas, const std::vector<MeasuredTest>& sim,
+  void finish(const std::vector<TriaxialTest>& meas, const std::vector<TriaxialTest>& sim,
               const std::string& what) const;
 };
 

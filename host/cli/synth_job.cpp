@@ -42,7 +42,7 @@ int synth_job(const Config& base, const SynthOptions& o) {
   comment += ", a specimen per test (packing seeds from " + std::to_string(specimen) + ", " +
              std::to_string(kGeneratorCellFactor) + " times the config's balls)";
   PeriodicLab lab(larger_cell(base, kGeneratorCellFactor), false, static_cast<int>(o.sigma3.size()), specimen);
-  const std::vector<MeasuredTest> tests = synthetic_tests(lab, truth, o.sigma3, o.material, o.seed);
+  const std::vector<TriaxialTest> tests = synthetic_tests(lab, truth, o.sigma3, o.material, o.seed);
   write_measured_curves(o.output, tests, comment);
   std::printf("synth: %s -> %s\n", comment.c_str(), o.output.c_str());
   return 0;

@@ -69,20 +69,20 @@ RowNoise row_noise(const std::vector<Real>& eps_a, const std::vector<Real>& v) {
   return {sd, rho};
 }
 
-MeasuredTest mean_curve(const std::vector<MeasuredTest>& members) {
-  const MeasuredTest* first = nullptr;
-  for (const MeasuredTest& t : members)
+TriaxialTest mean_curve(const std::vector<TriaxialTest>& members) {
+  const TriaxialTest* first = nullptr;
+  for (const TriaxialTest& t : members)
     if (!t.q.empty() && std::isfinite(t.q_peak)) {
       first = &t;
       break;
     }
   if (!first) return members.front();
-  MeasuredTest out = *first;
+  TriaxialTest out = *first;
   const bool volume = !first->eps_v.empty();
   for (std::size_t i = 0; i < out.eps_a.size(); ++i) {
     Real q = 0, ev = 0, vr = 0;
     int n = 0;
-    for (const MeasuredTest& t : members) {
+    for (const TriaxialTest& t : members) {
       if (t.q.empty() || !std::isfinite(t.q_peak) || out.eps_a[i] > t.eps_a.back()) continue;
       q += interpolate(t.eps_a, t.q, out.eps_a[i]);
       if (volume) ev += interpolate(t.eps_a, t.eps_v, out.eps_a[i]);

@@ -31,6 +31,6 @@ Real interpolate(const std::vector<Real>& eps_a, const std::vector<Real>& y, Rea
 
 /// The mean curve of an ensemble's members (each interpolated onto the first successful member's strains),
 /// summarised: what the figures and tables show for a parameter point.
-MeasuredTest mean_curve(const std::vector<MeasuredTest>& members);
+TriaxialTest mean_curve(const std::vector<TriaxialTest>& members);
 
 }  // namespace dem

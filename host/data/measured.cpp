@@ -203,12 +203,12 @@ std::pair<Real, Real> void_ratio_of(const RowReader& r) {
   return {n / (1 - n), r.sd("porosity") / ((1 - n) * (1 - n))};
 }
 
-std::string describe(const MeasuredTest& t) {
+std::string describe(const TriaxialTest& t) {
   return t.material + " at " + str(t.sigma3 / 1e3) + " kPa" + (t.replicate.empty() ? "" : ", test " + t.replicate);
 }
 
 /// The state is one per test, repeated on its rows: a row that differs is a typo or two tests under one key.
-void check_same_state(const RowReader& r, const MeasuredTest& row, const MeasuredTest& t, const std::string& first) {
+void check_same_state(const RowReader& r, const TriaxialTest& row, const TriaxialTest& t, const std::string& first) {
   const std::string e = r.has("porosity") ? "porosity" : "void_ratio";
   const std::string why = " differs from the test's first row, " + first + " (one value per test, on each of its rows)";
   if (r.has(e) && row.void_ratio != t.void_ratio) r.refuse(e, "'" + r.cell(e) + "'" + why);
@@ -224,8 +224,8 @@ struct TestIndex {
   std::vector<std::string> first_at;
 };
 
-MeasuredTest& test_of(const RowReader& r, MeasuredData& d, TestIndex& tests) {
-  MeasuredTest key;
+TriaxialTest& test_of(const RowReader& r, MeasuredData& d, TestIndex& tests) {
+  TriaxialTest key;
   key.material = r.cell("material");
   if (key.material.empty()) r.refuse("material", "empty");
   key.sigma3 = r.number("sigma3");
@@ -248,7 +248,7 @@ MeasuredTest& test_of(const RowReader& r, MeasuredData& d, TestIndex& tests) {
   return d.tests[it->second];
 }
 
-void read_curve_row(const RowReader& r, MeasuredTest& t) {
+void read_curve_row(const RowReader& r, TriaxialTest& t) {
   const Real ea = strain(r, "eps_a");
   if (!t.eps_a.empty() && !(ea > t.eps_a.back()))
     r.refuse("eps_a", "axial strain must increase within a test (" + describe(t) + ")");
@@ -259,7 +259,7 @@ void read_curve_row(const RowReader& r, MeasuredTest& t) {
   if (r.has("eps_v_sd")) t.eps_v_sd.push_back(r.sd("eps_v"));
 }
 
-void read_summary_row(const RowReader& r, MeasuredTest& t) {
+void read_summary_row(const RowReader& r, TriaxialTest& t) {
   t.q_peak = stress(r, "q_peak", t.sigma3);
   t.eps_a_peak = strain(r, "eps_a_peak");
   t.q_end = stress(r, "q_end", t.sigma3);
@@ -315,7 +315,7 @@ bool is_hdf5_path(const std::string& path) {
   return ext == ".h5" || ext == ".hdf5";
 }
 
-std::vector<std::vector<std::size_t>> replicate_groups(const std::vector<MeasuredTest>& tests) {
+std::vector<std::vector<std::size_t>> replicate_groups(const std::vector<TriaxialTest>& tests) {
   std::vector<std::vector<std::size_t>> groups;
   std::vector<bool> taken(tests.size());
   for (std::size_t i = 0; i < tests.size(); ++i) {
@@ -348,7 +348,7 @@ MeasuredData load_measured(const std::string& path) {
                            std::to_string(cols.names.size()));
     const RowReader r{cols, row};
     read_q_measure(r, d);
-    MeasuredTest& t = test_of(r, d, tests);
+    TriaxialTest& t = test_of(r, d, tests);
     if (d.curves)
       read_curve_row(r, t);
     else
@@ -356,7 +356,7 @@ MeasuredData load_measured(const std::string& path) {
   }
   if (d.tests.empty()) throw DataError(path + ": no data rows");
   if (d.curves)
-    for (MeasuredTest& t : d.tests) {
+    for (TriaxialTest& t : d.tests) {
       if (t.eps_a.size() < kMinCurveRows)
         throw DataError(path + ": " + describe(t) + ": " + std::to_string(t.eps_a.size()) + " row" +
                         (t.eps_a.size() == 1 ? "" : "s") + " (allowed: at least " + std::to_string(kMinCurveRows) +
@@ -377,7 +377,7 @@ MeasuredData load_measured(const std::string& path) {
 }
 
 void check_pressures(const MeasuredData& d, const std::vector<Real>& sigma3) {
-  for (const MeasuredTest& t : d.tests) {
+  for (const TriaxialTest& t : d.tests) {
     const bool known = std::any_of(sigma3.begin(), sigma3.end(),
                                    [&](Real s) { return std::fabs(s - t.sigma3) <= 1e-9 * std::max(s, t.sigma3); });
     if (!known) {

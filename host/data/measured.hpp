@@ -60,9 +60,9 @@ constexpr int kQMeasures = 4;
 constexpr const char* kQMeasureNames[kQMeasures] = {"fixed_area", "area_corrected", "parabolic", "membrane_corrected"};
 inline const char* name_of(QMeasure m) { return kQMeasureNames[static_cast<int>(m)]; }
 
-/// One test (material, sigma3). Curve vectors are empty in a summary file; NaN marks a summary value the
-/// file does not give.
-struct MeasuredTest {
+/// One drained triaxial test (material, sigma3), as a lab measured it or the simulator ran it: its curves and
+/// summary. Curve vectors are empty in a summary file; NaN marks a summary value the file does not give.
+struct TriaxialTest {
   std::string material;
   Real sigma3 = 0;                          ///< Pa
   std::vector<Real> eps_a, q, eps_v;        ///< fractions, Pa, fractions (compression / contraction positive)
@@ -82,7 +82,7 @@ struct MeasuredTest {
 struct MeasuredData {
   std::string path;
   bool curves = false;                      ///< curve file (else summary)
-  std::vector<MeasuredTest> tests;          ///< in file order of first appearance
+  std::vector<TriaxialTest> tests;          ///< in file order of first appearance
   QMeasure q_measure = QMeasure::kFixedArea;  ///< which q the file's q columns are
   bool q_measure_given = false;             ///< false: the file did not say (fixed_area taken, with a note)
   std::vector<std::string> notes;           ///< what the reader accepted but a user should know (near-equal pressures)
@@ -95,7 +95,7 @@ constexpr Real kReplicateTolerance = 0.02;
 
 /// Groups of replicate tests (indices into tests): the same material, sigma3 within kReplicateTolerance; every
 /// test is in exactly one group, groups in order of their first test.
-std::vector<std::vector<std::size_t>> replicate_groups(const std::vector<MeasuredTest>& tests);
+std::vector<std::vector<std::size_t>> replicate_groups(const std::vector<TriaxialTest>& tests);
 
 /// Reads and validates a measured-data file: CSV, or HDF5 (.h5, .hdf5) with the same columns: one group per
 /// material holding a 2-D dataset `table` (rows x columns, numbers) whose string attribute `columns` names
@@ -142,14 +142,14 @@ constexpr Real kEarlyStrain = 0.01, kMidStrain = 0.03;
 /// between rows), q_peak and its strain, q at the end,
 /// the initial stiffness (least-squares slope of the raw rows over the first 0.2% of strain) and the maximum dilatancy
 /// -d eps_v / d eps_a (the slope over one 0.5% window). The same function summarises simulated curves.
-void summarise(MeasuredTest& t);
+void summarise(TriaxialTest& t);
 
 /// A simulated test's rows (any type with eps_a, q and eps_v) as a curve test, summarised like measured curves:
 /// its peak is the peak of the moving mean, not the highest single row (rows of a full-scale specimen scatter
 /// by about 4% of q), so that simulated and measured peaks compare like with like.
 template <class Row>
-MeasuredTest summarised(const std::vector<Row>& rows, Real sigma3) {
-  MeasuredTest t;
+TriaxialTest summarised(const std::vector<Row>& rows, Real sigma3) {
+  TriaxialTest t;
   t.sigma3 = sigma3;
   for (const Row& r : rows) {
     t.eps_a.push_back(r.eps_a);
@@ -166,7 +166,7 @@ Real friction_angle_deg(Real q, Real sigma3);
 /// Copies a summarised test's curve values into a result with the same field names (q_peak, eps_a_peak,
 /// phi_peak_deg, q_end, max_dilatancy), the friction angle from q_peak at the test's sigma3.
 template <class Result>
-void take_curve_values(Result& r, const MeasuredTest& t) {
+void take_curve_values(Result& r, const TriaxialTest& t) {
   r.q_peak = t.q_peak;
   r.eps_a_peak = t.eps_a_peak;
   r.phi_peak_deg = friction_angle_deg(t.q_peak, t.sigma3);

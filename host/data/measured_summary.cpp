@@ -31,7 +31,7 @@ std::vector<Real> smooth(const std::vector<Real>& eps_a, const std::vector<Real>
 
 Real friction_angle_deg(Real q, Real sigma3) { return std::asin(q / (q + 2 * sigma3)) * 180 / M_PI; }
 
-void summarise(MeasuredTest& t) {
+void summarise(TriaxialTest& t) {
   if (t.q.empty()) return;
   const std::vector<Real> q = smooth(t.eps_a, t.q, kSmoothHalfWidth);
   // The peak is sought where the window is whole: towards either end it shrinks to the end row alone, whose

@@ -358,7 +358,7 @@ CalibrationResult calibrate(const Simulator& simulate, const Model& base, const 
 }
 
 CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,
-                            const std::vector<MeasuredTest>& measured, const Misfit& misfit, int rounds,
+                            const std::vector<TriaxialTest>& measured, const Misfit& misfit, int rounds,
                             const CalibrationProgress& progress, int widen) {
   const long planned = planned_points(static_cast<int>(free.size()), rounds) * static_cast<long>(measured.size()) *
                        lab.members();

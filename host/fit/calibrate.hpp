@@ -81,7 +81,7 @@ class QuadraticSurface {
 /// One evaluated point of a search.
 struct Evaluation {
   std::vector<Real> u;                ///< unit coordinates of the free parameters
-  std::vector<MeasuredTest> sim;      ///< simulated tests: the mean curves of the ensemble (mean_curve)
+  std::vector<TriaxialTest> sim;      ///< simulated tests: the mean curves of the ensemble (mean_curve)
   std::vector<Real> r;                ///< normalised residuals (all tests)
   Real chi2 = 0;
 };
@@ -136,7 +136,7 @@ using CalibrationProgress = std::function<void(long, long, Real)>;
 
 /// What a search asks of its simulator at one model: the simulated tests and the normalised residuals.
 struct SimulatedPoint {
-  std::vector<MeasuredTest> sim;
+  std::vector<TriaxialTest> sim;
   std::vector<Real> r;
 };
 using Simulator = std::function<SimulatedPoint(const Model&)>;
@@ -146,7 +146,7 @@ CalibrationResult calibrate(const Simulator& simulate, const Model& base, const 
                             int rounds = 4, int widen = 2);
 /// The same on `measured` (one material, any number of pressures), simulated by the lab's ensemble.
 CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,
-                            const std::vector<MeasuredTest>& measured, const Misfit& misfit, int rounds = 4,
+                            const std::vector<TriaxialTest>& measured, const Misfit& misfit, int rounds = 4,
                             const CalibrationProgress& progress = {}, int widen = 2);
 /// A run of the base model found after the calibration (a nested model's run at strength 0) that beats its best:
 /// it joins the design and becomes the best, and the values, the model (`base` with them) and the uncertainty are

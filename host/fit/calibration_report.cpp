@@ -30,7 +30,7 @@ std::pair<double, const char*> feature_unit(const Feature& f, Real v) {
 }  // namespace
 
 /// The errors table (like the paper's Table 6): measured, simulated and error per test and quantity.
-std::string errors_csv(const std::vector<MeasuredTest>& meas, const std::vector<MeasuredTest>& sim) {
+std::string errors_csv(const std::vector<TriaxialTest>& meas, const std::vector<TriaxialTest>& sim) {
   std::ostringstream s;
   s << "material,sigma3_kPa,quantity,unit,measured,simulated,error_pct\n";
   for (std::size_t k = 0; k < meas.size(); ++k) {
@@ -46,7 +46,7 @@ std::string errors_csv(const std::vector<MeasuredTest>& meas, const std::vector<
   return s.str();
 }
 
-void print_errors(const std::vector<MeasuredTest>& meas, const std::vector<MeasuredTest>& sim) {
+void print_errors(const std::vector<TriaxialTest>& meas, const std::vector<TriaxialTest>& sim) {
   std::printf("%-10s %7s %-14s %12s %12s %8s\n", "material", "s3 kPa", "quantity", "measured", "simulated", "err %");
   std::istringstream in(errors_csv(meas, sim));
   std::string line;
@@ -83,7 +83,7 @@ std::string uncertainty_text(const CalibrationResult& r, const std::string& mate
 }
 
 /// The noise used, per test and quantity: the median over the test's features of each part.
-std::string noise_table(const Misfit& mf, const std::vector<MeasuredTest>& tests) {
+std::string noise_table(const Misfit& mf, const std::vector<TriaxialTest>& tests) {
   std::ostringstream md;
   md << "Noise (" << mf.source() << "; median standard deviation over each test's data; the simulator's is that of "
      << "the mean of " << mf.members() << " specimens"
@@ -116,7 +116,7 @@ std::string noise_table(const Misfit& mf, const std::vector<MeasuredTest>& tests
 /// The gain in markdown: chi2 of the base and the extended model by pressure, by strain range and by quantity,
 /// then every datum. Strain ranges: small (up to 0.2%), hardening (to 3%), large (beyond); summary data: E_ini
 /// and q at 1% small, q at 3%, the peak and its strain hardening, q_end and dilatancy large.
-std::string gain_tables(const Misfit& mf, const std::vector<MeasuredTest>& tests, const Evaluation& base,
+std::string gain_tables(const Misfit& mf, const std::vector<TriaxialTest>& tests, const Evaluation& base,
                         const Evaluation& ext, const std::string& name) {
   static const char* range_of[kQuantities] = {"small strain", "small strain", "hardening", "hardening",
                                               "hardening", "large strain", "large strain"};

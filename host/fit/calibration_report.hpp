@@ -11,15 +11,15 @@
 namespace dem {
 
 /// Measured, simulated and error per test and quantity, as CSV.
-std::string errors_csv(const std::vector<MeasuredTest>& meas, const std::vector<MeasuredTest>& sim);
+std::string errors_csv(const std::vector<TriaxialTest>& meas, const std::vector<TriaxialTest>& sim);
 /// The same table on stdout.
-void print_errors(const std::vector<MeasuredTest>& meas, const std::vector<MeasuredTest>& sim);
+void print_errors(const std::vector<TriaxialTest>& meas, const std::vector<TriaxialTest>& sim);
 /// The calibrated values with their 95% intervals and correlations, in lines prefixed "<job>: <material>: ".
 std::string uncertainty_text(const CalibrationResult& r, const std::string& material, const std::string& job);
 /// The noise used, per test and quantity (markdown).
-std::string noise_table(const Misfit& mf, const std::vector<MeasuredTest>& tests);
+std::string noise_table(const Misfit& mf, const std::vector<TriaxialTest>& tests);
 /// The gain of an extension over the base by pressure, strain range and quantity, then every datum (markdown).
-std::string gain_tables(const Misfit& mf, const std::vector<MeasuredTest>& tests, const Evaluation& base,
+std::string gain_tables(const Misfit& mf, const std::vector<TriaxialTest>& tests, const Evaluation& base,
                         const Evaluation& ext, const std::string& name);
 
 }  // namespace dem

@@ -18,7 +18,7 @@ Real cell_bias_sd(Real diff, Real diff_var, Real extrapolation) {
   return extrapolation * std::sqrt(std::max(Real(0), diff * diff - diff_var));
 }
 
-void measure_cell_bias(PeriodicLab& lab, const Model& base, const std::vector<MeasuredTest>& measured,
+void measure_cell_bias(PeriodicLab& lab, const Model& base, const std::vector<TriaxialTest>& measured,
                        const Ensemble& reference, Misfit& misfit) {
   // Prepared as the simulator's specimens are: to the data's void ratio where they give one (on this cell's own
   // preparation friction), else with the same preparation.

@@ -44,7 +44,7 @@ Real cell_bias_sd(Real diff, Real diff_var, Real extrapolation);
 
 /// Runs the check cells of `lab`'s cell at `base` on every measured test and counts the bias in `misfit`
 /// (Misfit::add_cell_bias). `reference`: the scatter specimens' runs at `base` on `lab`'s present cell.
-void measure_cell_bias(PeriodicLab& lab, const Model& base, const std::vector<MeasuredTest>& measured,
+void measure_cell_bias(PeriodicLab& lab, const Model& base, const std::vector<TriaxialTest>& measured,
                        const Ensemble& reference, Misfit& misfit);
 
 }  // namespace dem

@@ -60,7 +60,7 @@ using ResidualModel = std::function<std::vector<Real>(const std::vector<Real>&)>
 
 /// Held-out chi2: for each test, the surrogate minimised on the other tests gives the parameters, and a run
 /// of the simulator with them predicts the test (a run, not the surrogate: the verdict rests on it).
-Real heldout_chi2(const ResidualModel& model, int d, const std::vector<MeasuredTest>& measured,
+Real heldout_chi2(const ResidualModel& model, int d, const std::vector<TriaxialTest>& measured,
                   const std::function<Model(const std::vector<Real>&)>& model_at, PeriodicLab& lab,
                   const Misfit& misfit) {
   const auto ranges = test_ranges(misfit);
@@ -102,7 +102,7 @@ struct FitContext {
   const CalibrationResult& base;
   const std::function<std::vector<Real>(const std::vector<Real>&)>& base_model;
   const std::function<Model(const std::vector<Real>&)>& base_at;
-  const std::vector<MeasuredTest>& measured;
+  const std::vector<TriaxialTest>& measured;
   const Misfit& misfit;
   const std::function<void()>& report;  ///< a progress line after each batch of runs
 };
@@ -247,7 +247,7 @@ void give_verdict(Diagnosis& dg, int n, int d) {
 }  // namespace
 
 Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free0,
-                   const std::vector<MeasuredTest>& measured, const Misfit& misfit, bool verbose) {
+                   const std::vector<TriaxialTest>& measured, const Misfit& misfit, bool verbose) {
   Diagnosis dg;
   const int d = static_cast<int>(free0.size());
   auto say = [&](const char* fmt, auto... a) {

@@ -66,7 +66,7 @@ struct Diagnosis {
 
 /// Runs the diagnosis of `measured` (one material) from `base` with base parameters `free`.
 Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,
-                   const std::vector<MeasuredTest>& measured, const Misfit& misfit, bool verbose);
+                   const std::vector<TriaxialTest>& measured, const Misfit& misfit, bool verbose);
 
 /// A hidden strength drawn from `seed`: log-uniform between the extension's lowest and highest level.
 Real draw_strength(const Extension& e, unsigned seed);
@@ -75,7 +75,7 @@ Real draw_strength(const Extension& e, unsigned seed);
 /// its members: a lab prepares a specimen per test), with lab-like noise from `seed`:
 /// a specimen-to-specimen factor on q (2% standard deviation), and on each row 0.5% of sigma3 on q and 0.02%
 /// on eps_v, all scaled by `noise` (0: as precise as the simulation). Rows as the simulator records them.
-std::vector<MeasuredTest> synthetic_tests(PeriodicLab& lab, const Model& truth, const std::vector<Real>& sigma3,
+std::vector<TriaxialTest> synthetic_tests(PeriodicLab& lab, const Model& truth, const std::vector<Real>& sigma3,
                                           const std::string& material, unsigned seed, Real noise = 1);
 
 /// Synthetic data come from cells this many times larger than the simulator's, as real data come from specimens
@@ -85,7 +85,7 @@ constexpr int kGeneratorCellFactor = 4;
 /// Writes tests as a measured-data curve file (kPa, pct; eps_v, void_ratio and specimen_balls when every test has
 /// them, the test labels when every test has one that is a number, and q_measure when given): CSV, or HDF5 when
 /// the path ends in .h5 or .hdf5; through a temporary file and a rename.
-void write_measured_curves(const std::string& path, const std::vector<MeasuredTest>& tests,
+void write_measured_curves(const std::string& path, const std::vector<TriaxialTest>& tests,
                            const std::string& comment, const std::string& q_measure = "");
 
 }  // namespace dem

@@ -12,7 +12,7 @@
 
 namespace dem {
 
-std::array<Real, kQuantities> quantities(const MeasuredTest& t) {
+std::array<Real, kQuantities> quantities(const TriaxialTest& t) {
   return {t.e_ini, t.q_1pct, t.q_3pct, t.q_peak, t.eps_a_peak, t.q_end, t.max_dilatancy};
 }
 
@@ -67,7 +67,7 @@ std::vector<Real> whiten(const Eigen::MatrixXd& cov, const std::vector<Real>& di
 
 }  // namespace
 
-std::array<Real, kQuantities> test_residuals(const MeasuredTest& measured, const MeasuredTest& simulated,
+std::array<Real, kQuantities> test_residuals(const TriaxialTest& measured, const TriaxialTest& simulated,
                                              const NoiseModel& noise) {
   const auto m = quantities(measured), s = quantities(simulated);
   std::array<Real, kQuantities> r;
@@ -81,7 +81,7 @@ std::array<Real, kQuantities> test_residuals(const MeasuredTest& measured, const
   return r;
 }
 
-std::vector<Real> Misfit::values(std::size_t k, const MeasuredTest& t) const {
+std::vector<Real> Misfit::values(std::size_t k, const TriaxialTest& t) const {
   std::vector<Real> out;
   if (!curves_) {
     const auto q = quantities(t);
@@ -95,7 +95,7 @@ std::vector<Real> Misfit::values(std::size_t k, const MeasuredTest& t) const {
   return out;
 }
 
-Misfit::Misfit(const std::vector<MeasuredTest>& measured, const NoiseOptions& noise, const Ensemble& reference,
+Misfit::Misfit(const std::vector<TriaxialTest>& measured, const NoiseOptions& noise, const Ensemble& reference,
                int members, Real sim_end, Real sim_balls) {
   if (measured.empty()) throw std::invalid_argument("misfit: no measured tests");
   if (noise.mode != "data" && noise.mode != "lab")
@@ -106,12 +106,12 @@ Misfit::Misfit(const std::vector<MeasuredTest>& measured, const NoiseOptions& no
   for (const auto& runs : reference) {
     Real sum = 0;
     int n = 0;
-    for (const MeasuredTest& t : runs)
+    for (const TriaxialTest& t : runs)
       if (std::isfinite(t.void_ratio)) sum += t.void_ratio, ++n;
     void_ratio_.push_back(n ? sum / n : kNaN);
   }
   curves_ = !measured.front().q.empty();
-  for (const MeasuredTest& t : measured) {
+  for (const TriaxialTest& t : measured) {
     std::vector<Feature> fs;
     if (!curves_) {
       const auto m = quantities(t);
@@ -146,9 +146,9 @@ int Misfit::data() const {
   return n;
 }
 
-void Misfit::build_summary_noise(const std::vector<MeasuredTest>& measured, const NoiseOptions& noise,
+void Misfit::build_summary_noise(const std::vector<TriaxialTest>& measured, const NoiseOptions& noise,
                                  const Ensemble& ref) {
-  const bool given = std::any_of(measured.begin(), measured.end(), [](const MeasuredTest& t) {
+  const bool given = std::any_of(measured.begin(), measured.end(), [](const TriaxialTest& t) {
     return !t.summary_sd.empty();
   });
   source_ = given && noise.mode == "data" ? "the data's standard-deviation columns" : noise.lab_name;
@@ -173,7 +173,7 @@ void Misfit::build_summary_noise(const std::vector<MeasuredTest>& measured, cons
       // The ensemble's scatter of this quantity (sample variance over the members).
       Real s = 0, s2 = 0;
       int m = 0;
-      for (const MeasuredTest& t : ref[k]) {
+      for (const TriaxialTest& t : ref[k]) {
         const Real v = quantities(t)[fs[i].quantity];
         if (std::isfinite(v)) s += v, s2 += v * v, ++m;
       }
@@ -213,7 +213,7 @@ Real chi2_quantile(Real nu, Real z) {
   return nu * std::pow(1 - a + z * std::sqrt(a), 3);
 }
 
-Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<MeasuredTest>& measured,
+Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<TriaxialTest>& measured,
                       const NoiseOptions& noise, bool cell_bias, StateMatch* state) {
   Ensemble scatter = lab.run_ensemble(base, measured, true);
   auto misfit = [&] {
@@ -236,10 +236,10 @@ Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<Mea
   return m;
 }
 
-std::vector<Real> Misfit::mean_values(std::size_t k, const std::vector<MeasuredTest>& members) const {
+std::vector<Real> Misfit::mean_values(std::size_t k, const std::vector<TriaxialTest>& members) const {
   std::vector<Real> sum(features_[k].size(), 0.0);
   std::vector<int> n(sum.size(), 0);
-  for (const MeasuredTest& t : members) {
+  for (const TriaxialTest& t : members) {
     const std::vector<Real> v = values(k, t);
     for (std::size_t f = 0; f < v.size(); ++f)
       if (std::isfinite(v[f])) sum[f] += v[f], ++n[f];
@@ -248,7 +248,7 @@ std::vector<Real> Misfit::mean_values(std::size_t k, const std::vector<MeasuredT
   return sum;
 }
 
-std::vector<Real> Misfit::test_residuals(std::size_t k, const std::vector<MeasuredTest>& members) const {
+std::vector<Real> Misfit::test_residuals(std::size_t k, const std::vector<TriaxialTest>& members) const {
   const std::vector<Real> s = mean_values(k, members);
   const int n = static_cast<int>(s.size());
   std::vector<Real> diff(n);

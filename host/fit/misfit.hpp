@@ -45,7 +45,7 @@
 namespace dem {
 
 /// The quantities of a test (NaN where absent).
-std::array<Real, kQuantities> quantities(const MeasuredTest& t);
+std::array<Real, kQuantities> quantities(const TriaxialTest& t);
 
 /// The simulator's standard error that an ensemble aims below, as a share of the data's noise: its mean then adds
 /// at most a quarter to the variance.
@@ -67,7 +67,7 @@ constexpr Real kMissingResidual = 10;
 /// Whitened residuals of one summary test against one simulated test with lab noise, one per quantity (NaN where
 /// the measured test lacks it). L is lower triangular in quantity order: r_q is what datum q says beyond the
 /// quantities before it (E_ini first), the shared specimen factor counted once.
-std::array<Real, kQuantities> test_residuals(const MeasuredTest& measured, const MeasuredTest& simulated,
+std::array<Real, kQuantities> test_residuals(const TriaxialTest& measured, const TriaxialTest& simulated,
                                              const NoiseModel& noise);
 
 /// How the data's noise is taken: "data" (standard-deviation columns, else replicates, else the curves'
@@ -103,18 +103,18 @@ class Misfit {
   /// simulator's last axial strain.
   /// `sim_balls`: particles in a simulator specimen, against which a test's specimen_balls scales its specimen
   /// term.
-  Misfit(const std::vector<MeasuredTest>& measured, const NoiseOptions& noise, const Ensemble& reference,
+  Misfit(const std::vector<TriaxialTest>& measured, const NoiseOptions& noise, const Ensemble& reference,
          int members, Real sim_end, Real sim_balls = 0);
   std::size_t tests() const { return features_.size(); }
   int data() const;                               ///< compared data in all tests
   int data(std::size_t test) const { return static_cast<int>(features_[test].size()); }
   const std::vector<Feature>& features(std::size_t test) const { return features_[test]; }
   /// Whitened residuals of test k against its members' runs.
-  std::vector<Real> test_residuals(std::size_t k, const std::vector<MeasuredTest>& members) const;
+  std::vector<Real> test_residuals(std::size_t k, const std::vector<TriaxialTest>& members) const;
   /// All tests', concatenated in test order.
   std::vector<Real> residuals(const Ensemble& sim) const;
   /// The members' mean feature values of test k (NaN where no member has one).
-  std::vector<Real> mean_values(std::size_t k, const std::vector<MeasuredTest>& members) const;
+  std::vector<Real> mean_values(std::size_t k, const std::vector<TriaxialTest>& members) const;
   /// What noise was used, per test and in words, for the report.
   const std::vector<std::string>& notes() const { return notes_; }
   std::string source() const { return source_; }
@@ -140,10 +140,10 @@ class Misfit {
 
  private:
   std::vector<Real> void_ratio_;
-  std::vector<Real> values(std::size_t k, const MeasuredTest& t) const;
-  void build_curve_noise(const std::vector<MeasuredTest>& measured, const NoiseOptions& noise, const Ensemble& ref,
+  std::vector<Real> values(std::size_t k, const TriaxialTest& t) const;
+  void build_curve_noise(const std::vector<TriaxialTest>& measured, const NoiseOptions& noise, const Ensemble& ref,
                          Real sim_balls);
-  void build_summary_noise(const std::vector<MeasuredTest>& measured, const NoiseOptions& noise, const Ensemble& ref);
+  void build_summary_noise(const std::vector<TriaxialTest>& measured, const NoiseOptions& noise, const Ensemble& ref);
   /// Sets each feature's `field` to sd[test][feature] and adds it to Sigma, correlated along strain.
   void add_correlated(const std::vector<std::vector<Real>>& sd, Real Feature::*field, const std::string& what);
   std::vector<std::vector<Feature>> features_;
@@ -164,7 +164,7 @@ class Misfit {
 /// 1 / sqrt(K N)) and the scatter is measured again on it; where `state` holds the lab's match to the data's void
 /// ratio, the grown cell is matched again (PeriodicLab::grow_cell) and `state` says what it reaches. Then the cell's
 /// bias is measured and counted (measure_cell_bias) unless `cell_bias` is false.
-Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<MeasuredTest>& measured,
+Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<TriaxialTest>& measured,
                       const NoiseOptions& noise, bool cell_bias = true, StateMatch* state = nullptr);
 
 /// The chi2 of whitened residuals: the sum of their squares, of r[from, to) where given.

@@ -46,7 +46,7 @@ struct PooledVariance {
 /// The simulator's scatter: member deviations from their test's mean (`values` [test][member][feature]),
 /// pooled over tests per feature key and inflated by Student's t; `z` receives the scaled deviations.
 PooledVariance ensemble_scatter(const std::vector<std::vector<Feature>>& features,
-                                const std::vector<MeasuredTest>& measured,
+                                const std::vector<TriaxialTest>& measured,
                                 const std::vector<std::vector<std::vector<Real>>>& values,
                                 std::vector<std::vector<std::vector<Real>>>& z) {
   PooledVariance p;
@@ -106,7 +106,7 @@ Real fitted_length(const std::vector<std::vector<Feature>>& features,
 
 /// Replicates: the pooled scatter between the tests of one material and pressure holds data and specimen noise.
 PooledVariance replicate_scatter(const std::vector<std::vector<Feature>>& features,
-                                 const std::vector<MeasuredTest>& measured) {
+                                 const std::vector<TriaxialTest>& measured) {
   PooledVariance p;
   for (const auto& g : replicate_groups(measured)) {
     if (g.size() < 2) continue;
@@ -128,7 +128,7 @@ PooledVariance replicate_scatter(const std::vector<std::vector<Feature>>& featur
 /// A test's own noise of each feature (variances, in `data_var`), from its standard-deviation columns or the scatter
 /// of its rows; false where it has too few rows for either and no replicates: the lab model is used instead.
 /// `notes` gets what was done, `where` naming the test.
-bool data_noise(const MeasuredTest& t, const std::vector<Feature>& fs, bool have_replicates, const std::string& where,
+bool data_noise(const TriaxialTest& t, const std::vector<Feature>& fs, bool have_replicates, const std::string& where,
                 std::vector<Real>& data_var, std::vector<std::string>& notes) {
   const int n = static_cast<int>(fs.size());
   bool use_lab = false;
@@ -167,14 +167,14 @@ bool data_noise(const MeasuredTest& t, const std::vector<Feature>& fs, bool have
 
 }  // namespace
 
-void Misfit::build_curve_noise(const std::vector<MeasuredTest>& measured, const NoiseOptions& noise,
+void Misfit::build_curve_noise(const std::vector<TriaxialTest>& measured, const NoiseOptions& noise,
                                const Ensemble& ref, Real sim_balls) {
   std::vector<std::vector<std::vector<Real>>> z(measured.size());  // [test][member][feature], scaled deviations
   PooledVariance ens, rep = replicate_scatter(features_, measured);
   {
     std::vector<std::vector<std::vector<Real>>> v(measured.size());
     for (std::size_t k = 0; k < measured.size(); ++k)
-      for (const MeasuredTest& t : ref[k]) v[k].push_back(values(k, t));
+      for (const TriaxialTest& t : ref[k]) v[k].push_back(values(k, t));
     ens = ensemble_scatter(features_, measured, v, z);
   }
   length_ = ref.front().size() > 2 ? fitted_length(features_, z, noise.lab.length) : noise.lab.length;
@@ -188,7 +188,7 @@ void Misfit::build_curve_noise(const std::vector<MeasuredTest>& measured, const 
     notes_.push_back("the simulator has one specimen: its scatter is not measured and counts as zero");
 
   for (std::size_t k = 0; k < measured.size(); ++k) {
-    const MeasuredTest& t = measured[k];
+    const TriaxialTest& t = measured[k];
     std::vector<Feature>& fs = features_[k];
     const int n = static_cast<int>(fs.size());
     const std::string where = t.material + " at " + fmt("%g kPa", 1e-3 * t.sigma3);

@@ -64,7 +64,7 @@ Config prediction_config(const Config& membrane, const Model& calibrated, const 
 }
 
 std::vector<Prediction> predict(const Config& membrane, const Model& calibrated, const std::vector<std::string>& free,
-                                const std::vector<MeasuredTest>& tests, QMeasure measure, int specimens,
+                                const std::vector<TriaxialTest>& tests, QMeasure measure, int specimens,
                                 const std::string& cache, bool verbose) {
   Ensemble runs(tests.size());
   Progress progress("prediction: membrane tests", static_cast<long>(tests.size() * specimens));
@@ -78,7 +78,7 @@ std::vector<Prediction> predict(const Config& membrane, const Model& calibrated,
     for (std::size_t j = 0; j < tests.size(); ++j) {
       const Config c = prediction_config(membrane, calibrated, free, tests[j].sigma3, k);
       const TriaxialResult r = run_triaxial(c, sp, nullptr, false);
-      MeasuredTest t = curves_of(r, q_field(measure), c.triaxial.sigma3);
+      TriaxialTest t = curves_of(r, q_field(measure), c.triaxial.sigma3);
       t.material = tests[j].material;
       t.replicate = std::to_string(k + 1);
       t.void_ratio = r.void_ratio_consolidated;
@@ -93,7 +93,7 @@ std::vector<Prediction> predict(const Config& membrane, const Model& calibrated,
   return predictions_of(tests, std::move(runs));
 }
 
-std::vector<Prediction> predictions_of(const std::vector<MeasuredTest>& tests, Ensemble runs) {
+std::vector<Prediction> predictions_of(const std::vector<TriaxialTest>& tests, Ensemble runs) {
   if (runs.size() != tests.size()) throw std::logic_error("predictions_of: runs for other tests than those given");
   std::vector<Prediction> out(tests.size());
   for (std::size_t j = 0; j < tests.size(); ++j) {
@@ -102,10 +102,10 @@ std::vector<Prediction> predictions_of(const std::vector<MeasuredTest>& tests, E
   }
   for (Prediction& p : out) {
     Real sum = 0, sum2 = 0;
-    for (const MeasuredTest& t : p.members) sum += t.q_peak;
+    for (const TriaxialTest& t : p.members) sum += t.q_peak;
     const Real n = static_cast<Real>(p.members.size());
     p.q_peak_mean = sum / n;
-    for (const MeasuredTest& t : p.members) sum2 += (t.q_peak - p.q_peak_mean) * (t.q_peak - p.q_peak_mean);
+    for (const TriaxialTest& t : p.members) sum2 += (t.q_peak - p.q_peak_mean) * (t.q_peak - p.q_peak_mean);
     p.q_peak_sd = n > 1 ? std::sqrt(sum2 / (n - 1)) : 0;
     p.error = (p.q_peak_mean - p.measured.q_peak) / p.measured.q_peak;
   }
@@ -113,7 +113,7 @@ std::vector<Prediction> predictions_of(const std::vector<MeasuredTest>& tests, E
 }
 
 std::vector<Prediction> predict_walls(const Config& walls, const Model& calibrated,
-                                      const std::vector<MeasuredTest>& tests, int specimens, int workers) {
+                                      const std::vector<TriaxialTest>& tests, int specimens, int workers) {
   PeriodicLab lab(walls, false, specimens, walls.run.seed, specimens, workers);
   lab.set_progress("prediction: walled cells");
   Ensemble runs = lab.run_ensemble(calibrated, tests);

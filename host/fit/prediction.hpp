@@ -44,8 +44,8 @@ Config prediction_config(const Config& membrane, const Model& calibrated, const 
 
 /// One pressure of one material, predicted.
 struct Prediction {
-  MeasuredTest measured;               ///< the data's test
-  std::vector<MeasuredTest> members;   ///< one per specimen, q in the data's measure, labelled by member
+  TriaxialTest measured;               ///< the data's test
+  std::vector<TriaxialTest> members;   ///< one per specimen, q in the data's measure, labelled by member
   Real q_peak_mean = 0, q_peak_sd = 0; ///< Pa, over the members (sd 0 with one)
   Real error = 0;                      ///< (q_peak_mean - measured q_peak) / measured q_peak
   /// Pa, the calibration's periodic cell at the same parameters and pressure (NaN: not given): the membrane
@@ -55,19 +55,19 @@ struct Prediction {
 
 /// One Prediction per test of `tests` from `runs` (one list of members per test): the members' mean q_peak and
 /// its sample sd, and the error against the test's q_peak.
-std::vector<Prediction> predictions_of(const std::vector<MeasuredTest>& tests, Ensemble runs);
+std::vector<Prediction> predictions_of(const std::vector<TriaxialTest>& tests, Ensemble runs);
 
 /// Runs the template at `calibrated` for every test of `tests` on `specimens` specimens (packed once each, cached in
 /// `cache`), q summarised in `measure`. Prints a progress line when `verbose`.
 std::vector<Prediction> predict(const Config& membrane, const Model& calibrated, const std::vector<std::string>& free,
-                                const std::vector<MeasuredTest>& tests, QMeasure measure, int specimens,
+                                const std::vector<TriaxialTest>& tests, QMeasure measure, int specimens,
                                 const std::string& cache, bool verbose);
 
 /// The cell between six walls of `walls` (a walled config: reference_cell(base, "walls"), its preparation matched)
 /// at `calibrated` for every test of `tests`, on its first `specimens` specimens (packing seeds from [run] seed),
 /// `workers` runs at once, with a progress line.
 std::vector<Prediction> predict_walls(const Config& walls, const Model& calibrated,
-                                      const std::vector<MeasuredTest>& tests, int specimens, int workers);
+                                      const std::vector<TriaxialTest>& tests, int specimens, int workers);
 
 /// The predictions as a Markdown table (material, sigma3, measured and predicted q_peak with the members' scatter,
 /// error; the periodic cell's q_peak and the boundary's share (predicted - periodic) / predicted where given) with

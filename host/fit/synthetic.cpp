@@ -16,16 +16,16 @@ Real draw_strength(const Extension& e, unsigned seed) {
   return e.levels.front() * std::pow(e.levels.back() / e.levels.front(), u(rng));
 }
 
-std::vector<MeasuredTest> synthetic_tests(PeriodicLab& lab, const Model& truth, const std::vector<Real>& sigma3,
+std::vector<TriaxialTest> synthetic_tests(PeriodicLab& lab, const Model& truth, const std::vector<Real>& sigma3,
                                           const std::string& material, unsigned seed, Real noise) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<Real> gauss(0, 1);
-  std::vector<MeasuredTest> like(sigma3.size());
+  std::vector<TriaxialTest> like(sigma3.size());
   for (std::size_t j = 0; j < sigma3.size(); ++j) like[j].sigma3 = sigma3[j], like[j].material = material;
-  std::vector<MeasuredTest> out = lab.run_each(truth, like);
+  std::vector<TriaxialTest> out = lab.run_each(truth, like);
   for (std::size_t j = 0; j < sigma3.size(); ++j) {
     const Real s3 = sigma3[j];
-    MeasuredTest& t = out[j];
+    TriaxialTest& t = out[j];
     t.specimen_balls = static_cast<Real>(lab.balls());
     const Real factor = 1 + noise * 0.02 * gauss(rng);
     for (std::size_t i = 0; i < t.q.size(); ++i) {
@@ -37,13 +37,13 @@ std::vector<MeasuredTest> synthetic_tests(PeriodicLab& lab, const Model& truth, 
   return out;
 }
 
-void write_measured_curves(const std::string& path, const std::vector<MeasuredTest>& tests,
+void write_measured_curves(const std::string& path, const std::vector<TriaxialTest>& tests,
                            const std::string& comment, const std::string& q_measure) {
-  const bool volume = std::all_of(tests.begin(), tests.end(), [](const MeasuredTest& t) { return !t.eps_v.empty(); });
-  auto all = [&](Real MeasuredTest::*m) {
-    return std::all_of(tests.begin(), tests.end(), [&](const MeasuredTest& t) { return std::isfinite(t.*m); });
+  const bool volume = std::all_of(tests.begin(), tests.end(), [](const TriaxialTest& t) { return !t.eps_v.empty(); });
+  auto all = [&](Real TriaxialTest::*m) {
+    return std::all_of(tests.begin(), tests.end(), [&](const TriaxialTest& t) { return std::isfinite(t.*m); });
   };
-  const bool state = all(&MeasuredTest::void_ratio), size = all(&MeasuredTest::specimen_balls);
+  const bool state = all(&TriaxialTest::void_ratio), size = all(&TriaxialTest::specimen_balls);
   // The HDF5 form's table holds numbers: labels are written where each is one (member numbers, seeds).
   std::vector<double> label(tests.size());
   bool labels = !tests.empty();
@@ -61,7 +61,7 @@ void write_measured_curves(const std::string& path, const std::vector<MeasuredTe
   std::map<std::string, std::vector<std::vector<double>>> rows;  // by material
   std::vector<std::string> order;                                 // materials in file order
   for (std::size_t k = 0; k < tests.size(); ++k) {
-    const MeasuredTest& t = tests[k];
+    const TriaxialTest& t = tests[k];
     if (!rows.count(t.material)) order.push_back(t.material);
     for (std::size_t i = 0; i < t.q.size(); ++i) {
       rows[t.material].push_back({1e-3 * t.sigma3});

@@ -10,11 +10,11 @@ namespace dem {
 namespace {
 
 /// Per feature: the sample variance of the members' values about their mean, over the members that have one.
-std::vector<Real> sample_variance(const Misfit& misfit, std::size_t k, const std::vector<MeasuredTest>& members,
+std::vector<Real> sample_variance(const Misfit& misfit, std::size_t k, const std::vector<TriaxialTest>& members,
                                   const std::vector<Real>& mean) {
   std::vector<Real> sum(mean.size(), 0);
   std::vector<int> n(mean.size(), 0);
-  for (const MeasuredTest& t : members) {
+  for (const TriaxialTest& t : members) {
     const std::vector<Real> v = misfit.mean_values(k, {t});
     for (std::size_t f = 0; f < v.size(); ++f)
       if (std::isfinite(v[f])) sum[f] += (v[f] - mean[f]) * (v[f] - mean[f]), ++n[f];
@@ -57,7 +57,7 @@ Discrepancy measure_discrepancy(const Misfit& misfit, const std::vector<Predicti
     throw std::logic_error("two-fidelity: runs for other tests than the misfit's");
   Discrepancy d;
   for (std::size_t k = 0; k < misfit.tests(); ++k) {
-    const std::vector<MeasuredTest>& mem = membrane[k].members;
+    const std::vector<TriaxialTest>& mem = membrane[k].members;
     if (mem.size() < 2 || periodic[k].size() < 2)
       throw std::invalid_argument("two-fidelity: the discrepancy's scatter needs at least 2 specimens of each test "
                                   "([calibrate] predict_specimens and the ensemble)");
@@ -85,7 +85,7 @@ Discrepancy measure_discrepancy(const Misfit& misfit, const std::vector<Predicti
   return d;
 }
 
-std::string discrepancy_text(const Misfit& misfit, const Discrepancy& d, const std::vector<MeasuredTest>& tests) {
+std::string discrepancy_text(const Misfit& misfit, const Discrepancy& d, const std::vector<TriaxialTest>& tests) {
   std::string s;
   for (std::size_t k = 0; k < d.delta.size(); ++k) {
     Real delta = 0, sd = 0, ratio = 0;

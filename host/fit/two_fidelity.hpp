@@ -46,6 +46,6 @@ Discrepancy measure_discrepancy(const Misfit& misfit, const std::vector<Predicti
 
 /// The discrepancy in words for the report: per test, the cell's ratio to the membrane test and the correction of the
 /// data's q with its sd (kPa), means over the compared stresses (E_ini left out).
-std::string discrepancy_text(const Misfit& misfit, const Discrepancy& d, const std::vector<MeasuredTest>& tests);
+std::string discrepancy_text(const Misfit& misfit, const Discrepancy& d, const std::vector<TriaxialTest>& tests);
 
 }  // namespace dem

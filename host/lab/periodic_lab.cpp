@@ -24,7 +24,7 @@ namespace dem {
 namespace {
 
 /// A run that produced no test (a blow-up): every quantity NaN, counted as missing by residuals().
-void mark_failed(MeasuredTest& t) {
+void mark_failed(TriaxialTest& t) {
   t.q_peak = t.eps_a_peak = t.q_end = t.max_dilatancy = t.e_ini = t.q_1pct = t.q_3pct =
       std::numeric_limits<Real>::quiet_NaN();
 }
@@ -139,10 +139,10 @@ void PeriodicLab::set_members(int k) {
   members_ = k;
 }
 
-MeasuredTest PeriodicLab::run(const Model& m, Real sigma3, const std::string& material, int member) {
+TriaxialTest PeriodicLab::run(const Model& m, Real sigma3, const std::string& material, int member) {
   const auto t0 = std::chrono::steady_clock::now();
   const PackedCell& sp = specimens_.at(static_cast<std::size_t>(member));
-  MeasuredTest t;
+  TriaxialTest t;
   PeriodicTriaxialParams p = cfg_.periodic.triax;
   p.sigma3 = sigma3;
   p.membrane_stiffness = m.membrane;
@@ -183,7 +183,7 @@ namespace {
 /// The curves of a test as bytes to `put(pointer, count)`: row count, void ratio, then eps_a, q, eps_v (a count of
 /// -1: the run blew up). Through a child's pipe (send_curves) and into the run store.
 template <class Put>
-void put_curves(const MeasuredTest& t, Put put) {
+void put_curves(const TriaxialTest& t, Put put) {
   const long n = std::isfinite(t.q_peak) ? static_cast<long>(t.q.size()) : -1;
   put(&n, sizeof n);
   put(&t.void_ratio, sizeof t.void_ratio);
@@ -191,11 +191,11 @@ void put_curves(const MeasuredTest& t, Put put) {
     if (n > 0) put(v->data(), sizeof(Real) * v->size());
 }
 
-void send_curves(int fd, const MeasuredTest& t) {
+void send_curves(int fd, const TriaxialTest& t) {
   put_curves(t, [fd](const void* p, std::size_t n) { put_bytes(fd, p, n); });
 }
 
-bool receive_curves(int fd, MeasuredTest& t) {
+bool receive_curves(int fd, TriaxialTest& t) {
   long n = 0;
   if (!get_bytes(fd, &n, sizeof n) || !get_bytes(fd, &t.void_ratio, sizeof t.void_ratio)) return false;
   if (n < 0) {
@@ -232,7 +232,7 @@ std::string PeriodicLab::stored_path(const Model& m, const Case& c) const {
 
 namespace {
 /// A run's curves into the store (put_curves' bytes, as through a pipe).
-void store_run(const std::string& path, const MeasuredTest& t) {
+void store_run(const std::string& path, const TriaxialTest& t) {
   if (path.empty()) return;
   std::string bytes;
   put_curves(t, [&](const void* p, std::size_t n) { bytes.append(static_cast<const char*>(p), n); });
@@ -240,15 +240,15 @@ void store_run(const std::string& path, const MeasuredTest& t) {
 }
 }  // namespace
 
-std::vector<MeasuredTest> PeriodicLab::run_cases(const Model& m, const std::vector<Case>& cases) {
-  std::vector<MeasuredTest> out = run_or_read(m, cases);
-  for (const MeasuredTest& t : out)
+std::vector<TriaxialTest> PeriodicLab::run_cases(const Model& m, const std::vector<Case>& cases) {
+  std::vector<TriaxialTest> out = run_or_read(m, cases);
+  for (const TriaxialTest& t : out)
     if (!std::isfinite(t.q_peak)) ++failed_, failed_sigma3_ = std::max(failed_sigma3_, t.sigma3);
   return out;
 }
 
-std::vector<MeasuredTest> PeriodicLab::run_or_read(const Model& m, const std::vector<Case>& cases) {
-  std::vector<MeasuredTest> out(cases.size());
+std::vector<TriaxialTest> PeriodicLab::run_or_read(const Model& m, const std::vector<Case>& cases) {
+  std::vector<TriaxialTest> out(cases.size());
   std::optional<Progress> progress;
   if (!progress_label_.empty()) progress.emplace(progress_label_, static_cast<long>(cases.size()));
   long done = 0;
@@ -266,7 +266,7 @@ std::vector<MeasuredTest> PeriodicLab::run_or_read(const Model& m, const std::ve
       ++runs_;  // a run of the search, read: the counts a resumed search reports are those it reported
       one_done();
     } else {
-      out[j] = MeasuredTest{};
+      out[j] = TriaxialTest{};
       todo.push_back(j);
     }
   }
@@ -300,18 +300,18 @@ std::vector<MeasuredTest> PeriodicLab::run_or_read(const Model& m, const std::ve
   return out;
 }
 
-Ensemble PeriodicLab::run_ensemble(const Model& m, const std::vector<MeasuredTest>& like, bool all) {
+Ensemble PeriodicLab::run_ensemble(const Model& m, const std::vector<TriaxialTest>& like, bool all) {
   const std::size_t M = all ? specimens_.size() : static_cast<std::size_t>(members_);
   std::vector<Case> cases;  // case j: test j / M on member j % M
   for (std::size_t j = 0; j < like.size() * M; ++j)
     cases.push_back({like[j / M].material, like[j / M].sigma3, static_cast<int>(j % M)});
-  const std::vector<MeasuredTest> done = run_cases(m, cases);
+  const std::vector<TriaxialTest> done = run_cases(m, cases);
   Ensemble out(like.size());
   for (std::size_t j = 0; j < done.size(); ++j) out[j / M].push_back(done[j]);
   return out;
 }
 
-std::vector<MeasuredTest> PeriodicLab::run_each(const Model& m, const std::vector<MeasuredTest>& like) {
+std::vector<TriaxialTest> PeriodicLab::run_each(const Model& m, const std::vector<TriaxialTest>& like) {
   std::vector<Case> cases;
   for (std::size_t j = 0; j < like.size(); ++j)
     cases.push_back({like[j].material, like[j].sigma3, static_cast<int>(j % static_cast<std::size_t>(members_))});

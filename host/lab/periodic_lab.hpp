@@ -26,7 +26,7 @@ struct Model {
 Model model_of(const Config& cfg);
 
 /// Simulated tests of an ensemble: [test][member], each summarised like measured curves.
-using Ensemble = std::vector<std::vector<MeasuredTest>>;
+using Ensemble = std::vector<std::vector<TriaxialTest>>;
 
 /// Packing seeds of synthetic data start this far above the config's seed: never a member of an ensemble
 /// (at most 64 members, config.cpp).
@@ -47,12 +47,12 @@ class PeriodicLab {
   /// until measure_misfit chooses.
   PeriodicLab(const Config& base, bool verbose, int workers = 1);
   /// One simulated test (curves, summarised; its void ratio at the start of shear) of one member at sigma3 (Pa).
-  MeasuredTest run(const Model& m, Real sigma3, const std::string& material = "sim", int member = 0);
+  TriaxialTest run(const Model& m, Real sigma3, const std::string& material = "sim", int member = 0);
   /// Every test of `like` (its materials and pressures) on every member (on every specimen with `all`); up to
   /// workers() runs at once.
-  Ensemble run_ensemble(const Model& m, const std::vector<MeasuredTest>& like, bool all = false);
+  Ensemble run_ensemble(const Model& m, const std::vector<TriaxialTest>& like, bool all = false);
   /// Test j of `like` (its material and pressure) on member j % members(): data made on a specimen per test.
-  std::vector<MeasuredTest> run_each(const Model& m, const std::vector<MeasuredTest>& like);
+  std::vector<TriaxialTest> run_each(const Model& m, const std::vector<TriaxialTest>& like);
   /// Runs at once: each in a child process (fork) with the same specimens; the results are the same as one at a
   /// time, bit for bit. Only where that is safe: a host backend on one thread (OMP_NUM_THREADS=1); otherwise
   /// the runs go one at a time with all threads. Returns the value in effect.
@@ -117,9 +117,9 @@ class PeriodicLab {
     int member;
   };
   /// run_or_read, then the blown-up runs among them counted (failed_runs), whichever way each test came.
-  std::vector<MeasuredTest> run_cases(const Model& m, const std::vector<Case>& cases);
+  std::vector<TriaxialTest> run_cases(const Model& m, const std::vector<Case>& cases);
   /// The cases in order, up to workers() at once; those in the run store are read.
-  std::vector<MeasuredTest> run_or_read(const Model& m, const std::vector<Case>& cases);
+  std::vector<TriaxialTest> run_or_read(const Model& m, const std::vector<Case>& cases);
   /// The run store's file of a case ("" without a store).
   std::string stored_path(const Model& m, const Case& c) const;
 };
@@ -185,7 +185,7 @@ struct StateMatch {
 
 /// The base config with the preparation friction that packs the mean void ratio of the tests that give one
 /// (prep_friction_for); the base config itself when none does.
-Config matched_state(const Config& base, const std::vector<MeasuredTest>& tests, StateMatch& m, bool verbose,
+Config matched_state(const Config& base, const std::vector<TriaxialTest>& tests, StateMatch& m, bool verbose,
                      const MatchPlan& plan);
 
 /// Before Kokkos starts, in a program that will run `workers` > 1 simulator runs at once: sets OpenMP to one

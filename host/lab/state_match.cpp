@@ -103,11 +103,11 @@ Real prep_friction_for(const Config& base, Real target, Real& reached, bool verb
   return bisect(0, 1, e_lo, e_hi);
 }
 
-Config matched_state(const Config& base, const std::vector<MeasuredTest>& tests, StateMatch& m, bool verbose,
+Config matched_state(const Config& base, const std::vector<TriaxialTest>& tests, StateMatch& m, bool verbose,
                      const MatchPlan& plan) {
   m = StateMatch{};
   Real sum = 0;
-  for (const MeasuredTest& t : tests)
+  for (const TriaxialTest& t : tests)
     if (std::isfinite(t.void_ratio)) sum += t.void_ratio, ++m.tests;
   if (m.tests == 0) return base;
   m.target = sum / m.tests;

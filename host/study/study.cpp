@@ -69,7 +69,7 @@ PeakComparison compare_peaks(const MeasuredData& data, const std::vector<StudyCa
   c.error.assign(cases.size(), kNaN);
   Real sum = 0;
   for (std::size_t k = 0; k < cases.size(); ++k) {
-    for (const MeasuredTest& t : data.tests)
+    for (const TriaxialTest& t : data.tests)
       if (t.material == cases[k].material && std::fabs(t.sigma3 - summaries[k].sigma3) <= 1e-6 * t.sigma3)
         c.measured[k] = t.q_peak;
     const Real simulated = q_peak_as(summaries[k], c.measure);

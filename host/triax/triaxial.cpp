@@ -269,7 +269,7 @@ Real TriaxialRecord::*q_field(QMeasure m) {
   return &TriaxialRecord::q;
 }
 
-MeasuredTest curves_of(const TriaxialResult& r, Real TriaxialRecord::*q, Real sigma3) {
+TriaxialTest curves_of(const TriaxialResult& r, Real TriaxialRecord::*q, Real sigma3) {
   std::vector<TriaxialRecord> rows = r.records;
   for (TriaxialRecord& x : rows) x.q = x.*q;
   return summarised(rows, sigma3);

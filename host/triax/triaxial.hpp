@@ -63,7 +63,7 @@ Real TriaxialRecord::*q_field(QMeasure m);
 
 /// The shear's curves with q from the records' field `q` (q_field(m), or q_lw), eps_v from the membrane,
 /// summarised like measured curves.
-MeasuredTest curves_of(const TriaxialResult& r, Real TriaxialRecord::*q, Real sigma3);
+TriaxialTest curves_of(const TriaxialResult& r, Real TriaxialRecord::*q, Real sigma3);
 
 /// Runs consolidation and shear on `specimen`; writes series and snapshots to `out` when given. With a
 /// `plan`: checkpoints (the simulation, the stage, the records and the output so far) as it says, continues
