@@ -30,32 +30,41 @@ std::pair<double, const char*> feature_unit(const Feature& f, Real v) {
 }  // namespace
 
 /// The errors table (like the paper's Table 6): measured, simulated and error per test and quantity.
-std::string errors_csv(const std::vector<TriaxialTest>& meas, const std::vector<TriaxialTest>& sim) {
-  std::ostringstream s;
-  s << "material,sigma3_kPa,quantity,unit,measured,simulated,error_pct\n";
+namespace {
+
+/// The errors table's rows, their cells as written: material, sigma3 (kPa), quantity, unit, measured, simulated,
+/// error (%). One source for the CSV and the printed table.
+std::vector<std::array<std::string, 7>> error_rows(const std::vector<TriaxialTest>& meas,
+                                                   const std::vector<TriaxialTest>& sim) {
+  std::vector<std::array<std::string, 7>> rows;
   for (std::size_t k = 0; k < meas.size(); ++k) {
     const auto m = quantities(meas[k]), q = quantities(sim[k]);
     for (int i = 0; i < kQuantities; ++i) {
       if (!std::isfinite(m[i])) continue;
-      s << meas[k].material << "," << fmt("%g", 1e-3 * meas[k].sigma3) << "," << quantity_name(i) << ","
-        << in_table_unit(i, m[i]).second << "," << fmt("%.5g", in_table_unit(i, m[i]).first) << ","
-        << fmt("%.5g", in_table_unit(i, q[i]).first) << ","
-        << fmt("%.2f", 100 * (q[i] - m[i]) / std::fabs(m[i])) << "\n";
+      rows.push_back({meas[k].material, fmt("%g", 1e-3 * meas[k].sigma3), quantity_name(i),
+                      in_table_unit(i, m[i]).second, fmt("%.5g", in_table_unit(i, m[i]).first),
+                      fmt("%.5g", in_table_unit(i, q[i]).first), fmt("%.2f", 100 * (q[i] - m[i]) / std::fabs(m[i]))});
     }
   }
-  return s.str();
+  return rows;
+}
+
+}  // namespace
+
+std::string errors_csv(const std::vector<TriaxialTest>& meas, const std::vector<TriaxialTest>& sim) {
+  std::string s = "material,sigma3_kPa,quantity,unit,measured,simulated,error_pct\n";
+  for (const auto& c : error_rows(meas, sim)) {
+    for (std::size_t j = 0; j < c.size(); ++j) s += (j ? "," : "") + c[j];
+    s += "\n";
+  }
+  return s;
 }
 
 void print_errors(const std::vector<TriaxialTest>& meas, const std::vector<TriaxialTest>& sim) {
   std::printf("%-10s %7s %-14s %12s %12s %8s\n", "material", "s3 kPa", "quantity", "measured", "simulated", "err %");
-  std::istringstream in(errors_csv(meas, sim));
-  std::string line;
-  std::getline(in, line);
-  while (std::getline(in, line)) {
-    const std::vector<std::string> c = split_fields(line);
+  for (const auto& c : error_rows(meas, sim))
     std::printf("%-10s %7s %-14s %12s %12s %8s\n", c[0].c_str(), c[1].c_str(), (c[2] + " " + c[3]).c_str(),
                 c[4].c_str(), c[5].c_str(), c[6].c_str());
-  }
 }
 
 /// The calibrated values with their 95% intervals and correlations, in lines prefixed "<job>: <material>: ".
