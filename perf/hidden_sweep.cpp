@@ -1,4 +1,4 @@
-/// Identification sweep of the diagnosis (issue 5): for each hidden extension (and none) and each seed, draws
+/// Identification sweep of the diagnosis: for each hidden extension (and none) and each seed, draws
 /// the strength from the seed over the extension's whole physical range (draw_strength), generates noisy
 /// synthetic data, diagnoses them and records the verdict. Prints the confusion matrix (rows: hidden, columns:
 /// named) and the rate of correct answers, and writes one CSV row per case.

@@ -1,4 +1,4 @@
-/// Checkpoints and resume (issue 7). A resumed run must be the run that was not stopped, bit for bit: the
+/// Checkpoints and resume. A resumed run must be the run that was not stopped, bit for bit: the
 /// comparisons below are exact (==), since any difference, however small, grows in a chaotic granular
 /// system and would make a resumed study differ from an unstopped one.
 #include <gtest/gtest.h>

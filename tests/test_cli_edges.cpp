@@ -1,4 +1,4 @@
-// Settings that would make a result meaningless or lose a file are refused before any run (issue 40): the
+// Settings that would make a result meaningless or lose a file are refused before any run: the
 // program itself, run as a user runs it, on the shipped configs.
 #include <gtest/gtest.h>
 

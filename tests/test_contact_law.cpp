@@ -391,7 +391,7 @@ TEST(ContactLaw, HistoryFollowsTurningContactPlane) {
 }
 
 // ---------------------------------------------------------------------------------------------------
-// Model extensions (issue 5). Each has a closed form written out here; the law's tangent stiffness is
+// Model extensions. Each has a closed form written out here; the law's tangent stiffness is
 // also checked against a central difference of its own force, which is what the shear and rolling
 // springs and the dashpot rely on. Central difference with h = 1e-5 overlap: truncation (h/d)^2 f'''/f'
 // ~ 1e-10, rounding 1e-16 / 1e-5 ~ 1e-11; tolerance 1e-7 relative.

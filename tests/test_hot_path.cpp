@@ -1,4 +1,4 @@
-/// What a time step costs besides its arithmetic (issue 43, item 2): kernel launches, allocations and copies
+/// What a time step costs besides its arithmetic: kernel launches, allocations and copies
 /// between memory spaces, counted through Kokkos' tool callbacks on steps that neither rebuild the neighbour list
 /// nor record. A GPU pays for an allocation or a copy to the host with a wait; the goal is none on such a step.
 /// (Kokkos 3.4 reports no global fence to the tools, so fences are not counted here.)

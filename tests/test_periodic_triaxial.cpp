@@ -166,7 +166,7 @@ TEST(PeriodicTriaxial, HigherFrictionGivesHigherPeak) {
 TEST(PeriodicTriaxial, DenseSpecimenContractsThenDilates) {
   // mu_s = 0.3 on a dense specimen: contraction to about 0.11% near eps_a = 0.4%, then dilation. Each quantity
   // must lie in its 99% prediction interval for one more specimen, mean +- t(0.995, 10) s sqrt(1 + 1/11), from
-  // the scatter of eleven other specimens (packing seeds 1-3 and 5-12, 25 November); this one is seed 4.
+  // the scatter of eleven other specimens (packing seeds 1-3 and 5-12); this one is seed 4.
   // (mean, half-width) of: void ratio at the start of shear; eps_v at the first record (0.1%); the largest
   // contraction; the strain where it occurs; the dilation from there to eps_a = 2%; from 2% to the end (4%).
   const Specimen s = dense_specimen(kBalls, 4);

@@ -52,7 +52,7 @@ TEST(Study, SummaryRoundTripsInFileUnits) {
   s.phi_peak_deg = 30.5;
   s.eps_a_peak = 0.042;
   s.max_dilatancy = 0.61;
-  // Where it came from (issue 40: a summary did not say): a comma in a path stays in one cell.
+  // Where it came from (a summary did not say): a comma in a path stays in one cell.
   s.provenance = {"0.1.0+abc1234-dirty", "OpenMP x2", "configs/a,b.toml", "0123456789abcdef", 17};
   write_summary(dir.string(), s);
   std::ifstream f(dir / "summary.csv");

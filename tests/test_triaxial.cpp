@@ -46,7 +46,7 @@ TEST_F(Triaxial, DenseFrictionalSpecimenContractsThenDilatesInsideTheMembrane) {
   EXPECT_EQ(r.escaped, 0);
   EXPECT_LE(r.inertial_number, 1e-2);
   // Love-Weber stress of all contacts (platens and membrane included) is the specimen's mean stress: when
-  // consolidated it must equal the boundary stresses within 2% (issue 4). Axially the two platens differ by
+  // consolidated it must equal the boundary stresses within 2%. Axially the two platens differ by
   // what the membrane carries by friction, so the mean of the two is the boundary value.
   ASSERT_EQ(r.micro.size(), r.records.size());
   const MicroRow& m0 = r.micro.front();

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The identification sweep's tables under the decision rule of issue 39 (docs/calibration.md, The identification
+"""The identification sweep's tables under the identification decision rule (docs/calibration.md, The identification
 rate): the rate's denominator is the identifiable cases, those whose hidden extension, fitted freely, passes both
 tests of the verdict (the CSV's `data_show`); the goal is all of those named, no wrong name anywhere, and no false
 alarm on the null cases, whose own largest gains check the threshold the verdict uses.

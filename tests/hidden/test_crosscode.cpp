@@ -54,8 +54,8 @@ TEST_P(CrossCode, DiagnosisOfAnotherCodesCurves) {
   for (const ExtensionFit& f : dg.fits) std::printf("  %s: %s\n", f.ext.name.c_str(), f.reason.c_str());
   EXPECT_EQ(dg.verdict, c.verdict) << dg.explanation;
   if (c.verdict == "none") {
-    // The generating friction must lie inside the reported joint 95% region (issue 26). On the CI's cell it
-    // does only narrowly, 0.94 of the region's chi2 rise on 25 November (mu_s 0.293 [0.233, 0.378], mu_r 0.064
+    // The generating friction must lie inside the reported joint 95% region. On the CI's cell it
+    // does only narrowly, 0.94 of the region's chi2 rise (mu_s 0.293 [0.233, 0.378], mu_r 0.064
     // [0.029, 0.080], chi2 100 on 60 data; 0.94 again with the cell's bias counted, chi2 36.1), so there it is
     // printed, not asserted: it would turn on the rounding of the next kernel change. The fits lean to less
     // sliding and more rolling friction than YADE's, and without the cell's bias the simulator misses these data
@@ -65,7 +65,7 @@ TEST_P(CrossCode, DiagnosisOfAnotherCodesCurves) {
     // 0.471], mu_r 0.034 [0.009, 0.051]. That cell is the long case (ctest -L long), where the region must hold
     // YADE's values: there diagnose gives mu_s 0.411 [0.335, 0.503], mu_r 0.035 [0.017, 0.075] and (0.4, 0.04)
     // at the minimum (rise -0.06), verdict none with wear closest (BIC 5.2 lower, 6 needed), 22 minutes on 2
-    // shared cores (25 November).
+    // shared cores.
     const Real rise = dg.base.region_rise({0.4, 0.04});
     std::printf("  generating friction (0.4, 0.04): chi2 rise %.2f of the joint 95%% region's (inside at most 1)\n",
                 rise);
@@ -88,7 +88,7 @@ INSTANTIATE_TEST_SUITE_P(Yade, CrossCode,
 // data of YADE's walled test (walled_seed1.csv: 1000 balls between six walls under TriaxialStressController,
 // stresses at the walls) diagnosed with the walled cell of the data's 1000 balls (walled_base.toml,
 // reference_test = "walls"), whose joint 95% region must hold the generating friction. It does since the base
-// config raised the overlap guard (overlap_limit 0.25): on 27 November mu_s 0.570 [0.436, 0.699], mu_r 0.0007
+// config raised the overlap guard (overlap_limit 0.25): mu_s 0.570 [0.436, 0.699], mu_r 0.0007
 // [0, 0.027], correlation -0.68, (0.4, 0.04) at 0.94 of the region's chi2 rise (inside, narrowly; each marginal
 // interval alone misses it), verdict none, chi2 9.1 on 60 data, 643 s on 2 cores. Before, most runs at 300 kPa
 // stopped at the default 10% guard and counted as missing data, and the fits gave (0.355, 0.036) at 1.44 of the
@@ -104,7 +104,7 @@ INSTANTIATE_TEST_SUITE_P(LongYade, CrossCode,
 // Outside the suite's budget too: the walled data calibrated against the periodic cell, as a user who does not know
 // the data had walls would, and the walled cell run at that optimum (`--predict walls`). The periodic cell measures
 // no boundary, so the calibration puts the walls' looser layer and stress measure into friction, and the walled
-// test at the calibrated friction reads far above the data: the report states that share. On 27 November (1000
+// test at the calibrated friction reads far above the data: the report states that share. Measured (1000
 // balls, box 28 mm for random insertion, 2 cores, 10 minutes) the cell gave mu_s 0.844 [0.625, 0.914], mu_r 0.062,
 // chi2 172 on 60 data, and the walled cell there read 255, 511 and 767 kPa at 100, 200 and 300 kPa against the
 // data's 136, 298 and 433 (+72 to +88%), the walls' share 40-46% of its q_peak. The bounds below, a share of a

@@ -87,7 +87,7 @@ TEST_P(HiddenEffect, DiagnosisNamesIt) {
 
 // Wear (0.6, the top of its range) and the membrane (300 kPa) are not run here: on specimens the diagnosis never
 // ran, with the noise measured rather than assumed, this simulator (120 balls, an ensemble of two, 8% strain) does
-// not tell them from specimen scatter. Measured on 25 November: wear 0.6 gave BIC gains of -3.1 and -1.9 with two
+// not tell them from specimen scatter. Measured: wear 0.6 gave BIC gains of -3.1 and -1.9 with two
 // ensembles (verdict none); the membrane gave 2.2 and the roughness fit 6.5 (verdict roughness, a wrong name).
 // They passed before only because the data came from the diagnosis's own specimen. perf/hidden_sweep measures
 // their identification rate; a CI case for them needs a larger ensemble or cell than the CI budget allows.
