@@ -290,7 +290,7 @@ TEST(CellBias, ACountedBiasTakesUpTheShiftItMeasuredAndNothingElse) {
   std::vector<std::vector<Real>> sd(1);
   const std::vector<Real> big = m.mean_values(0, {shifted}), small = m.mean_values(0, {data});
   for (std::size_t i = 0; i < big.size(); ++i) sd[0].push_back(cell_bias_sd(big[i] - small[i], 0, 1));
-  m.add_cell_bias(sd, "test");
+  m.add_cell_bias({sd, "test"});
   EXPECT_LT(chi2(m.test_residuals(0, {shifted})), 4);
   EXPECT_NEAR(chi2(m.test_residuals(0, {contracts})), volume_before, 1e-6 * volume_before);
   for (const Feature& f : m.features(0))

@@ -18,8 +18,8 @@ Real cell_bias_sd(Real diff, Real diff_var, Real extrapolation) {
   return extrapolation * std::sqrt(std::max(Real(0), diff * diff - diff_var));
 }
 
-void measure_cell_bias(PeriodicLab& lab, const Model& base, const std::vector<TriaxialTest>& measured,
-                       const Ensemble& reference, Misfit& misfit) {
+CellBias measure_cell_bias(PeriodicLab& lab, const Model& base, const std::vector<TriaxialTest>& measured,
+                           const Ensemble& reference, const Misfit& misfit) {
   // Prepared as the simulator's specimens are: to the data's void ratio where they give one (on this cell's own
   // preparation friction), else with the same preparation.
   // The mean matched is the check cells' own (their first kStateMatchSpecimens).
@@ -61,7 +61,7 @@ void measure_cell_bias(PeriodicLab& lab, const Model& base, const std::vector<Tr
                      fmt(" differ from the %.0f scatter specimens beyond their own scatter by ", static_cast<Real>(reference.front().size())) +
                      fmt("%.2f of the data's noise (median; at most ", median) + fmt("%.2f),", top) +
                      " extrapolated to the data's specimen size and counted as noise";
-  misfit.add_cell_bias(sd, note);
+  return {sd, note};
 }
 
 }  // namespace dem

@@ -42,9 +42,10 @@ Real cell_bias_extrapolation(Real n, Real factor, Real m);
 /// `extrapolation`, as a standard deviation.
 Real cell_bias_sd(Real diff, Real diff_var, Real extrapolation);
 
-/// Runs the check cells of `lab`'s cell at `base` on every measured test and counts the bias in `misfit`
-/// (Misfit::add_cell_bias). `reference`: the scatter specimens' runs at `base` on `lab`'s present cell.
-void measure_cell_bias(PeriodicLab& lab, const Model& base, const std::vector<TriaxialTest>& measured,
-                       const Ensemble& reference, Misfit& misfit);
+/// Runs the check cells of `lab`'s cell at `base` on every measured test and returns the bias against `misfit`'s
+/// features, which it only reads (Misfit::add_cell_bias counts it). `reference`: the scatter specimens' runs at
+/// `base` on `lab`'s present cell.
+CellBias measure_cell_bias(PeriodicLab& lab, const Model& base, const std::vector<TriaxialTest>& measured,
+                           const Ensemble& reference, const Misfit& misfit);
 
 }  // namespace dem

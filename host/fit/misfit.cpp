@@ -232,7 +232,7 @@ Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<Tri
     lab.set_members(std::min(misfit().members_for(kEnsembleRatioGoal), lab.specimens()));
   }
   Misfit m = misfit();
-  if (cell_bias) measure_cell_bias(lab, base, measured, scatter, m);
+  if (cell_bias) m.add_cell_bias(measure_cell_bias(lab, base, measured, scatter, m));
   return m;
 }
 

@@ -96,6 +96,13 @@ struct Feature {
   Real data_noise() const { return std::hypot(data_sd, specimen_sd); }
 };
 
+/// The simulator's finite-cell bias as measured (host/fit/cell_bias.hpp): a standard deviation per test and
+/// feature, and how it was measured, in words.
+struct CellBias {
+  std::vector<std::vector<Real>> sd;
+  std::string note;
+};
+
 class Misfit {
  public:
   /// `reference`: runs at the base model on the scatter specimens ([test][specimen], tests as in `measured`),
@@ -127,9 +134,9 @@ class Misfit {
   int members() const { return members_; }
   /// Particles in a simulator specimen (0: not given).
   Real sim_balls() const { return sim_balls_; }
-  /// Sigma_cell: adds the simulator's finite-cell bias, sd[test][feature] (host/fit/cell_bias.hpp), correlated along
-  /// strain as the ensemble's scatter is (a bias moves a curve smoothly); `note` says how it was measured.
-  void add_cell_bias(const std::vector<std::vector<Real>>& sd, const std::string& note);
+  /// Sigma_cell: adds the simulator's finite-cell bias (host/fit/cell_bias.hpp), each test's correlated along
+  /// strain as the ensemble's scatter is (a bias moves a curve smoothly); its note goes to notes().
+  void add_cell_bias(const CellBias& bias);
   /// Two fidelities (host/fit/two_fidelity.hpp): the data are what the reference test measures, which exceeds what this
   /// simulator gives at the same parameters by delta[test][feature]; the simulator is then compared with the data
   /// less delta, and delta's uncertainty sd[test][feature] is counted, correlated along strain as a bias is.

@@ -258,9 +258,9 @@ void Misfit::add_correlated(const std::vector<std::vector<Real>>& sd, Real Featu
   }
 }
 
-void Misfit::add_cell_bias(const std::vector<std::vector<Real>>& sd, const std::string& note) {
-  add_correlated(sd, &Feature::cell_sd, "cell bias");
-  notes_.push_back(note);
+void Misfit::add_cell_bias(const CellBias& bias) {
+  add_correlated(bias.sd, &Feature::cell_sd, "cell bias");
+  notes_.push_back(bias.note);
 }
 
 void Misfit::add_discrepancy(const std::vector<std::vector<Real>>& delta, const std::vector<std::vector<Real>>& sd,
