@@ -295,6 +295,16 @@ TEST(CellBias, ACountedBiasTakesUpTheShiftItMeasuredAndNothingElse) {
   EXPECT_NEAR(chi2(m.test_residuals(0, {contracts})), volume_before, 1e-6 * volume_before);
   for (const Feature& f : m.features(0))
     if (f.quantity == 0) EXPECT_NEAR(f.cell_sd, 0.1 * f.measured, 1e-6 * f.measured) << f.name;
+  // Each datum's standard deviation, as the report divides by it, holds every term, the bias now among them.
+  for (std::size_t i = 0; i < m.features(0).size(); ++i) {
+    const Feature& f = m.features(0)[i];
+    const Real terms = f.data_sd * f.data_sd + f.specimen_sd * f.specimen_sd + f.cell_sd * f.cell_sd +
+                       f.ensemble_sd * f.ensemble_sd / m.members();
+    EXPECT_GE(m.sd(0, i) * m.sd(0, i), terms * (1 - 1e-12)) << f.name;
+    // Beyond them only the floor that keeps Sigma invertible: 0.1% of sigma3 on q, 1e-6 on eps_v.
+    const Real floor = f.quantity == 0 ? 1e-3 * data.sigma3 : 1e-6;
+    EXPECT_LE(m.sd(0, i) * m.sd(0, i), terms + floor * floor * (1 + 1e-9)) << f.name;
+  }
 }
 
 // Two fidelities (host/fit/two_fidelity.hpp): the lab's test reads q 30% above what the periodic cell gives at the same

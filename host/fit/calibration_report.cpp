@@ -154,9 +154,7 @@ std::string gain_tables(const Misfit& mf, const std::vector<TriaxialTest>& tests
         at(*t, key).first += cb;
         at(*t, key).second += ce;
       }
-      const Real s = std::sqrt(f.data_sd * f.data_sd + f.specimen_sd * f.specimen_sd +
-                               f.ensemble_sd * f.ensemble_sd / mf.members() + f.cell_sd * f.cell_sd +
-                               f.discrepancy_sd * f.discrepancy_sd);
+      const Real s = mf.sd(k, i);
       const auto u = feature_unit(f, f.measured);
       rows << "| " << fmt("%g", 1e-3 * tests[k].sigma3) << " | " << f.name << " | " << u.second << " | "
            << fmt("%.4g", u.first) << " | " << fmt("%.4g", feature_unit(f, b[i]).first) << " | "

@@ -120,6 +120,10 @@ class Misfit {
   std::vector<Real> test_residuals(std::size_t k, const std::vector<TriaxialTest>& members) const;
   /// All tests', concatenated in test order.
   std::vector<Real> residuals(const Ensemble& sim) const;
+  /// The standard deviation of feature i of test k: every term of Sigma on its diagonal, as the residuals whiten.
+  Real sd(std::size_t k, std::size_t i) const {
+    return std::sqrt(cov_[k][i * features_[k].size() + i]);
+  }
   /// The members' mean feature values of test k (NaN where no member has one).
   std::vector<Real> mean_values(std::size_t k, const std::vector<TriaxialTest>& members) const;
   /// What noise was used, per test and in words, for the report.
