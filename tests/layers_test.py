@@ -1,10 +1,9 @@
 #!/usr/bin/python3
 """Layers.IncludesGoOnlyDownward: every project include in kernels/<layer>/ and host/<layer>/ names a file of its own
-layer or of one below it, in the order CMake builds them (BUILD/layers.txt, from TRIAXDEM_KERNEL_LAYERS and
-TRIAXDEM_LAYERS in CMakeLists.txt), and spells it from the source root ("host/<layer>/<file>" or
-"kernels/<layer>/<file>"); a header the build generates is left alone. Each test file includes nothing above the
-layer its executable links (BUILD/test_layers.txt). Prints each offending include with its file and line, and the
-layer order.
+layer or of one below it, in the order CMake builds them (BUILD/layers.txt, from TRIAXDEM_LAYERS in
+CMakeLists.txt), and spells it from the source root ("host/<layer>/<file>" or "kernels/<layer>/<file>"); a header
+the build generates is left alone. Each test file includes nothing above the layer its executable links
+(BUILD/test_layers.txt). Prints each offending include with its file and line, and the layer order.
 
     tests/layers_test.py SOURCE_DIR BUILD_DIR
 """
