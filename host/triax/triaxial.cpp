@@ -214,6 +214,24 @@ void take_record(const ShearRecorder& sh, Real eps_a, long k, LazyContacts& cont
   }
 }
 
+/// The state step k of the shear left: its record where one is due (or `last`), and a snapshot where one is.
+void observe_shear(const ShearRecorder& sh, long k, bool last) {
+  Simulation& sim = *sh.cell.sim;
+  const bool micro = sh.cfg.micro.enabled;
+  const Real eps_a = (sh.h0 - sim.wall_point(kTopPlaten).z) / sh.h0;
+  LazyContacts contacts{sim};
+  if (eps_a >= sh.st.next_record - 1e-12 || last) take_record(sh, eps_a, k, contacts);
+  const int next_snap = sh.st.next_snap;
+  if (sh.out && next_snap < kSnapshotStrains && eps_a >= sh.snaps[next_snap] - 1e-12) {
+    char label[48];
+    std::snprintf(label, sizeof label, "shear eps_a=%.0f%%", 100 * sh.snaps[next_snap]);
+    const io::SurfaceSnapshot surface = membrane_surface(sh.cell.membrane);
+    const io::ContactTable table = micro ? contact_table(contacts.get()) : io::ContactTable();
+    sh.out->write_snapshot(take_snapshot(sim, label), &surface, micro ? &table : nullptr);
+    sh.st.next_snap += 1;
+  }
+}
+
 /// The series' columns: the boundary's, then the micromechanics' of the specimen and of its central cube where enabled.
 std::vector<std::string> series_columns(const MicroConfig& mc) {
   std::vector<std::string> columns = kSeriesColumns;
@@ -329,18 +347,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
   shear_stage.last = steps + 1;
   shear_stage.before = [&](long n) {
     const long k = n - 1;
-    const Real eps_a = (h0 - sim.wall_point(kTopPlaten).z) / h0;
-    LazyContacts contacts{sim};
-    if (eps_a >= st.next_record - 1e-12 || k == steps) take_record(recorder, eps_a, k, contacts);
-    const int next_snap = st.next_snap;
-    if (out && next_snap < kSnapshotStrains && eps_a >= snaps[next_snap] - 1e-12) {
-      char label[48];
-      std::snprintf(label, sizeof label, "shear eps_a=%.0f%%", 100 * snaps[next_snap]);
-      const io::SurfaceSnapshot surface = membrane_surface(cell.membrane);
-      const io::ContactTable table = mc.enabled ? contact_table(contacts.get()) : io::ContactTable();
-      out->write_snapshot(take_snapshot(sim, label), &surface, mc.enabled ? &table : nullptr);
-      st.next_snap += 1;
-    }
+    observe_shear(recorder, k, k == steps);
     if (k == steps) return StepPlan{true, false};
     if (k < ramp) set_top_velocity(cell, -res.shear_rate * h0 * static_cast<Real>(k + 1) / ramp);
     if (tc.damping_about_flow) {  // the bottom platen rests at z = 0: the flow is v_z = v_top z / h
