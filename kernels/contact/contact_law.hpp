@@ -224,22 +224,25 @@ struct RollingLinear {
   }
 };
 
-/// Twisting resistance, off where twist = 0 (see the top of the file): the spin moment on particle 1 about n.
+/// Twisting resistance, off where twist = 0 (see the top of the file): adds the spin moment on particle 1 about n to
+/// `moment`. Lanes without it keep their moment's bits and their history (adding a zero would turn a -0 into +0).
 struct TwistingLinear {
   template <class T>
   KOKKOS_INLINE_FUNCTION static unsigned slots(const ContactParamsT<T>& p) {
     return any(p.twist != T(0)) ? 1u << kTwistSlot : 0u;
   }
   template <class T>
-  KOKKOS_INLINE_FUNCTION static Vec3T<T> update(const ContactParamsT<T>& p, const ContactKinematicsT<T>& k,
-                                                const NormalResponseT<T>& nr, ContactHistoryT<T>& h) {
+  KOKKOS_INLINE_FUNCTION static void update(const ContactParamsT<T>& p, const ContactKinematicsT<T>& k,
+                                            const NormalResponseT<T>& nr, ContactHistoryT<T>& h, Vec3T<T>& moment) {
+    const auto on = p.twist != T(0);
+    if (!any(on)) return;
     const T rb = RollingLinear::rbar(k.r1, k.r2);
     const T cap = p.twist * rb * nr.fn;
     const T trial = h.slot[kTwistSlot] + nr.k / p.kratio * rb * rb * dot(k.dtheta, k.n);
     const auto capped = trial * trial > cap * cap;
     const T mt = select(capped, select(trial > T(0), cap, -cap), trial);
-    h.slot[kTwistSlot] = select(p.twist != T(0), mt, h.slot[kTwistSlot]);  // a lane without it keeps its history
-    return mt * k.n;
+    h.slot[kTwistSlot] = select(on, mt, h.slot[kTwistSlot]);
+    moment = select(on, moment + mt * k.n, moment);
   }
 };
 
@@ -265,11 +268,7 @@ struct ContactLaw {
     const Vec3T<T> fs = Tangential::update(p, k, nr, h);
     out.force = fs - fn_total * k.n;
     out.moment = Rolling::update(p, k, nr, h);
-    if (Twisting::slots(p)) {
-      // Lanes without it keep the rolling moment's bits (adding a zero would turn a -0 into +0).
-      const auto on = p.twist != T(0);
-      out.moment = select(on, out.moment + Twisting::update(p, k, nr, h), out.moment);
-    }
+    Twisting::update(p, k, nr, h, out.moment);
     out.fn = nr.fn;
     set_flag(h.flags, true, kTouching);
     return out;
