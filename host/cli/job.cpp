@@ -52,8 +52,8 @@ int run_job(const Config& cfg, bool resume, long stop_at_step) {
   run.first = sim->step_count() + 1;
   run.last = cfg.run.steps;
   run.before = [&](long s) { return StepPlan{false, s % cfg.run.series_every == 0}; };
-  run.after = [&](long s) {
-    if (s % cfg.run.series_every == 0) {
+  run.after = [&](long s, bool measured) {
+    if (measured) {
       const auto [ratio, ball_contacts] = record();
       char extra[96];
       std::snprintf(extra, sizeof extra, "KE %.3e J, unbalanced %.2e", sim->stats().kinetic, ratio);

@@ -9,7 +9,7 @@ StageEnd run_stage(Simulation& sim, const StageSteps& stage, CheckpointPlan* pla
       const StepPlan next = stage.before(n);
       if (next.done) return {n - 1, true};
       sim.step(next.measure);
-      if (stage.after && stage.after(n)) return {n, true};
+      if (stage.after && stage.after(n, next.measure)) return {n, true};
       if (!plan || !stage.checkpoint) continue;
       if (plan->due(sim.step_count())) {
         stage.checkpoint(n);

@@ -23,8 +23,9 @@ struct StageSteps {
   long last = 0;   ///< its cap: the stage takes no step beyond it
   /// Before step n: the stage's control (servo, boundary speeds), and what the step is to be.
   std::function<StepPlan(long n)> before;
-  /// After step n: records, snapshots, progress. True when the stage is done; then no checkpoint follows.
-  std::function<bool(long n)> after;
+  /// After step n, told whether it measured: records, snapshots, progress. True when the stage is done; then no
+  /// checkpoint follows.
+  std::function<bool(long n, bool measured)> after;
   /// Writes the stage's checkpoint after step n; unset: the stage keeps none.
   std::function<void(long n)> checkpoint;
   /// Saves the state a blow-up left, for inspection; unset: the error goes on as it is.

@@ -207,8 +207,8 @@ long consolidate_isotropic(Simulation& sim, const PeriodicTriaxialParams& prm_in
     servo.update(sim, all, none, target);
     return StepPlan{false, n % prm.check_every == 0};
   };
-  stage.after = [&](long n) {
-    if (n % prm.check_every != 0) return false;
+  stage.after = [&](long n, bool measured) {
+    if (!measured) return false;
     s = cell_stress(sim);
     err = 0;
     for (int d = 0; d < 3; ++d) err = std::max(err, std::fabs(s[d] - prm.sigma3) / prm.sigma3);
@@ -337,7 +337,7 @@ PeriodicTriaxialResult run_periodic_triaxial(Simulation& sim, const PeriodicTria
   const long total = static_cast<long>(std::ceil(-std::log(1 - prm.target_strain) / (prm.axial_rate * dt)));
   Progress progress(prm.name + " shear", total);
   Real next_record = prm.record_strain;
-  bool last = false, due = false;  // the step ends the test; the step is recorded
+  bool last = false;  // the step ends the test
   StageSteps stage;
   stage.last = std::numeric_limits<long>::max();  // until the target strain
   stage.before = [&](long) {
@@ -347,11 +347,10 @@ PeriodicTriaxialResult run_periodic_triaxial(Simulation& sim, const PeriodicTria
     const Real h = lengths[2];
     const Real eps_next = (res.h0 - h * (1 - prm.axial_rate * dt)) / res.h0;
     last = eps_next >= prm.target_strain;
-    due = last || eps_next >= next_record - 1e-12;
-    return StepPlan{false, due};
+    return StepPlan{false, last || eps_next >= next_record - 1e-12};  // a recorded step measures
   };
-  stage.after = [&](long n) {
-    if (due) {
+  stage.after = [&](long n, bool recorded) {
+    if (recorded) {
       record();
       while (next_record <= res.series.back().eps_a + 1e-12) next_record += prm.record_strain;
       const PeriodicTriaxialRecord& r = res.series.back();

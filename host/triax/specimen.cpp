@@ -71,8 +71,8 @@ std::pair<long, Real> compact(Simulation& sim, Real z_target, const SpecimenConf
     sim.set_wall_velocity(kTop, Vec3(0, 0, -std::max(v, Real(0))));
     return StepPlan{false, n % check_every == 0};
   };
-  layer.after = [&](long n) {
-    if (n % check_every != 0) return false;
+  layer.after = [&](long n, bool measured) {
+    if (!measured) return false;
     // A stop asked for here has no checkpoint to write: a half-built specimen is no state to resume.
     if (StopSignals::requested())
       throw RunStopped(std::string(StopSignals::name()) + " during the specimen build: nothing was stored, and "

@@ -89,8 +89,8 @@ void consolidate(const Config& cfg, const Specimen& sp, Cell& cell, Stage& st, b
     set_top_velocity(cell, -servo.speed(top, touching * cell.kn_wall, dt));
     return StepPlan{false, n % 200 == 0};
   };
-  stage.after = [&](long n) {
-    if (n % 200 == 0) {
+  stage.after = [&](long n, bool measured) {
+    if (measured) {
       const Real ratio = sim.unbalanced_ratio();
       // The servo holds the top platen; the bottom one differs by what the membrane carries through
       // friction and its own axial stiffness, so only the controlled stress decides.
@@ -358,7 +358,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
     const Real eps_next = (h0 - sim.wall_point(kTopPlaten).z) / h0 + res.shear_rate * dt;
     return StepPlan{false, eps_next >= st.next_record - 1e-12 || k + 1 == steps};
   };
-  shear_stage.after = [&](long n) {
+  shear_stage.after = [&](long n, bool) {
     st.step = n;
     return false;
   };
