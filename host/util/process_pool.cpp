@@ -14,8 +14,6 @@
 namespace dem {
 
 void run_pool(const PoolWork& w, const char* what) {
-  std::cout.flush();
-  std::fflush(nullptr);  // a child must not write the parent's buffered output again
   struct Child {
     std::size_t j;
     pid_t pid;
@@ -28,7 +26,7 @@ void run_pool(const PoolWork& w, const char* what) {
       const std::size_t j = next++;
       if (w.before && !w.before(j)) continue;
       std::cout.flush();
-      std::fflush(nullptr);
+      std::fflush(nullptr);  // a child must not write the parent's buffered output again
       int fd[2];
       if (::pipe(fd) != 0) throw std::runtime_error(std::string(what) + ": cannot create a pipe for a child process");
       const pid_t pid = ::fork();
