@@ -1,5 +1,7 @@
 #include "kernels/contact/accumulate.hpp"
 
+#include "kernels/core/reduce.hpp"
+
 namespace dem {
 
 Adjacency build_adjacency(int n, const ContactList& c, const IndexView& side) {
@@ -7,13 +9,7 @@ Adjacency build_adjacency(int n, const ContactList& c, const IndexView& side) {
   auto off = a.offset;
   Kokkos::parallel_for("dem::accumulate::count", RangePolicy(0, c.n),
                        KOKKOS_LAMBDA(const int k) { Kokkos::atomic_increment(&off(side(k))); });
-  int total = 0;
-  Kokkos::parallel_scan("dem::accumulate::scan", RangePolicy(0, n + 1),
-      KOKKOS_LAMBDA(const int i, int& acc, const bool final) {
-        const int cnt = i < n ? off(i) : 0;
-        if (final) off(i) = acc;
-        acc += cnt;
-      }, total);
+  const int total = exclusive_scan("dem::accumulate::scan", off, off, n);
   a.entry = IndexView("dem::accumulate::entry", total);
   auto entry = a.entry;
   IndexView cursor("dem::accumulate::cursor", n);

@@ -2,6 +2,17 @@
 
 namespace dem {
 
+int exclusive_scan(const char* label, const IndexView& counts, const IndexView& offsets, int n) {
+  int total = 0;
+  Kokkos::parallel_scan(label, RangePolicy(0, n + 1),
+      KOKKOS_LAMBDA(const int i, int& acc, const bool final) {
+        const int c = i < n ? counts(i) : 0;
+        if (final) offsets(i) = acc;
+        acc += c;
+      }, total);
+  return total;
+}
+
 Kokkos::View<Real*, MemSpace> reduce_scratch(std::size_t count) {
   // Freed by Kokkos::finalize's hook: a View that outlives the backend would be freed after it.
   static Kokkos::View<Real*, MemSpace>* buffer = nullptr;

@@ -18,6 +18,10 @@ constexpr int kReduceBlock = 256;
 /// so that a step allocates nothing. Kernels run in order, so one reduction's use ends before the next begins.
 Kokkos::View<Real*, MemSpace> reduce_scratch(std::size_t count);
 
+/// Exclusive scan of counts[0, n) into offsets[0, n] (offsets[n] the total, returned); `counts` may be `offsets`
+/// itself, each entry read before it is overwritten. Integer sums: the same for any order.
+int exclusive_scan(const char* label, const IndexView& counts, const IndexView& offsets, int n);
+
 namespace detail {
 
 using ReduceTeam = Kokkos::TeamPolicy<ExecSpace>::member_type;

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <vector>
 
+#include "kernels/core/reduce.hpp"
+
 namespace dem {
 
 namespace {
@@ -11,15 +13,7 @@ namespace {
 int scan_counts(const IndexView& count, IndexView& offset) {
   const int n = static_cast<int>(count.extent(0));
   offset = IndexView("dem::detect::offset", n + 1);
-  auto off = offset;
-  int total = 0;
-  Kokkos::parallel_scan("dem::detect::scan", RangePolicy(0, n + 1),
-      KOKKOS_LAMBDA(const int i, int& acc, const bool final) {
-        const int c = i < n ? count(i) : 0;
-        if (final) off(i) = acc;
-        acc += c;
-      }, total);
-  return total;
+  return exclusive_scan("dem::detect::scan", count, offset, n);
 }
 
 /// The count and fill passes shared by the searches. Derived provides visit(i, f), calling f(other)
