@@ -387,15 +387,18 @@ TEST(Calibrate, AutoCellGrowsWhereAllScatterSpecimensFallShort) {
   state.target = data[0].void_ratio;
   state.specimens = kStateMatchSpecimens;
   state.prep_mu_s = cfg.periodic.prep_mu_s;
-  const Misfit large = measure_misfit(grown, m, data, noise, false, &state);
+  const NoiseBudget budget = decide_noise_budget(grown, m, data, noise, false, state);
+  const Misfit large(data, noise, budget);
   const int factor = std::min(kMaxCellFactor, (wanted + 1) / 2);
   EXPECT_EQ(grown.cell_factor(), factor);
   EXPECT_EQ(grown.balls(), 100u * static_cast<unsigned>(factor));
   EXPECT_EQ(large.sim_balls(), 100.0 * factor) << "the scatter is measured again, on the grown cell";
-  EXPECT_EQ(grown.config().periodic.prep_mu_s, state.prep_mu_s);
+  EXPECT_EQ(budget.cell_factor, factor);
+  EXPECT_EQ(budget.members, grown.members());
+  EXPECT_EQ(grown.config().periodic.prep_mu_s, budget.state.prep_mu_s);
   Real sum = 0;
   for (int k = 0; k < kStateMatchSpecimens; ++k) sum += grown.prepared_void_ratio(k);
-  EXPECT_EQ(state.reached, sum / kStateMatchSpecimens) << "what the report gives is what the grown cell packs";
+  EXPECT_EQ(budget.state.reached, sum / kStateMatchSpecimens) << "what the report gives is what the grown cell packs";
 
   cfg.calibrate.ensemble = 2;
   PeriodicLab fixed_ensemble(cfg, false);

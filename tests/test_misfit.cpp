@@ -278,19 +278,25 @@ TEST(CellBias, CountsOnlyTheDifferenceBeyondItsOwnScatter) {
 // bias does not cover, is still seen in full.
 TEST(CellBias, ACountedBiasTakesUpTheShiftItMeasuredAndNothingElse) {
   const TriaxialTest data = smooth_test(100e3);
-  Misfit m({data}, NoiseOptions(), Ensemble{members_of(data, 8, 0.01)}, 8, 0.1);
+  NoiseBudget budget;
+  budget.scatter = Ensemble{members_of(data, 8, 0.01)};
+  budget.members = 8;
+  budget.sim_end = 0.1;
+  const Misfit before_bias({data}, NoiseOptions(), budget);
   TriaxialTest shifted = data;
   for (Real& q : shifted.q) q *= 1.1;
   summarise(shifted);
   TriaxialTest contracts = data;
   for (Real& v : contracts.eps_v) v += 2e-3;
   summarise(contracts);
-  const Real before = chi2(m.test_residuals(0, {shifted})), volume_before = chi2(m.test_residuals(0, {contracts}));
+  const Real before = chi2(before_bias.test_residuals(0, {shifted}));
+  const Real volume_before = chi2(before_bias.test_residuals(0, {contracts}));
   ASSERT_GT(before, 50) << "the lab's 2% specimen floor: a 10% shift is far outside the noise";
   std::vector<std::vector<Real>> sd(1);
-  const std::vector<Real> big = m.mean_values(0, {shifted}), small = m.mean_values(0, {data});
+  const std::vector<Real> big = before_bias.mean_values(0, {shifted}), small = before_bias.mean_values(0, {data});
   for (std::size_t i = 0; i < big.size(); ++i) sd[0].push_back(cell_bias_sd(big[i] - small[i], 0, 1));
-  m.add_cell_bias({sd, "test"});
+  budget.cell_bias = {sd, "test"};
+  const Misfit m({data}, NoiseOptions(), budget);
   EXPECT_LT(chi2(m.test_residuals(0, {shifted})), 4);
   EXPECT_NEAR(chi2(m.test_residuals(0, {contracts})), volume_before, 1e-6 * volume_before);
   for (const Feature& f : m.features(0))

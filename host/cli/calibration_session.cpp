@@ -55,6 +55,15 @@ std::vector<FreeParam> free_params(const Config& cfg, const std::vector<std::str
   return out;
 }
 
+/// The data's noise as --noise names it: "data", "lab", or a lab noise file. Read before any simulator runs, so
+/// that a bad file is refused at once.
+NoiseOptions noise_options(const std::string& name) {
+  if (name != "data" && name != "lab") return lab_noise_options(name);
+  NoiseOptions n;
+  n.mode = name;
+  return n;
+}
+
 /// --predict walls, checked: the reference test must not be the walled cell already.
 bool walls_prediction_wanted(const Config& base, const CalibrationOptions& o) {
   if (!predicts_walls(base, o.predict)) return false;
@@ -80,7 +89,7 @@ Session::Session(const Config& base, const CalibrationOptions& o, const std::str
     : data(load_measured(o.data)),
       ref(o.reference.empty() ? ReferenceValues{}
                               : load_reference(o.reference, [](const std::string& n) { free_param(n); })),
-      free(free_params(base, o.free)), predict_template(prediction_template(base, o.predict)),
+      free(free_params(base, o.free)), noise(noise_options(o.noise)), predict_template(prediction_template(base, o.predict)),
       walls_prediction(walls_prediction_wanted(base, o)), workers(o.workers),
       two_fidelity(two_fidelity_wanted(base, o.reference_test, predict_template.has_value())),
       lab(matched(reference_cell(base, o.reference_test), o.workers), true, o.workers),
@@ -89,8 +98,6 @@ Session::Session(const Config& base, const CalibrationOptions& o, const std::str
   lab.set_run_store(folder + "/runs");
   if (!o.resume.empty())
     std::printf("%s: resuming in %s: the runs stored there are read, not run again\n", kind.c_str(), folder.c_str());
-  if (o.noise == "data" || o.noise == "lab") noise.mode = o.noise;
-  else noise = lab_noise_options(o.noise);
   for (const std::string& n : data.notes) std::printf("%s: note: %s\n", kind.c_str(), n.c_str());
 }
 
@@ -150,8 +157,10 @@ Misfit Session::misfit_of(const Config& base, const std::string& material, const
   std::printf("%s: %s: measuring the simulator's scatter: %d specimens of %zu balls at the base model\n",
               folder.c_str(), material.c_str(), lab.specimens(), lab.balls());
   lab.set_progress("  " + material + ": scatter");
-  Misfit m = measure_misfit(lab, model_of(base), tests, noise, true, &state);
+  const NoiseBudget budget = decide_noise_budget(lab, model_of(base), tests, noise, true, state);
   lab.set_progress("");
+  state = budget.state;  // a grown cell was matched again: the next material's budget starts from it
+  const Misfit m(tests, noise, budget);
   for (const std::string& n : m.notes()) std::printf("  noise: %s\n", n.c_str());
   const Real ratio = m.ensemble_ratio();
   const bool chosen = base.calibrate.ensemble == kAutoEnsemble;

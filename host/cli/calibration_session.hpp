@@ -43,7 +43,8 @@ struct Session {
   MeasuredData data;
   ReferenceValues ref;
   std::vector<FreeParam> free;
-  StateMatch state;  ///< the data's void ratio and the preparation that packs it
+  NoiseOptions noise;
+  StateMatch state;  ///< the data's void ratio and the preparation that packs it, on the lab's present cell
   std::optional<Config> predict_template;
   bool walls_prediction = false;  ///< the prediction is the reference cell between six walls (kPredictWalls)
   int workers = 1;
@@ -52,7 +53,6 @@ struct Session {
   PeriodicLab lab;
   std::string folder, output;
   EmptyFolderRemover remover{folder};
-  NoiseOptions noise;
   Session(const Config& base, const CalibrationOptions& o, const std::string& kind);
   /// The reference test's cell, for the report.
   std::string cell_text() const;

@@ -95,6 +95,11 @@ std::vector<Real> Misfit::values(std::size_t k, const TriaxialTest& t) const {
   return out;
 }
 
+Misfit::Misfit(const std::vector<TriaxialTest>& measured, const NoiseOptions& noise, const NoiseBudget& budget)
+    : Misfit(measured, noise, budget.scatter, budget.members, budget.sim_end, budget.sim_balls) {
+  if (!budget.cell_bias.sd.empty()) add_cell_bias(budget.cell_bias);
+}
+
 Misfit::Misfit(const std::vector<TriaxialTest>& measured, const NoiseOptions& noise, const Ensemble& reference,
                int members, Real sim_end, Real sim_balls) {
   if (measured.empty()) throw std::invalid_argument("misfit: no measured tests");
@@ -213,27 +218,34 @@ Real chi2_quantile(Real nu, Real z) {
   return nu * std::pow(1 - a + z * std::sqrt(a), 3);
 }
 
-Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<TriaxialTest>& measured,
-                      const NoiseOptions& noise, bool cell_bias, StateMatch* state) {
-  Ensemble scatter = lab.run_ensemble(base, measured, true);
-  auto misfit = [&] {
-    return Misfit(measured, noise, scatter, lab.members(), lab.config().periodic.triax.target_strain,
-                  static_cast<Real>(lab.balls()));
-  };
+NoiseBudget decide_noise_budget(PeriodicLab& lab, const Model& base, const std::vector<TriaxialTest>& measured,
+                                const NoiseOptions& noise, bool cell_bias, const StateMatch& state) {
+  NoiseBudget b;
+  b.state = state;
+  b.sim_end = lab.config().periodic.triax.target_strain;
+  b.scatter = lab.run_ensemble(base, measured, true);
+  auto misfit = [&] { return Misfit(measured, noise, b.scatter, lab.members(), b.sim_end, Real(lab.balls())); };
   if (lab.config().calibrate.ensemble == kAutoEnsemble) {
     lab.set_members(lab.specimens());
     const int wanted = misfit().members_for(kEnsembleRatioGoal);
     // The cap is on the cell, not on one step: a lab shared by several materials may have grown for an earlier one.
     const int room = kMaxCellFactor / lab.cell_factor();
     if (wanted > lab.specimens() && room > 1 && lab.config().calibrate.cell_factor == kAutoCell) {
-      lab.grow_cell(std::min(room, (wanted + lab.specimens() - 1) / lab.specimens()), state);
-      scatter = lab.run_ensemble(base, measured, true);
+      b.state = lab.grow_cell(std::min(room, (wanted + lab.specimens() - 1) / lab.specimens()), b.state);
+      b.scatter = lab.run_ensemble(base, measured, true);
     }
     lab.set_members(std::min(misfit().members_for(kEnsembleRatioGoal), lab.specimens()));
   }
-  Misfit m = misfit();
-  if (cell_bias) m.add_cell_bias(measure_cell_bias(lab, base, measured, scatter, m));
-  return m;
+  b.members = lab.members();
+  b.cell_factor = lab.cell_factor();
+  b.sim_balls = static_cast<Real>(lab.balls());
+  if (cell_bias) b.cell_bias = measure_cell_bias(lab, base, measured, b.scatter, misfit());
+  return b;
+}
+
+Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<TriaxialTest>& measured,
+                      const NoiseOptions& noise, bool cell_bias, const StateMatch& state) {
+  return Misfit(measured, noise, decide_noise_budget(lab, base, measured, noise, cell_bias, state));
 }
 
 std::vector<Real> Misfit::mean_values(std::size_t k, const std::vector<TriaxialTest>& members) const {

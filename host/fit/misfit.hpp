@@ -103,8 +103,23 @@ struct CellBias {
   std::string note;
 };
 
+/// The noise budget of one material's data, decided once (decide_noise_budget) and then only read: the simulator's
+/// scatter, the ensemble and the cell it chose, the state its specimens were matched to on that cell, and the cell's
+/// bias. The misfit is built from it and the report prints it; neither runs the simulator.
+struct NoiseBudget {
+  Ensemble scatter;      ///< the scatter specimens at the base model on the final cell, [test][specimen]
+  int members = 1;       ///< the ensemble whose mean is compared
+  int cell_factor = 1;   ///< the cell's balls as a multiple of the config's
+  Real sim_balls = 0;    ///< particles in a simulator specimen (0: not given)
+  Real sim_end = 0;      ///< the simulator's last axial strain
+  StateMatch state;      ///< the data's state as matched on the final cell (tests 0: none matched)
+  CellBias cell_bias;    ///< empty: not measured
+};
+
 class Misfit {
  public:
+  /// The misfit of a decided noise budget: its scatter, ensemble and cell bias.
+  Misfit(const std::vector<TriaxialTest>& measured, const NoiseOptions& noise, const NoiseBudget& budget);
   /// `reference`: runs at the base model on the scatter specimens ([test][specimen], tests as in `measured`),
   /// which measure the simulator's scatter; `members`: the ensemble size whose mean is compared; `sim_end`: the
   /// simulator's last axial strain.
@@ -138,9 +153,6 @@ class Misfit {
   int members() const { return members_; }
   /// Particles in a simulator specimen (0: not given).
   Real sim_balls() const { return sim_balls_; }
-  /// Sigma_cell: adds the simulator's finite-cell bias (host/fit/cell_bias.hpp), each test's correlated along
-  /// strain as the ensemble's scatter is (a bias moves a curve smoothly); its note goes to notes().
-  void add_cell_bias(const CellBias& bias);
   /// Two fidelities (host/fit/two_fidelity.hpp): the data are what the reference test measures, which exceeds what this
   /// simulator gives at the same parameters by delta[test][feature]; the simulator is then compared with the data
   /// less delta, and delta's uncertainty sd[test][feature] is counted, correlated along strain as a bias is.
@@ -151,6 +163,9 @@ class Misfit {
 
  private:
   std::vector<Real> void_ratio_;
+  /// Sigma_cell: adds the simulator's finite-cell bias (host/fit/cell_bias.hpp), each test's correlated along
+  /// strain as the ensemble's scatter is (a bias moves a curve smoothly); its note goes to notes().
+  void add_cell_bias(const CellBias& bias);
   std::vector<Real> values(std::size_t k, const TriaxialTest& t) const;
   void build_curve_noise(const std::vector<TriaxialTest>& measured, const NoiseOptions& noise, const Ensemble& ref,
                          Real sim_balls);
@@ -167,16 +182,19 @@ class Misfit {
   bool curves_ = true;
 };
 
-/// The simulator's scatter measured: `lab`'s scatter specimens run at `base` on every measured test, and the
-/// misfit built on it. With an "auto" ensemble ([calibrate] ensemble), the lab's ensemble becomes the fewest
-/// specimens (at most all the scatter specimens) whose mean's standard error is below kEnsembleRatioGoal of the
-/// data's noise. Where all of them fall short and the cell is "auto" too ([calibrate] cell_factor), the cell grows
-/// by the factor that makes up the rest (at most kMaxCellFactor; the mean of K specimens of N balls scatters as
-/// 1 / sqrt(K N)) and the scatter is measured again on it; where `state` holds the lab's match to the data's void
-/// ratio, the grown cell is matched again (PeriodicLab::grow_cell) and `state` says what it reaches. Then the cell's
-/// bias is measured and counted (measure_cell_bias) unless `cell_bias` is false.
+/// The noise budget decided: `lab`'s scatter specimens run at `base` on every measured test. With an "auto" ensemble
+/// ([calibrate] ensemble), the lab's ensemble becomes the fewest specimens (at most all the scatter specimens) whose
+/// mean's standard error is below kEnsembleRatioGoal of the data's noise. Where all of them fall short and the cell
+/// is "auto" too ([calibrate] cell_factor), the cell grows by the factor that makes up the rest (at most
+/// kMaxCellFactor; the mean of K specimens of N balls scatters as 1 / sqrt(K N)) and the scatter is measured again
+/// on it; where `state` holds the lab's match to the data's void ratio, the grown cell is matched again
+/// (PeriodicLab::grow_cell) and the budget's state says what it reaches. Then the cell's bias is measured
+/// (measure_cell_bias) unless `cell_bias` is false. This is the one place that sets the lab's ensemble and cell.
+NoiseBudget decide_noise_budget(PeriodicLab& lab, const Model& base, const std::vector<TriaxialTest>& measured,
+                                const NoiseOptions& noise, bool cell_bias = true, const StateMatch& state = {});
+/// The misfit of the budget decide_noise_budget decides.
 Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<TriaxialTest>& measured,
-                      const NoiseOptions& noise, bool cell_bias = true, StateMatch* state = nullptr);
+                      const NoiseOptions& noise, bool cell_bias = true, const StateMatch& state = {});
 
 /// The chi2 of whitened residuals: the sum of their squares, of r[from, to) where given.
 Real sum_sq(const std::vector<Real>& r, std::size_t from, std::size_t to);

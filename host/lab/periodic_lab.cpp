@@ -101,19 +101,21 @@ void PeriodicLab::pack(int count, bool verbose) {
       "specimen preparation");
 }
 
-void PeriodicLab::grow_cell(int factor, StateMatch* state) {
+StateMatch PeriodicLab::grow_cell(int factor, const StateMatch& state) {
   if (factor < 1) throw std::invalid_argument("cell factor " + std::to_string(factor) + " (allowed: 1 or more)");
   cfg_ = larger_cell(cfg_, factor);
   cell_factor_ *= factor;
   // The friction that packs the data's void ratio in a small cell packs a larger one to another.
-  if (state && state->tests > 0) {
+  StateMatch grown = state;
+  if (state.tests > 0) {
     MatchPlan plan;
     plan.first_seed = first_seed_;
-    plan.specimens = state->specimens;
+    plan.specimens = state.specimens;
     plan.workers = workers_;
-    cfg_.periodic.prep_mu_s = state->prep_mu_s = prep_friction_for(cfg_, state->target, state->reached, false, plan);
+    cfg_.periodic.prep_mu_s = grown.prep_mu_s = prep_friction_for(cfg_, state.target, grown.reached, false, plan);
   }
   pack(specimens(), false);
+  return grown;
 }
 
 MatchPlan match_plan(const Config& base, int workers) {

@@ -63,8 +63,8 @@ class PeriodicLab {
   void set_members(int k);
   /// Packs every specimen again (same seeds) in a cell of `factor` times the balls (larger_cell), workers() at once.
   /// Where `state` holds a match to the data's void ratio, the preparation friction is matched again, on the larger
-  /// cell's first specimens (prep_friction_for), and `state` gets what it reaches.
-  void grow_cell(int factor, StateMatch* state = nullptr);
+  /// cell's first specimens (prep_friction_for). Returns the match on the larger cell (`state` where it holds none).
+  StateMatch grow_cell(int factor, const StateMatch& state);
   /// The cell's balls as a multiple of the config's.
   int cell_factor() const { return cell_factor_; }
   int specimens() const { return static_cast<int>(specimens_.size()); }
