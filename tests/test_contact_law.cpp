@@ -261,6 +261,32 @@ void check_twisting(double R1, double R2, double rbar_expect) {
 TEST(ContactLaw, TwistingResistanceBallBall) { check_twisting(0.8e-3, 1.2e-3, 0.8e-3 * 1.2e-3 / 2.0e-3); }
 TEST(ContactLaw, TwistingResistanceWall) { check_twisting(1e-3, 0, 1e-3); }
 
+// Adhesion (adhesion = c > 0): two touching balls pull on each other with F_a = c (2 r)^2, r the smaller radius,
+// whatever the overlap: the normal force is kn delta - F_a, tensile at a small overlap and zero where kn delta = F_a.
+// The shear cap stays mu_s kn delta (the elastic force), and a ball on a wall feels no pull. Exact to rounding: one
+// product and one difference, 1e-12 of the forces.
+TEST(ContactLaw, AdhesionPullsTouchingBallsOnly) {
+  ContactParams p = test::law(1e8, 1.5, 0.5, 0.0);
+  p.adhesion = 3e4;
+  const double R1 = 0.8e-3, R2 = 1.2e-3, dt = 1e-7;
+  const double fa = 4 * p.adhesion * R1 * R1, kn = kn_formula(p.emod, R1, R2);
+  const Vec3 n = unit(Vec3(0.3, -0.4, 1.0));
+  for (const double d : {0.1 * fa / kn, fa / kn, 5 * fa / kn}) {
+    ContactKinematics k = kin(p, n, d, R1, R2, dt);
+    k.vrel = Vec3(0.1, 0, 0) - dot(Vec3(0.1, 0, 0), n) * n;  // sliding: the shear force reaches its cap
+    ContactHistory h;
+    ContactOutput out;
+    for (int s = 0; s < 2000; ++s) out = RRLinear::eval(p, k, h);
+    // The force on 1 is -Fn n (n points from 1 to 2): a pull is along +n.
+    EXPECT_NEAR(-dot(out.force, n), kn * d - fa, 1e-12 * fa) << "overlap " << d;
+    EXPECT_NEAR(out.fn, kn * d, 1e-12 * kn * d) << "the elastic force, on which the caps stand";
+    EXPECT_NEAR(norm(tangential(out.force, n)), p.mu_s * kn * d, 1e-12 * kn * d);
+    const ContactKinematics wall = kin(p, n, d, R1, 0, dt);
+    ContactHistory hw;
+    EXPECT_NEAR(-dot(RRLinear::eval(p, wall, hw).force, n), wall.kn * d, 1e-12 * wall.kn * d) << "no pull at a wall";
+  }
+}
+
 // ---------------------------------------------------------------------------------------------------
 // No tension. (a) With beta_n > 0, a fast separation makes kn d - 2 beta sqrt(mc kn) vn negative: the
 // total normal force is clamped to zero (exactly), while the linear force fn stays kn d > 0.

@@ -55,7 +55,7 @@ test::CaseResults periodic_cell(unsigned seed) {
   add_curves(v, base, {0.1, 1, 2, 5, 8});
   v["void_ratio_sheared"] = base.void_ratio;
   const std::map<std::string, Real> strength{
-      {"hertz", 3e-3}, {"roughness", 1e-2}, {"wear", 0.6}, {"twist", 0.2}, {"membrane", 300e3}};
+      {"hertz", 3e-3}, {"roughness", 1e-2}, {"wear", 0.6}, {"twist", 0.2}, {"adhesion", 3e4}, {"membrane", 300e3}};
   test::CaseResults out{{"periodic_cell", v}};
   std::map<std::string, double> ext;
   for (const Extension& e : extensions()) {
@@ -126,15 +126,17 @@ test::CaseResults contact_laws(unsigned) {
   };
   ContactParams linear = test::law(1e8, 1.5, 0.3, 0.05, 0.2);
   std::vector<Law> laws{{"linear", linear}};
-  ContactParams hertz = linear, rough = linear, wear = linear, twist = linear;
+  ContactParams hertz = linear, rough = linear, wear = linear, twist = linear, adhesion = linear;
   hertz.hertz_overlap = 3e-3;
   rough.roughness = 1e-2;
   wear.wear = 0.6;
   twist.twist = 0.2;
+  adhesion.adhesion = 3e4;
   laws.push_back({"hertz", hertz});
   laws.push_back({"roughness", rough});
   laws.push_back({"wear", wear});
   laws.push_back({"twist", twist});
+  laws.push_back({"adhesion", adhesion});
   std::map<std::string, double> v;
   for (const Law& law : laws) {
     const Real R = 1e-3;
@@ -173,7 +175,7 @@ TEST(Reference, PeriodicCell) {
                            "void_ratio_sheared"}},
                          {"periodic_extensions",
                           {"hertz_q_peak_over_sigma3", "roughness_q_peak_over_sigma3", "wear_q_end_over_sigma3",
-                           "twist_q_peak_over_sigma3", "membrane_q_end_over_sigma3"}}});
+                           "twist_q_peak_over_sigma3", "adhesion_q_peak_over_sigma3", "membrane_q_end_over_sigma3"}}});
 }
 
 TEST(Reference, MembraneTriaxial) {

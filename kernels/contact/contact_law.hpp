@@ -36,6 +36,13 @@
 ///     LAMMPS `twisting marshall` ties both to the contact radius a instead (k_tw = ks a^2 / 2, cap 2/3 a mu_s
 ///     Fn), which makes it negligible for stiff spheres; a free coefficient stands for rough or flattened
 ///     contacts. The moment is a scalar about n (slot kTwistSlot), so a turning contact plane carries it as is.
+///   Adhesion (adhesion = a stress c > 0): touching balls pull on each other with the constant force
+///     F_a = c (2 r)^2, the DMT idealisation of a pull-off force (a bond, or a capillary bridge at a wetted contact),
+///     which acts while the balls overlap and ends when they part; the normal force is then kn delta - F_a, tensile
+///     near separation. The Coulomb and rolling caps stay on the elastic force: an adhered contact under tension
+///     holds no friction. Between balls only (a wall's r2 = 0): the membrane and the platens are not sticky. Per
+///     contact it is a stress over the ball's cross-section, so at confinement sigma3 it acts as about c / sigma3 of
+///     extra confinement: an apparent cohesion, largest relative to low sigma3, from the first strain on.
 #include "kernels/core/contact_params.hpp"
 #include "kernels/core/vec3.hpp"
 
@@ -52,7 +59,7 @@ using Arg = typename Same<T>::type;
 /// The parameters of W material pairs as lanes: pair(k) gives lane k's.
 template <class T, class Pair>
 KOKKOS_INLINE_FUNCTION ContactParamsT<T> params_of_lanes(const Pair& pair) {
-  static_assert(sizeof(ContactParams) == 10 * sizeof(Real), "a new ContactParams field must be copied here");
+  static_assert(sizeof(ContactParams) == 11 * sizeof(Real), "a new ContactParams field must be copied here");
   const auto field = [&](Real ContactParams::*m) { return from_lanes<T>([&](int k) { return pair(k).*m; }); };
   ContactParamsT<T> P;
   P.emod = field(&ContactParams::emod);
@@ -65,6 +72,7 @@ KOKKOS_INLINE_FUNCTION ContactParamsT<T> params_of_lanes(const Pair& pair) {
   P.wear = field(&ContactParams::wear);
   P.wear_slip = field(&ContactParams::wear_slip);
   P.twist = field(&ContactParams::twist);
+  P.adhesion = field(&ContactParams::adhesion);
   return P;
 }
 
@@ -159,6 +167,12 @@ struct NormalElastic {
       return {select(hertz, k.kn * d * root, k.kn * d), select(hertz, Real(1.5) * k.kn * root * dd, k.kn * dd)};
     }
     return {k.kn * d, k.kn * dd};
+  }
+  /// The adhesive pull of a touching pair of balls (N, >= 0; 0 at walls), subtracted from the normal force.
+  template <class T>
+  KOKKOS_INLINE_FUNCTION static T adhesion(const ContactParamsT<T>& p, const ContactKinematicsT<T>& k) {
+    const T r = contact_radius(k.r1, k.r2);
+    return select(k.r2 > T(0), 4 * p.adhesion * r * r, T(0));
   }
   /// The dashpot's addition (may make the sum tensile; clamped by the caller), from the tangent stiffness.
   template <class T>
@@ -264,7 +278,10 @@ struct ContactLaw {
                                                            ContactHistoryT<T>& h) {
     ContactOutputT<T> out;
     const NormalResponseT<T> nr = Normal::response(p, k);
-    const T fn_total = kc::max(nr.fn - Normal::dashpot(p, k, nr.k), T(0));  // no tension
+    T fn_total = kc::max(nr.fn - Normal::dashpot(p, k, nr.k), T(0));  // no tension but adhesion's
+    // Lanes without adhesion keep their bits (subtracting a zero would turn a -0 into +0).
+    const auto sticky = p.adhesion != T(0);
+    if (any(sticky)) fn_total = select(sticky, fn_total - Normal::adhesion(p, k), fn_total);
     const Vec3T<T> fs = Tangential::update(p, k, nr, h);
     out.force = fs - fn_total * k.n;
     out.moment = Rolling::update(p, k, nr, h);

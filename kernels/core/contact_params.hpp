@@ -5,7 +5,7 @@
 
 namespace dem {
 
-/// Parameters of one material pair. Units: Pa, -, -, -, -. T is Real, or a pack of W pairs' values (simd.hpp).
+/// Parameters of one material pair. Units: Pa, -, -, -, -, then as each field says. T is Real, or a pack of W pairs' values (simd.hpp).
 template <class T>
 struct ContactParamsT {
   T emod = 1e8;     ///< effective modulus E* of the deformability method (Pa)
@@ -19,11 +19,12 @@ struct ContactParamsT {
   T wear = 0.0;           ///< slip weakening: fraction of mu_s lost after long sliding
   T wear_slip = 0.5;      ///< slip weakening: sliding distance / r over which friction decays by 1/e
   T twist = 0.0;          ///< twisting resistance: the spin moment's cap over Rbar Fn (the spin analogue of mu_r)
+  T adhesion = 0.0;       ///< adhesion between touching balls: pull-off force over (2 r)^2 (Pa)
 
   /// The same pair without the extensions (specimen preparation, which must not depend on them).
   ContactParamsT base() const {
     ContactParamsT b = *this;
-    b.hertz_overlap = b.roughness = b.wear = b.twist = 0;
+    b.hertz_overlap = b.roughness = b.wear = b.twist = b.adhesion = 0;
     return b;
   }
 };

@@ -98,7 +98,8 @@ INSTANTIATE_TEST_SUITE_P(OneCasePerExtension, HiddenEffect, ::testing::Values(Hi
 // in YADE's Hertz-Mindlin data), and the null case (the suite must name nothing in YADE's linear data, whose
 // preparation, rate, cell and rolling law differ from the simulator's: a harder null than the simulator's own).
 INSTANTIATE_TEST_SUITE_P(LongOneCasePerExtension, HiddenEffect,
-                         ::testing::Values(HiddenCase{"hertz", 3e-3, 1}, HiddenCase{"none", 0, 1}),
+                         ::testing::Values(HiddenCase{"hertz", 3e-3, 1}, HiddenCase{"adhesion", 1e5, 1},
+                                           HiddenCase{"none", 0, 1}),
                          [](const ::testing::TestParamInfo<HiddenCase>& i) { return i.param.extension; });
 
 // Twisting resistance at the top of its range (a spin moment capped at 0.2 Rbar Fn: q_peak 32% above the base law's
