@@ -1,5 +1,7 @@
-/// The state match (periodic_lab.hpp, MatchPlan): the preparation friction that packs a lab's specimens to the
+/// The state match (state_match.hpp, MatchPlan): the preparation friction that packs a lab's specimens to the
 /// data's void ratio, by bisection over packings that the run store may keep.
+#include "host/lab/state_match.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
