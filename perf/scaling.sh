@@ -22,7 +22,7 @@ for k in $sizes; do
   stage() { sed -n "s/.*$1 \([0-9.]*\) s.*/\1/p" <<< "$line"; }
   rss_kb=$(tail -1 "$work/rss_k$k")
   printf "%9d %14.4g %9.1f %9s %9s %9s %9s %12.0f\n" "$n" "$rate" "$(awk -v r="$rate" 'BEGIN { print 1e9 / r }')" \
-    "$(stage rebuild)" "$(stage forces)" "$(stage 'gather+integrate')" "$(stage boundaries)" \
+    "$(stage rebuild)" "$(stage ball-ball)" "$(stage 'gather+integrate')" "$(stage boundaries)" \
     "$(awk -v m="$rss_kb" -v n="$n" 'BEGIN { print m * 1024 / n }')"
 done
 echo "(bytes/ball: the process's peak resident memory over the balls, so it includes the program and, at small N, is dominated by it)"

@@ -49,6 +49,7 @@ int run_job(const Config& cfg, bool resume, long stop_at_step) {
                       stop_at_step, cfg.fingerprint};
   StopSignals signals;
   StageSteps run;
+  StageTiming timing;
   run.first = sim->step_count() + 1;
   run.last = cfg.run.steps;
   run.before = [&](long s) { return StepPlan{false, s % cfg.run.series_every == 0}; };
@@ -78,7 +79,8 @@ int run_job(const Config& cfg, bool resume, long stop_at_step) {
     write_checkpoint(blowup_path(out.folder()), checkpoint_of("run", *sim, &out, cfg.fingerprint));
   };
   try {
-    run_stage(*sim, run, &plan);
+    timing = run_stage(*sim, run, &plan).timing;
+    timing.name = "run";
   } catch (const BlowUp& e) {
     std::fprintf(stderr, "\ntriaxdem: %s\n  state at the blow-up saved in %s (snapshot) and %s (for inspection); "
                  "the last good checkpoint, %s, continues with --resume once the cause is fixed\n",
@@ -93,9 +95,16 @@ int run_job(const Config& cfg, bool resume, long stop_at_step) {
   write_checkpoint(ckpt, checkpoint_of("run", *sim, &out, cfg.fingerprint));
   progress.finish("");
   std::printf("time loop: %s\n", describe(sim->times(), sim->particles().n, sim->step_count()).c_str());
+  report_timings(out.folder(), {timing});
   std::printf("output: %s/snapshots.xdmf (ParaView), %s/series.csv; checkpoint %s (more steps: --resume -n N)\n",
               out.folder().c_str(), out.folder().c_str(), ckpt.c_str());
   return 0;
+}
+
+void report_timings(const std::string& folder, const std::vector<StageTiming>& stages) {
+  if (stages.empty()) return;
+  io::write_text_atomic(folder + "/timings.csv", timings_csv(stages));
+  std::printf("timings (%s/timings.csv):\n%s", folder.c_str(), timings_table(stages).c_str());
 }
 
 int specimen_job(const Config& cfg) {
@@ -116,6 +125,7 @@ int specimen_job(const Config& cfg) {
     return e.code;
   }
   write_specimen_report(out.folder(), cfg, sp);
+  report_timings(out.folder(), sp.stages);
   io::Snapshot snap;
   snap.label = "specimen";
   for (std::size_t q = 0; q < sp.balls.size(); ++q) {

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "host/config/config.hpp"
+#include "host/engine/stage_loop.hpp"
 #include "host/study/study.hpp"
 
 namespace dem {
@@ -14,6 +15,10 @@ namespace dem {
 /// success, 2 on a blow-up (after saving a snapshot and the state for inspection), 128 + the signal when
 /// stopped by one, 3 at stop_at_step.
 int run_job(const Config& cfg, bool resume = false, long stop_at_step = -1);
+
+/// What each stage of a job cost, stage by stage and part by part of the step: printed, and written to
+/// `folder`/timings.csv (nothing where no stage ran in this process).
+void report_timings(const std::string& folder, const std::vector<StageTiming>& stages);
 
 /// `triaxdem check`: validates the config and describes the job it is for (a membrane triaxial test when it has
 /// [specimen], a periodic cell when it has [periodic], else the `run` job's box): balls, geometry, stages, the time

@@ -58,6 +58,9 @@ int triaxial_job(const Config& cfg, bool resume, long stop_at_step) {
     }
     std::printf("time loop (consolidation and shear): %s; measurements and output %.1f s\n",
                 describe(r.times, r.balls, r.steps).c_str(), r.wall_seconds - r.times.loop());
+    std::vector<StageTiming> stages = sp.stages;
+    stages.insert(stages.end(), r.stages.begin(), r.stages.end());
+    report_timings(out.folder(), stages);
     TestSummary s;
     s.kind = "membrane";
     s.sigma3 = cfg.triaxial.sigma3;
@@ -103,6 +106,7 @@ int run_periodic_job(const Config& cfg) {
   tp.name = cfg.run.name;
   io::Output out(cfg.run.output);
   std::unique_ptr<Simulation> sim;
+  std::vector<StageTiming> timings;
   auto announce = [&](const char* what) {
     const std::array<Real, 3> l = cell_lengths(*sim);
     std::printf("triaxdem: %s: %zu balls in %s %.2f x %.2f x %.2f mm; critical dt %.3e s, dt %.3e s\n", what,
@@ -116,6 +120,7 @@ int run_periodic_job(const Config& cfg) {
     sim = make_periodic_simulation(balls, cell, cfg.ball, cfg.solver, cfg.periodic.boundary);
     announce("test");
     const PeriodicTriaxialResult r = run_periodic_triaxial(*sim, tp, &out);
+    timings = r.stages;
     TestSummary su;
     su.kind = cfg.periodic.boundary == CellBoundary::walls ? "walls" : "periodic";
     su.sigma3 = r.params.sigma3;
@@ -146,6 +151,7 @@ int run_periodic_job(const Config& cfg) {
     return 2;
   }
   std::printf("time loop (test): %s\n", describe(sim->times(), sim->particles().n, sim->step_count()).c_str());
+  report_timings(out.folder(), timings);
   std::printf("output: %s/series.csv, summary.csv, snapshots.xdmf\n", out.folder().c_str());
   run_plot_script("plot_triaxial.py", {out.folder(), "--title", cfg.run.name});
   return 0;

@@ -258,7 +258,7 @@ Checkpoint checkpoint_of(const std::string& job, const Simulation& sim, const io
   c.sim = sim.state();
   const StageTimes& t = sim.times();
   c.numbers["stage_times_s"] = {t.rebuild, t.forces, t.integrate, t.boundaries, t.membrane,
-                                static_cast<double>(t.rebuilds)};
+                                static_cast<double>(t.rebuilds), t.walls};
   if (out) {
     c.numbers["series"] = out->series_rows();
     c.texts["snapshots"] = out->snapshot_index();
@@ -280,9 +280,10 @@ Checkpoint resume_checkpoint(const std::string& path, const std::string& job, co
 void resume_from(const Checkpoint& c, Simulation& sim, io::Output* out) {
   sim.restore(c.sim);
   const auto times = c.numbers.find("stage_times_s");
-  if (times != c.numbers.end() && times->second.size() == 6) {
+  // Six numbers: a checkpoint from before the ball-wall share was timed on its own (it is in the forces).
+  if (times != c.numbers.end() && (times->second.size() == 6 || times->second.size() == 7)) {
     const std::vector<double>& t = times->second;
-    sim.set_times(StageTimes{t[0], t[1], t[2], t[3], t[4], static_cast<long>(t[5])});
+    sim.set_times(StageTimes{t[0], t[1], t[2], t[3], t[4], static_cast<long>(t[5]), t.size() == 7 ? t[6] : 0});
   }
   if (!out) return;
   const auto rows = c.numbers.find("series");

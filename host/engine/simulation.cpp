@@ -150,8 +150,9 @@ void Simulation::step(bool measure) {
   times_.rebuild += seconds_since(t);
   const Real dt = prm_.integ.dt;
   const OverlapStat ob = compute_ball_forces(p_, balls_, params_, prm_.domain, dt);
-  const OverlapStat ow = compute_wall_forces(p_, wall_c_, adj_walls_, walls_, mesh_, params_, dt);
   times_.forces += seconds_since(t);
+  const OverlapStat ow = compute_wall_forces(p_, wall_c_, adj_walls_, walls_, mesh_, params_, dt);
+  times_.walls += seconds_since(t);
   check_blowup(ob, ow);
   if (membrane_.ntri > 0) {
     // Before integrate: the reactions are split at the closest points of the balls' current centres.
@@ -360,7 +361,7 @@ std::array<long, 2> Simulation::touching() const {
 }
 
 std::string describe(const StageTimes& t, long particles, long steps) {
-  char line[360];
+  char line[400];
   // A membrane's share only where there is one; "boundaries": moving walls, membrane nodes or the periodic
   // cell's stretch. A GPU's thread count says nothing a user can set.
   char membrane[48] = "";
@@ -368,10 +369,12 @@ std::string describe(const StageTimes& t, long particles, long steps) {
   char threads[32] = "";
   if (Kokkos::SpaceAccessibility<HostSpace, MemSpace>::accessible)
     std::snprintf(threads, sizeof threads, " (%d threads)", ExecSpace().concurrency());
+  char walls[48] = "";
+  if (t.walls > 0) std::snprintf(walls, sizeof walls, "ball-wall %.1f s, ", t.walls);
   std::snprintf(line, sizeof line,
-                "%ld steps, rebuild %.1f s (%ld rebuilds), forces %.1f s, %sgather+integrate %.1f s, "
+                "%ld steps, rebuild %.1f s (%ld rebuilds), ball-ball %.1f s, %s%sgather+integrate %.1f s, "
                 "boundaries %.1f s; %.3g particle-steps/s on %s%s",
-                steps, t.rebuild, t.rebuilds, t.forces, membrane, t.integrate, t.boundaries,
+                steps, t.rebuild, t.rebuilds, t.forces, walls, membrane, t.integrate, t.boundaries,
                 particles * static_cast<double>(steps) / std::max(1e-9, t.loop()), ExecSpace::name(), threads);
   return line;
 }

@@ -28,12 +28,21 @@ struct SimParams {
   Real overlap_limit = 0.1;     ///< stop when an overlap exceeds this fraction of the radius
 };
 
-/// Wall-clock seconds spent per stage.
+/// Wall-clock seconds spent per part of the step.
 struct StageTimes {
-  double rebuild = 0, forces = 0, integrate = 0, boundaries = 0;  ///< integrate includes the gather
-  double membrane = 0;  ///< membrane elasticity, pressure, reactions and node integration
+  double rebuild = 0;     ///< binning, contact detection and the history's remap
+  double forces = 0;      ///< ball-ball contacts
+  double integrate = 0;   ///< the gather of each ball's forces and the leapfrog
+  double boundaries = 0;  ///< moving walls, membrane nodes or the periodic cell's stretch
+  double membrane = 0;    ///< membrane elasticity, pressure, reactions and node integration
   long rebuilds = 0;
-  double loop() const { return rebuild + forces + membrane + integrate + boundaries; }
+  double walls = 0;       ///< ball-wall and ball-facet contacts (platens, mould, membrane)
+  double loop() const { return rebuild + forces + walls + membrane + integrate + boundaries; }
+  /// What was spent between an earlier reading `t` and this one.
+  StageTimes since(const StageTimes& t) const {
+    return {rebuild - t.rebuild, forces - t.forces,     integrate - t.integrate, boundaries - t.boundaries,
+            membrane - t.membrane, rebuilds - t.rebuilds, walls - t.walls};
+  }
 };
 
 /// One line for a log: seconds per stage, rebuild count and particle-steps per second of the time loop.

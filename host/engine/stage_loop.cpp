@@ -1,15 +1,20 @@
 #include "host/engine/stage_loop.hpp"
 
+#include <chrono>
+#include <cstdio>
+
 namespace dem {
 
-StageEnd run_stage(Simulation& sim, const StageSteps& stage, CheckpointPlan* plan) {
+namespace {
+
+StageEnd run_steps(Simulation& sim, const StageSteps& stage, CheckpointPlan* plan) {
   long n = stage.first;
   try {
     for (; n <= stage.last; ++n) {
       const StepPlan next = stage.before(n);
-      if (next.done) return {n - 1, true};
+      if (next.done) return {n - 1, true, {}};
       sim.step(next.measure);
-      if (stage.after && stage.after(n, next.measure)) return {n, true};
+      if (stage.after && stage.after(n, next.measure)) return {n, true, {}};
       if (!plan || !stage.checkpoint) continue;
       if (plan->due(sim.step_count())) {
         stage.checkpoint(n);
@@ -21,7 +26,58 @@ StageEnd run_stage(Simulation& sim, const StageSteps& stage, CheckpointPlan* pla
     if (stage.save_blowup) stage.save_blowup();
     throw;
   }
-  return {n - 1, false};
+  return {n - 1, false, {}};
+}
+
+/// Nanoseconds per particle-step of `seconds` over a stage.
+double ns_per(double seconds, const StageTiming& t) {
+  const double work = static_cast<double>(t.balls) * static_cast<double>(t.steps);
+  return work > 0 ? 1e9 * seconds / work : 0;
+}
+
+}  // namespace
+
+StageEnd run_stage(Simulation& sim, const StageSteps& stage, CheckpointPlan* plan) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const StageTimes parts0 = sim.times();
+  const long step0 = sim.step_count();
+  StageEnd end = run_steps(sim, stage, plan);
+  end.timing.balls = sim.particles().n;
+  end.timing.steps = sim.step_count() - step0;
+  end.timing.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  end.timing.parts = sim.times().since(parts0);
+  return end;
+}
+
+std::string timings_csv(const std::vector<StageTiming>& stages) {
+  std::string s = "stage,balls,steps,wall_s,particle_steps_per_s,rebuilds,rebuild_ns,ball_ball_ns,ball_wall_ns,"
+                  "membrane_ns,gather_integrate_ns,boundaries_ns,host_ns\n";
+  char line[400];
+  for (const StageTiming& t : stages) {
+    const StageTimes& p = t.parts;
+    std::snprintf(line, sizeof line, "%s,%ld,%ld,%.3f,%.4g,%ld,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f\n", t.name.c_str(),
+                  t.balls, t.steps, t.wall, t.rate(), p.rebuilds, ns_per(p.rebuild, t), ns_per(p.forces, t),
+                  ns_per(p.walls, t), ns_per(p.membrane, t), ns_per(p.integrate, t), ns_per(p.boundaries, t),
+                  ns_per(t.host(), t));
+    s += line;
+  }
+  return s;
+}
+
+std::string timings_table(const std::vector<StageTiming>& stages) {
+  std::string s = "                                                     | ns per particle-step\n"
+                  "stage                  balls    steps  wall s psteps/s | rebuild ball-ball ball-wall membrane "
+                  "integrate boundaries    host\n";
+  char line[400];
+  for (const StageTiming& t : stages) {
+    const StageTimes& p = t.parts;
+    std::snprintf(line, sizeof line, "%-20s %7ld %8ld %7.1f %8.3g | %7.1f %9.1f %9.1f %8.1f %9.1f %10.1f %7.1f\n",
+                  t.name.c_str(), t.balls, t.steps, t.wall, t.rate(), ns_per(p.rebuild, t), ns_per(p.forces, t),
+                  ns_per(p.walls, t), ns_per(p.membrane, t), ns_per(p.integrate, t), ns_per(p.boundaries, t),
+                  ns_per(t.host(), t));
+    s += line;
+  }
+  return s;
 }
 
 }  // namespace dem

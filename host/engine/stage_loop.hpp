@@ -5,6 +5,8 @@
 /// they share, in one order: the step, the checkpoint when due and the stop when asked, and on a blow-up the
 /// stage's state saved for inspection before the error goes on.
 #include <functional>
+#include <string>
+#include <vector>
 
 #include "host/engine/checkpoint.hpp"
 #include "host/engine/simulation.hpp"
@@ -32,11 +34,30 @@ struct StageSteps {
   std::function<void()> save_blowup;
 };
 
-/// How a stage ended: the number of its last step, and whether it was done (else it reached its cap).
+/// What a stage's steps cost: wall-clock seconds in all, and the step's parts (StageTimes); the rest is the stage's
+/// own host work between steps (servo, records, snapshots, progress, checkpoints).
+struct StageTiming {
+  std::string name;
+  long balls = 0;
+  long steps = 0;
+  double wall = 0;
+  StageTimes parts;
+  double host() const { return wall - parts.loop(); }
+  double rate() const { return wall > 0 ? static_cast<double>(balls) * static_cast<double>(steps) / wall : 0; }
+};
+
+/// How a stage ended: the number of its last step, whether it was done (else it reached its cap), and its cost.
 struct StageEnd {
   long step = 0;
   bool done = false;
+  StageTiming timing;
 };
+
+/// Stage timings as CSV (timings.csv): per stage its balls, steps, wall seconds, particle-steps per second and
+/// nanoseconds per particle-step in each part of the step and in the host's work between steps.
+std::string timings_csv(const std::vector<StageTiming>& stages);
+/// The same as a table for the log, one line a stage.
+std::string timings_table(const std::vector<StageTiming>& stages);
 
 /// Runs the stage's steps. `plan` (may be null) decides when a checkpoint is due, by the simulation's step count,
 /// and when the job stops after one (RunStopped thrown).

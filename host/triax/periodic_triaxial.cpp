@@ -192,7 +192,7 @@ PeriodicTriaxialParams resolve_periodic_params(Simulation& sim, PeriodicTriaxial
   return prm;
 }
 
-long consolidate_isotropic(Simulation& sim, const PeriodicTriaxialParams& prm_in) {
+StageEnd consolidate_isotropic(Simulation& sim, const PeriodicTriaxialParams& prm_in) {
   const PeriodicTriaxialParams prm = resolve_periodic_params(sim, prm_in);  // idempotent
   CellServo servo(prm, prm.consolidation_rate);
   const bool all[3] = {true, true, true};
@@ -221,11 +221,12 @@ long consolidate_isotropic(Simulation& sim, const PeriodicTriaxialParams& prm_in
     }
     return err < prm.stress_tolerance && ratio < prm.unbalanced_tolerance;
   };
-  const StageEnd end = run_stage(sim, stage, nullptr);
+  StageEnd end = run_stage(sim, stage, nullptr);
   set_cell_rates(sim, Vec3());
   if (end.done) {
     if (prm.verbose) progress.finish("(converged after " + std::to_string(end.step) + " steps)");
-    return end.step;
+    end.timing.name = "consolidation";
+    return end;
   }
   std::ostringstream msg;
   msg << "periodic triaxial: isotropic consolidation to sigma3 = " << 1e-3 * prm.sigma3 << " kPa did not converge in "
@@ -316,7 +317,9 @@ PeriodicTriaxialResult run_periodic_triaxial(Simulation& sim, const PeriodicTria
   const Real dt = sim.params().integ.dt;
   if (prm.verbose) announce(prm, res.inertial, dt);
 
-  res.consolidation_steps = consolidate_isotropic(sim, prm);
+  const StageEnd consolidated = consolidate_isotropic(sim, prm);
+  res.consolidation_steps = consolidated.step;
+  res.stages.push_back(consolidated.timing);
 
   const std::array<Real, 3> L0 = cell_lengths(sim);
   res.h0 = L0[2];
@@ -365,7 +368,8 @@ PeriodicTriaxialResult run_periodic_triaxial(Simulation& sim, const PeriodicTria
     snapshots.at((res.h0 - cell_lengths(sim)[2]) / res.h0);
     return last;
   };
-  run_stage(sim, stage, nullptr);
+  res.stages.push_back(run_stage(sim, stage, nullptr).timing);
+  res.stages.back().name = "shear";
   set_cell_rates(sim, Vec3());
   if (out) out->flush_series();
 

@@ -38,6 +38,7 @@
 #include "host/engine/builder.hpp"
 #include "host/io/io_hdf5.hpp"
 #include "host/engine/simulation.hpp"
+#include "host/engine/stage_loop.hpp"
 
 namespace dem {
 
@@ -71,6 +72,7 @@ struct PeriodicTriaxialResult {
   Real max_lateral_error = 0;        ///< max over rows of |sigma2 or sigma3 - applied| / applied
   Real max_kinetic = 0;              ///< J, over rows
   double wall_seconds = 0;
+  std::vector<StageTiming> stages;   ///< consolidation and shear
 };
 
 /// Fills in the automatic rates and checks the parameters against the simulation: fully periodic, no
@@ -80,7 +82,7 @@ PeriodicTriaxialParams resolve_periodic_params(Simulation& sim, PeriodicTriaxial
 /// Stage (a) alone: all three axes servoed to sigma3 (rates clamped to consolidation_rate). Returns the steps
 /// taken; throws std::runtime_error naming the stresses and unbalanced ratio reached when
 /// max_consolidation_steps pass without convergence, std::invalid_argument as resolve_periodic_params.
-long consolidate_isotropic(Simulation& sim, const PeriodicTriaxialParams& prm);
+StageEnd consolidate_isotropic(Simulation& sim, const PeriodicTriaxialParams& prm);
 
 /// Stages (a) and (b). With `out`, writes series.csv/.h5 and the snapshots at snapshot_strains.
 PeriodicTriaxialResult run_periodic_triaxial(Simulation& sim, const PeriodicTriaxialParams& prm,

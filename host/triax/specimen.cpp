@@ -50,10 +50,10 @@ std::vector<WallSpec> mould(Real radius, Real z_top) {
 /// force of its contacts and stops where that force would squeeze them by 1% of the radius (f_limit): the
 /// layer is then looser than asked, and pressing on would only overlap the balls. The proportional approach
 /// avoids the stop-and-go of an on/off limit, which keeps a packing agitated and the unbalanced ratio
-/// high. Returns the layer's step count and ratio; `progress` (may be null) is told the platen's travel in
-/// micrometres.
-std::pair<long, Real> compact(Simulation& sim, Real z_target, const SpecimenConfig& sc, Real f_limit,
-                              Progress* progress, const std::vector<ContactParams>* settle) {
+/// high. Returns how the layer's stage ended (its steps and cost) and its ratio; `progress` (may be null) is told
+/// the platen's travel in micrometres.
+std::pair<StageEnd, Real> compact(Simulation& sim, Real z_target, const SpecimenConfig& sc, Real f_limit,
+                                  Progress* progress, const std::vector<ContactParams>* settle) {
   const long check_every = 200;
   const Real z_start = sim.wall_point(kTop).z;
   Real ratio = 1, load = 0;  // load: mean platen contact force / f_limit
@@ -102,9 +102,9 @@ std::pair<long, Real> compact(Simulation& sim, Real z_target, const SpecimenConf
     }
     return (z - z_target < 1e-9 || blocked) && ratio < sc.stop_ratio;
   };
-  const long s = run_stage(sim, layer, nullptr).step;
+  const StageEnd end = run_stage(sim, layer, nullptr);
   sim.set_wall_velocity(kTop, Vec3());
-  return {s, ratio};
+  return {end, ratio};
 }
 
 }  // namespace
@@ -172,8 +172,11 @@ Specimen build_specimen(const Config& cfg, bool verbose) {
     ContactParams settle_law = ball_law;
     settle_law.mu_s = sc.settle_mu_s;
     const std::vector<ContactParams> settle_table{settle_law, wall_law, wall_law, wall_law};
-    const auto [steps, ratio] = compact(sim, z1, sc, f_limit, verbose ? &progress : nullptr,
-                                        sc.settle_mu_s >= 0 ? &settle_table : nullptr);
+    const auto [end, ratio] = compact(sim, z1, sc, f_limit, verbose ? &progress : nullptr,
+                                      sc.settle_mu_s >= 0 ? &settle_table : nullptr);
+    const long steps = end.step;
+    out.stages.push_back(end.timing);
+    out.stages.back().name = "specimen layer " + std::to_string(k + 1);
     const HostParticles h = to_host_by_gid(sim.particles());
     for (std::size_t q = 0; q < all.size(); ++q) {
       all[q].x = h.x[q];

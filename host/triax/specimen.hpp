@@ -8,6 +8,7 @@
 
 #include "host/config/config.hpp"
 #include "host/engine/builder.hpp"
+#include "host/engine/stage_loop.hpp"
 
 namespace dem {
 
@@ -26,6 +27,8 @@ struct Specimen {
   Real height = 0;               ///< m, where the last platen stopped
   /// Porosity in `profile_bins` equal slices from bottom to top.
   std::vector<Real> porosity_profile;
+  /// What each layer's compaction cost, where this process built it (not kept in the specimen's file).
+  std::vector<StageTiming> stages;
 };
 
 /// Balls needed for the target void ratio: V / ((1 + e) V_ball), V_ball of the mean diameter.

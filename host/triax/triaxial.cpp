@@ -69,8 +69,8 @@ void measure_stresses(const Cell& c, const TriaxialConfig& tc, const ContactSet&
 /// servo on the top platen, until the platen's stress and the unbalanced ratio settle; then `st` moves to shear with
 /// the consolidated height, volumes and void ratio. `stage` comes with what both stages of the test do alike
 /// (checkpoints, the blow-up's save); `plan` may be null.
-void consolidate(const Config& cfg, const Specimen& sp, Cell& cell, Stage& st, bool verbose, StageSteps stage,
-                 CheckpointPlan* plan) {
+StageTiming consolidate(const Config& cfg, const Specimen& sp, Cell& cell, Stage& st, bool verbose, StageSteps stage,
+                        CheckpointPlan* plan) {
   const TriaxialConfig& tc = cfg.triaxial;
   Simulation& sim = *cell.sim;
   const Real dt = sim.params().integ.dt;
@@ -121,6 +121,9 @@ void consolidate(const Config& cfg, const Specimen& sp, Cell& cell, Stage& st, b
   if (verbose)
     std::printf("\nconsolidated at %.0f kPa: e = %.4f, height %.3f mm after %ld steps\n", tc.sigma3 / 1e3,
                 st.void_ratio, st.h0 * 1e3, st.consolidation_steps);
+  StageTiming timing = end.timing;
+  timing.name = "consolidation";
+  return timing;
 }
 
 /// What a blow-up leaves for inspection: the curve so far, a snapshot of balls, membrane and contacts, and the
@@ -323,7 +326,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
     save_triaxial(plan->path, sim, out, st, res, plan->config);
   };
   if (out) shared.save_blowup = [&] { save_blowup(sim, cell, *out, st, res, plan); };
-  if (!st.shear) consolidate(cfg, sp, cell, st, verbose, shared, plan);
+  if (!st.shear) res.stages.push_back(consolidate(cfg, sp, cell, st, verbose, shared, plan));
   res.consolidation_steps = st.consolidation_steps;
   res.void_ratio_consolidated = st.void_ratio;
   const Real h0 = st.h0, v0 = st.v0, v0_envelope = st.v0_envelope;
@@ -362,7 +365,8 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
     st.step = n;
     return false;
   };
-  run_stage(sim, shear_stage, plan);
+  res.stages.push_back(run_stage(sim, shear_stage, plan).timing);
+  res.stages.back().name = "shear";
   if (out) out->flush_series();
   finish_result(cell, tc.sigma3, elapsed(), res);
   return res;

@@ -12,6 +12,7 @@
 #include "host/io/io_hdf5.hpp"
 #include "host/data/measured.hpp"
 #include "host/engine/simulation.hpp"
+#include "host/engine/stage_loop.hpp"
 
 namespace dem {
 
@@ -54,6 +55,7 @@ struct TriaxialResult {
   int escaped = 0;             ///< balls whose centre ended outside the membrane (should be 0)
   double wall_seconds = 0;
   StageTimes times;            ///< time loop of consolidation and shear, per stage
+  std::vector<StageTiming> stages;  ///< the stages run by this process (a resumed run's later ones only)
   long steps = 0;              ///< time steps of consolidation and shear
   long balls = 0;
 };
