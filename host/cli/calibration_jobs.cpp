@@ -189,6 +189,7 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
   io::write_text_atomic(ss.folder + "/calibrated.csv", table.str());
   std::printf("calibrate: %s in %s; results in %s (calibrated.csv, errors.csv, simulated_curves.csv)\n",
               ss.runs_text().c_str(), format_duration(ss.lab.seconds()).c_str(), ss.folder.c_str());
+  if (const std::string w = ss.workers_text(); !w.empty()) std::printf("calibrate: %s\n", w.c_str());
   ss.finish(all_meas, all_sim, "the calibrated parameters");
   const std::string prediction = ss.predict_boundary(base, models);
   if (!prediction.empty()) io::write_text_atomic(ss.folder + "/prediction.md", prediction);
@@ -255,6 +256,7 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
   io::write_text_atomic(ss.folder + "/models.csv", csv.str());
   std::printf("diagnose: %s in %s; report in %s/diagnosis.md\n", ss.runs_text().c_str(),
               format_duration(ss.lab.seconds()).c_str(), ss.folder.c_str());
+  if (const std::string w = ss.workers_text(); !w.empty()) std::printf("diagnose: %s\n", w.c_str());
   ss.finish(all_meas, all_sim, "the calibrated base model");
   // The report stands before the membrane tests run; their section is added when they end.
   const std::string prediction = ss.predict_boundary(base, models);

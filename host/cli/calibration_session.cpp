@@ -7,6 +7,7 @@
 #include "host/fit/two_fidelity.hpp"
 #include "host/io/io_hdf5.hpp"
 #include "host/triax/summary.hpp"
+#include "host/util/process_pool.hpp"
 #include "host/util/text_format.hpp"
 
 namespace dem {
@@ -112,6 +113,20 @@ std::string Session::runs_text() const {
   return std::to_string(lab.runs()) + " runs" +
          (read > 0 ? " (" + std::to_string(read) + " of them read from the run store)" : "") +
          (lab.failed_runs() > 0 ? "; WARNING: " + failed_text() : "");
+}
+
+std::string Session::workers_text() const {
+  const PoolUse use = pool_use();
+  const double job = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  if (use.pieces == 0) {
+    const long ran = lab.runs() - lab.stored_runs_read();
+    return ran > 0 ? fmt("runs took %.1f s each on average, one at a time", lab.seconds() / ran) : "";
+  }
+  return fmt("%.0f pieces of work (runs and specimen packings) in child processes", static_cast<double>(use.pieces)) +
+         fmt(", %.1f s each on average", use.busy / use.pieces) +
+         fmt("; the workers were busy %.0f%% of the time the pools ran", 100 * use.busy / std::max(use.offered, 1e-9)) +
+         fmt(" (idle %.0f worker-seconds, waiting for the longest run of a batch)", use.idle()) +
+         fmt(", and the pools ran %.0f%% of the job's time", 100 * use.wall / std::max(job, 1e-9));
 }
 
 std::string Session::failed_text() const {

@@ -1,6 +1,7 @@
 #pragma once
 /// What `calibrate` and `diagnose` share (host/cli/calibration_jobs.cpp): the data, the free parameters, the
 /// reference test's simulator, the noise, the prediction that ends them, and a new result folder.
+#include <chrono>
 #include <filesystem>
 #include <map>
 #include <optional>
@@ -43,6 +44,7 @@ struct Session {
   MeasuredData data;
   ReferenceValues ref;
   std::vector<FreeParam> free;
+  std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();
   NoiseOptions noise;
   StateMatch state;  ///< the data's void ratio and the preparation that packs it, on the lab's present cell
   std::optional<Config> predict_template;
@@ -59,6 +61,9 @@ struct Session {
   /// "N runs", how many of them a resumed session read from its store, and how many a blow-up stopped: their data
   /// count as missing (kMissingResidual), which pushes the fit away from where they happen.
   std::string runs_text() const;
+  /// How the runs used the workers: their mean length, the workers' busy share while the pools ran (the rest
+  /// they waited for a batch's longest run) and the pools' share of the job's time (the rest the fits took).
+  std::string workers_text() const;
   std::string failed_text() const;
   std::vector<std::string> free_names() const;
   /// The membrane test at `model` on every test of `tests`, q in the data's measure (a template must be set).

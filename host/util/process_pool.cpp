@@ -4,7 +4,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <cstdio>
 #include <iostream>
 #include <stdexcept>
@@ -13,16 +15,41 @@
 
 namespace dem {
 
+namespace {
+
+PoolUse use_so_far;
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
+
+}  // namespace
+
+PoolUse pool_use() { return use_so_far; }
+
 void run_pool(const PoolWork& w, const char* what) {
   struct Child {
     std::size_t j;
     pid_t pid;
     int fd;
+    Clock::time_point start;
   };
+  const std::size_t workers = static_cast<std::size_t>(w.workers > 1 ? w.workers : 1);
+  const Clock::time_point t0 = Clock::now();
+  // The offer is counted as the pool ends, whichever way: by then every child it started has ended.
+  struct Account {
+    Clock::time_point t0;
+    std::size_t workers;
+    ~Account() {
+      const double wall = seconds_between(t0, Clock::now());
+      use_so_far.wall += wall;
+      use_so_far.offered += wall * static_cast<double>(workers);
+    }
+  } account{t0, std::min(workers, std::max<std::size_t>(w.pieces, 1))};
   std::vector<Child> running;
   std::size_t next = 0;
   for (;;) {
-    while (next < w.pieces && running.size() < static_cast<std::size_t>(w.workers > 1 ? w.workers : 1)) {
+    while (next < w.pieces && running.size() < workers) {
       const std::size_t j = next++;
       if (w.before && !w.before(j)) continue;
       std::cout.flush();
@@ -39,7 +66,7 @@ void run_pool(const PoolWork& w, const char* what) {
         ::_exit(0);
       }
       ::close(fd[1]);
-      running.push_back({j, pid, fd[0]});
+      running.push_back({j, pid, fd[0], Clock::now()});
     }
     if (running.empty()) return;
     std::vector<pollfd> polled;
@@ -58,6 +85,8 @@ void run_pool(const PoolWork& w, const char* what) {
     while (::waitpid(c.pid, &ws, 0) < 0 && errno == EINTR) {
     }
     const int status = WIFEXITED(ws) ? WEXITSTATUS(ws) : 128 + WTERMSIG(ws);
+    use_so_far.busy += seconds_between(c.start, Clock::now());
+    ++use_so_far.pieces;
     if (w.after) w.after(c.j, whole ? status : -1);
   }
 }

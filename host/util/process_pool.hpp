@@ -28,4 +28,16 @@ struct PoolWork {
 /// Runs the pieces; `what` names them in the error when a pipe or a process cannot be made.
 void run_pool(const PoolWork& w, const char* what);
 
+/// How this process's pools have been used so far, for a job's account of its workers: a pool of W workers that
+/// runs for T seconds offers W T worker-seconds; what its pieces did not use, its workers sat idle (the last pieces
+/// of a batch, while the longest runs).
+struct PoolUse {
+  long pieces = 0;
+  double busy = 0;      ///< seconds the pieces ran, summed
+  double offered = 0;   ///< seconds each pool ran times its workers
+  double wall = 0;      ///< seconds the pools ran
+  double idle() const { return offered - busy; }
+};
+PoolUse pool_use();
+
 }  // namespace dem
