@@ -122,7 +122,8 @@ std::string Session::workers_text() const {
     const long ran = lab.runs() - lab.stored_runs_read();
     return ran > 0 ? fmt("runs took %.1f s each on average, one at a time", lab.seconds() / ran) : "";
   }
-  return fmt("%.0f pieces of work (runs and specimen packings) in child processes", static_cast<double>(use.pieces)) +
+  return fmt("%.0f pieces of work (runs and specimen packings) in child processes",
+             static_cast<double>(use.pieces)) +
          fmt(", %.1f s each on average", use.busy / use.pieces) +
          fmt("; the workers were busy %.0f%% of the time the pools ran", 100 * use.busy / std::max(use.offered, 1e-9)) +
          fmt(" (idle %.0f worker-seconds, waiting for the longest run of a batch)", use.idle()) +
