@@ -60,6 +60,10 @@ grep -q "identifiable cases named right: \*\*14 of 14\*\*" "$work/sweep_table.py
   { cat "$work/sweep_table.py.log"; echo "scripts_smoke: sweep_table miscounted the shipped lab-like sweep" >&2; exit 1; }
 
 check perf/scaling.sh env BUILD="$build" WORK="$work/scaling" K=4 STEPS=20 bash "$root/perf/scaling.sh"
+check perf/stage_profile.sh env BUILD="$build" WORK="$work/profile" CONFIG="$root/tests/data/tiny_triaxial.toml" \
+  DIAG_CONFIG="$base" PRESSURES=100 BENCH_STEPS=20 NP=1 bash "$root/perf/stage_profile.sh"
+grep -q "^shear .* | " "$work/stage_profile.sh.log" && grep -q "^diagnose: .* runs" "$work/stage_profile.sh.log" ||
+  { cat "$work/stage_profile.sh.log"; echo "scripts_smoke: stage_profile gave no shear stage or no diagnosis" >&2; exit 1; }
 check perf/device_check.sh bash -c "TINY=1 CPU_BUILD='$build' bash '$root/perf/device_check.sh' prepare '$work/dc_ref' &&
   TINY=1 BUILD='$build' bash '$root/perf/device_check.sh' run '$work/dc_ref' '$work/dc'"
 # The peers' packing format and the instruction count, on a 216-ball packing, triaxdem alone (the peers are

@@ -8,6 +8,7 @@
 #include "host/io/io_hdf5.hpp"
 #include "host/triax/summary.hpp"
 #include "host/util/process_pool.hpp"
+#include "host/util/progress.hpp"
 #include "host/util/text_format.hpp"
 
 namespace dem {
@@ -118,16 +119,16 @@ std::string Session::runs_text() const {
 std::string Session::workers_text() const {
   const PoolUse use = pool_use();
   const double job = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  if (use.pieces == 0) {
-    const long ran = lab.runs() - lab.stored_runs_read();
-    return ran > 0 ? fmt("runs took %.1f s each on average, one at a time", lab.seconds() / ran) : "";
-  }
-  return fmt("%.0f pieces of work (runs and specimen packings) in child processes",
-             static_cast<double>(use.pieces)) +
+  const LabTime t = lab_time();
+  std::string s = "the job's " + format_duration(job) + fmt(": %.0f simulator runs ", static_cast<double>(t.ran)) +
+                  format_duration(t.runs) + (t.ran > 0 ? fmt(" (%.1f s a run)", t.runs / t.ran) : std::string()) +
+                  ", packing specimens " + format_duration(t.packing) + ", the rest (fits, reports) " +
+                  format_duration(std::max(0.0, job - t.runs - t.packing));
+  if (use.pieces == 0) return s + "; one run at a time";
+  return s + fmt("; %.0f pieces of work in child processes", static_cast<double>(use.pieces)) +
          fmt(", %.1f s each on average", use.busy / use.pieces) +
-         fmt("; the workers were busy %.0f%% of the time the pools ran", 100 * use.busy / std::max(use.offered, 1e-9)) +
-         fmt(" (idle %.0f worker-seconds, waiting for the longest run of a batch)", use.idle()) +
-         fmt(", and the pools ran %.0f%% of the job's time", 100 * use.wall / std::max(job, 1e-9));
+         fmt(", the workers busy %.0f%% of the time the pools ran", 100 * use.busy / std::max(use.offered, 1e-9)) +
+         fmt(" (idle %.0f worker-seconds, waiting for the longest piece of a batch)", use.idle());
 }
 
 std::string Session::failed_text() const {

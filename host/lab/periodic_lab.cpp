@@ -64,7 +64,21 @@ PeriodicLab::PeriodicLab(const Config& base, bool verbose, int members, unsigned
   pack(std::max(members_, specimens), verbose);
 }
 
+namespace {
+LabTime time_so_far;
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+}  // namespace
+
+LabTime lab_time() { return time_so_far; }
+
 void PeriodicLab::pack(int count, bool verbose) {
+  const auto t0 = std::chrono::steady_clock::now();
+  struct Clock {  // counted however the packing ends
+    std::chrono::steady_clock::time_point t0;
+    ~Clock() { time_so_far.packing += seconds_since(t0); }
+  } clock{t0};
   specimens_.assign(static_cast<std::size_t>(count), PackedCell{});
   auto prepare = [&](std::size_t k) {
     Config c = cfg_;
@@ -161,7 +175,10 @@ TriaxialTest PeriodicLab::run(const Model& m, Real sigma3, const std::string& ma
   }
   t.material = material;
   ++runs_;
-  seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double s = seconds_since(t0);
+  seconds_ += s;
+  time_so_far.runs += s;
+  ++time_so_far.ran;
   return t;
 }
 
@@ -298,7 +315,10 @@ std::vector<TriaxialTest> PeriodicLab::run_or_read(const Model& m, const std::ve
       },
       "calibration");
   runs_ += static_cast<long>(todo.size());
-  seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double s = seconds_since(t0);
+  seconds_ += s;
+  time_so_far.runs += s;
+  time_so_far.ran += static_cast<long>(todo.size());
   return out;
 }
 

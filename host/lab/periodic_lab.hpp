@@ -123,6 +123,16 @@ class PeriodicLab {
   std::string stored_path(const Model& m, const Case& c) const;
 };
 
+/// Where this process's labs spent their time (every lab's: the state match's and the cell check's too), for a
+/// job's account of its time: wall seconds running the simulator, the runs made (not read from a store), and wall
+/// seconds packing specimens.
+struct LabTime {
+  double runs = 0;
+  long ran = 0;
+  double packing = 0;
+};
+LabTime lab_time();
+
 /// Runs at once that `workers` asks for, where that is safe (PeriodicLab::set_workers); otherwise 1.
 int runs_at_once(int workers);
 
