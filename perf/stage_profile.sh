@@ -41,13 +41,16 @@ import csv, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
 bench = list(csv.DictReader(open(sys.argv[2])))[0]
 parts = ["rebuild", "ball_ball", "ball_wall", "membrane", "gather_integrate", "boundaries", "host"]
+pairs = ["ball_pairs_per_ball", "wall_pairs_per_ball"]
 rate0 = float(bench["particle_steps_per_s"])
 print("%-20s %7s %8s %8s %9s %6s | %s" % ("stage", "balls", "steps", "wall_s", "psteps/s", "bench",
-      " ".join("%9s" % p[:9] for p in parts) + "   (ns per particle-step)"))
+      " ".join("%9s" % p[:9] for p in parts) + " | pairs/ball: balls walls"))
 for r in rows + [dict(bench, stage="benchmark")]:
     rate = float(r["particle_steps_per_s"])
-    print("%-20s %7s %8s %8.1f %9.3g %6.2f | %s" % (r["stage"], r["balls"], r["steps"], float(r["wall_s"]), rate,
-          rate / rate0, " ".join("%9.1f" % float(r[p + "_ns"]) for p in parts)))
+    print("%-20s %7s %8s %8.1f %9.3g %6.2f | %s | %5.2f %5.2f" % (r["stage"], r["balls"], r["steps"],
+          float(r["wall_s"]), rate, rate / rate0, " ".join("%9.1f" % float(r[p + "_ns"]) for p in parts),
+          float(r[pairs[0]]), float(r[pairs[1]])))
+print("(the parts in ns per particle-step; pairs/ball: candidate pairs in the contact lists per ball at the end)")
 total = sum(float(r["wall_s"]) for r in rows)
 steps = sum(int(r["steps"]) for r in rows)
 print("all stages: %d steps in %.1f s; the benchmark: %s balls at %.3g particle-steps/s" %

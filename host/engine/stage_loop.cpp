@@ -1,5 +1,6 @@
 #include "host/engine/stage_loop.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 
@@ -46,19 +47,22 @@ StageEnd run_stage(Simulation& sim, const StageSteps& stage, CheckpointPlan* pla
   end.timing.steps = sim.step_count() - step0;
   end.timing.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   end.timing.parts = sim.times().since(parts0);
+  const double n = std::max(1, sim.particles().n);
+  end.timing.ball_pairs = sim.ball_contacts().n / n;
+  end.timing.wall_pairs = sim.wall_contacts().n / n;
   return end;
 }
 
 std::string timings_csv(const std::vector<StageTiming>& stages) {
   std::string s = "stage,balls,steps,wall_s,particle_steps_per_s,rebuilds,rebuild_ns,ball_ball_ns,ball_wall_ns,"
-                  "membrane_ns,gather_integrate_ns,boundaries_ns,host_ns\n";
+                  "membrane_ns,gather_integrate_ns,boundaries_ns,host_ns,ball_pairs_per_ball,wall_pairs_per_ball\n";
   char line[400];
   for (const StageTiming& t : stages) {
     const StageTimes& p = t.parts;
-    std::snprintf(line, sizeof line, "%s,%ld,%ld,%.3f,%.4g,%ld,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f\n", t.name.c_str(),
-                  t.balls, t.steps, t.wall, t.rate(), p.rebuilds, ns_per(p.rebuild, t), ns_per(p.forces, t),
-                  ns_per(p.walls, t), ns_per(p.membrane, t), ns_per(p.integrate, t), ns_per(p.boundaries, t),
-                  ns_per(t.host(), t));
+    std::snprintf(line, sizeof line, "%s,%ld,%ld,%.3f,%.4g,%ld,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.3f,%.3f\n",
+                  t.name.c_str(), t.balls, t.steps, t.wall, t.rate(), p.rebuilds, ns_per(p.rebuild, t),
+                  ns_per(p.forces, t), ns_per(p.walls, t), ns_per(p.membrane, t), ns_per(p.integrate, t),
+                  ns_per(p.boundaries, t), ns_per(t.host(), t), t.ball_pairs, t.wall_pairs);
     s += line;
   }
   return s;

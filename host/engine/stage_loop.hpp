@@ -42,6 +42,9 @@ struct StageTiming {
   long steps = 0;
   double wall = 0;
   StageTimes parts;
+  /// Candidate pairs in the contact lists (touching or within the Verlet skin) per ball at the stage's end: what a
+  /// ball-ball or ball-wall particle-step costs grows with them.
+  double ball_pairs = 0, wall_pairs = 0;
   double host() const { return wall - parts.loop(); }
   double rate() const { return wall > 0 ? static_cast<double>(balls) * static_cast<double>(steps) / wall : 0; }
 };
