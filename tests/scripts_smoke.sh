@@ -90,6 +90,9 @@ check tools/specimen_scatter.py "$py" "$root/tools/specimen_scatter.py" "$work/s
 check perf/bench_engine "$build/perf/bench_engine" --benchmark_filter='BM_TimeLoop/12/1' --benchmark_min_time=0.01
 check perf/hidden_sweep "$build/perf/hidden_sweep" --config "$base" --seeds 1 --hidden none -j 1 -o "$work/sweep.csv"
 exists "$work/sweep.csv"
+check perf/inertial_scan "$build/perf/inertial_scan" --config "$base" --specimens 2 --pressures 100 \
+  --inertial 1e-3,4e-3 -j 1 -o "$work/inertial.csv"
+exists "$work/inertial.csv"
 
 # Every script and perf program has its line above.
 missing=""
