@@ -29,6 +29,9 @@ struct ModelKey {
   std::array<Real, 3> strengths;
   const char* signature;
   bool from_off;
+  /// The diagnosis tries it (and synth makes data with it). An extension that names another code's data, which lack
+  /// it, is a parameter to calibrate, not a verdict to offer.
+  bool diagnosed = true;
 };
 
 /// The table: the base law first, then its extensions and the membrane.
@@ -36,8 +39,8 @@ const std::vector<ModelKey>& model_keys();
 /// The row of a parameter a calibration may free; throws std::invalid_argument naming the allowed ones.
 const ModelKey& model_key(const std::string& key);
 
-/// The names in words, comma-separated, for help texts: the extensions' ("hertz, roughness, ...") or the keys a
-/// calibration may free.
+/// The names in words, comma-separated, for help texts: the extensions the diagnosis tries ("hertz, roughness, ...")
+/// or the keys a calibration may free.
 std::string extension_names();
 std::string free_key_names();
 

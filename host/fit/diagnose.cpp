@@ -22,7 +22,7 @@ const std::vector<Extension>& extensions() {
   static const std::vector<Extension> list = [] {
     std::vector<Extension> out;
     for (const ModelKey& k : model_keys())
-      if (*k.extension)
+      if (*k.extension && k.diagnosed)
         out.push_back({k.extension, k.key, {k.strengths.begin(), k.strengths.end()}, k.signature, k.from_off});
     return out;
   }();
