@@ -60,6 +60,10 @@ grep -q "identifiable cases named right: \*\*14 of 14\*\*" "$work/sweep_table.py
   { cat "$work/sweep_table.py.log"; echo "scripts_smoke: sweep_table miscounted the shipped lab-like sweep" >&2; exit 1; }
 
 check perf/scaling.sh env BUILD="$build" WORK="$work/scaling" K=4 STEPS=20 bash "$root/perf/scaling.sh"
+check perf/specimen_settling.sh env BUILD="$build" WORK="$work/settling" CONFIG="$root/tests/data/tiny_triaxial.toml" \
+  SEEDS="1 2" NP=1 bash "$root/perf/specimen_settling.sh"
+grep -q "^q_peak kPa " "$work/specimen_settling.sh.log" ||
+  { cat "$work/specimen_settling.sh.log"; echo "scripts_smoke: specimen_settling compared nothing" >&2; exit 1; }
 check perf/stage_profile.sh env BUILD="$build" WORK="$work/profile" CONFIG="$root/tests/data/tiny_triaxial.toml" \
   DIAG_CONFIG="$base" PRESSURES=100 BENCH_STEPS=20 NP=1 bash "$root/perf/stage_profile.sh"
 grep -q "^shear .* | " "$work/stage_profile.sh.log" && grep -q "^diagnose: .* runs" "$work/stage_profile.sh.log" ||

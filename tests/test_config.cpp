@@ -53,6 +53,8 @@ TEST(Config, OutOfRangeNamesAllowedRange) {
   EXPECT_NE(e.find("allowed: [0, 10]"), std::string::npos) << e;
   EXPECT_NE(error_of("[particles]\ndiameter_mm = 0\n").find("diameter_mm"), std::string::npos);
   EXPECT_NE(error_of("[solver]\ndamping = 1.5\n").find("damping"), std::string::npos);
+  const std::string layers = error_of("[specimen]\nlayer_stop_ratio = 2\n");
+  EXPECT_NE(layers.find("layer_stop_ratio: value 2 out of range (allowed: [0, 1])"), std::string::npos) << layers;
 }
 
 TEST(Config, WrongTypeUnknownTableAndSyntaxError) {

@@ -93,6 +93,23 @@ TEST(Specimen, SmallSpecimenReachesTheTargetVoidRatio) {
   EXPECT_EQ(s.porosity_profile.size(), 24u);
 }
 
+TEST(Specimen, LowerLayersEndAtTheirOwnStopRatio) {
+  // The layers below the top one are pressed again by the next ones: with layer_stop_ratio they end at that ratio,
+  // in fewer steps than at stop_ratio (which a lower layer that ignored it would not take), and the top one still
+  // ends at stop_ratio; the specimen keeps its void ratio (within 0.01, as the other specimen tests).
+  Config c = test::specimen_config(12e-3, 0.75, 2);
+  const Specimen strict = build_specimen(c, false);
+  c.specimen.layer_stop_ratio = 1e-2;
+  const Specimen quick = build_specimen(c, false);
+  ASSERT_EQ(quick.layers.size(), 2u);
+  EXPECT_LT(quick.layers[0].unbalanced, 1e-2);
+  EXPECT_LT(quick.layers[0].steps, strict.layers[0].steps);
+  EXPECT_LT(quick.layers[1].unbalanced, c.specimen.stop_ratio);
+  EXPECT_NEAR(quick.void_ratio, 0.75, 0.01);
+  EXPECT_NE(specimen_key(c), specimen_key(test::specimen_config(12e-3, 0.75, 2))) << "a cached specimen of the "
+                                                                                      "other protocol is not reused";
+}
+
 TEST(Specimen, FrictionWhileSettlingKeepsTheTargetAndSavesSteps) {
   // Frictionless packings creep: a layer pressed without friction takes long to reach the unbalanced ratio
   // of 1e-3. Friction switched on once the layer is pressed must not change how far it was pressed (e

@@ -123,6 +123,7 @@ void read_specimen(const Tables& read, Config& c) {
   sp.number("settle_mu_s", c.specimen.settle_mu_s, 0, 10);
   sp.number("platen_speed_mm_s", c.specimen.platen_speed, 0, 1e4, 1e-3, true);
   sp.number("stop_ratio", c.specimen.stop_ratio, 0, 1, 1, true);
+  sp.number("layer_stop_ratio", c.specimen.layer_stop_ratio, 0, 1);
   sp.integer("max_steps_per_layer", c.specimen.max_steps_per_layer, 1, 1000000000L);
   sp.boolean("accept_unsettled", c.specimen.accept_unsettled);
   sp.finish();

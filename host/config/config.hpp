@@ -67,6 +67,9 @@ struct SpecimenConfig {
   Real settle_mu_s = -1;         ///< >= 0: ball-ball friction once a layer is pressed, while it settles
   Real platen_speed = 0.05;      ///< m/s, top platen speed while compacting a layer (file: platen_speed_mm_s)
   Real stop_ratio = 1e-3;        ///< unbalanced-force ratio that ends a layer
+  /// > 0: the ratio that ends the layers below the top one, which the next layers press on again (the top one
+  /// still ends at stop_ratio); 0: every layer ends at stop_ratio (the paper's protocol).
+  Real layer_stop_ratio = 0;
   long max_steps_per_layer = 200000;
   /// A layer that reaches max_steps_per_layer before stop_ratio is not at rest: the specimen is refused (and
   /// cached, so that a rerun that accepts it starts at once) unless this is set.

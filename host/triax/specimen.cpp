@@ -52,8 +52,8 @@ std::vector<WallSpec> mould(Real radius, Real z_top) {
 /// avoids the stop-and-go of an on/off limit, which keeps a packing agitated and the unbalanced ratio
 /// high. Returns how the layer's stage ended (its steps and cost) and its ratio; `progress` (may be null) is told
 /// the platen's travel in micrometres.
-std::pair<StageEnd, Real> compact(Simulation& sim, Real z_target, const SpecimenConfig& sc, Real f_limit,
-                                  Progress* progress, const std::vector<ContactParams>* settle) {
+std::pair<StageEnd, Real> compact(Simulation& sim, Real z_target, const SpecimenConfig& sc, Real stop_ratio,
+                                  Real f_limit, Progress* progress, const std::vector<ContactParams>* settle) {
   const long check_every = 200;
   const Real z_start = sim.wall_point(kTop).z;
   Real ratio = 1, load = 0;  // load: mean platen contact force / f_limit
@@ -84,23 +84,23 @@ std::pair<StageEnd, Real> compact(Simulation& sim, Real z_target, const Specimen
       char extra[160];
       if (z - z_target < 1e-9) {
         std::snprintf(extra, sizeof extra, "platen at its height, settling until the unbalanced ratio is below "
-                      "%.0e (now %.1e), at most %ld steps more (the layer's step cap)", sc.stop_ratio, ratio,
+                      "%.0e (now %.1e), at most %ld steps more (the layer's step cap)", stop_ratio, ratio,
                       sc.max_steps_per_layer - n);
         progress->settling(extra);
       } else {
         std::snprintf(extra, sizeof extra, "(um of platen travel), unbalanced ratio %.1e (stop at %.0e)", ratio,
-                      sc.stop_ratio);
+                      stop_ratio);
         progress->update(std::lround((z_start - z) * 1e6), extra);
       }
     }
     const bool blocked = load > 0.9;
     // Pressed to its height (or as far as it goes, nearly at rest): friction now only helps the layer come
     // to rest; switched on earlier, it would lock the packing before the platen gets there.
-    if (settle && (z - z_target < 1e-9 || (blocked && ratio < 10 * sc.stop_ratio))) {
+    if (settle && (z - z_target < 1e-9 || (blocked && ratio < 10 * stop_ratio))) {
       sim.set_contact_params(*settle);
       settle = nullptr;
     }
-    return (z - z_target < 1e-9 || blocked) && ratio < sc.stop_ratio;
+    return (z - z_target < 1e-9 || blocked) && ratio < stop_ratio;
   };
   const StageEnd end = run_stage(sim, layer, nullptr);
   sim.set_wall_velocity(kTop, Vec3());
@@ -172,7 +172,7 @@ Specimen build_specimen(const Config& cfg, bool verbose) {
     ContactParams settle_law = ball_law;
     settle_law.mu_s = sc.settle_mu_s;
     const std::vector<ContactParams> settle_table{settle_law, wall_law, wall_law, wall_law};
-    const auto [end, ratio] = compact(sim, z1, sc, f_limit, verbose ? &progress : nullptr,
+    const auto [end, ratio] = compact(sim, z1, sc, layer_stop_ratio(sc, k), f_limit, verbose ? &progress : nullptr,
                                       sc.settle_mu_s >= 0 ? &settle_table : nullptr);
     const long steps = end.step;
     out.stages.push_back(end.timing);
@@ -202,6 +202,10 @@ Specimen build_specimen(const Config& cfg, bool verbose) {
   return out;
 }
 
+Real layer_stop_ratio(const SpecimenConfig& sc, long k) {
+  return sc.layer_stop_ratio > 0 && k + 1 < sc.layers ? sc.layer_stop_ratio : sc.stop_ratio;
+}
+
 std::string specimen_key(const Config& cfg) {
   const SpecimenConfig& sc = cfg.specimen;
   const ParticleConfig& pc = cfg.particles;
@@ -216,6 +220,7 @@ std::string specimen_key(const Config& cfg) {
     << cfg.wall.emod << " krw " << cfg.wall.kratio << " bnw " << cfg.wall.beta_n << " damp " << sv.damping << " g "
     << sv.gravity[0] << " " << sv.gravity[1] << " " << sv.gravity[2] << " dts " << sv.dt_safety << " dt " << sv.dt
     << " ms " << sv.mass_scale << " skin " << sv.skin;
+  if (sc.layer_stop_ratio > 0) k << " lstop " << sc.layer_stop_ratio;  // absent: the keys of earlier specimens hold
   return k.str();
 }
 
@@ -308,12 +313,13 @@ void require_settled(const Config& cfg, const Specimen& sp) {
   if (sc.accept_unsettled) return;
   for (std::size_t k = 0; k < sp.layers.size(); ++k) {
     const LayerReport& l = sp.layers[k];
-    if (l.steps < sc.max_steps_per_layer || l.unbalanced < sc.stop_ratio) continue;
+    const Real stop = layer_stop_ratio(sc, static_cast<long>(k));
+    if (l.steps < sc.max_steps_per_layer || l.unbalanced < stop) continue;
     char msg[400];
     std::snprintf(msg, sizeof msg, "[specimen] layer %zu/%zu stopped at max_steps_per_layer = %ld with the unbalanced "
-                  "ratio at %.1e, above stop_ratio = %.0e: it is not at rest. Raise max_steps_per_layer, or set "
+                  "ratio at %.1e, above its stop ratio %.0e: it is not at rest. Raise max_steps_per_layer, or set "
                   "accept_unsettled = true to go on with it (the specimen is kept: a rerun does not build it again)",
-                  k + 1, sp.layers.size(), sc.max_steps_per_layer, l.unbalanced, sc.stop_ratio);
+                  k + 1, sp.layers.size(), sc.max_steps_per_layer, l.unbalanced, stop);
     throw ConfigError(cfg.path + ": " + msg);
   }
 }

@@ -31,6 +31,10 @@ struct Specimen {
   std::vector<StageTiming> stages;
 };
 
+/// The unbalanced ratio that ends layer k (from 0): layer_stop_ratio below the top layer where it is set, else
+/// stop_ratio.
+Real layer_stop_ratio(const SpecimenConfig& sc, long k);
+
 /// Balls needed for the target void ratio: V / ((1 + e) V_ball), V_ball of the mean diameter.
 long specimen_ball_count(const Config& cfg);
 
