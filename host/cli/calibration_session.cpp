@@ -118,7 +118,7 @@ std::string Session::runs_text() const {
 
 std::string Session::workers_text() const {
   const PoolUse use = pool_use();
-  const double job = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  const double job = seconds_since(started);
   const LabTime t = lab_time();
   std::string s = "the job's " + format_duration(job) + fmt(": %.0f simulator runs ", static_cast<double>(t.ran)) +
                   format_duration(t.runs) + (t.ran > 0 ? fmt(" (%.1f s a run)", t.runs / t.ran) : std::string()) +

@@ -1,6 +1,9 @@
 #include "host/engine/stage_loop.hpp"
 
+#include "host/util/progress.hpp"
+
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
 
@@ -30,10 +33,14 @@ StageEnd run_steps(Simulation& sim, const StageSteps& stage, CheckpointPlan* pla
   return {n - 1, false, {}};
 }
 
-/// Nanoseconds per particle-step of `seconds` over a stage.
-double ns_per(double seconds, const StageTiming& t) {
+/// Nanoseconds per particle-step of each part of a stage, in the columns' order: rebuild, ball-ball, ball-wall,
+/// membrane, gather + integration, boundaries, the host's work between steps.
+std::array<double, 7> ns_per_part(const StageTiming& t) {
   const double work = static_cast<double>(t.balls) * static_cast<double>(t.steps);
-  return work > 0 ? 1e9 * seconds / work : 0;
+  const StageTimes& p = t.parts;
+  std::array<double, 7> ns{p.rebuild, p.forces, p.walls, p.membrane, p.integrate, p.boundaries, t.host()};
+  for (double& x : ns) x = work > 0 ? 1e9 * x / work : 0;
+  return ns;
 }
 
 }  // namespace
@@ -45,7 +52,7 @@ StageEnd run_stage(Simulation& sim, const StageSteps& stage, CheckpointPlan* pla
   StageEnd end = run_steps(sim, stage, plan);
   end.timing.balls = sim.particles().n;
   end.timing.steps = sim.step_count() - step0;
-  end.timing.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  end.timing.wall = seconds_since(t0);
   end.timing.parts = sim.times().since(parts0);
   const double n = std::max(1, sim.particles().n);
   end.timing.ball_pairs = sim.ball_contacts().n / n;
@@ -58,11 +65,10 @@ std::string timings_csv(const std::vector<StageTiming>& stages) {
                   "membrane_ns,gather_integrate_ns,boundaries_ns,host_ns,ball_pairs_per_ball,wall_pairs_per_ball\n";
   char line[400];
   for (const StageTiming& t : stages) {
-    const StageTimes& p = t.parts;
+    const auto ns = ns_per_part(t);
     std::snprintf(line, sizeof line, "%s,%ld,%ld,%.3f,%.4g,%ld,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.3f,%.3f\n",
-                  t.name.c_str(), t.balls, t.steps, t.wall, t.rate(), p.rebuilds, ns_per(p.rebuild, t),
-                  ns_per(p.forces, t), ns_per(p.walls, t), ns_per(p.membrane, t), ns_per(p.integrate, t),
-                  ns_per(p.boundaries, t), ns_per(t.host(), t), t.ball_pairs, t.wall_pairs);
+                  t.name.c_str(), t.balls, t.steps, t.wall, t.rate(), t.parts.rebuilds, ns[0], ns[1], ns[2], ns[3],
+                  ns[4], ns[5], ns[6], t.ball_pairs, t.wall_pairs);
     s += line;
   }
   return s;
@@ -74,11 +80,9 @@ std::string timings_table(const std::vector<StageTiming>& stages) {
                   "integrate boundaries    host\n";
   char line[400];
   for (const StageTiming& t : stages) {
-    const StageTimes& p = t.parts;
+    const auto ns = ns_per_part(t);
     std::snprintf(line, sizeof line, "%-20s %7ld %8ld %7.1f %8.3g | %7.1f %9.1f %9.1f %8.1f %9.1f %10.1f %7.1f\n",
-                  t.name.c_str(), t.balls, t.steps, t.wall, t.rate(), ns_per(p.rebuild, t), ns_per(p.forces, t),
-                  ns_per(p.walls, t), ns_per(p.membrane, t), ns_per(p.integrate, t), ns_per(p.boundaries, t),
-                  ns_per(t.host(), t));
+                  t.name.c_str(), t.balls, t.steps, t.wall, t.rate(), ns[0], ns[1], ns[2], ns[3], ns[4], ns[5], ns[6]);
     s += line;
   }
   return s;

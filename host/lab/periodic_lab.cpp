@@ -66,9 +66,6 @@ PeriodicLab::PeriodicLab(const Config& base, bool verbose, int members, unsigned
 
 namespace {
 LabTime time_so_far;
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 }  // namespace
 
 LabTime lab_time() { return time_so_far; }

@@ -1,5 +1,7 @@
 #include "host/util/process_pool.hpp"
 
+#include "host/util/progress.hpp"
+
 #include <poll.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -21,8 +23,6 @@ PoolUse use_so_far;
 
 using Clock = std::chrono::steady_clock;
 
-double seconds_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
-
 }  // namespace
 
 PoolUse pool_use() { return use_so_far; }
@@ -41,7 +41,7 @@ void run_pool(const PoolWork& w, const char* what) {
     Clock::time_point t0;
     std::size_t workers;
     ~Account() {
-      const double wall = seconds_between(t0, Clock::now());
+      const double wall = seconds_since(t0);
       use_so_far.wall += wall;
       use_so_far.offered += wall * static_cast<double>(workers);
     }
@@ -85,7 +85,7 @@ void run_pool(const PoolWork& w, const char* what) {
     while (::waitpid(c.pid, &ws, 0) < 0 && errno == EINTR) {
     }
     const int status = WIFEXITED(ws) ? WEXITSTATUS(ws) : 128 + WTERMSIG(ws);
-    use_so_far.busy += seconds_between(c.start, Clock::now());
+    use_so_far.busy += seconds_since(c.start);
     ++use_so_far.pieces;
     if (w.after) w.after(c.j, whole ? status : -1);
   }

@@ -30,4 +30,9 @@ class Progress {
 
 std::string format_duration(double seconds);
 
+/// Wall-clock seconds from t0 to now.
+inline double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
 }  // namespace dem
