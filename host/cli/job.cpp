@@ -18,22 +18,32 @@
 namespace dem {
 
 
+namespace {
+
+/// The `run` job's start: from its checkpoint `ckpt` where resumed (refused when that is at the step count already),
+/// else its initial snapshot.
+void resume_or_start(const Config& cfg, const std::string& ckpt, bool resume, Simulation& sim, io::Output& out) {
+  if (!resume) {
+    out.write_snapshot(take_snapshot(sim, "initial"));
+    return;
+  }
+  resume_from(resume_checkpoint(ckpt, "run", cfg.fingerprint), sim, &out);
+  if (sim.step_count() >= cfg.run.steps)
+    throw std::runtime_error(ckpt + " is at step " + std::to_string(sim.step_count()) + ", the step count is " +
+                             std::to_string(cfg.run.steps) + " ([run] steps or -n): nothing to continue; give -n above " +
+                             std::to_string(sim.step_count()) + " to run on");
+  std::printf("triaxdem: resuming %s at step %ld (t = %.6g s)\n", ckpt.c_str(), sim.step_count(), sim.time());
+}
+
+}  // namespace
+
 int run_job(const Config& cfg, bool resume, long stop_at_step) {
   io::Output out(cfg.run.output);
   auto sim = build_simulation(cfg, true);
   out.set_series_columns({"step", "time_s", "kinetic_energy_J", "unbalanced_ratio", "contacts_ball_ball",
                           "contacts_ball_wall", "wall_force_sum_N"});
   const std::string ckpt = checkpoint_path(out.folder());
-  if (resume) {
-    resume_from(resume_checkpoint(ckpt, "run", cfg.fingerprint), *sim, &out);
-    if (sim->step_count() >= cfg.run.steps)
-      throw std::runtime_error(ckpt + " is at step " + std::to_string(sim->step_count()) + ", the step count is " +
-                               std::to_string(cfg.run.steps) + " ([run] steps or -n): nothing to continue; give -n above " +
-                               std::to_string(sim->step_count()) + " to run on");
-    std::printf("triaxdem: resuming %s at step %ld (t = %.6g s)\n", ckpt.c_str(), sim->step_count(), sim->time());
-  } else {
-    out.write_snapshot(take_snapshot(*sim, "initial"));
-  }
+  resume_or_start(cfg, ckpt, resume, *sim, out);
   // One row of the time series; returns the unbalanced-force ratio (the stop criterion reads it too).
   auto record = [&]() {
     const auto c = sim->touching();
