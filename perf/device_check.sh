@@ -2,20 +2,42 @@
 # The GPU check (docs/performance.md, "GPU"): everything a lent GPU's few minutes should answer, prepared on the
 # CPU machine and run as one script there.
 #   perf/device_check.sh prepare REF       # CPU build: the reference runs the device's are compared with
+#   perf/device_check.sh pack BUILD DIR    # a CUDA build's programs and the Debian libraries they link, for `carry`
 #   perf/device_check.sh run REF OUT       # any build: particle-steps/s, launch overhead, CPU-GPU agreement, tests
 # BUILD: the build whose binaries run (default build); CPU_BUILD: the one that prepares (default build).
 # TINY=1: a few hundred balls and steps, no membrane specimen and not the suite's tests, for CI on any build.
-# PARTS: which of the suite's tests run (default "kernels other"; "kernels" when device time is short).
+# PARTS: which of the suite's tests run (default "kernels other"; "kernels" when device time is short), each part
+# for at most TEST_LIMIT s (90); FULL_LIMIT: seconds for the full-scale test from nothing (60).
 # Each stage has its own time limit, so that a slow stage costs its limit and not the rest.
 set -uo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 mode="${1:-}"; ref="$(realpath -m "${2:-}")"
-[ "$mode" = prepare ] || [ "$mode" = run ] && [ -n "${2:-}" ] ||
-  { echo "usage: perf/device_check.sh prepare REF | run REF OUT" >&2; exit 2; }
+[ "$mode" = prepare ] || [ "$mode" = pack ] || [ "$mode" = run ] && [ -n "${2:-}" ] ||
+  { echo "usage: perf/device_check.sh prepare REF | pack BUILD DIR | run REF OUT" >&2; exit 2; }
 tiny="${TINY:-0}"
 small_cfg="$root/configs/small/S1_100kPa.toml"
 # The membrane comparison: from a checkpoint inside consolidation to a few records into the shear.
 small_start=2000; small_stop=10000
+
+if [ "$mode" = pack ]; then
+  # A GPU machine starts bare: it gets the programs, the shared libraries they link from this machine (all but the C
+  # and C++ runtimes, which it has), and in DIR/build wrappers that look like a build folder to the run mode.
+  from="$ref"; dir="$(realpath -m "${3:?usage: perf/device_check.sh pack BUILD DIR}")"
+  rm -rf "$dir"; mkdir -p "$dir/bin" "$dir/lib" "$dir/build/tests"
+  progs=("$from/triaxdem"); for t in "$from"/tests/triaxdem_tests_*; do [ -x "$t" ] && [ -f "$t" ] && progs+=("$t"); done
+  for p in "${progs[@]}"; do
+    cp "$p" "$dir/bin/"; strip "$dir/bin/$(basename "$p")" 2>/dev/null || true  # symbols are a tenth of the size
+    ldd "$p" | awk '$3 ~ /^\// { print $3 }' | grep -Ev '/(libc|libm|libstdc\+\+|libgcc_s|ld-linux[^/]*|libcuda)\.so' |
+      xargs -r cp -Lu -t "$dir/lib/"
+    name="$(basename "$p")"; rel=build; [ "$name" = triaxdem ] || rel=build/tests
+    up=..; [ "$rel" = build ] || up=../..
+    printf '#!/usr/bin/env bash\nhere="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"\nLD_LIBRARY_PATH="$here/%s/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}" exec "$here/%s/bin/%s" "$@"\n' \
+      "$up" "$up" "$name" > "$dir/$rel/$name"
+    chmod +x "$dir/$rel/$name"
+  done
+  echo "device_check: packed ${#progs[@]} programs in $dir ($(du -sh "$dir" | cut -f1))"
+  exit 0
+fi
 
 if [ "$mode" = prepare ]; then
   bin="$(realpath "${CPU_BUILD:-$root/build}")/triaxdem"
@@ -66,6 +88,23 @@ timeout -k 5 60 "$bin" periodic "$ref/periodic.toml" -o "$out/periodic" --overwr
 grep "^time loop" "$out/periodic.log"
 "$py" "$root/tools/compare_runs.py" "$ref/periodic_cpu" "$out/periodic" || failed+=" periodic"
 
+# Today's way of running many calibration cells on one GPU: separate processes, each its own context and launches.
+# Their summed rate is the figure a batched simulation (issue 43 item 3) is measured against.
+cells="${CELLS:-16}"; [ "$tiny" = 1 ] && cells=2
+stage "$cells periodic cells as $cells processes at once"
+start=$(date +%s.%N)
+for i in $(seq "$cells"); do
+  timeout -k 5 120 "$bin" periodic "$ref/periodic.toml" -o "$out/cells/c$i" --overwrite > "$out/cells_$i.log" 2>&1 &
+done
+wait
+wall=$(awk -v s="$start" -v e="$(date +%s.%N)" 'BEGIN { print e - s }')
+# Each time loop's steps and particle-steps/s; the wall time holds the processes' starts, preparation and output too.
+cat "$out"/cells_*.log | sed -n 's/^time loop.*: \([0-9]*\) steps.*; \([0-9.e+]*\) particle-steps\/s.*/\1 \2/p' |
+  awk -v w="$wall" -v n="$(awk -F' = ' '$1 == "count" { print $2 }' "$ref/periodic.toml")" -v c="$cells" \
+  '{ s += $1; r += $2; k++ } END { printf "%d cells of %d balls (%d time loops): %.1f s wall for %d steps in all, " \
+     "%.3g particle-steps/s together; each time loop %.3g particle-steps/s on average\n", c, n, k, w, s, s * n / w, r / k }'
+rm -rf "$out/cells"
+
 if [ "$tiny" != 1 ]; then
   stage "membrane triaxial test against the CPU's (steps $small_start-$small_stop)"
   rm -rf "$out/small"; cp -r "$ref/small_start" "$out/small"
@@ -76,13 +115,14 @@ fi
 
 tests=$(find "$build/tests" -maxdepth 1 -type f -name 'triaxdem_tests_*' -perm -u+x 2>/dev/null | sort)
 if [ -n "$tests" ] && [ "$tiny" != 1 ]; then
-  kernels='ContactLaw.*:Detection.*:Dynamics.*:BlowUp.*:Membrane*:Stress.*:Micro.*:SimdLanes.*:Reference.*:PeriodicCell.*:IoHdf5.*:Checkpoint.*:Determinism.*:TriaxialMeasures.*'
-  limit=90
+  kernels='HotPath.*:Reduce.*:ContactLaw.*:Detection.*:Dynamics.*:BlowUp.*:Membrane*:Stress.*:Micro.*:SimdLanes.*:Reference.*:PeriodicCell.*:IoHdf5.*:Checkpoint.*:Determinism.*:TriaxialMeasures.*'
+  limit="${TEST_LIMIT:-90}"
   for part in ${PARTS:-kernels other}; do
     filter="$kernels"; [ "$part" = other ] && filter="-$kernels"
     stage "the suite's $part tests (at most $limit s)"
     # The unit tests are one executable per layer (tests/CMakeLists.txt): each runs the part's tests it holds.
-    timeout -k 5 "$limit" bash -c 'for t in $1; do "$t" --gtest_filter="$2"; done' _ "$tests" "$filter" \
+    # The tests that run the program as a child find it through TRIAXDEM_BINARY (a packed build is not where it was built).
+    TRIAXDEM_BINARY="$bin" timeout -k 5 "$limit" bash -c 'for t in $1; do "$t" --gtest_filter="$2"; done' _ "$tests" "$filter" \
       > "$out/tests_$part.log" 2>&1; echo "exit status $? (124: stopped at the limit)"
     echo "passed $(grep -c '^\[       OK \]' "$out/tests_$part.log"), failed $(grep -c '^\[  FAILED  \].*ms)$' "$out/tests_$part.log")"
     grep -E '^\[  FAILED  \].*ms\)$|^\[  SKIPPED \]' "$out/tests_$part.log"
@@ -91,11 +131,13 @@ if [ -n "$tests" ] && [ "$tiny" != 1 ]; then
 fi
 
 if [ "$tiny" != 1 ]; then
-  stage "full scale: the paper's S-1 specimen (53,704 beads), as far as 60 s go"
-  timeout -k 5 60 "$bin" specimen "$root/configs/paper/S1_100kPa.toml" -o "$out/full" > "$out/full.log" 2>&1
+  full_limit="${FULL_LIMIT:-60}"
+  stage "full scale: the paper's S-1 test (53,704 beads) from nothing, as far as $full_limit s go"
+  timeout -k 5 "$full_limit" "$bin" triaxial "$root/configs/paper/S1_100kPa.toml" -o "$out/full" > "$out/full.log" 2>&1
   echo "exit status $? (124: stopped at the limit)"
-  tr '\r' '\n' < "$out/full.log" | grep -E "layer|time loop" | awk 'NR % 20 == 1' | tail -n 12
-  tr '\r' '\n' < "$out/full.log" | grep -E "layer" | tail -n 1
+  tr '\r' '\n' < "$out/full.log" | grep -E "^specimen: layer|time loop|q_peak" | tail -n 12
+  tr '\r' '\n' < "$out/full.log" | grep -E "layer|consolidat|shear|axial" | tail -n 1
+  [ -f "$out/full/timings.csv" ] && cat "$out/full/timings.csv"
 fi
 stage "done"
 [ -z "$failed" ] || { echo "device_check: differed or failed:$failed"; exit 1; }

@@ -88,7 +88,7 @@ std::string text_of(const fs::path& p) {
 
 /// The triaxdem program, run as a child process (spawned: a fork of this multi-threaded test would not be safe).
 pid_t spawn_triaxdem(const std::vector<std::string>& args, const fs::path& log) {
-  std::vector<std::string> all{TRIAXDEM_BINARY};
+  std::vector<std::string> all{dem::test::triaxdem_binary()};
   all.insert(all.end(), args.begin(), args.end());
   std::vector<char*> argv;
   for (std::string& a : all) argv.push_back(a.data());

@@ -35,7 +35,7 @@ struct Outcome {
 /// printed (stdout and stderr).
 Outcome triaxdem(const std::string& args, const fs::path& dir, const std::string& prefix = "OMP_NUM_THREADS=1") {
   const fs::path log = dir / "log.txt";
-  const std::string cmd = "cd " + std::string(TRIAXDEM_SOURCE_DIR) + " && " + prefix + " " TRIAXDEM_BINARY " " +
+  const std::string cmd = "cd " + std::string(TRIAXDEM_SOURCE_DIR) + " && " + prefix + " " + dem::test::triaxdem_binary() + " " +
                           args + " > " + log.string() + " 2>&1";
   const int status = std::system(cmd.c_str());
   std::ifstream in(log);

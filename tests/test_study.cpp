@@ -98,7 +98,7 @@ TEST(Study, ResumeKeepsFinishedCasesAndRunsTheRest) {
   done.q_peak = 12345e3;
   std::filesystem::create_directories(dir / "out" / "a");
   write_summary((dir / "out" / "a").string(), done);
-  ASSERT_EQ(study_job({(dir / "configs").string()}, opt, TRIAXDEM_BINARY), 0);
+  ASSERT_EQ(study_job({(dir / "configs").string()}, opt, dem::test::triaxdem_binary().c_str()), 0);
   EXPECT_NEAR(read_summary((dir / "out" / "a" / "summary.csv").string()).q_peak, 12345e3, 1);
   const double b = read_summary((dir / "out" / "b" / "summary.csv").string()).q_peak;
   EXPECT_GT(b, 10e3);

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 
@@ -12,6 +13,13 @@
 namespace dem::test {
 
 constexpr double kPi = 3.14159265358979323846;
+
+/// The triaxdem program the tests that run it as a child use: the build's own, or $TRIAXDEM_BINARY where the tests
+/// run away from their build folder (a GPU machine gets the programs alone: perf/device_check.sh pack).
+inline std::string triaxdem_binary() {
+  const char* moved = std::getenv("TRIAXDEM_BINARY");
+  return moved && *moved ? moved : TRIAXDEM_BINARY;
+}
 
 /// An empty folder `name` (nested names allowed) of this test process's own: ctest runs every test at 1 and
 /// 2 threads, possibly at once, so the root carries the pid. The root goes when the process exits, so a

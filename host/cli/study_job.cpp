@@ -18,6 +18,7 @@
 #include "host/study/study.hpp"
 #include "host/util/process_pool.hpp"
 #include "host/util/progress.hpp"
+#include "kernels/core/types.hpp"
 
 namespace dem {
 
@@ -89,7 +90,13 @@ int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, c
   std::vector<MeasuredData> compare;  // read before anything runs: a bad file stops the study at once
   for (const std::string& f : opt.compare) compare.push_back(load_measured(f));
   const int cores = std::max(1u, std::thread::hardware_concurrency());
-  const int workers = std::clamp(opt.workers > 0 ? opt.workers : cores / 2, 1, static_cast<int>(cases.size()));
+  int workers = std::clamp(opt.workers > 0 ? opt.workers : cores / 2, 1, static_cast<int>(cases.size()));
+  if (kOnDevice && workers > 1) {
+    if (opt.workers > 1)
+      std::printf("study: one case at a time on the GPU, not %d: processes that share a GPU time-slice it and run "
+                  "slower together than one after another\n", opt.workers);
+    workers = 1;
+  }
   const int threads = opt.threads > 0 ? opt.threads : std::max(1, cores / workers);
   fs::create_directories(opt.output);
   std::printf("study: %zu cases, %d at a time with %d OpenMP threads each; logs in %s/<case>/log.txt\n",

@@ -188,8 +188,7 @@ void prepare_parallel_runs(int workers) {
 }
 
 int runs_at_once(int workers) {
-  constexpr bool host = std::is_same<ExecSpace::memory_space, Kokkos::HostSpace>::value;
-  return host && ExecSpace().concurrency() == 1 ? std::max(workers, 1) : 1;
+  return !kOnDevice && ExecSpace().concurrency() == 1 ? std::max(workers, 1) : 1;
 }
 
 int PeriodicLab::set_workers(int workers) { return workers_ = runs_at_once(workers); }

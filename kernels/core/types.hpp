@@ -3,6 +3,7 @@
 /// arguments: a change of layout or precision happens here and is measured in perf/.
 #include <Kokkos_Core.hpp>
 #include <cstdint>
+#include <type_traits>
 
 #include "kernels/core/contact_params.hpp"
 
@@ -14,6 +15,10 @@ using HostSpace = Kokkos::HostSpace;
 /// The execution space's natural layout: LayoutRight on CPUs (a 3-vector is one cache line for
 /// gathers through neighbour indices), LayoutLeft on GPUs (coalesced components). perf/ measures both.
 using Layout = ExecSpace::array_layout;
+/// Whether the kernels run on an accelerator. Processes that share one time-slice it: on an H100, 4 calibration
+/// cells as 4 processes ran 4.7 times slower together than one alone (docs/performance.md), so a device build runs
+/// one simulation at a time.
+constexpr bool kOnDevice = !std::is_same<MemSpace, HostSpace>::value;
 
 using Vec3View = Kokkos::View<Real* [3], Layout, MemSpace>;          ///< per-item 3-vector (m, m/s, N, ...)
 using ConstVec3View = Kokkos::View<const Real* [3], Layout, MemSpace>;
