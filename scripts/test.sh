@@ -8,6 +8,7 @@ cd "$root"
 bash scripts/setup.sh
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j2
+echo "test: set-up and build in ${SECONDS} s"
 log="$(mktemp)"
 trap 'rm -f "$log"' EXIT
 # Tests declare the cores they keep busy (PROCESSORS, tests/CMakeLists.txt), so ctest fills every core without
@@ -23,4 +24,6 @@ if [ "$passed" -lt "$expected" ]; then
   echo "test count: FAILED: fewer tests passed than tests/expected_test_count says; a test file or case dropped out" >&2
   exit 1
 fi
+echo "test: the suite done at ${SECONDS} s"
 bash tests/run_gates.sh
+echo "test: the gates done at ${SECONDS} s"

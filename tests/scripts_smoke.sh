@@ -69,7 +69,8 @@ check perf/stage_profile.sh env BUILD="$build" WORK="$work/profile" CONFIG="$roo
 grep -q "^shear .* | " "$work/stage_profile.sh.log" && grep -q "^diagnose: .* runs" "$work/stage_profile.sh.log" ||
   { cat "$work/stage_profile.sh.log"; echo "scripts_smoke: stage_profile gave no shear stage or no diagnosis" >&2; exit 1; }
 check perf/device_check.sh bash -c "TINY=1 CPU_BUILD='$build' bash '$root/perf/device_check.sh' prepare '$work/dc_ref' &&
-  TINY=1 BUILD='$build' bash '$root/perf/device_check.sh' run '$work/dc_ref' '$work/dc'"
+  bash '$root/perf/device_check.sh' pack '$build' '$work/dc_pack' &&
+  TINY=1 BUILD='$work/dc_pack/build' bash '$root/perf/device_check.sh' run '$work/dc_ref' '$work/dc'"
 # The peers' packing format and the instruction count, on a 216-ball packing, triaxdem alone (the peers are
 # Debian packages the CI does not install).
 sed -e 's/^count = .*/count = 216/' -e 's/^size_mm = .*/size_mm = [11.94, 11.94, 11.94]/' \
@@ -92,7 +93,9 @@ check perf/specimen_scatter.sh env BUILD="$build" WORK="$work/scatter" SEEDS=2 F
   bash "$root/perf/specimen_scatter.sh"
 check tools/specimen_scatter.py "$py" "$root/tools/specimen_scatter.py" "$work/scatter"
 check perf/bench_engine "$build/perf/bench_engine" --benchmark_filter='BM_TimeLoop/12/1' --benchmark_min_time=0.01
-check perf/hidden_sweep "$build/perf/hidden_sweep" --config "$base" --seeds 1 --hidden none -j 1 -o "$work/sweep.csv"
+# The data on a cell of the simulator's size: the generator's larger cell is the sweep's default, not what this checks.
+check perf/hidden_sweep "$build/perf/hidden_sweep" --config "$base" --seeds 1 --hidden none -j 1 --data-cell-factor 1 \
+  -o "$work/sweep.csv"
 exists "$work/sweep.csv"
 check perf/inertial_scan "$build/perf/inertial_scan" --config "$base" --specimens 2 --pressures 100 \
   --inertial 1e-3,4e-3 -j 1 -o "$work/inertial.csv"

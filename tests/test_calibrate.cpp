@@ -190,8 +190,10 @@ TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
   PeriodicLab lab(cfg, false, 2, 1);
   Model m;
   m.law = cfg.ball;
-  std::vector<TriaxialTest> like(3);
-  for (int k = 0; k < 3; ++k) like[k].sigma3 = 100e3 * (k + 1);
+  // Two pressures: each member runs at both, and run_each below gives one to each member. (Under the sanitizers a
+  // run is about 25 times slower; a third pressure cost the gate 27 s and checked nothing more.)
+  std::vector<TriaxialTest> like(2);
+  for (int k = 0; k < 2; ++k) like[k].sigma3 = 100e3 * (k + 1);
   const Ensemble one = lab.run_ensemble(m, like);
   ASSERT_EQ(lab.set_workers(2), 2) << "the runs fork only from a one-thread process (ctest runs this test so)";
   // The scatter measurement printed nothing for minutes: a labelled batch reports its runs as they come back.
@@ -199,10 +201,10 @@ TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
   testing::internal::CaptureStdout();
   const Ensemble par = lab.run_ensemble(m, like);
   const std::string shown = testing::internal::GetCapturedStdout();
-  EXPECT_NE(shown.find("scatter 6/6 (100%)"), std::string::npos) << shown;
+  EXPECT_NE(shown.find("scatter 4/4 (100%)"), std::string::npos) << shown;
   lab.set_progress("");
-  ASSERT_EQ(par.size(), 3u);
-  for (int k = 0; k < 3; ++k) {
+  ASSERT_EQ(par.size(), 2u);
+  for (int k = 0; k < 2; ++k) {
     ASSERT_EQ(par[k].size(), 2u);
     for (int j = 0; j < 2; ++j) {
       EXPECT_EQ(par[k][j].sigma3, like[k].sigma3);
@@ -214,14 +216,14 @@ TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
     }
     EXPECT_NE(one[k][0].q, one[k][1].q) << "the two members are different specimens";
   }
-  EXPECT_EQ(lab.runs(), 12);
+  EXPECT_EQ(lab.runs(), 8);
   // Specimens packed side by side are those packed one at a time; run_each runs test k on member k % 2.
   PeriodicLab packed_apart(cfg, false, 2, 1, 0, 2);
   ASSERT_EQ(packed_apart.workers(), 2);
   for (int j = 0; j < 2; ++j) EXPECT_EQ(packed_apart.prepared_void_ratio(j), lab.prepared_void_ratio(j));
   const std::vector<TriaxialTest> each = packed_apart.run_each(m, like);
-  ASSERT_EQ(each.size(), 3u);
-  for (int k = 0; k < 3; ++k) EXPECT_EQ(each[k].q, one[k][k % 2].q) << "sigma3 " << like[k].sigma3;
+  ASSERT_EQ(each.size(), 2u);
+  for (int k = 0; k < 2; ++k) EXPECT_EQ(each[k].q, one[k][k % 2].q) << "sigma3 " << like[k].sigma3;
 }
 
 // A run stopped by a blow-up gives no test (every quantity missing) and is counted with its pressure, so that the
