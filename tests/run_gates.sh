@@ -3,10 +3,10 @@
 # and libFuzzer's coverage (build-gates/), in which
 #   1. the fast tests (unit tests and readers, one thread) run: any sanitizer report fails its test;
 #   2. each fuzz harness runs for a fixed time (tests/fuzz/run_fuzz.sh): a finding fails the gate.
-#   tests/run_gates.sh [FUZZ_SECONDS]        (default 30 s per harness)
+#   tests/run_gates.sh [FUZZ_SECONDS]        (default 20 s per harness: six harnesses, three rounds on 2 cores)
 # The whole suite under sanitizers (gcc, slower): tests/run_sanitizers.sh.
 set -euo pipefail
-secs="${1:-30}"
+secs="${1:-20}"
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${TRIAXDEM_GATES_BUILD:-$root/build-gates}"
 # Line tables, not full debug information: a report's stack still names file and line, and the build (from scratch in
