@@ -101,8 +101,10 @@ wall=$(awk -v s="$start" -v e="$(date +%s.%N)" 'BEGIN { print e - s }')
 # Each time loop's steps and particle-steps/s; the wall time holds the processes' starts, preparation and output too.
 cat "$out"/cells_*.log | sed -n 's/^time loop.*: \([0-9]*\) steps.*; \([0-9.e+]*\) particle-steps\/s.*/\1 \2/p' |
   awk -v w="$wall" -v n="$(awk -F' = ' '$1 == "count" { print $2 }' "$ref/periodic.toml")" -v c="$cells" \
-  '{ s += $1; r += $2; k++ } END { printf "%d cells of %d balls (%d time loops): %.1f s wall for %d steps in all, " \
-     "%.3g particle-steps/s together; each time loop %.3g particle-steps/s on average\n", c, n, k, w, s, s * n / w, r / k }'
+  '{ s += $1; r += $2; k++ }
+   END { if (k == 0) { printf "%d cells of %d balls: none finished within its 120 s (%.1f s wall)\n", c, n, w; exit }
+         printf "%d cells of %d balls (%d finished): %.1f s wall for %d steps in all, %.3g particle-steps/s " \
+           "together; each time loop %.3g particle-steps/s on average\n", c, n, k, w, s, s * n / w, r / k }'
 rm -rf "$out/cells"
 
 if [ "$tiny" != 1 ]; then
