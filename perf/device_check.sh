@@ -29,8 +29,8 @@ if [ "$mode" = pack ]; then
     cp "$p" "$dir/bin/"; strip "$dir/bin/$(basename "$p")" 2>/dev/null || true  # symbols are a tenth of the size
     ldd "$p" | awk '$3 ~ /^\// { print $3 }' | grep -Ev '/(libc|libm|libstdc\+\+|libgcc_s|ld-linux[^/]*|libcuda)\.so' |
       xargs -r cp -Lu -t "$dir/lib/"
-    name="$(basename "$p")"; rel=build; [ "$name" = triaxdem ] || rel=build/tests
-    up=..; [ "$rel" = build ] || up=../..
+    name="$(basename "$p")"
+    case "$name" in triaxdem) rel=build; up=.. ;; *) rel=build/tests; up=../.. ;; esac
     printf '#!/usr/bin/env bash\nhere="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"\nLD_LIBRARY_PATH="$here/%s/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}" exec "$here/%s/bin/%s" "$@"\n' \
       "$up" "$up" "$name" > "$dir/$rel/$name"
     chmod +x "$dir/$rel/$name"

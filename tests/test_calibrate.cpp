@@ -192,8 +192,9 @@ TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
   m.law = cfg.ball;
   // Two pressures: each member runs at both, and run_each below gives one to each member. (Under the sanitizers a
   // run is about 25 times slower; a third pressure cost the gate 27 s and checked nothing more.)
-  std::vector<TriaxialTest> like(2);
-  for (int k = 0; k < 2; ++k) like[k].sigma3 = 100e3 * (k + 1);
+  constexpr int kPressures = 2;
+  std::vector<TriaxialTest> like(kPressures);
+  for (int k = 0; k < kPressures; ++k) like[k].sigma3 = 100e3 * (k + 1);
   const Ensemble one = lab.run_ensemble(m, like);
   ASSERT_EQ(lab.set_workers(2), 2) << "the runs fork only from a one-thread process (ctest runs this test so)";
   // The scatter measurement printed nothing for minutes: a labelled batch reports its runs as they come back.
@@ -204,7 +205,7 @@ TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
   EXPECT_NE(shown.find("scatter 4/4 (100%)"), std::string::npos) << shown;
   lab.set_progress("");
   ASSERT_EQ(par.size(), 2u);
-  for (int k = 0; k < 2; ++k) {
+  for (int k = 0; k < kPressures; ++k) {
     ASSERT_EQ(par[k].size(), 2u);
     for (int j = 0; j < 2; ++j) {
       EXPECT_EQ(par[k][j].sigma3, like[k].sigma3);
@@ -223,7 +224,7 @@ TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
   for (int j = 0; j < 2; ++j) EXPECT_EQ(packed_apart.prepared_void_ratio(j), lab.prepared_void_ratio(j));
   const std::vector<TriaxialTest> each = packed_apart.run_each(m, like);
   ASSERT_EQ(each.size(), 2u);
-  for (int k = 0; k < 2; ++k) EXPECT_EQ(each[k].q, one[k][k % 2].q) << "sigma3 " << like[k].sigma3;
+  for (int k = 0; k < kPressures; ++k) EXPECT_EQ(each[k].q, one[k][k % 2].q) << "sigma3 " << like[k].sigma3;
 }
 
 // A run stopped by a blow-up gives no test (every quantity missing) and is counted with its pressure, so that the
