@@ -8,7 +8,8 @@ here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 
 pkgs=(cmake g++ make libeigen3-dev libhdf5-dev libcli11-dev libtomlplusplus-dev
       libgtest-dev googletest libbenchmark-dev python3-matplotlib python3-h5py python3-numpy
-      clang libclang-rt-dev libomp-dev)  # clang: the sanitizer and fuzz gates (tests/run_gates.sh)
+      clang libclang-rt-dev libomp-dev  # clang: the sanitizer and fuzz gates (tests/run_gates.sh)
+      libopenmpi-dev openmpi-bin)       # optional for a build; jobs spread over ranks (docs/cluster.md)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

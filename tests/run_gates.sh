@@ -2,7 +2,8 @@
 # The gates after the suite (scripts/test.sh): one clang build with AddressSanitizer, UndefinedBehaviorSanitizer
 # and libFuzzer's coverage (build-gates/), in which
 #   1. the fast tests (unit tests and readers, one thread) run: any sanitizer report fails its test;
-#   2. each fuzz harness runs for a fixed time (tests/fuzz/run_fuzz.sh): a finding fails the gate.
+#   2. each fuzz harness runs for a fixed time (tests/fuzz/run_fuzz.sh): a finding fails the gate;
+#   3. the program, built without MPI, refuses a start by mpirun.
 #   tests/run_gates.sh [FUZZ_SECONDS]        (default 20 s per harness: six harnesses, three rounds on 2 cores)
 # The whole suite under sanitizers (gcc, slower): tests/run_sanitizers.sh.
 set -euo pipefail
@@ -13,7 +14,7 @@ build="${TRIAXDEM_GATES_BUILD:-$root/build-gates}"
 # CI) compiles about a fifth faster (calibrate.cpp 31.5 -> 25.9 s, its object 16.5 -> 3.8 MB).
 cmake -S "$root" -B "$build" -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -gline-tables-only -DNDEBUG" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O2 -gline-tables-only -DNDEBUG" \
-  -DTRIAXDEM_FUZZ=ON -DTRIAXDEM_SANITIZE=address,undefined -DTRIAXDEM_PERF=OFF >/dev/null
+  -DTRIAXDEM_FUZZ=ON -DTRIAXDEM_SANITIZE=address,undefined -DTRIAXDEM_PERF=OFF -DTRIAXDEM_MPI=OFF >/dev/null
 targets=$(sed -n 's/^foreach(target \(.*\))$/\1/p' "$root/tests/fuzz/CMakeLists.txt")
 cmake --build "$build" -j"$(nproc)" --target triaxdem triaxdem_tests $targets
 # Leak reports from the OpenMP runtime's thread pool at exit are not ours; everything else stops the test.
@@ -28,3 +29,12 @@ echo "gates: the fast tests under ASan and UBSan"
 (cd "$build" && ctest -j"$(nproc)" --output-on-failure -R "$fast" -E '\.omp2$|^Calibrate\.(AutoCell|MeasureMisfitCountsTheCellsBias|StateIsMatched|AMatchNear)')
 echo "gates: fuzzing, ${secs} s per harness"
 TRIAXDEM_FUZZ_BUILD="$build" TRIAXDEM_FUZZ_CONFIGURED=1 bash "$root/tests/fuzz/run_fuzz.sh" "$secs"
+# Built without MPI (as this build is), a program that mpirun starts as one of several ranks must stop before it
+# writes anything: each rank would run the whole job into the same folder.
+echo "gates: a build without MPI refuses mpirun"
+nompi="$build/nompi_check"; rm -rf "$nompi"
+if OMPI_COMM_WORLD_SIZE=3 OMPI_COMM_WORLD_RANK=0 "$build/triaxdem" study "$root/configs/small" -o "$nompi" > "$build/nompi.log" 2>&1; then
+  echo "gates: FAILED: a build without MPI ran a study that mpirun started as 3 ranks" >&2; exit 1
+fi
+grep -q "built without MPI" "$build/nompi.log" && [ ! -e "$nompi" ] ||
+  { cat "$build/nompi.log"; echo "gates: FAILED: no clear refusal, or the folder was made" >&2; exit 1; }

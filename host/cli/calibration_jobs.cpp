@@ -18,6 +18,7 @@
 #include "host/io/io_hdf5.hpp"
 #include "host/triax/summary.hpp"
 #include "host/util/progress.hpp"
+#include "host/util/ranks.hpp"
 #include "host/util/text_format.hpp"
 
 namespace dem {
@@ -25,6 +26,7 @@ namespace dem {
 namespace fs = std::filesystem;
 
 std::string new_dated_folder(const std::string& parent, const std::string& prefix) {
+  if (!ranks::leader()) return ranks::agree("");  // the leader's folder: each rank's clock would name another
   const std::time_t now = std::time(nullptr);
   char stamp[32];
   std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", std::localtime(&now));
@@ -32,7 +34,7 @@ std::string new_dated_folder(const std::string& parent, const std::string& prefi
   const std::string stem = (fs::path(parent) / (prefix + "_" + stamp)).string();
   for (int k = 1;; ++k) {
     const std::string path = k == 1 ? stem : stem + "-" + std::to_string(k);
-    if (fs::create_directory(path)) return path;  // false: it exists; never reuse it
+    if (fs::create_directory(path)) return ranks::agree(path);  // false: it exists; never reuse it
   }
 }
 

@@ -8,6 +8,7 @@
 #include "host/io/io_hdf5.hpp"
 #include "host/triax/summary.hpp"
 #include "host/util/process_pool.hpp"
+#include "host/util/ranks.hpp"
 #include "host/util/progress.hpp"
 #include "host/util/text_format.hpp"
 
@@ -97,6 +98,7 @@ Session::Session(const Config& base, const CalibrationOptions& o, const std::str
       lab(matched(reference_cell(base, o.reference_test), o.workers), true, o.workers),
       folder(o.resume.empty() ? new_dated_folder(o.output, kind) : resumed_folder(o.resume, kind)),
       output(o.resume.empty() ? o.output : resumed_parent(o.resume)) {
+  ranks::check_shared_folder(folder);  // every rank reads the run store there
   lab.set_run_store(folder + "/runs");
   if (!o.resume.empty())
     std::printf("%s: resuming in %s: the runs stored there are read, not run again\n", kind.c_str(), folder.c_str());

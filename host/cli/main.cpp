@@ -3,6 +3,7 @@
 #include <Kokkos_Core.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -24,6 +25,7 @@
 #include "host/config/provenance.hpp"
 #include "host/study/study.hpp"
 #include "host/triax/triaxial.hpp"
+#include "host/util/ranks.hpp"
 #include "host/util/text_format.hpp"
 
 namespace {
@@ -266,9 +268,48 @@ int run_command(const Commands& c, Args& a) {
   return dem::run_job(cfg, a.resume, a.stop_at);
 }
 
+/// The study's folder claimed by the leader alone, with every rank told whether it was refused, then checked to be
+/// seen by every rank (each writes its cases there).
+dem::io::FolderLock claim_for_all_ranks(const std::string& folder) {
+  dem::io::FolderLock lock;
+  std::string refused;
+  if (dem::ranks::leader()) {
+    try {
+      lock = dem::io::FolderLock(folder);
+    } catch (const std::exception& e) {
+      refused = e.what();
+    }
+  }
+  if (const std::string why = dem::ranks::agree(refused); !why.empty()) throw std::runtime_error(why);
+  dem::ranks::check_shared_folder(folder);
+  return lock;
+}
+
+/// An error ends the program: on one rank as ever; spread over ranks, every rank stops, as a rank left alone would
+/// wait for the others at the next pool. Every rank meets the same error on the same inputs: the leader says it,
+/// and a shadow only where the leader has not ended the job first (an error of that rank's own).
+int fail(const std::string& text) {
+  if (!dem::ranks::spread()) {
+    std::fprintf(stderr, "%s\n", text.c_str());
+    return 1;
+  }
+  if (!dem::ranks::leader()) std::this_thread::sleep_for(std::chrono::seconds(3));
+  dem::ranks::error_line(text);
+  dem::ranks::abort_all(1);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  try {
+    dem::ranks::start(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "triaxdem: %s\n", e.what());
+    return 1;
+  }
+  struct RanksEnd {
+    ~RanksEnd() { dem::ranks::stop(); }
+  } ranks_end;  // after Kokkos' own end below
   CLI::App app{"triaxdem: DEM laboratory for triaxial tests on granular materials"};
   app.set_version_flag("--version", dem::version_line());
   app.require_subcommand(1);
@@ -290,29 +331,37 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "triaxdem: %s\n", problem.c_str());
     return 1;
   }
-  // Parallel calibration runs are child processes of one thread each (PeriodicLab::set_workers).
-  if (c.calibrate->parsed() || c.diagnose->parsed()) dem::prepare_parallel_runs(a.cal.workers);
+  if (dem::ranks::spread()) {
+    if (!c.study->parsed() && !c.calibrate->parsed() && !c.diagnose->parsed())
+      return fail("triaxdem: only study, calibrate and diagnose spread over MPI ranks (their runs are independent); "
+                  "run one test without mpirun or srun");
+    // A calibration's runs are child processes of one thread each, as on one machine (PeriodicLab::set_workers):
+    // one rank per core. A study's cases are programs of their own, with the node's cores shared among its ranks.
+    a.cal.workers = std::max(2, dem::ranks::size() - 1);
+    if (!c.study->parsed()) dem::prepare_parallel_runs(a.cal.workers);
+    dem::ranks::quiet_shadows();
+  } else if (c.calibrate->parsed() || c.diagnose->parsed()) {
+    // Parallel calibration runs are child processes of one thread each (PeriodicLab::set_workers).
+    dem::prepare_parallel_runs(a.cal.workers);
+  }
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // progress reaches a log file as it happens
   if (c.study->parsed()) {  // the study only starts child processes: no Kokkos of its own
     try {
-      const dem::io::FolderLock lock(a.study.output);  // two studies into one folder would mix their cases
+      // Two studies into one folder would mix their cases.
+      const dem::io::FolderLock lock = claim_for_all_ranks(a.study.output);
       return dem::study_job(a.study_inputs, a.study, "/proc/self/exe");
     } catch (const std::exception& e) {
-      std::fprintf(stderr, "triaxdem: %s\n", e.what());
-      return 1;
+      return fail(std::string("triaxdem: ") + e.what());
     }
   }
   Kokkos::ScopeGuard guard(argc, argv);
   try {
     return run_command(c, a);
   } catch (const dem::DataError& e) {
-    std::fprintf(stderr, "triaxdem: data error: %s\n", e.what());
-    return 1;
+    return fail(std::string("triaxdem: data error: ") + e.what());
   } catch (const dem::ConfigError& e) {
-    std::fprintf(stderr, "triaxdem: config error: %s\n", e.what());
-    return 1;
+    return fail(std::string("triaxdem: config error: ") + e.what());
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "triaxdem: error: %s\n", e.what());
-    return 1;
+    return fail(std::string("triaxdem: error: ") + e.what());
   }
 }

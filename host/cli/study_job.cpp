@@ -18,6 +18,7 @@
 #include "host/study/study.hpp"
 #include "host/util/process_pool.hpp"
 #include "host/util/progress.hpp"
+#include "host/util/ranks.hpp"
 #include "kernels/core/types.hpp"
 
 namespace dem {
@@ -26,9 +27,14 @@ namespace fs = std::filesystem;
 
 namespace {
 
+/// How a case starts: afresh, from its checkpoint (study --resume, or a rerun after its process was killed), or over
+/// the outputs a killed process left without a checkpoint.
+enum class Start : char { fresh, resume, overwrite };
+
 /// In the child of piece `c`: `self job config -o folder` with its output in folder/log.txt and `threads` OpenMP
-/// threads. `resume`: the case continues from its checkpoint, and its log goes on.
-[[noreturn]] void exec_case(const char* self, const StudyCase& c, const std::string& folder, int threads, bool resume) {
+/// threads. Resumed, the case continues from its checkpoint, and its log goes on.
+[[noreturn]] void exec_case(const char* self, const StudyCase& c, const std::string& folder, int threads, Start start) {
+  const bool resume = start == Start::resume;
   const std::string log = folder + "/log.txt";
   const int fd = open(log.c_str(), O_WRONLY | O_CREAT | (resume ? O_APPEND : O_TRUNC), 0644);
   if (fd >= 0) {
@@ -38,8 +44,8 @@ namespace {
   }
   setenv("OMP_NUM_THREADS", std::to_string(threads).c_str(), 1);
   setenv("OMP_PROC_BIND", "false", 0);
-  execl(self, self, c.job.c_str(), c.config.c_str(), "-o", folder.c_str(), resume ? "--resume" : nullptr,
-        static_cast<char*>(nullptr));
+  const char* flag = resume ? "--resume" : start == Start::overwrite ? "--overwrite" : nullptr;
+  execl(self, self, c.job.c_str(), c.config.c_str(), "-o", folder.c_str(), flag, static_cast<char*>(nullptr));
   std::perror("study: exec");
   _exit(127);
 }
@@ -97,8 +103,11 @@ int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, c
                   "slower together than one after another\n", opt.workers);
     workers = 1;
   }
-  const int threads = opt.threads > 0 ? opt.threads : std::max(1, cores / workers);
+  if (ranks::spread()) workers = ranks::size() - 1;  // the leader hands out the cases; each other rank runs one
+  const int threads =
+      opt.threads > 0 ? opt.threads : std::max(1, cores / (ranks::spread() ? ranks::per_node() : workers));
   fs::create_directories(opt.output);
+  if (ranks::spread()) std::printf("study: spread over %d MPI ranks\n", ranks::size());
   std::printf("study: %zu cases, %d at a time with %d OpenMP threads each; logs in %s/<case>/log.txt\n",
               cases.size(), workers, threads, opt.output.c_str());
   std::vector<int> status(cases.size(), -1);
@@ -111,8 +120,12 @@ int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, c
   // Kept cases took no time in this run: left out of the rate behind the ETA.
   Progress progress("study", static_cast<long>(cases.size()), kept);
   std::vector<std::chrono::steady_clock::time_point> started(cases.size());
-  std::vector<char> go_on(cases.size(), 0);
+  std::vector<Start> start(cases.size(), Start::fresh);
   auto folder = [&](std::size_t k) { return opt.output + "/" + cases[k].name; };
+  // Only the triaxial job checkpoints; a periodic case (minutes) starts again.
+  auto has_checkpoint = [&](std::size_t k) {
+    return cases[k].job == "triaxial" && fs::exists(checkpoint_path(folder(k)));
+  };
   PoolWork w;
   w.pieces = cases.size();
   w.workers = workers;
@@ -123,15 +136,15 @@ int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, c
       ++done;
       return false;
     }
-    // Only the triaxial job checkpoints; a periodic case (minutes) starts again.
-    go_on[k] = opt.resume && cases[k].job == "triaxial" && fs::exists(checkpoint_path(folder(k)));
+    start[k] = opt.resume && has_checkpoint(k) ? Start::resume : Start::fresh;
     fs::create_directories(folder(k));
     started[k] = std::chrono::steady_clock::now();
-    std::printf("study: %s %s (%s)\n", go_on[k] ? "resumed" : "started", cases[k].name.c_str(),
+    std::printf("study: %s %s (%s)\n", start[k] == Start::resume ? "resumed" : "started", cases[k].name.c_str(),
                 cases[k].config.c_str());
     return true;
   };
-  w.child = [&](std::size_t k, int) { exec_case(self_exe, cases[k], folder(k), threads, go_on[k] != 0); };
+  w.again = [&](std::size_t k) { start[k] = has_checkpoint(k) ? Start::resume : Start::overwrite; };
+  w.child = [&](std::size_t k, int) { exec_case(self_exe, cases[k], folder(k), threads, start[k]); };
   w.after = [&](std::size_t k, int st) {
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - started[k]).count();
     status[k] = st;

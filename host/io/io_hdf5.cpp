@@ -2,6 +2,7 @@
 
 #include "host/io/h5_file.hpp"
 #include "host/io/xdmf.hpp"
+#include "host/util/ranks.hpp"
 
 #include <hdf5.h>
 
@@ -342,6 +343,7 @@ FolderLock claim_output_folder(const std::string& folder, bool resume, bool over
 }
 
 void write_text_atomic(const std::string& path, const std::string& text) {
+  if (!ranks::leader()) return;  // a shadow rank computes what the leader writes
   replace_atomically(path, [&](const std::string& tmp) { write_text_file(tmp, path, text); });
 }
 

@@ -17,6 +17,7 @@
 #include "host/util/forked_runs.hpp"
 #include "host/triax/periodic_triaxial.hpp"
 #include "host/util/progress.hpp"
+#include "host/util/ranks.hpp"
 #include "host/lab/run_store.hpp"
 
 namespace dem {
@@ -188,6 +189,9 @@ void prepare_parallel_runs(int workers) {
 }
 
 int runs_at_once(int workers) {
+  // Spread over ranks, the pools' pieces go to the other ranks, one at a time each (ranks.hpp), in child processes:
+  // a GPU build cannot fork once its device has started, so there every rank runs every piece itself.
+  if (ranks::spread()) return kOnDevice ? 1 : std::max(2, ranks::size() - 1);
   return !kOnDevice && ExecSpace().concurrency() == 1 ? std::max(workers, 1) : 1;
 }
 

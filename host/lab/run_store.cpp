@@ -8,6 +8,7 @@
 #include "host/util/fnv1a.hpp"
 #include "host/io/io_hdf5.hpp"
 #include "host/config/provenance.hpp"
+#include "host/util/ranks.hpp"
 
 namespace dem {
 
@@ -26,6 +27,7 @@ bool read_stored(const std::string& path, const std::function<bool(int fd)>& rea
 }
 
 void write_stored(const std::string& path, const std::string& bytes) {
+  if (!ranks::leader()) return;
   std::filesystem::create_directories(std::filesystem::path(path).parent_path());
   io::write_text_atomic(path, bytes);
 }

@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "host/io/io_hdf5.hpp"
+#include "host/util/ranks.hpp"
 #include "host/util/text_format.hpp"
 
 namespace dem {
@@ -170,6 +171,7 @@ bool summarise_series(const std::string& folder, TestSummary& s) {
 }
 
 bool run_plot_script(const std::string& script, const std::vector<std::string>& args) {
+  if (!ranks::leader()) return true;  // the leader draws it
   const std::string path = find_tool(script);
   if (path.empty()) {
     std::fprintf(stderr, "triaxdem: tools/%s not found: no plot drawn\n", script.c_str());

@@ -1,6 +1,7 @@
 #include "host/util/process_pool.hpp"
 
 #include "host/util/progress.hpp"
+#include "host/util/ranks.hpp"
 
 #include <poll.h>
 #include <sys/wait.h>
@@ -27,7 +28,21 @@ using Clock = std::chrono::steady_clock;
 
 PoolUse pool_use() { return use_so_far; }
 
+void record_pool_use(double busy, double wall, int workers, long pieces) {
+  use_so_far.busy += busy;
+  use_so_far.wall += wall;
+  use_so_far.offered += wall * workers;
+  use_so_far.pieces += pieces;
+}
+
 void run_pool(const PoolWork& w, const char* what) {
+  // A piece whose process a signal ended (the machine's out-of-memory killer, a node's fault) gets a second rank.
+  constexpr int kTries = 2;
+  if (ranks::spread()) ranks::run_pool_on_ranks(w, what, kTries);
+  else run_pool_here(w, what);
+}
+
+void run_pool_here(const PoolWork& w, const char* what) {
   struct Child {
     std::size_t j;
     pid_t pid;

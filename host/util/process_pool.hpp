@@ -20,13 +20,19 @@ struct PoolWork {
   /// In the parent as piece j's pipe turns readable: reads its result (none: return true); false where it is cut
   /// short. Results come in the order the children end: put result j in its place.
   std::function<bool(std::size_t, int)> collect;
+  /// Spread over ranks (ranks.hpp), before piece j runs again on another rank after a signal killed its process part
+  /// way: readies it to start over from what that process left (unset: it starts as the first time).
+  std::function<void(std::size_t)> again;
   /// In the parent once piece j has ended: its exit status as a shell gives it (128 + the signal that ended it),
   /// or -1 where collect found its result cut short.
   std::function<void(std::size_t, int)> after;
 };
 
-/// Runs the pieces; `what` names them in the error when a pipe or a process cannot be made.
+/// Runs the pieces; `what` names them in the error when a pipe or a process cannot be made. In a job spread over
+/// MPI ranks (ranks.hpp) the ranks run them, one piece each at a time; else this process's children.
 void run_pool(const PoolWork& w, const char* what);
+/// The pieces in this process's children, whatever the ranks.
+void run_pool_here(const PoolWork& w, const char* what);
 
 /// How this process's pools have been used so far, for a job's account of its workers: a pool of W workers that
 /// runs for T seconds offers W T worker-seconds; what its pieces did not use, its workers sat idle (the last pieces
@@ -39,5 +45,7 @@ struct PoolUse {
   double idle() const { return offered - busy; }
 };
 PoolUse pool_use();
+/// Adds a pool that ran elsewhere (on the ranks) to pool_use().
+void record_pool_use(double busy, double wall, int workers, long pieces);
 
 }  // namespace dem
