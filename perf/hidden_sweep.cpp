@@ -8,25 +8,44 @@
 /// About 1.5 minutes a case on 2 cores with the default simulator (tests/data/hidden_effects.toml). Each seed
 /// draws the same quantile of every extension's range (log-uniform), so a row compares the extensions at the
 /// same relative strength.
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 #include <Kokkos_Core.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "host/fit/calibrate.hpp"
 #include "host/config/config.hpp"
 #include "host/fit/diagnose.hpp"
+#include "host/util/forked_runs.hpp"
+#include "host/util/process_pool.hpp"
 #include "host/util/progress.hpp"
+#include "host/util/ranks.hpp"
 
 using namespace dem;
 
 int main(int argc, char** argv) {
+  // Under mpirun or srun the diagnoses' runs spread over the ranks, as triaxdem diagnose's do (host/util/ranks.hpp).
+  try {
+    ranks::start(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "hidden_sweep: %s\n", e.what());
+    return 1;
+  }
+  struct RanksEnd {
+    ~RanksEnd() { ranks::stop(); }
+  } ranks_end;
+  const auto t0 = std::chrono::steady_clock::now();
   CLI::App app("triaxdem hidden-effect identification sweep");
   std::string config = std::string(TRIAXDEM_SOURCE_DIR) + "/tests/data/hidden_effects.toml";
   std::string out = "hidden_sweep.csv";
@@ -61,8 +80,21 @@ int main(int argc, char** argv) {
   app.add_option("--data-cell-factor", data_cell, "the data's specimens have this many times the simulator's balls "
                  "(default " + std::to_string(kGeneratorCellFactor) + ")")->check(CLI::Range(1, 64));
   app.add_flag("--own-specimen", own, "generate the data on the diagnosis's own first specimen (the old, easier test)");
+  int cases_at_once = 1;
+  app.add_option("--cases-at-once", cases_at_once, "cases run side by side, each a child process whose diagnosis runs "
+                 "one run at a time (-j is then unused; under mpirun the ranks take the cases, one each at a time)")
+      ->check(CLI::Range(1, 512));
   CLI11_PARSE(app, argc, argv);
-  prepare_parallel_runs(workers);
+  // Cases side by side (or spread over ranks): each a diagnosis in a child of one thread, its own runs one at a time.
+  // The sweep's diagnoses hold few runs per pool, so cases, not runs, are what many workers can share.
+  const bool case_pool = cases_at_once > 1 || ranks::spread();
+  if (case_pool) {
+    workers = 1;
+    prepare_parallel_runs(2);
+    ranks::quiet_shadows();
+  } else {
+    prepare_parallel_runs(workers);
+  }
   Kokkos::ScopeGuard guard(argc, argv);
   Config cfg = load_config(config);
   if (ensemble == "auto") cfg.calibrate.ensemble = kAutoEnsemble;
@@ -91,7 +123,7 @@ int main(int argc, char** argv) {
     bool named;
   };
   std::vector<Residue> residues;
-  std::ofstream csv(out);
+  std::ofstream csv(ranks::leader() ? out : "/dev/null");  // the leader writes
   // Every extension's BIC gain and held-out chi2 too, so that a decision rule can be judged on the whole sweep.
   csv << "hidden,strength,seed,verdict,base_chi2,chi2_limit,base_heldout,true_heldout,data_show,base_chi2_over_null";
   for (const Extension& e : extensions()) csv << "," << e.name << "_bic_gain," << e.name << "_heldout";
@@ -100,61 +132,158 @@ int main(int argc, char** argv) {
   csv << "\n";
   std::vector<unsigned> seeds = listed;
   for (unsigned s = first; listed.empty() && s <= last; ++s) seeds.push_back(s);
-  Progress progress("hidden sweep", static_cast<long>(run.size() * seeds.size()));
-  long done = 0;
+  struct Case {
+    unsigned seed;
+    std::string hidden;
+  };
+  std::vector<Case> cases;
   for (unsigned seed : seeds)
-    for (const std::string& h : run) {
-      Model truth = base;
-      Real strength = 0;
-      if (h != "none") set_param(truth, extension(h).param, strength = draw_strength(extension(h), seed));
-      // The data come from a specimen per pressure that the diagnosis never runs (own: its first member, as before).
-      PeriodicLab generator(own ? cfg : larger_cell(cfg, data_cell), false, own ? 1 : 3,
-                            own ? cfg.run.seed : cfg.run.seed + kForeignSeedOffset + 3 * seed, 0, workers);
-      const std::vector<TriaxialTest> data = synthetic_tests(generator, truth, {100e3, 200e3, 300e3}, "hidden", seed, noise);
-      StateMatch state;  // the data's void ratio sets the preparation, as triaxdem diagnose does
-      PeriodicLab matched(matched_state(cfg, data, state, false, match_plan(cfg, workers)), false, workers);
-      const Diagnosis dg = diagnose(matched, base, free, data, measure_misfit(matched, base, data, NoiseOptions()), false);
-      Real true_heldout = dg.base_heldout;
-      bool data_show = false;
-      for (const ExtensionFit& f : dg.fits)
-        if (f.ext.name == h) true_heldout = f.heldout, data_show = f.accepted;
-      // A tie ("a or b") counts for the first named; the CSV keeps the whole verdict.
-      const std::string named = dg.verdict.substr(0, dg.verdict.find(' '));
-      ++confusion[h][named];
-      if (h != "none") (named == h ? found : missed)[h].push_back(strength);
-      shown += data_show;  // never for "none": no extension has that name
-      shown_right += data_show && named == h;
-      if (named != h && named != "none") {
-        std::string line = h + " " + std::to_string(strength) + " named " + named + ":";
-        for (const ExtensionFit& f : dg.fits)
-          if (f.ext.name == h || f.ext.name == named)
-            line += " " + f.ext.name + " BIC gain " + std::to_string(dg.base_bic - f.bic) + ", held-out " +
-                    std::to_string(dg.base_heldout) + " -> " + std::to_string(f.heldout) + ";";
-        mixups.push_back(line);
-      }
-      if (h == "none") null_chi2[seed] = dg.base.best.chi2;
-      const bool has_null = null_chi2.count(seed) > 0;
-      const Real over_null = has_null ? dg.base.best.chi2 - null_chi2[seed] : 0;
-      if (h != "none" && has_null) residues.push_back({h, strength, over_null, named == h});
-      char row[256];
-      std::snprintf(row, sizeof row, "%s,%.4g,%u,%s,%.2f,%.2f,%.2f,%.2f,%d,", h.c_str(), strength, seed,
-                    dg.verdict.c_str(), dg.base.best.chi2, dg.chi2_limit, dg.base_heldout, true_heldout, data_show);
-      csv << row;
-      if (has_null) {
-        std::snprintf(row, sizeof row, "%.2f", over_null);
-        csv << row;
-      }
-      for (const ExtensionFit& f : dg.fits) {
-        std::snprintf(row, sizeof row, ",%.2f,%.2f", dg.base_bic - f.bic, f.heldout);
-        csv << row;
-      }
-      for (std::size_t k = 0; k < free.size(); ++k) {
-        std::snprintf(row, sizeof row, ",%.4g", free[k].shown * dg.base.values[k]);
-        csv << row;
-      }
-      csv << "\n" << std::flush;
-      progress.update(++done, h + " -> " + dg.verdict);
+    for (const std::string& h : run) cases.push_back({seed, h});
+  // One case's diagnosis, as text: verdict, then strength, chi2s and held-out values, then each fit's name, BIC and
+  // held-out chi2, then the base values. Reals as %a, so that a case run in a child comes back to the bit.
+  auto diagnose_case = [&](const Case& c) {
+    Model truth = base;
+    Real strength = 0;
+    if (c.hidden != "none") set_param(truth, extension(c.hidden).param, strength = draw_strength(extension(c.hidden), c.seed));
+    // The data come from a specimen per pressure that the diagnosis never runs (own: its first member, as before).
+    PeriodicLab generator(own ? cfg : larger_cell(cfg, data_cell), false, own ? 1 : 3,
+                          own ? cfg.run.seed : cfg.run.seed + kForeignSeedOffset + 3 * c.seed, 0, workers);
+    const std::vector<TriaxialTest> data =
+        synthetic_tests(generator, truth, {100e3, 200e3, 300e3}, "hidden", c.seed, noise);
+    StateMatch state;  // the data's void ratio sets the preparation, as triaxdem diagnose does
+    PeriodicLab matched(matched_state(cfg, data, state, false, match_plan(cfg, workers)), false, workers);
+    const Diagnosis dg = diagnose(matched, base, free, data, measure_misfit(matched, base, data, NoiseOptions()), false);
+    std::string t = dg.verdict + "\n";
+    char num[64];
+    auto put = [&](double v) {
+      std::snprintf(num, sizeof num, "%a ", v);
+      t += num;
+    };
+    for (double v : {double(strength), double(dg.base.best.chi2), double(dg.chi2_limit), double(dg.base_heldout),
+                     double(dg.base_bic)})
+      put(v);
+    t += "\n";
+    for (const ExtensionFit& f : dg.fits) {
+      t += f.ext.name + " " + (f.accepted ? "1 " : "0 ");
+      put(f.bic);
+      put(f.heldout);
     }
+    t += "\n";
+    for (Real v : dg.base.values) put(v);
+    return t + "\n";
+  };
+  // A case's row and its share of the tables, in case order as the cases end: "none" comes first at every seed, and
+  // the others are set against it.
+  std::vector<std::string> results(cases.size());
+  auto emit = [&](std::size_t j) {
+    const std::string& h = cases[j].hidden;
+    const unsigned seed = cases[j].seed;
+    std::istringstream in(results[j]);
+    std::string verdict, line;
+    std::getline(in, verdict);
+    auto real = [](std::istream& is) {
+      std::string tok;
+      is >> tok;
+      return static_cast<Real>(std::strtod(tok.c_str(), nullptr));
+    };
+    std::getline(in, line);
+    std::istringstream nums(line);
+    const Real strength = real(nums), base_chi2 = real(nums), chi2_limit = real(nums), base_heldout = real(nums),
+               base_bic = real(nums);
+    struct Fit {
+      std::string name;
+      bool accepted;
+      Real bic, heldout;
+    };
+    std::vector<Fit> fits;
+    std::getline(in, line);
+    std::istringstream fl(line);
+    for (Fit f; fl >> f.name;) {
+      int acc = 0;
+      fl >> acc;
+      f.accepted = acc != 0;
+      f.bic = real(fl);
+      f.heldout = real(fl);
+      fits.push_back(f);
+    }
+    std::getline(in, line);
+    std::istringstream bl(line);
+    std::vector<Real> base_values;
+    for (std::size_t k = 0; k < free.size(); ++k) base_values.push_back(real(bl));
+    Real true_heldout = base_heldout;
+    bool data_show = false;
+    for (const Fit& f : fits)
+      if (f.name == h) true_heldout = f.heldout, data_show = f.accepted;
+    // A tie ("a or b") counts for the first named; the CSV keeps the whole verdict.
+    const std::string named = verdict.substr(0, verdict.find(' '));
+    ++confusion[h][named];
+    if (h != "none") (named == h ? found : missed)[h].push_back(strength);
+    shown += data_show;  // never for "none": no extension has that name
+    shown_right += data_show && named == h;
+    if (named != h && named != "none") {
+      std::string text = h + " " + std::to_string(strength) + " named " + named + ":";
+      for (const Fit& f : fits)
+        if (f.name == h || f.name == named)
+          text += " " + f.name + " BIC gain " + std::to_string(base_bic - f.bic) + ", held-out " +
+                  std::to_string(base_heldout) + " -> " + std::to_string(f.heldout) + ";";
+      mixups.push_back(text);
+    }
+    if (h == "none") null_chi2[seed] = base_chi2;
+    const bool has_null = null_chi2.count(seed) > 0;
+    const Real over_null = has_null ? base_chi2 - null_chi2[seed] : 0;
+    if (h != "none" && has_null) residues.push_back({h, strength, over_null, named == h});
+    char row[256];
+    std::snprintf(row, sizeof row, "%s,%.4g,%u,%s,%.2f,%.2f,%.2f,%.2f,%d,", h.c_str(), strength, seed,
+                  verdict.c_str(), base_chi2, chi2_limit, base_heldout, true_heldout, data_show);
+    csv << row;
+    if (has_null) {
+      std::snprintf(row, sizeof row, "%.2f", over_null);
+      csv << row;
+    }
+    for (const Fit& f : fits) {
+      std::snprintf(row, sizeof row, ",%.2f,%.2f", base_bic - f.bic, f.heldout);
+      csv << row;
+    }
+    for (std::size_t k = 0; k < free.size(); ++k) {
+      std::snprintf(row, sizeof row, ",%.4g", free[k].shown * base_values[k]);
+      csv << row;
+    }
+    csv << "\n" << std::flush;
+  };
+  std::size_t next_row = 0;
+  Progress progress("hidden sweep", static_cast<long>(cases.size()));
+  long done = 0;
+  auto case_done = [&](std::size_t j) {
+    progress.update(++done, cases[j].hidden + " -> " + results[j].substr(0, results[j].find('\n')));
+    while (next_row < cases.size() && !results[next_row].empty()) emit(next_row++);
+  };
+  if (case_pool) {
+    PoolWork w;
+    w.pieces = cases.size();
+    w.workers = cases_at_once;
+    w.child = [&](std::size_t j, int fd) {
+      const std::string t = diagnose_case(cases[j]);
+      put_bytes(fd, t.data(), t.size());
+    };
+    w.collect = [&](std::size_t j, int fd) {
+      char buf[4096];
+      results[j].clear();
+      for (ssize_t r; (r = ::read(fd, buf, sizeof buf)) > 0;) results[j].append(buf, static_cast<std::size_t>(r));
+      return !results[j].empty();
+    };
+    w.after = [&](std::size_t j, int status) {
+      if (status != 0)
+        throw std::runtime_error("hidden_sweep: the case " + cases[j].hidden + ", seed " + std::to_string(cases[j].seed) +
+                                 " failed (exit status " + std::to_string(status) + ")");
+      case_done(j);
+    };
+    run_pool(w, "hidden sweep");
+  } else {
+    for (std::size_t j = 0; j < cases.size(); ++j) {
+      results[j] = diagnose_case(cases[j]);
+      case_done(j);
+    }
+  }
   progress.finish("");
   std::printf("\nconfusion matrix (rows: hidden effect, columns: named by diagnose), %zu seeds:\n%-10s", seeds.size(),
               "hidden");
@@ -203,5 +332,9 @@ int main(int argc, char** argv) {
     for (const Residue& r : residues)
       std::printf("%-10s %12.4g %14.1f %s\n", r.hidden.c_str(), r.strength, r.over_null, r.named ? "yes" : "no");
   }
+  // Each pool's pieces and their run times: tools/schedule_projection.py projects the sweep on more ranks from it.
+  if (ranks::leader())
+    std::ofstream(out + ".pools.csv")
+        << pools_csv(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   return 0;
 }

@@ -37,6 +37,7 @@ sed -e 's/^ensemble = .*/ensemble = 1/' -e 's/^scatter_specimens = .*/scatter_sp
   > "$work/cal.log" 2>&1
 cal="$(ls -d "$work"/cal/calibrate_*)"
 
+check tools/schedule_projection.py "$py" "$root/tools/schedule_projection.py" "$cal/pools.csv" --ranks 2,64
 check tools/plot_triaxial.py "$py" "$root/tools/plot_triaxial.py" "$work/tiny" -o "$work/triaxial.png"
 exists "$work/triaxial.png"
 check tools/plot_micro.py "$py" "$root/tools/plot_micro.py" "$work/tiny"

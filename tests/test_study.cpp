@@ -9,6 +9,7 @@
 
 #include "host/cli/job.hpp"
 #include "host/study/study.hpp"
+#include "host/util/process_pool.hpp"
 #include "test_util.hpp"
 
 using namespace dem;
@@ -239,4 +240,24 @@ TEST(Study, KeptCasesAreSummarisedAfreshFromTheirSeries) {
   untouched.q_peak = 7;
   EXPECT_FALSE(summarise_series((dir / "nothing_here").string(), untouched));
   EXPECT_EQ(untouched.q_peak, 7);
+}
+
+// The study starts its longest cases first (process_pool.hpp's start_order, by study_case_cost). At one inertial
+// number a case's shear takes steps as 1/sqrt(sigma3): the paper's S-1 cases took 65 min at 100 kPa and 34 at
+// 300 kPa on 2 threads (docs/performance.md), so a 100 kPa case must come before any 300 kPa case, and the estimate's
+// ratio is sqrt(3) for the same specimen. Without a cost the pieces start in index order.
+TEST(Study, LongestCasesStartFirst) {
+  const auto cases = study_cases({std::string(TRIAXDEM_SOURCE_DIR) + "/configs/paper"});
+  PoolWork w;
+  w.pieces = cases.size();
+  std::vector<std::size_t> plain = start_order(w);
+  for (std::size_t k = 0; k < plain.size(); ++k) EXPECT_EQ(plain[k], k);
+  w.cost = [&](std::size_t k) { return cases[k].cost; };
+  const std::vector<std::size_t> order = start_order(w);
+  ASSERT_EQ(order.size(), 9u);
+  EXPECT_NE(cases[order.front()].name.find("100kPa"), std::string::npos) << cases[order.front()].name;
+  EXPECT_NE(cases[order.back()].name.find("300kPa"), std::string::npos) << cases[order.back()].name;
+  for (std::size_t k = 1; k < order.size(); ++k) EXPECT_GE(cases[order[k - 1]].cost, cases[order[k]].cost);
+  // S1_100kPa is case 0 and S1_300kPa case 2 (name order): the same specimen at three times the pressure.
+  EXPECT_NEAR(cases[0].cost / cases[2].cost, std::sqrt(3.0), 1e-9);
 }

@@ -195,6 +195,7 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
   ss.finish(all_meas, all_sim, "the calibrated parameters");
   const std::string prediction = ss.predict_boundary(base, models);
   if (!prediction.empty()) io::write_text_atomic(ss.folder + "/prediction.md", prediction);
+  ss.write_pools();
   return 0;
 }
 
@@ -263,6 +264,7 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
   // The report stands before the membrane tests run; their section is added when they end.
   const std::string prediction = ss.predict_boundary(base, models);
   if (!prediction.empty()) io::write_text_atomic(ss.folder + "/diagnosis.md", md.str() + "\n" + prediction);
+  ss.write_pools();
   return 0;
 }
 

@@ -133,6 +133,8 @@ std::string Session::workers_text() const {
          fmt(" (idle %.0f worker-seconds, waiting for the longest piece of a batch)", use.idle());
 }
 
+void Session::write_pools() const { io::write_text_atomic(folder + "/pools.csv", pools_csv(seconds_since(started))); }
+
 std::string Session::failed_text() const {
   return std::to_string(lab.failed_runs()) + " of the runs stopped at a blow-up" +
          fmt(" (up to %g kPa)", 1e-3 * lab.highest_failed_sigma3()) +

@@ -64,6 +64,9 @@ struct Session {
   /// How the runs used the workers: their mean length, the workers' busy share while the pools ran (the rest
   /// they waited for a batch's longest run) and the pools' share of the job's time (the rest the fits took).
   std::string workers_text() const;
+  /// pools.csv in the result folder: each pool's pieces and their run times, and the job's wall time so far
+  /// (tools/schedule_projection.py projects the job on more ranks from it).
+  void write_pools() const;
   std::string failed_text() const;
   std::vector<std::string> free_names() const;
   /// The membrane test at `model` on every test of `tests`, q in the data's measure (a template must be set).

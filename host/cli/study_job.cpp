@@ -92,6 +92,7 @@ int print_study_table(const std::vector<StudyCase>& cases, const StudyTable& tab
 }  // namespace
 
 int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, const char* self_exe) {
+  const auto t0 = std::chrono::steady_clock::now();
   const std::vector<StudyCase> cases = study_cases(inputs);
   std::vector<MeasuredData> compare;  // read before anything runs: a bad file stops the study at once
   for (const std::string& f : opt.compare) compare.push_back(load_measured(f));
@@ -129,6 +130,7 @@ int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, c
   PoolWork w;
   w.pieces = cases.size();
   w.workers = workers;
+  w.cost = [&](std::size_t k) { return cases[k].cost; };
   w.before = [&](std::size_t k) {
     if (finished_before(k)) {
       std::printf("study: %s finished before (summary.csv): kept\n", cases[k].name.c_str());
@@ -157,11 +159,18 @@ int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, c
   };
   run_pool(w, "study");
   progress.finish("");
+  // The schedule's efficiency: the cases' run times summed, against the wall time times the workers (ranks).
+  if (const PoolUse use = pool_use(); use.pieces > 0)
+    std::printf("study: %ld cases ran for %s in all, in %s on %d %s: %.0f%% efficiency (the rest idle, waiting for the "
+                "last case)\n", use.pieces, format_duration(use.busy).c_str(), format_duration(use.wall).c_str(),
+                workers, ranks::spread() ? "ranks" : "workers", 100 * use.busy / std::max(use.offered, 1e-9));
 
   const StudyTable table = study_table(cases, status, opt.output, compare);
   const int failed = print_study_table(cases, table, opt);
   io::write_text_atomic(opt.output + "/study_summary.csv", table.csv);
-  std::printf("\nstudy: summary in %s/study_summary.csv\n", opt.output.c_str());
+  io::write_text_atomic(opt.output + "/pools.csv",
+                        pools_csv(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()));
+  std::printf("\nstudy: summary in %s/study_summary.csv; the cases' run times in pools.csv\n", opt.output.c_str());
   if (run_plot_script("plot_study.py", {opt.output}))
     std::printf("study: figure in %s/study.png\n", opt.output.c_str());
   return failed == 0 ? 0 : 1;

@@ -27,6 +27,20 @@ namespace dem {
 
 namespace fs = std::filesystem;
 
+double study_case_cost(const Config& cfg) {
+  const double d = cfg.particles.diameter;
+  const double ball = M_PI / 6 * d * d * d;
+  if (cfg.has_periodic) {
+    const PeriodicTriaxialParams& t = cfg.periodic.triax;
+    return static_cast<double>(cfg.particles.count) * t.target_strain / (t.target_inertial * std::sqrt(t.sigma3));
+  }
+  const SpecimenConfig& s = cfg.specimen;
+  const double balls = s.ball_count > 0 ? static_cast<double>(s.ball_count)
+                                        : M_PI / 4 * s.diameter * s.diameter * s.height / (1 + s.void_ratio) / ball;
+  const TriaxialConfig& t = cfg.triaxial;
+  return balls * t.axial_strain_end / (t.inertial_number * std::sqrt(t.sigma3));
+}
+
 std::vector<StudyCase> study_cases(const std::vector<std::string>& inputs) {
   std::vector<std::string> files;
   for (const std::string& in : inputs) {
@@ -50,6 +64,7 @@ std::vector<StudyCase> study_cases(const std::vector<std::string>& inputs) {
     c.config = f;
     c.material = cfg.run.material;
     c.name = fs::path(f).stem().string();
+    c.cost = study_case_cost(cfg);
     if (cfg.has_periodic) c.job = "periodic";
     else if (cfg.has_specimen) c.job = "triaxial";
     else throw ConfigError(f + ": neither a [specimen] (membrane test) nor a [periodic] table: not a triaxial test");

@@ -18,7 +18,14 @@ struct StudyCase {
   std::string name;             ///< file stem, also the output subfolder
   std::string job;              ///< "triaxial" ([specimen] + [triaxial]) or "periodic" ([periodic])
   std::string material;         ///< [run] material ("" when the config names none)
+  /// The case's work relative to the others', from its config (study_case_cost): the study starts the longest first.
+  double cost = 0;
 };
+
+/// A case's work in arbitrary units, for the order the cases start in: balls times the shear's steps, which at one
+/// ball size and stiffness go as the strain to reach over the inertial number times sqrt(sigma3) (the strain rate
+/// is I sqrt(sigma3 / rho) / d). The specimen's packing, which grows with the balls alone, rides on the balls.
+double study_case_cost(const Config& cfg);
 
 /// The cases of `inputs` (folders, whose *.toml files are taken in name order, or single files). Every file
 /// is validated first; one that describes no triaxial test is refused with its name and why.

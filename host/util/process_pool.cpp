@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cstdio>
 #include <iostream>
+#include <numeric>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -21,6 +22,7 @@ namespace dem {
 namespace {
 
 PoolUse use_so_far;
+std::vector<PoolRecord> records;
 
 using Clock = std::chrono::steady_clock;
 
@@ -28,11 +30,33 @@ using Clock = std::chrono::steady_clock;
 
 PoolUse pool_use() { return use_so_far; }
 
-void record_pool_use(double busy, double wall, int workers, long pieces) {
-  use_so_far.busy += busy;
-  use_so_far.wall += wall;
-  use_so_far.offered += wall * workers;
-  use_so_far.pieces += pieces;
+void record_pool(PoolRecord r) {
+  for (double s : r.piece_seconds) use_so_far.busy += s;
+  use_so_far.pieces += static_cast<long>(r.piece_seconds.size());
+  use_so_far.wall += r.wall;
+  use_so_far.offered += r.wall * r.workers;
+  records.push_back(std::move(r));
+}
+
+std::string pools_csv(double job_wall) {
+  std::string out = "# the process pools of a job: each piece's run time (s); job_wall_s " +
+                    std::to_string(job_wall) + "\npool,what,workers,pool_wall_s,piece,seconds\n";
+  char line[256];
+  for (std::size_t p = 0; p < records.size(); ++p)
+    for (std::size_t k = 0; k < records[p].piece_seconds.size(); ++k) {
+      std::snprintf(line, sizeof line, "%zu,%s,%d,%.3f,%zu,%.3f\n", p + 1, records[p].what.c_str(), records[p].workers,
+                    records[p].wall, k + 1, records[p].piece_seconds[k]);
+      out += line;
+    }
+  return out;
+}
+
+std::vector<std::size_t> start_order(const PoolWork& w) {
+  std::vector<std::size_t> order(w.pieces);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  if (w.cost)
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return w.cost(a) > w.cost(b); });
+  return order;
 }
 
 void run_pool(const PoolWork& w, const char* what) {
@@ -50,22 +74,21 @@ void run_pool_here(const PoolWork& w, const char* what) {
     Clock::time_point start;
   };
   const std::size_t workers = static_cast<std::size_t>(w.workers > 1 ? w.workers : 1);
-  const Clock::time_point t0 = Clock::now();
-  // The offer is counted as the pool ends, whichever way: by then every child it started has ended.
+  // Recorded as the pool ends, whichever way: by then every child it started has ended.
   struct Account {
-    Clock::time_point t0;
-    std::size_t workers;
+    PoolRecord r;
+    Clock::time_point t0 = Clock::now();
     ~Account() {
-      const double wall = seconds_since(t0);
-      use_so_far.wall += wall;
-      use_so_far.offered += wall * static_cast<double>(workers);
+      r.wall = seconds_since(t0);
+      record_pool(std::move(r));
     }
-  } account{t0, std::min(workers, std::max<std::size_t>(w.pieces, 1))};
+  } account{{what, static_cast<int>(std::min(workers, std::max<std::size_t>(w.pieces, 1))), 0, {}}};
   std::vector<Child> running;
+  const std::vector<std::size_t> order = start_order(w);
   std::size_t next = 0;
   for (;;) {
     while (next < w.pieces && running.size() < workers) {
-      const std::size_t j = next++;
+      const std::size_t j = order[next++];
       if (w.before && !w.before(j)) continue;
       std::cout.flush();
       std::fflush(nullptr);  // a child must not write the parent's buffered output again
@@ -100,8 +123,7 @@ void run_pool_here(const PoolWork& w, const char* what) {
     while (::waitpid(c.pid, &ws, 0) < 0 && errno == EINTR) {
     }
     const int status = WIFEXITED(ws) ? WEXITSTATUS(ws) : 128 + WTERMSIG(ws);
-    use_so_far.busy += seconds_since(c.start);
-    ++use_so_far.pieces;
+    account.r.piece_seconds.push_back(seconds_since(c.start));
     if (w.after) w.after(c.j, whole ? status : -1);
   }
 }

@@ -6,12 +6,17 @@
 /// result, from that pipe alone.
 #include <cstddef>
 #include <functional>
+#include <string>
+#include <vector>
 
 namespace dem {
 
 struct PoolWork {
   std::size_t pieces = 0;
   int workers = 1;
+  /// Piece j's work relative to the others' (unset: all alike): the pool starts the longest first, so that the last
+  /// to end is not a long one started late. Results do not depend on the order.
+  std::function<double(std::size_t)> cost;
   /// In the parent, before piece j starts: false leaves it out (finished before, or the pool is stopping).
   std::function<bool(std::size_t)> before;
   /// In the child: the piece, with `fd` the write end of its pipe. The child ends with exit status 0 when this
@@ -33,6 +38,8 @@ struct PoolWork {
 void run_pool(const PoolWork& w, const char* what);
 /// The pieces in this process's children, whatever the ranks.
 void run_pool_here(const PoolWork& w, const char* what);
+/// The order the pieces start in: by cost, longest first, ties (and all, without a cost) in index order.
+std::vector<std::size_t> start_order(const PoolWork& w);
 
 /// How this process's pools have been used so far, for a job's account of its workers: a pool of W workers that
 /// runs for T seconds offers W T worker-seconds; what its pieces did not use, its workers sat idle (the last pieces
@@ -45,7 +52,17 @@ struct PoolUse {
   double idle() const { return offered - busy; }
 };
 PoolUse pool_use();
-/// Adds a pool that ran elsewhere (on the ranks) to pool_use().
-void record_pool_use(double busy, double wall, int workers, long pieces);
+/// One pool as it ran: its name, its workers, its wall time and each piece's run time (s), in the order they ended.
+struct PoolRecord {
+  std::string what;
+  int workers = 1;
+  double wall = 0;
+  std::vector<double> piece_seconds;
+};
+/// Adds a pool to pool_use() and to pools_csv() (run_pool does; so does the pool spread over ranks).
+void record_pool(PoolRecord r);
+/// This process's pools so far as CSV (pools.csv in a job's folder), with the job's wall time in its first line:
+/// what tools/schedule_projection.py needs to project the job's wall time on more ranks.
+std::string pools_csv(double job_wall);
 
 }  // namespace dem

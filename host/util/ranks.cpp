@@ -284,7 +284,8 @@ class Leader {
  public:
   Leader(const PoolWork& w, const char* what, int tries, std::function<bool(std::size_t)> before)
       : w_(w), what_(what), tries_(tries), before_(std::move(before)), tried_(w.pieces, 0), last_rank_(w.pieces, -1),
-        started_(w.pieces), holds_(static_cast<std::size_t>(my_size), -1), heard_(static_cast<std::size_t>(my_size)) {
+        started_(w.pieces), holds_(static_cast<std::size_t>(my_size), -1), heard_(static_cast<std::size_t>(my_size)),
+        order_(start_order(w)) {
     for (int r = my_size - 1; r >= 1; --r)
       if (alive()[static_cast<std::size_t>(r)]) idle_.push_back(r);
   }
@@ -297,7 +298,7 @@ class Leader {
       if (busy_ == 0) break;
       wait_for_word();
     }
-    record_pool_use(piece_seconds_, seconds(t0), my_size - 1, static_cast<long>(w_.pieces));
+    record_pool({what_, my_size - 1, seconds(t0), std::move(piece_seconds_)});
     return std::move(events_);
   }
 
@@ -315,7 +316,7 @@ class Leader {
       return j;
     }
     while (next_ < w_.pieces) {
-      const std::size_t k = next_++;
+      const std::size_t k = order_[next_++];
       const bool go = before_(k);
       events_.push_back({static_cast<long>(k), 0, go ? 1 : 0, {}});
       if (go) return k;
@@ -387,7 +388,7 @@ class Leader {
     --busy_;
     holds_[static_cast<std::size_t>(r)] = -1;
     idle_.push_back(r);
-    piece_seconds_ += seconds(started_[j]);
+    piece_seconds_.push_back(seconds(started_[j]));
     if (status > 128) {
       char why[96];
       std::snprintf(why, sizeof why, "its process was killed on rank %d (signal %d)", r, status - 128);
@@ -427,9 +428,10 @@ class Leader {
   std::vector<int> idle_;
   std::deque<std::size_t> again_;
   std::vector<Event> events_;
+  std::vector<std::size_t> order_;
   std::size_t next_ = 0;
   int busy_ = 0;
-  double piece_seconds_ = 0;
+  std::vector<double> piece_seconds_;  // each run's time, killed ones included (their rank's time was spent)
 };
 
 }  // namespace
