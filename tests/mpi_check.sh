@@ -59,7 +59,11 @@ echo "mpi_check: study on 3 ranks, rank 2 killed part way: identical to the loca
 # one specimen, to 1%).
 sed -e 's/^ensemble = .*/ensemble = 1/' -e 's/^scatter_specimens = .*/scatter_specimens = 2/' \
     -e 's/^target_axial_strain_pct = .*/target_axial_strain_pct = 1.0/' "$root/tests/data/hidden_effects.toml" > base.toml
-"$tdem" synth --config base.toml -o data.csv --extension none --seed 1 --pressures 100 > synth.log 2>&1
+"$tdem" synth --config base.toml -o synth.csv --extension none --seed 1 --pressures 100 > synth.log 2>&1
+# Without the data's void ratio: no state match, whose packings were two thirds of each job (33 -> 10 s); the pools
+# (the specimens' packing, the cell-bias check, the ensemble's runs) are the same code.
+awk -F, 'BEGIN { OFS = "," } /^#/ { print; next } { print $1, $2, $3, $4, $5, $7 }' synth.csv > data.csv
+head -3 data.csv | grep -q "^material,sigma3_kPa,eps_a_pct,q_kPa,eps_v_pct,specimen_balls$" || fail "data.csv's columns"
 for job in calibrate diagnose; do
   args=(data.csv --config base.toml --predict none)
   "$tdem" "$job" "${args[@]}" -o "${job}_local" -j 2 > "${job}_local.log" 2>&1 || { cat "${job}_local.log"; fail "$job"; }

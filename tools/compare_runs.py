@@ -6,7 +6,7 @@ row by row, and for checkpoint.h5 (read with h5py where installed) every numeric
 when every value is equal as written (CSV: the text; HDF5: the bits); otherwise it gives the largest relative
 difference, |a - b| / max(|a|, |b|, floor), with the column and row where it occurs. The floor (default 1e-12)
 keeps values that are zero in one run from dividing by zero. What says where and how long a run ran, not what it
-computed, is left out: wall-clock times (wall_s, a checkpoint's stage_times_s, timings.csv) and the build and machine
+computed, is left out: wall-clock times (wall_s, a checkpoint's stage_times_s, timings.csv, pools.csv) and the build and machine
 (version, backend, config: a CSV column or an HDF5 dataset whose name ends in an ignored name).
 
     tools/compare_runs.py RUN_A RUN_B [--tolerance 1e-9] [--floor 1e-12] [--ignore wall_s,...]
@@ -115,8 +115,8 @@ def main():
     for run in (args.run_a, args.run_b):
         if not os.path.isdir(run):
             sys.exit(f"compare_runs: {run}: not a folder")
-    # timings.csv says how long each stage took, nothing the run computed.
-    files = sorted((set(os.listdir(args.run_a)) & set(os.listdir(args.run_b))) - {"timings.csv"})
+    # timings.csv and pools.csv say how long each stage and each run took, nothing the job computed.
+    files = sorted((set(os.listdir(args.run_a)) & set(os.listdir(args.run_b))) - {"timings.csv", "pools.csv"})
     compared, failed = 0, False
     print(f"| file | values | unequal | largest relative difference | where | notes |\n|---|---|---|---|---|---|")
     for name in files:
