@@ -59,6 +59,31 @@ std::vector<std::size_t> start_order(const PoolWork& w) {
   return order;
 }
 
+int start_child(const char* what, int& read_fd, const std::function<void(int)>& body) {
+  std::cout.flush();
+  std::fflush(nullptr);
+  int fd[2];
+  if (::pipe(fd) != 0) throw std::runtime_error(std::string(what) + ": cannot create a pipe for a child process");
+  const pid_t pid = ::fork();
+  if (pid < 0) throw std::runtime_error(std::string(what) + ": cannot start a child process (fork failed)");
+  if (pid == 0) {
+    ::close(fd[0]);
+    body(fd[1]);
+    std::fflush(nullptr);
+    ::_exit(0);
+  }
+  ::close(fd[1]);
+  read_fd = fd[0];
+  return pid;
+}
+
+int wait_child(int pid) {
+  int ws = 0;
+  while (::waitpid(pid, &ws, 0) < 0 && errno == EINTR) {
+  }
+  return WIFEXITED(ws) ? WEXITSTATUS(ws) : 128 + WTERMSIG(ws);
+}
+
 void run_pool(const PoolWork& w, const char* what) {
   // A piece whose process a signal ended (the machine's out-of-memory killer, a node's fault) gets a second rank.
   constexpr int kTries = 2;
@@ -90,21 +115,12 @@ void run_pool_here(const PoolWork& w, const char* what) {
     while (next < w.pieces && running.size() < workers) {
       const std::size_t j = order[next++];
       if (w.before && !w.before(j)) continue;
-      std::cout.flush();
-      std::fflush(nullptr);  // a child must not write the parent's buffered output again
-      int fd[2];
-      if (::pipe(fd) != 0) throw std::runtime_error(std::string(what) + ": cannot create a pipe for a child process");
-      const pid_t pid = ::fork();
-      if (pid < 0) throw std::runtime_error(std::string(what) + ": cannot start a child process (fork failed)");
-      if (pid == 0) {
-        ::close(fd[0]);
+      int fd = -1;
+      const pid_t pid = start_child(what, fd, [&](int out) {
         for (const Child& c : running) ::close(c.fd);  // the siblings' pipes are the parent's to read
-        w.child(j, fd[1]);
-        std::fflush(nullptr);
-        ::_exit(0);
-      }
-      ::close(fd[1]);
-      running.push_back({j, pid, fd[0], Clock::now()});
+        w.child(j, out);
+      });
+      running.push_back({j, pid, fd, Clock::now()});
     }
     if (running.empty()) return;
     std::vector<pollfd> polled;
@@ -119,10 +135,7 @@ void run_pool_here(const PoolWork& w, const char* what) {
     running.erase(running.begin() + static_cast<std::ptrdiff_t>(k));
     const bool whole = !w.collect || w.collect(c.j, c.fd);
     ::close(c.fd);
-    int ws = 0;
-    while (::waitpid(c.pid, &ws, 0) < 0 && errno == EINTR) {
-    }
-    const int status = WIFEXITED(ws) ? WEXITSTATUS(ws) : 128 + WTERMSIG(ws);
+    const int status = wait_child(c.pid);
     account.r.piece_seconds.push_back(seconds_since(c.start));
     if (w.after) w.after(c.j, whole ? status : -1);
   }

@@ -38,6 +38,13 @@ struct PoolWork {
 void run_pool(const PoolWork& w, const char* what);
 /// The pieces in this process's children, whatever the ranks.
 void run_pool_here(const PoolWork& w, const char* what);
+/// A child process with a pipe back to this one. In the child: body(the pipe's write end), then exit status 0 with
+/// no atexit handlers (the parent owns those). In the parent: the child's pid, with `read_fd` the pipe's read end.
+/// Buffered output is flushed first, so that a child does not write it again; `what` names the work in the error
+/// when the pipe or the process cannot be made.
+int start_child(const char* what, int& read_fd, const std::function<void(int)>& body);
+/// Waits for a child started so; its exit status as a shell gives it (128 + the signal that ended it).
+int wait_child(int pid);
 /// The order the pieces start in: by cost, longest first, ties (and all, without a cost) in index order.
 std::vector<std::size_t> start_order(const PoolWork& w);
 

@@ -5,7 +5,6 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <sys/prctl.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -224,13 +223,8 @@ double rank_timeout() {
 /// On a shadow: piece j in a child process, as the local pool runs one, with word to the leader that this rank lives
 /// while it runs; its bytes and exit status then go to the leader.
 void serve_piece(const PoolWork& w, std::size_t j, const char* what) {
-  std::fflush(nullptr);
-  int fd[2];
-  if (::pipe(fd) != 0) throw std::runtime_error(std::string(what) + ": cannot create a pipe for a child process");
-  const pid_t pid = ::fork();
-  if (pid < 0) throw std::runtime_error(std::string(what) + ": cannot start a child process (fork failed)");
-  if (pid == 0) {
-    ::close(fd[0]);
+  int fd = -1;
+  const int pid = start_child(what, fd, [&](int out) {
     // The piece ends with its rank: a piece given to another rank must not race an orphan in the same folder.
     ::prctl(PR_SET_PDEATHSIG, SIGKILL);
     // The child is a process of its own, as the local pool's are: it writes what they write, and a program it
@@ -238,23 +232,20 @@ void serve_piece(const PoolWork& w, std::size_t j, const char* what) {
     my_rank = 0;
     my_size = node_size = 1;
     ::setenv(kChildMark, "1", 1);
-    w.child(j, fd[1]);
-    std::fflush(nullptr);
-    ::_exit(0);
-  }
-  ::close(fd[1]);
+    w.child(j, out);
+  });
   std::vector<char> bytes;
   bool whole = true;
   const int beat_ms = static_cast<int>(100 * rank_timeout());
   for (char buf[1 << 16];;) {
-    pollfd p{fd[0], POLLIN, 0};
+    pollfd p{fd, POLLIN, 0};
     const int ready = ::poll(&p, 1, beat_ms);
     if (ready == 0 || (ready < 0 && errno == EINTR)) {
       const long beat = static_cast<long>(j);
       MPI_Send(&beat, 1, MPI_LONG, 0, kAlive, MPI_COMM_WORLD);
       continue;
     }
-    const ssize_t r = ready < 0 ? -1 : ::read(fd[0], buf, sizeof buf);
+    const ssize_t r = ready < 0 ? -1 : ::read(fd, buf, sizeof buf);
     if (r == 0) break;
     if (r < 0 && errno == EINTR) continue;
     if (r < 0) {
@@ -263,11 +254,9 @@ void serve_piece(const PoolWork& w, std::size_t j, const char* what) {
     }
     bytes.insert(bytes.end(), buf, buf + r);
   }
-  ::close(fd[0]);
-  int ws = 0;
-  while (::waitpid(pid, &ws, 0) < 0 && errno == EINTR) {
-  }
-  const int status = !whole ? -1 : WIFEXITED(ws) ? WEXITSTATUS(ws) : 128 + WTERMSIG(ws);
+  ::close(fd);
+  const int exit_status = wait_child(pid);
+  const int status = whole ? exit_status : -1;
   const long head[3] = {static_cast<long>(j), status, static_cast<long>(bytes.size())};
   MPI_Send(head, 3, MPI_LONG, 0, kHeader, MPI_COMM_WORLD);
   MPI_Send(bytes.data(), static_cast<int>(bytes.size()), MPI_CHAR, 0, kBytes, MPI_COMM_WORLD);
