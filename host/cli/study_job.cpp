@@ -89,6 +89,15 @@ int print_study_table(const std::vector<StudyCase>& cases, const StudyTable& tab
   return failed;
 }
 
+/// The schedule's efficiency: the cases' run times summed, against the wall time times the workers (ranks).
+void print_efficiency(int workers) {
+  const PoolUse use = pool_use();
+  if (use.pieces == 0) return;
+  std::printf("study: %ld cases ran for %s in all, in %s on %d %s: %.0f%% efficiency (the rest idle, waiting for the "
+              "last case)\n", use.pieces, format_duration(use.busy).c_str(), format_duration(use.wall).c_str(),
+              workers, ranks::spread() ? "ranks" : "workers", 100 * use.busy / std::max(use.offered, 1e-9));
+}
+
 }  // namespace
 
 int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, const char* self_exe) {
@@ -159,11 +168,7 @@ int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, c
   };
   run_pool(w, "study");
   progress.finish("");
-  // The schedule's efficiency: the cases' run times summed, against the wall time times the workers (ranks).
-  if (const PoolUse use = pool_use(); use.pieces > 0)
-    std::printf("study: %ld cases ran for %s in all, in %s on %d %s: %.0f%% efficiency (the rest idle, waiting for the "
-                "last case)\n", use.pieces, format_duration(use.busy).c_str(), format_duration(use.wall).c_str(),
-                workers, ranks::spread() ? "ranks" : "workers", 100 * use.busy / std::max(use.offered, 1e-9));
+  print_efficiency(workers);
 
   const StudyTable table = study_table(cases, status, opt.output, compare);
   const int failed = print_study_table(cases, table, opt);
