@@ -1,69 +1,171 @@
-/// What a time step costs besides its arithmetic: kernel launches, allocations and copies
-/// between memory spaces, counted through Kokkos' tool callbacks on steps that neither rebuild the neighbour list
-/// nor record. A GPU pays for an allocation or a copy to the host with a wait; the goal is none on such a step.
-/// (Kokkos 3.4 reports no global fence to the tools, so fences are not counted here.)
+/// What a time step costs besides its arithmetic: kernel launches, allocations and the host's waits for the device
+/// (copies, results read on return, fences), counted through Kokkos' tool callbacks (host/util/sync_counts.hpp) on
+/// the steps of the run job and of each stage of a membrane test and a periodic cell. A GPU pays for each wait; the
+/// goal is none on a step outside records and rebuilds.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <string>
+#include <vector>
 
-#include "host/config/config.hpp"
 #include "host/cli/job.hpp"
+#include "host/config/config.hpp"
+#include "host/engine/packing.hpp"
 #include "host/engine/setup.hpp"
 #include "host/engine/simulation.hpp"
+#include "host/triax/periodic_triaxial.hpp"
+#include "host/triax/triaxial.hpp"
+#include "host/util/sync_counts.hpp"
+#include "test_util.hpp"
 
 using namespace dem;
 
 namespace {
 
-struct Counts {
-  long launches = 0, allocations = 0, copies = 0;
-};
-Counts counted;
-
-void on_launch(const char*, std::uint32_t, std::uint64_t*) { ++counted.launches; }
-void on_allocate(Kokkos_Profiling_SpaceHandle, const char*, const void*, std::uint64_t) { ++counted.allocations; }
-void on_copy(Kokkos_Profiling_SpaceHandle, const char*, const void*, Kokkos_Profiling_SpaceHandle, const char*,
-             const void*, std::uint64_t) {
-  ++counted.copies;
+void print_stage(const StageTiming& t) {
+  const double n = std::max(1L, t.steps);
+  const SyncCounts control = t.syncs[static_cast<int>(SyncPart::kControl)];
+  const SyncCounts step = t.syncs[static_cast<int>(SyncPart::kStep)];
+  std::printf("%-16s %6ld steps | step: %.2f launches %.3f allocations %.3f copies %.3f results %.3f fences | "
+              "control: %.2f launches %.3f copies %.3f results | %.1f syncs per rebuild, %.3f record syncs per step\n",
+              t.name.c_str(), t.steps, step.launches / n, step.allocations / n, step.copies / n,
+              step.host_results / n, step.fences / n, control.launches / n, control.copies / n,
+              control.host_results / n,
+              t.syncs[static_cast<int>(SyncPart::kRebuild)].syncs() / std::max(1.0, double(t.parts.rebuilds)),
+              t.syncs[static_cast<int>(SyncPart::kRecord)].syncs() / n);
 }
 
-/// Counts what f does, with the callbacks set only meanwhile.
-template <class F>
-Counts count_during(F&& f) {
-  namespace T = Kokkos::Tools::Experimental;
-  counted = Counts{};
-  T::set_begin_parallel_for_callback(on_launch);
-  T::set_begin_parallel_reduce_callback(on_launch);
-  T::set_begin_parallel_scan_callback(on_launch);
-  T::set_allocate_data_callback(on_allocate);
-  T::set_begin_deep_copy_callback(on_copy);
-  f();
-  T::set_begin_parallel_for_callback(nullptr);
-  T::set_begin_parallel_reduce_callback(nullptr);
-  T::set_begin_parallel_scan_callback(nullptr);
-  T::set_allocate_data_callback(nullptr);
-  T::set_begin_deep_copy_callback(nullptr);
-  return counted;
+SyncCounts part_of(const StageTiming& t, SyncPart part) { return t.syncs[static_cast<int>(part)]; }
+
+/// The tiny membrane test, specimen and triaxial stages, reading the statistics every `every` steps.
+struct MembraneRun {
+  std::vector<StageTiming> stages;
+  TriaxialResult result;
+};
+MembraneRun membrane_run(int every) {
+  Config c = test::tiny_triaxial_config(0.3, 0.02);
+  c.solver.stats_every = every;
+  MembraneRun r;
+  const Specimen sp = build_specimen(c, false);
+  r.stages = sp.stages;
+  r.result = run_triaxial(c, sp, nullptr, false);
+  for (const StageTiming& t : r.result.stages) r.stages.push_back(t);
+  return r;
+}
+
+PeriodicTriaxialResult periodic_run(int every) {
+  Config cfg = test::tiny_cell_config();
+  cfg.solver.stats_every = every;
+  auto sim = make_periodic_simulation(make_packing(cfg), cfg.box.size, cfg.ball, cfg.solver);
+  PeriodicTriaxialParams p = cfg.periodic.triax;
+  p.sigma3 = 100e3;
+  p.verbose = false;
+  return run_periodic_triaxial(*sim, p);
+}
+
+/// A step's own waits (its control's and its records' left out): copies and results read on return, per step. The
+/// timers' fences (one step in 16) are counted apart.
+double step_waits(const StageTiming& t) {
+  const SyncCounts c = part_of(t, SyncPart::kStep);
+  return double(c.copies + c.host_results) / double(std::max(1L, t.steps));
 }
 
 }  // namespace
 
-// The run job's step (walls, 2,000 balls): forces, then the leapfrog with its tree reduction. Today the root of the
-// reduction (unbalanced force, kinetic energy, the blow-up flag and the largest moves) comes back every step: one
-// copy, which item 2 removes by keeping the statistics on the device and reading them every k steps.
-TEST(HotPath, AStepAllocatesNothingAndReadsBackOneReductionsRoot) {
+// The run job's step (walls, 2,000 balls), counted between rebuilds: its forces and leapfrog allocate nothing, and
+// with stats_every = 16 the statistics come back once in 16 steps (two copies: the rows and the overlaps).
+TEST(HotPath, AStepAllocatesNothingAndReadsItsStatisticsEveryKSteps) {
   Config cfg = load_config(std::string(TRIAXDEM_SOURCE_DIR) + "/configs/default.toml");
+  cfg.solver.stats_every = 16;
   auto sim = build_simulation(cfg, false);
+  ASSERT_TRUE(count_syncs()) << "a profiling tool holds Kokkos' callbacks";
   for (int k = 0; k < 50; ++k) sim->step(false);
   const long rebuilds = sim->times().rebuilds;
-  const int steps = 20;
-  const Counts c = count_during([&] {
+  const int steps = 32;
+  const SyncTally before = sync_tally();
+  {
+    const SyncScope part(SyncPart::kStep);
     for (int k = 0; k < steps; ++k) sim->step(false);
-  });
+  }
+  const SyncCounts c = sync_tally()[static_cast<int>(SyncPart::kStep)] - before[static_cast<int>(SyncPart::kStep)];
   ASSERT_EQ(sim->times().rebuilds, rebuilds) << "a rebuild in the counted steps";
-  std::printf("per step: %.1f launches, %.1f allocations, %.1f copies\n", double(c.launches) / steps,
-              double(c.allocations) / steps, double(c.copies) / steps);
+  std::printf("per step: %.2f launches, %.2f allocations, %.3f copies, %.3f results, %.3f fences\n",
+              double(c.launches) / steps, double(c.allocations) / steps, double(c.copies) / steps,
+              double(c.host_results) / steps, double(c.fences) / steps);
   ASSERT_GT(c.launches, 0) << "the callbacks never fired: Kokkos built without its tools interface";
   EXPECT_EQ(c.allocations, 0);
-  EXPECT_LE(c.copies, steps);
+  EXPECT_EQ(c.host_results, 0);
+  // At most a read every 16 steps, of two copies each; a read the bound on the balls' speed asks for adds two.
+  EXPECT_LE(c.copies, 2 * (steps / 16) + 2);
+  // The part timers fence on one step in 16 (host/engine/simulation.cpp), 6 times at most, and not on the others.
+  EXPECT_LE(c.fences, 6 * (steps / 16));
+}
+
+// Every stage of the tiny membrane test (specimen layers, consolidation, shear) and of the tiny periodic cell, with
+// the statistics read every step and every 16 steps: the same steps bit for bit (the rebuilds decided between reads
+// as a read at every step decides them), and the steps' own waits down to the reads. What remains per step is the
+// stages' control (servo readings, platen speeds: docs/performance.md).
+TEST(HotPath, StatisticsReadEvery16StepsGiveTheSameStepsWithFewerWaits) {
+  const MembraneRun every1 = membrane_run(1), every16 = membrane_run(16);
+  ASSERT_EQ(every1.stages.size(), every16.stages.size());
+  for (std::size_t k = 0; k < every1.stages.size(); ++k) {
+    const StageTiming &a = every1.stages[k], &b = every16.stages[k];
+    print_stage(a);
+    print_stage(b);
+    EXPECT_EQ(a.steps, b.steps) << a.name;
+    EXPECT_EQ(a.parts.rebuilds, b.parts.rebuilds) << a.name;
+    EXPECT_EQ(b.parts.late_rebuilds, 0) << a.name;
+    EXPECT_EQ(part_of(b, SyncPart::kStep).allocations, 0) << a.name;
+    // Read every step: two copies a step. Every 16: two copies in 16 steps, and the reads the rebuilds ask for.
+    EXPECT_NEAR(step_waits(a), 2.0, 0.01) << a.name;
+    EXPECT_LT(step_waits(b), 0.25) << a.name;
+  }
+  const std::vector<TriaxialRecord>&r1 = every1.result.records, &r16 = every16.result.records;
+  ASSERT_EQ(r1.size(), r16.size());
+  ASSERT_FALSE(r1.empty());
+  for (std::size_t k = 0; k < r1.size(); ++k) {
+    EXPECT_EQ(r1[k].q, r16[k].q) << "record " << k;
+    EXPECT_EQ(r1[k].eps_v, r16[k].eps_v) << "record " << k;
+    EXPECT_EQ(r1[k].unbalanced, r16[k].unbalanced) << "record " << k;
+  }
+
+  const PeriodicTriaxialResult p1 = periodic_run(1), p16 = periodic_run(16);
+  ASSERT_EQ(p1.stages.size(), p16.stages.size());
+  for (std::size_t k = 0; k < p1.stages.size(); ++k) {
+    print_stage(p1.stages[k]);
+    print_stage(p16.stages[k]);
+    EXPECT_EQ(p1.stages[k].steps, p16.stages[k].steps);
+    EXPECT_EQ(p16.stages[k].parts.late_rebuilds, 0);
+    EXPECT_LT(step_waits(p16.stages[k]), 0.25);
+  }
+  ASSERT_EQ(p1.series.size(), p16.series.size());
+  for (std::size_t k = 0; k < p1.series.size(); ++k) {
+    EXPECT_EQ(p1.series[k].q, p16.series[k].q) << "record " << k;
+    EXPECT_EQ(p1.series[k].eps_v, p16.series[k].eps_v) << "record " << k;
+  }
+}
+
+// The bound between reads can fail: a ball given, between two reads, a speed far above any of the last read's has
+// passed half the skin before the next one. The read finds the lists expired steps late, counts it and says so, and
+// the rebuild follows at once.
+TEST(HotPath, ABallThatOutrunsTheBoundIsALateRebuild) {
+  Config cfg = load_config(std::string(TRIAXDEM_SOURCE_DIR) + "/configs/default.toml");
+  cfg.solver.stats_every = 64;
+  auto sim = build_simulation(cfg, false);
+  for (int k = 0; k < 100; ++k) sim->step(false);
+  const Real skin = sim->params().skin, dt = sim->params().integ.dt;
+  sim->step(true);  // read now: the bound starts from this step's speeds
+  ASSERT_EQ(sim->times().late_rebuilds, 0);
+  const long rebuilds = sim->times().rebuilds;
+  // Half the skin in 8 steps: the bound, from far lower speeds, lets many more steps go unread.
+  auto v = sim->particles().v;
+  const Real kick = skin / (16 * dt);
+  Kokkos::parallel_for("test::kick", RangePolicy(0, 1), KOKKOS_LAMBDA(const int) { v(0, 0) += kick; });
+  testing::internal::CaptureStderr();
+  for (int k = 0; k < 64; ++k) sim->step(false);
+  sim->step(false);  // the rebuild the late read found due
+  const std::string said = testing::internal::GetCapturedStderr();
+  EXPECT_GE(sim->times().late_rebuilds, 1);
+  EXPECT_GT(sim->times().rebuilds, rebuilds);
+  EXPECT_NE(said.find("found expired some steps late"), std::string::npos) << said;
 }

@@ -7,6 +7,11 @@
 
 namespace dem {
 
+int stats_every_of(const SolverConfig& solver) {
+  if (solver.stats_every > 0) return static_cast<int>(solver.stats_every);
+  return kOnDevice ? 16 : 1;
+}
+
 SimParams solver_params(const Config& cfg) {
   SimParams prm;
   prm.integ.gravity = Vec3(cfg.solver.gravity[0], cfg.solver.gravity[1], cfg.solver.gravity[2]);
@@ -14,6 +19,7 @@ SimParams solver_params(const Config& cfg) {
   prm.integ.mass_scale = cfg.solver.mass_scale;
   prm.skin = cfg.solver.skin * cfg.particles.diameter;
   prm.overlap_limit = cfg.solver.overlap_limit;
+  prm.stats_every = stats_every_of(cfg.solver);
   return prm;
 }
 

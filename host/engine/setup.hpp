@@ -13,6 +13,8 @@ namespace dem {
 /// The [solver] settings as simulation parameters (gravity, damping, density scaling, skin, blow-up limit);
 /// the domain is left open (non-periodic).
 SimParams solver_params(const Config& cfg);
+/// [solver] stats_every, with 0 resolved for this build (SolverConfig::stats_every).
+int stats_every_of(const SolverConfig& solver);
 
 /// The simulation a config describes (particles, box walls, materials, time step). Prints the time
 /// step it chose and why.

@@ -7,12 +7,14 @@
 
 #include "kernels/neighbor/history_remap.hpp"
 #include "kernels/core/reduce.hpp"
+#include "host/util/sync_counts.hpp"
 
 namespace dem {
 
 namespace {
 double seconds_since(Kokkos::Timer& t) {
   Kokkos::fence();
+  count_fence();
   const double s = t.seconds();
   t.reset();
   return s;
@@ -29,6 +31,15 @@ Real max_radius(const Particles& p) {
   return rmax;
 }
 
+/// Moves each wall with a velocity by dt times it, as move_boundaries moves the host's copy.
+void move_walls(const WallSet& walls, Real dt) {
+  auto point = walls.point, velocity = walls.velocity;
+  Kokkos::parallel_for("dem::sim::move_walls", RangePolicy(0, walls.n), KOKKOS_LAMBDA(const int w) {
+    const Vec3 v = load(velocity, w);
+    if (norm2(v) != 0) store(point, w, load(point, w) + dt * v);
+  });
+}
+
 /// The periodic cell's affine step: positions, and the positions of the last rebuild, stretched by s about lo.
 void stretch_about(const Particles& p, const Real (&lo)[3], const Real (&s)[3]) {
   auto x = p.x, xr = p.x_ref;
@@ -42,17 +53,14 @@ void stretch_about(const Particles& p, const Real (&lo)[3], const Real (&s)[3]) 
   });
 }
 
-/// Moves the facet mesh's nodes by dt node_v; returns the largest node speed (m/s).
-Real move_nodes(const FacetMesh& mesh, Real dt) {
+/// Moves the facet mesh's nodes by dt node_v; the largest node speed (m/s) goes to `speed`, in device memory.
+void move_nodes(const FacetMesh& mesh, Real dt, Real* speed) {
   auto nx = mesh.node_x, nv = mesh.node_v;
-  Real nmax = 0;
-  Kokkos::parallel_reduce("dem::sim::move_mesh", RangePolicy(0, mesh.nnode),
-      KOKKOS_LAMBDA(const int k, Real& acc) {
-        const Vec3 v = load(nv, k);
-        store(nx, k, load(nx, k) + dt * v);
-        acc = norm(v) > acc ? norm(v) : acc;
-      }, Kokkos::Max<Real>(nmax));
-  return nmax;
+  deterministic_reduce_to<0, 1>("dem::sim::move_mesh", mesh.nnode, KOKKOS_LAMBDA(const int k, Real* acc) {
+    const Vec3 v = load(nv, k);
+    store(nx, k, load(nx, k) + dt * v);
+    acc[0] = norm(v);
+  }, speed);
 }
 
 }  // namespace
@@ -65,10 +73,17 @@ Simulation::Simulation(Particles particles, WallSet walls, FacetMesh mesh, const
   params_ = ParamTableView("dem::sim::params", nmat, nmat);
   set_contact_params(table);
   if (walls_.n == 0) walls_ = WallSet(0);
-  hwall_point_ = Kokkos::create_mirror_view_and_copy(HostSpace(), walls_.point);
-  hwall_vel_ = Kokkos::create_mirror_view_and_copy(HostSpace(), walls_.velocity);
+  // Copies of their own even where the device is the host: the host moves its copy as the device moves its own
+  // (move_boundaries), so the two must not be one.
+  hwall_point_ = Kokkos::create_mirror(HostSpace(), walls_.point);
+  hwall_vel_ = Kokkos::create_mirror(HostSpace(), walls_.velocity);
+  Kokkos::deep_copy(hwall_point_, walls_.point);
+  Kokkos::deep_copy(hwall_vel_, walls_.velocity);
   rmax_ = max_radius(p_);
+  count_syncs();
   if (prm_.skin <= 0) throw std::invalid_argument("Verlet skin must be > 0");
+  if (prm_.stats_every < 1 || prm_.stats_every > StepRows::kSlots)
+    throw std::invalid_argument("stats_every must be in [1, " + std::to_string(StepRows::kSlots) + "]");
 }
 
 void Simulation::set_contact_params(const std::vector<ContactParams>& table) {
@@ -102,13 +117,8 @@ Real Simulation::critical_dt() const {
   return dt * std::sqrt(prm_.integ.mass_scale);
 }
 
-bool Simulation::rebuild_due() const {
-  if (fresh_) return true;
-  const Real d = std::sqrt(stats_.max_disp2);
-  return 2 * d > prm_.skin || d + wall_disp_ > prm_.skin;
-}
-
 void Simulation::rebuild() {
+  const SyncScope part(SyncPart::kRebuild);
   // Balls move less than the skin between rebuilds, so an escape is caught within a rebuild of happening.
   const int out = ball_outside(p_, prm_.domain, 2);
   if (out >= 0) {
@@ -144,31 +154,66 @@ void Simulation::index_contacts() {
   obj_offsets_ = object_offsets(wall_c_, walls_.n + mesh_.ntri);
 }
 
+namespace {
+
+/// One step in this many has its parts timed, each behind a fence, and counts for as many: on a GPU a fence holds
+/// the host until the device is done, and the other steps go through without one. The parts' times are estimates
+/// (a stage of thousands of steps samples hundreds of them); the stage's wall time (stage_loop.hpp) is measured.
+constexpr long kTimedEvery = 16;
+
+/// The step's part timers: on a timed step, each lap's seconds behind a fence, counted `weight` times; else nothing.
+class PartClock {
+ public:
+  explicit PartClock(long weight) : weight_(static_cast<double>(weight)) {
+    if (weight_ > 0) restart();
+  }
+  void lap(double& into) {
+    if (weight_ > 0) into += weight_ * seconds_since(t_);
+  }
+  /// A lap taken whatever the weight, counted once: a rebuild, which waits for the device anyway.
+  void lap_always(double& into) { into += seconds_since(t_); }
+  /// From now, behind a fence: the device's work queued before is not the next lap's.
+  void restart() {
+    Kokkos::fence();
+    count_fence();
+    t_.reset();
+  }
+
+ private:
+  double weight_;
+  Kokkos::Timer t_;
+};
+
+}  // namespace
+
 void Simulation::step(bool measure) {
-  Kokkos::Timer t;
-  if (rebuild_due()) rebuild();
-  times_.rebuild += seconds_since(t);
+  PartClock clock(step_ % kTimedEvery == 0 ? kTimedEvery : 0);
+  if (rebuild_due()) {
+    if (step_ % kTimedEvery != 0) clock.restart();
+    rebuild();
+    clock.lap_always(times_.rebuild);
+  }
   const Real dt = prm_.integ.dt;
-  const OverlapStat ob = compute_ball_forces(p_, balls_, params_, prm_.domain, dt);
-  times_.forces += seconds_since(t);
-  const OverlapStat ow = compute_wall_forces(p_, wall_c_, adj_walls_, walls_, mesh_, params_, dt);
-  times_.walls += seconds_since(t);
-  check_blowup(ob, ow);
+  compute_ball_forces(p_, balls_, params_, prm_.domain, dt, rows_.overlap(step_, StepRows::kBalls));
+  clock.lap(times_.forces);
+  compute_wall_forces(p_, wall_c_, adj_walls_, walls_, mesh_, params_, dt, rows_.overlap(step_, StepRows::kWalls));
+  clock.lap(times_.walls);
   if (membrane_.ntri > 0) {
     // Before integrate: the reactions are split at the closest points of the balls' current centres.
     membrane_prm_.dt = dt;
     membrane_forces(membrane_, cell_pressure_, FacetContacts{wall_c_, obj_offsets_, walls_.n, p_.x}, membrane_f_);
-    membrane_stats_ = membrane_integrate(membrane_, membrane_f_, membrane_prm_);
-    times_.membrane += seconds_since(t);
+    membrane_integrate_to(membrane_, membrane_f_, membrane_prm_, rows_.at(step_, StepRows::kMembrane));
+    clock.lap(times_.membrane);
   }
   prm_.integ.measure = measure;
-  stats_ = integrate(p_, prm_.integ, make_gather(balls_, own_, adj_balls_, wall_c_, adj_walls_));
-  times_.integrate += seconds_since(t);
-  if (stats_.bad >= 0 || stats_.max_move2 > prm_.overlap_limit * prm_.overlap_limit) check_blowup(ob, ow);
+  integrate_to(p_, prm_.integ, make_gather(balls_, own_, adj_balls_, wall_c_, adj_walls_),
+               rows_.at(step_, StepRows::kLeapfrog));
+  clock.lap(times_.integrate);
   move_boundaries();
-  times_.boundaries += seconds_since(t);
+  clock.lap(times_.boundaries);
   time_ += dt;
   ++step_;
+  if (measure || step_ - read_to_ >= prm_.stats_every) read_rows();
 }
 
 void Simulation::move_boundaries() {
@@ -180,7 +225,9 @@ void Simulation::move_boundaries() {
     store(hwall_point_, w, load(hwall_point_, w) + dt * v);
     vmax = std::max(vmax, norm(v));
   }
-  if (vmax > 0) Kokkos::deep_copy(walls_.point, hwall_point_);
+  // The device moves its copy of the walls by the same arithmetic (no contraction, CMakeLists.txt): the host's
+  // stays equal to it bit for bit, with no copy between them.
+  if (vmax > 0) move_walls(walls_, dt);
   const Real* rate = prm_.domain.strain_rate;
   if (rate[0] != 0 || rate[1] != 0 || rate[2] != 0) {
     Domain& dom = prm_.domain;
@@ -192,54 +239,9 @@ void Simulation::move_boundaries() {
     const Real rate_max = std::max({std::fabs(rate[0]), std::fabs(rate[1]), std::fabs(rate[2])});
     vmax = std::max(vmax, rate_max * (2 * rmax_ + prm_.skin));
   }
-  if (mesh_.ntri > 0) vmax = std::max(vmax, move_nodes(mesh_, dt));
-  wall_disp_ += vmax * dt;
-}
-
-void Simulation::check_blowup(const OverlapStat& ob, const OverlapStat& ow) const {
-  std::ostringstream msg;
-  auto gid_of = [&](const ContactList& c, int k) {
-    auto hi = Kokkos::create_mirror_view_and_copy(HostSpace(), Kokkos::subview(c.i, std::make_pair(k, k + 1)));
-    auto hg = Kokkos::create_mirror_view_and_copy(HostSpace(), Kokkos::subview(p_.gid, std::make_pair(hi(0), hi(0) + 1)));
-    return hg(0);
-  };
-  if (stats_.bad >= 0) {
-    auto hg = Kokkos::create_mirror_view_and_copy(HostSpace(), p_.gid);
-    msg << "blow-up at step " << step_ << ": particle " << hg(stats_.bad)
-        << " has a non-finite position. Likely cause: time step above the critical one or a servo gain too high; "
-           "suggested fix: lower [solver] dt_safety (now dt = "
-        << prm_.integ.dt << " s, critical " << critical_dt() << " s)";
-    throw BlowUp(msg.str());
-  }
-  if (stats_.max_move2 > prm_.overlap_limit * prm_.overlap_limit) {
-    // A ball that moves this far in one step would overlap anything it meets by more than the overlap limit.
-    auto hv = Kokkos::create_mirror_view_and_copy(HostSpace(), p_.v);
-    auto hr = Kokkos::create_mirror_view_and_copy(HostSpace(), p_.radius);
-    auto hg = Kokkos::create_mirror_view_and_copy(HostSpace(), p_.gid);
-    int fast = 0;
-    Real worst_move = -1;
-    for (int i = 0; i < p_.n; ++i) {
-      const Real move = norm(load(hv, i)) * prm_.integ.dt / hr(i);
-      if (move > worst_move) worst_move = move, fast = i;
-    }
-    msg << "blow-up at step " << step_ << ": particle " << hg(fast) << " moved " << worst_move * 100
-        << "% of its radius in one step (limit " << prm_.overlap_limit * 100
-        << "%, the overlap limit): its kinetic energy jumped beyond what the loads can give. Likely cause: a time "
-           "step above the critical one for the stiffness reached, or a servo gain or wall speed too high; "
-           "suggested fix: lower [solver] dt_safety (now dt = "
-        << prm_.integ.dt << " s, critical " << critical_dt() << " s) or the servo gain";
-    throw BlowUp(msg.str());
-  }
-  const OverlapStat& worst = ob.ratio >= ow.ratio ? ob : ow;
-  if (worst.ratio > prm_.overlap_limit) {
-    const bool wall = ow.ratio > ob.ratio;
-    msg << "blow-up at step " << step_ << ": particle " << gid_of(wall ? wall_c_ : balls_, worst.contact)
-        << " overlaps " << (wall ? "a wall" : "another particle") << " by " << worst.ratio * 100
-        << "% of its radius (limit " << prm_.overlap_limit * 100
-        << "%). Likely cause: stiffness too low for the load, a wall or servo moving too fast, or too large a time "
-           "step; suggested fix: raise emod, lower the wall speed or servo gain, or lower [solver] dt_safety";
-    throw BlowUp(msg.str());
-  }
+  // The membrane nodes' speed joins vmax when the row is read (read_rows).
+  if (mesh_.ntri > 0) move_nodes(mesh_, dt, rows_.at(step_, StepRows::kNodeSpeed));
+  boundary_steps_[static_cast<std::size_t>(StepRows::slot(step_))] = {vmax, dt};
 }
 
 void Simulation::set_membrane(const Membrane& m, const MembraneIntegrateParams& prm) {
@@ -247,6 +249,7 @@ void Simulation::set_membrane(const Membrane& m, const MembraneIntegrateParams& 
     throw std::invalid_argument("set_membrane: the membrane's mesh is not this simulation's facet mesh");
   membrane_ = m;
   membrane_prm_ = prm;
+  membrane_f_ = Vec3View("dem::sim::membrane_force", m.nnode);  // here, not in a step
   membrane_prm_.move_nodes = false;  // move_boundaries moves every facet node by dt node_v
 }
 
@@ -285,6 +288,8 @@ std::array<Real, 3> Simulation::contact_stress_diagonal(Real volume) const {
 }
 
 void Simulation::set_wall_velocity(int w, const Vec3& v) {
+  const Vec3 now = load(hwall_vel_, w);
+  if (v.x == now.x && v.y == now.y && v.z == now.z) return;  // a constant speed costs no copy a step
   store(hwall_vel_, w, v);
   Kokkos::deep_copy(walls_.velocity, hwall_vel_);
 }
@@ -293,8 +298,13 @@ void Simulation::set_wall_velocities(const std::vector<Vec3>& v) {
   if (static_cast<int>(v.size()) != walls_.n)
     throw std::invalid_argument("set_wall_velocities: " + std::to_string(v.size()) + " velocities for " +
                                 std::to_string(walls_.n) + " walls");
-  for (int w = 0; w < walls_.n; ++w) store(hwall_vel_, w, v[static_cast<std::size_t>(w)]);
-  Kokkos::deep_copy(walls_.velocity, hwall_vel_);
+  bool changed = false;
+  for (int w = 0; w < walls_.n; ++w) {
+    const Vec3 now = load(hwall_vel_, w), to = v[static_cast<std::size_t>(w)];
+    changed = changed || to.x != now.x || to.y != now.y || to.z != now.z;
+    store(hwall_vel_, w, to);
+  }
+  if (changed) Kokkos::deep_copy(walls_.velocity, hwall_vel_);
 }
 
 Vec3 Simulation::wall_velocity(int w) const { return load(hwall_vel_, w); }
@@ -302,34 +312,30 @@ Vec3 Simulation::wall_velocity(int w) const { return load(hwall_vel_, w); }
 Vec3 Simulation::wall_point(int w) const { return load(hwall_point_, w); }
 
 void Simulation::set_wall_point(int w, const Vec3& p) {
+  read_rows();  // the steps before add to wall_disp_ first, as they happened first
   const Real moved = norm(p - load(hwall_point_, w));
   store(hwall_point_, w, p);
   Kokkos::deep_copy(walls_.point, hwall_point_);
   wall_disp_ += moved;
 }
 
-std::vector<Vec3> Simulation::wall_forces() {
-  if (fresh_) return std::vector<Vec3>(walls_.n + mesh_.ntri);
-  wall_forces_into(wall_c_, obj_offsets_, wall_force_);
-  auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), wall_force_);
-  std::vector<Vec3> out(h.extent(0));
-  for (std::size_t k = 0; k < out.size(); ++k) out[k] = load(h, static_cast<int>(k));
+Simulation::WallLoads Simulation::wall_loads(bool facets) const {
+  const int nobj = walls_.n + (facets ? mesh_.ntri : 0);
+  WallLoads out{std::vector<Vec3>(static_cast<std::size_t>(nobj)), std::vector<int>(static_cast<std::size_t>(nobj), 0)};
+  if (fresh_ || nobj == 0) return out;
+  wall_loads_into(wall_c_, obj_offsets_, nobj, wall_force_, wall_touching_);
+  if (hwall_force_.extent(0) != wall_force_.extent(0)) {
+    hwall_force_ = Kokkos::create_mirror(HostSpace(), wall_force_);
+    hwall_touching_ = Kokkos::create_mirror(HostSpace(), wall_touching_);
+  }
+  const auto first = std::make_pair(0, nobj);
+  Kokkos::deep_copy(Kokkos::subview(hwall_force_, first, Kokkos::ALL), Kokkos::subview(wall_force_, first, Kokkos::ALL));
+  Kokkos::deep_copy(Kokkos::subview(hwall_touching_, first), Kokkos::subview(wall_touching_, first));
+  for (int k = 0; k < nobj; ++k) {
+    out.force[static_cast<std::size_t>(k)] = load(hwall_force_, k);
+    out.touching[static_cast<std::size_t>(k)] = hwall_touching_(k);
+  }
   return out;
-}
-
-std::vector<int> Simulation::wall_contact_counts() const {
-  const int nobj = walls_.n + mesh_.ntri;
-  if (fresh_) return std::vector<int>(nobj, 0);
-  IndexView counts("dem::sim::wall_contact_counts", nobj);
-  auto off = obj_offsets_;
-  auto fn = wall_c_.fn;
-  Kokkos::parallel_for("dem::sim::wall_contact_counts", RangePolicy(0, nobj), KOKKOS_LAMBDA(const int o) {
-    int c = 0;
-    for (int k = off(o); k < off(o + 1); ++k) c += fn(k) > 0 ? 1 : 0;
-    counts(o) = c;
-  });
-  auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), counts);
-  return std::vector<int>(h.data(), h.data() + nobj);
 }
 
 Real Simulation::unbalanced_ratio() const {
@@ -344,7 +350,7 @@ Real Simulation::unbalanced_ratio() const {
     v[1] = fn > 0 ? Real(1) : Real(0);
   }, s);
   if (s[1] == 0) return 1;
-  return (stats_.unbalanced / p_.n) / (s[0] / s[1]);
+  return (stats().unbalanced / p_.n) / (s[0] / s[1]);
 }
 
 std::array<long, 2> Simulation::touching() const {

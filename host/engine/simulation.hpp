@@ -13,6 +13,7 @@
 #include "kernels/motion/integrate.hpp"
 #include "kernels/motion/membrane.hpp"
 #include "host/engine/sim_state.hpp"
+#include "host/engine/step_rows.hpp"
 
 namespace dem {
 
@@ -26,6 +27,9 @@ struct SimParams {
   IntegrateParams integ;        ///< dt must be set (see critical_dt)
   Real skin = 0;                ///< Verlet skin (m)
   Real overlap_limit = 0.1;     ///< stop when an overlap exceeds this fraction of the radius
+  /// The host reads the steps' statistics (blow-up checks, displacements since the last rebuild) at least every
+  /// this many steps, 1 to StepRows::kSlots; in between they stay on the device (host/engine/step_reads.cpp).
+  int stats_every = 1;
 };
 
 /// Wall-clock seconds spent per part of the step.
@@ -37,11 +41,15 @@ struct StageTimes {
   double membrane = 0;    ///< membrane elasticity, pressure, reactions and node integration
   long rebuilds = 0;
   double walls = 0;       ///< ball-wall and ball-facet contacts (platens, mould, membrane)
+  /// Rebuilds found due at a step already taken, between two reads of the statistics (step_reads.cpp): a ball
+  /// outran the bound on its speed, and a contact may have been missed for the steps in between.
+  long late_rebuilds = 0;
   double loop() const { return rebuild + forces + walls + membrane + integrate + boundaries; }
   /// What was spent between an earlier reading `t` and this one.
   StageTimes since(const StageTimes& t) const {
-    return {rebuild - t.rebuild, forces - t.forces,     integrate - t.integrate, boundaries - t.boundaries,
-            membrane - t.membrane, rebuilds - t.rebuilds, walls - t.walls};
+    return {rebuild - t.rebuild,   forces - t.forces,     integrate - t.integrate,
+            boundaries - t.boundaries, membrane - t.membrane, rebuilds - t.rebuilds,
+            walls - t.walls,       late_rebuilds - t.late_rebuilds};
   }
 };
 
@@ -55,7 +63,8 @@ class Simulation {
              SimParams prm);
 
   /// One time step. `measure`: fill stats() (unbalanced force, kinetic energy) for this step; the
-  /// sums cost a pass of square roots, so unmeasured steps skip them.
+  /// sums cost a pass of square roots, so unmeasured steps skip them. A measured step's statistics are read at
+  /// once, the others' within SimParams::stats_every steps: a blow-up is reported then, with the step it happened at.
   void step(bool measure = true);
   /// nsteps steps; stats() describe the last one.
   void run(long nsteps) { for (long s = 0; s < nsteps; ++s) step(s + 1 == nsteps); }
@@ -63,7 +72,11 @@ class Simulation {
   Particles& particles() { return p_; }
   const ContactList& ball_contacts() const { return balls_; }
   const ContactList& wall_contacts() const { return wall_c_; }
-  const StepStats& stats() const { return stats_; }
+  /// The last step's statistics (read from the device where they wait).
+  const StepStats& stats() const {
+    read_rows();
+    return stats_;
+  }
   const StageTimes& times() const { return times_; }
   /// The stage times of the run segments before a resume, so that reports cover the whole run.
   void set_times(const StageTimes& t) { times_ = t; }
@@ -94,7 +107,10 @@ class Simulation {
   /// Cell pressure on the membrane (Pa), positive towards the axis.
   void set_cell_pressure(Real p) { cell_pressure_ = p; }
   Membrane& membrane() { return membrane_; }
-  const MembraneStepStats& membrane_stats() const { return membrane_stats_; }
+  const MembraneStepStats& membrane_stats() const {
+    read_rows();
+    return membrane_stats_;
+  }
 
   /// Homogeneous deformation of a periodic cell: each step the cell and the particle positions are
   /// stretched about domain.lo by (1 + rate dt) along each axis (1/s, extension positive).
@@ -113,11 +129,18 @@ class Simulation {
   Vec3 wall_velocity(int w) const;
   Vec3 wall_point(int w) const;
   void set_wall_point(int w, const Vec3& p);
-  /// Force exerted by the balls on wall object `obj` (analytic walls first, then facets), N.
-  std::vector<Vec3> wall_forces();
-
+  /// What the balls load each wall object with: the force (N) and the touching contacts, analytic walls first,
+  /// then the facets where `facets` (a servo needs its wall alone, and a membrane has thousands of facets). One
+  /// launch and two copies to the host.
+  struct WallLoads {
+    std::vector<Vec3> force;
+    std::vector<int> touching;
+  };
+  WallLoads wall_loads(bool facets = true) const;
+  /// Force exerted by the balls on each wall object (analytic walls first, then facets), N.
+  std::vector<Vec3> wall_forces() const { return wall_loads().force; }
   /// Touching contacts on each wall object (analytic walls first, then facets).
-  std::vector<int> wall_contact_counts() const;
+  std::vector<int> wall_contact_counts() const { return wall_loads().touching; }
 
   /// Mean unbalanced force over mean contact force (YADE/PFC definition) after the last measured step;
   /// 1 when there are no contacts.
@@ -135,7 +158,7 @@ class Simulation {
  private:
   Particles p_;
   WallSet walls_;
-  decltype(Kokkos::create_mirror_view(WallSet().point)) hwall_point_, hwall_vel_;
+  decltype(Kokkos::create_mirror(WallSet().point)) hwall_point_, hwall_vel_;
   FacetMesh mesh_;
   ParamTableView params_;
   SimParams prm_;
@@ -144,24 +167,47 @@ class Simulation {
   Adjacency adj_balls_, adj_walls_;
   Index2View own_;
   IndexView obj_offsets_;
-  Vec3View wall_force_;
+  // wall_loads' device scratch and the host's copies of it: a copy of their own even where the device is the host,
+  // so that a read is a copy there too and the sync counts (sync_counts.hpp) are the GPU's.
+  mutable Vec3View wall_force_;
+  mutable IndexView wall_touching_;
+  mutable decltype(Kokkos::create_mirror(Vec3View())) hwall_force_;
+  mutable decltype(Kokkos::create_mirror(IndexView())) hwall_touching_;
   Membrane membrane_;
   MembraneIntegrateParams membrane_prm_;
   Vec3View membrane_f_;
-  MembraneStepStats membrane_stats_;
   Real cell_pressure_ = 0;
-  StepStats stats_;
-  StageTimes times_;
-  Real rmax_ = 0, wall_disp_ = 0;
+  // The steps' statistics: on the device in rows_, and on the host up to step read_to_ (step_reads.cpp). Reading
+  // them changes nothing but when the host learns them, so the reader and what it fills are mutable.
+  mutable StepRows rows_;
+  mutable long read_to_ = 0;
+  mutable StepStats stats_;
+  mutable MembraneStepStats membrane_stats_;
+  mutable Real wall_disp_ = 0;       ///< how far a wall, the cell or a membrane node has moved since the rebuild (m)
+  mutable Real step_bound_ = 0;      ///< the farthest one ball moved in a step of the last read (m); 0: no read yet
+  mutable Real node_bound_ = 0;      ///< the fastest membrane node of the last read (m/s)
+  /// The host-known part of each step's boundary speed (walls, the cell's stretch; m/s) and its dt, by ring slot.
+  struct BoundaryStep {
+    Real speed = 0, dt = 0;
+  };
+  std::array<BoundaryStep, StepRows::kSlots> boundary_steps_{};
+  mutable StageTimes times_;
+  Real rmax_ = 0;
   long step_ = 0;
   Real time_ = 0;
   bool fresh_ = true;
 
-  bool rebuild_due() const;
+  bool rebuild_due();
+  /// Reads the rows of the steps not yet read: their blow-up checks, displacements and statistics.
+  void read_rows() const;
+  /// Whether the neighbour lists must be rebuilt after a step with largest displacement^2 `disp2` since the last
+  /// rebuild and boundaries moved by `walls` (m).
+  bool lists_expired(Real disp2, Real walls) const;
   void rebuild();
   void index_contacts();  ///< owner ranges, adjacency and object offsets of the contact lists
   void move_boundaries();
-  void check_blowup(const OverlapStat& ob, const OverlapStat& ow) const;
+  /// Throws BlowUp where step `step`'s statistics and overlaps show one.
+  void check_blowup(long step, const StepStats& st, const OverlapStat& ob, const OverlapStat& ow) const;
 };
 
 }  // namespace dem

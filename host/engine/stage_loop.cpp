@@ -15,9 +15,17 @@ StageEnd run_steps(Simulation& sim, const StageSteps& stage, CheckpointPlan* pla
   long n = stage.first;
   try {
     for (; n <= stage.last; ++n) {
-      const StepPlan next = stage.before(n);
+      StepPlan next;
+      {
+        const SyncScope part(SyncPart::kControl);
+        next = stage.before(n);
+      }
       if (next.done) return {n - 1, true, {}};
-      sim.step(next.measure);
+      {
+        const SyncScope part(SyncPart::kStep);
+        sim.step(next.measure);
+      }
+      const SyncScope part(SyncPart::kRecord);
       if (stage.after && stage.after(n, next.measure)) return {n, true, {}};
       if (!plan || !stage.checkpoint) continue;
       if (plan->due(sim.step_count())) {
@@ -49,7 +57,10 @@ StageEnd run_stage(Simulation& sim, const StageSteps& stage, CheckpointPlan* pla
   const auto t0 = std::chrono::steady_clock::now();
   const StageTimes parts0 = sim.times();
   const long step0 = sim.step_count();
+  const SyncTally syncs0 = sync_tally();
   StageEnd end = run_steps(sim, stage, plan);
+  const SyncTally syncs1 = sync_tally();
+  for (int k = 0; k < kSyncParts; ++k) end.timing.syncs[static_cast<std::size_t>(k)] = syncs1[k] - syncs0[k];
   end.timing.balls = sim.particles().n;
   end.timing.steps = sim.step_count() - step0;
   end.timing.wall = seconds_since(t0);
@@ -62,13 +73,19 @@ StageEnd run_stage(Simulation& sim, const StageSteps& stage, CheckpointPlan* pla
 
 std::string timings_csv(const std::vector<StageTiming>& stages) {
   std::string s = "stage,balls,steps,wall_s,particle_steps_per_s,rebuilds,rebuild_ns,ball_ball_ns,ball_wall_ns,"
-                  "membrane_ns,gather_integrate_ns,boundaries_ns,host_ns,ball_pairs_per_ball,wall_pairs_per_ball\n";
-  char line[400];
+                  "membrane_ns,gather_integrate_ns,boundaries_ns,host_ns,ball_pairs_per_ball,wall_pairs_per_ball,"
+                  "launches_per_step,syncs_per_step,allocations_per_step,syncs_per_rebuild,record_syncs_per_step\n";
+  char line[512];
   for (const StageTiming& t : stages) {
     const auto ns = ns_per_part(t);
-    std::snprintf(line, sizeof line, "%s,%ld,%ld,%.3f,%.4g,%ld,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.3f,%.3f\n",
+    const double steps = std::max(1L, t.steps), rebuilds = std::max(1L, t.parts.rebuilds);
+    const SyncCounts each = t.per_step_part();
+    std::snprintf(line, sizeof line,
+                  "%s,%ld,%ld,%.3f,%.4g,%ld,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.3f,%.3f,%.3f,%.3f,%.3f,%.2f,%.3f\n",
                   t.name.c_str(), t.balls, t.steps, t.wall, t.rate(), t.parts.rebuilds, ns[0], ns[1], ns[2], ns[3],
-                  ns[4], ns[5], ns[6], t.ball_pairs, t.wall_pairs);
+                  ns[4], ns[5], ns[6], t.ball_pairs, t.wall_pairs, each.launches / steps, each.syncs() / steps,
+                  each.allocations / steps, t.syncs[static_cast<int>(SyncPart::kRebuild)].syncs() / rebuilds,
+                  t.syncs[static_cast<int>(SyncPart::kRecord)].syncs() / steps);
     s += line;
   }
   return s;

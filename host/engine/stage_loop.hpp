@@ -10,6 +10,7 @@
 
 #include "host/engine/checkpoint.hpp"
 #include "host/engine/simulation.hpp"
+#include "host/util/sync_counts.hpp"
 
 namespace dem {
 
@@ -45,6 +46,12 @@ struct StageTiming {
   /// Candidate pairs in the contact lists (touching or within the Verlet skin) per ball at the stage's end: what a
   /// ball-ball or ball-wall particle-step costs grows with them.
   double ball_pairs = 0, wall_pairs = 0;
+  /// What the stage's steps made the host wait for, by part of the loop (sync_counts.hpp).
+  SyncTally syncs{};
+  /// Per step, the step's and its control's (a servo's) counts: what every step pays, rebuilds and records left out.
+  SyncCounts per_step_part() const {
+    return syncs[static_cast<int>(SyncPart::kControl)] + syncs[static_cast<int>(SyncPart::kStep)];
+  }
   double host() const { return wall - parts.loop(); }
   double rate() const { return wall > 0 ? static_cast<double>(balls) * static_cast<double>(steps) / wall : 0; }
 };

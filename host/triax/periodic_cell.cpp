@@ -37,6 +37,7 @@ std::unique_ptr<Simulation> make_periodic_simulation(const std::vector<BallSpec>
   prm.integ.mass_scale = solver.mass_scale;
   prm.skin = solver.skin * dmean;
   prm.overlap_limit = solver.overlap_limit;
+  prm.stats_every = stats_every_of(solver);
   std::vector<BallSpec> b = balls;
   for (BallSpec& s : b) s.material = 0;
   std::unique_ptr<Simulation> sim;

@@ -64,8 +64,9 @@ std::pair<StageEnd, Real> compact(Simulation& sim, Real z_target, const Specimen
     z = sim.wall_point(kTop).z;
     const Real dt = sim.params().integ.dt;
     if ((n - 1) % 5 == 0) {
-      const int touching = sim.wall_contact_counts()[kTop];
-      load = touching > 0 ? std::fabs(sim.wall_forces()[kTop].z) / (touching * f_limit) : 0;
+      const Simulation::WallLoads walls = sim.wall_loads(false);
+      const int touching = walls.touching[kTop];
+      load = touching > 0 ? std::fabs(walls.force[kTop].z) / (touching * f_limit) : 0;
     }
     const Real v = std::min(sc.platen_speed * std::clamp(1 - load, Real(0), Real(1)), (z - z_target) / dt);
     sim.set_wall_velocity(kTop, Vec3(0, 0, -std::max(v, Real(0))));

@@ -84,8 +84,9 @@ StageTiming consolidate(const Config& cfg, const Specimen& sp, Cell& cell, Stage
   stage.first = st.step + 1;
   stage.last = tc.max_consolidation_steps;
   stage.before = [&](long n) {
-    std::tie(top, bottom) = platen_stresses(cell, sim.wall_forces());
-    const int touching = sim.wall_contact_counts()[kTopPlaten];
+    const Simulation::WallLoads platens = sim.wall_loads(false);  // the membrane's facets are not the servo's
+    std::tie(top, bottom) = platen_stresses(cell, platens.force);
+    const int touching = platens.touching[kTopPlaten];
     set_top_velocity(cell, -servo.speed(top, touching * cell.kn_wall, dt));
     return StepPlan{false, n % 200 == 0};
   };

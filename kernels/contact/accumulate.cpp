@@ -55,15 +55,23 @@ IndexView object_offsets(const ContactList& walls, int nobj) {
   return off;
 }
 
-void wall_forces_into(const ContactList& walls, const IndexView& offsets, Vec3View& out) {
-  const int nobj = static_cast<int>(offsets.extent(0)) - 1;
-  if (static_cast<int>(out.extent(0)) != nobj) out = Vec3View("dem::accumulate::wall_force", nobj);
+void wall_loads_into(const ContactList& walls, const IndexView& offsets, int nobj, Vec3View& force,
+                     IndexView& touching) {
+  if (static_cast<int>(force.extent(0)) < nobj) force = Vec3View("dem::accumulate::wall_force", nobj);
+  if (static_cast<int>(touching.extent(0)) < nobj) touching = IndexView("dem::accumulate::wall_touching", nobj);
   auto fc = walls.fc;
-  auto res = out;
+  auto fn = walls.fn;
+  auto res = force;
+  auto count = touching;
   Kokkos::parallel_for("dem::accumulate::wall_force", RangePolicy(0, nobj), KOKKOS_LAMBDA(const int o) {
     Vec3 s;
-    for (int k = offsets(o); k < offsets(o + 1); ++k) s -= load(fc, k);
+    int c = 0;
+    for (int k = offsets(o); k < offsets(o + 1); ++k) {
+      s -= load(fc, k);
+      c += fn(k) > 0 ? 1 : 0;
+    }
     store(res, o, s);
+    count(o) = c;
   });
 }
 

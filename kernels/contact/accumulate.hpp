@@ -57,7 +57,9 @@ Gather make_gather(const ContactList& balls, const Index2View& own, const Adjace
 /// Offsets of each wall object's contacts in the (key-sorted) ball-wall list: nobj + 1 entries.
 IndexView object_offsets(const ContactList& walls, int nobj);
 
-/// Force on each wall object (N), the reaction of its contacts, summed in key order.
-void wall_forces_into(const ContactList& walls, const IndexView& offsets, Vec3View& out);
+/// Force on each of the first `nobj` wall objects (N), the reaction of its contacts summed in key order, and its
+/// touching contacts; `force` and `touching` are (re)allocated only where they are too short.
+void wall_loads_into(const ContactList& walls, const IndexView& offsets, int nobj, Vec3View& force,
+                     IndexView& touching);
 
 }  // namespace dem

@@ -202,28 +202,45 @@ void bind_particles(Kernel& k, const Particles& p) {
   k.x = p.x; k.v = p.v; k.w = p.w; k.radius = p.radius; k.mass = p.mass; k.material = p.material;
 }
 
+/// The largest overlap of a force kernel's contacts, returned to the host.
+template <class Launch>
+OverlapStat read_back(const Launch& launch) {
+  const OverlapRowsView worst("dem::force::worst", 1);
+  const OverlapResultView result(&worst(0, 0));
+  launch(result);
+  OverlapStat h;
+  Kokkos::deep_copy(h, result);
+  return h;
+}
+
 }  // namespace
 
-OverlapStat compute_ball_forces(const Particles& p, ContactList& c, const ParamTableView& params, const Domain& dom,
-                                Real dt) {
+void compute_ball_forces(const Particles& p, ContactList& c, const ParamTableView& params, const Domain& dom, Real dt,
+                         const OverlapResultView& worst) {
   BallForce k;
   bind_particles(k, p);
   k.c = c; k.params = params; k.dom = dom; k.image = MinImage(dom); k.dt = dt;
-  OverlapStat worst;
   const int items = (c.n + BallForce::W - 1) / BallForce::W;
-  Kokkos::parallel_reduce("dem::force::balls", RangePolicy(0, items), k, worst);
-  return worst;
+  Kokkos::parallel_reduce("dem::force::balls" TRIAXDEM_DEVICE_RESULT, RangePolicy(0, items), k, worst);
 }
 
-OverlapStat compute_wall_forces(const Particles& p, ContactList& c, const Adjacency& adj, const WallSet& walls,
-                                const FacetMesh& mesh, const ParamTableView& params, Real dt) {
+OverlapStat compute_ball_forces(const Particles& p, ContactList& c, const ParamTableView& params, const Domain& dom,
+                                Real dt) {
+  return read_back([&](const OverlapResultView& w) { compute_ball_forces(p, c, params, dom, dt, w); });
+}
+
+void compute_wall_forces(const Particles& p, ContactList& c, const Adjacency& adj, const WallSet& walls,
+                         const FacetMesh& mesh, const ParamTableView& params, Real dt, const OverlapResultView& worst) {
   WallForce k;
   bind_particles(k, p);
   k.c = c; k.adj_off = adj.offset; k.adj_entry = adj.entry; k.walls = walls; k.mesh = mesh;
   k.params = params; k.dt = dt;
-  OverlapStat worst;
-  Kokkos::parallel_reduce("dem::force::walls", RangePolicy(0, c.n), k, worst);
-  return worst;
+  Kokkos::parallel_reduce("dem::force::walls" TRIAXDEM_DEVICE_RESULT, RangePolicy(0, c.n), k, worst);
+}
+
+OverlapStat compute_wall_forces(const Particles& p, ContactList& c, const Adjacency& adj, const WallSet& walls,
+                                const FacetMesh& mesh, const ParamTableView& params, Real dt) {
+  return read_back([&](const OverlapResultView& w) { compute_wall_forces(p, c, adj, walls, mesh, params, dt, w); });
 }
 
 }  // namespace dem

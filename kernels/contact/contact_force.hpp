@@ -8,20 +8,20 @@
 
 namespace dem {
 
-/// Largest overlap / radius of the step and where it happened (for blow-up detection).
-struct OverlapStat {
-  Real ratio = 0;
-  int contact = -1;
-};
-
 /// Ball-ball forces with law RRLinear, kContactLanes contacts per work item (simd.hpp): writes each contact's
-/// force and moments on both sides (fc, mo, mt) for the gather (accumulate.hpp). Returns the largest overlap ratio.
+/// force and moments on both sides (fc, mo, mt) for the gather (accumulate.hpp), and the largest overlap ratio to
+/// `worst`, in device memory: the host does not wait.
+void compute_ball_forces(const Particles& p, ContactList& c, const ParamTableView& params, const Domain& dom, Real dt,
+                         const OverlapResultView& worst);
+/// The same, returning the largest overlap ratio to the host.
 OverlapStat compute_ball_forces(const Particles& p, ContactList& c, const ParamTableView& params, const Domain& dom,
                                 Real dt);
 
 /// Ball-wall forces (analytic walls and facets). A ball touching several facets at a shared edge or
 /// vertex gets one contact: an edge/vertex hit yields to a face hit, or an equal hit of a lower facet
 /// number, on any touching facet that holds the same edge or vertex.
+void compute_wall_forces(const Particles& p, ContactList& c, const Adjacency& adj, const WallSet& walls,
+                         const FacetMesh& mesh, const ParamTableView& params, Real dt, const OverlapResultView& worst);
 OverlapStat compute_wall_forces(const Particles& p, ContactList& c, const Adjacency& adj, const WallSet& walls,
                                 const FacetMesh& mesh, const ParamTableView& params, Real dt);
 

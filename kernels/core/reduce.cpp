@@ -29,4 +29,21 @@ Kokkos::View<Real*, MemSpace> reduce_scratch(std::size_t count) {
   return *buffer;
 }
 
+Kokkos::View<Real*, MemSpace> reduce_root() {
+  static Kokkos::View<Real*, MemSpace>* root = nullptr;
+  if (root == nullptr) {
+    root = new Kokkos::View<Real*, MemSpace>("dem::reduce::root", kMaxReduceValues);
+    Kokkos::push_finalize_hook([] {
+      delete root;
+      root = nullptr;
+    });
+  }
+  return *root;
+}
+
+void read_root(Real* out, int count) {
+  Kokkos::deep_copy(Kokkos::View<Real*, HostSpace, Kokkos::MemoryUnmanaged>(out, count),
+                    Kokkos::subview(reduce_root(), std::make_pair(0, count)));
+}
+
 }  // namespace dem

@@ -17,6 +17,12 @@ constexpr int kReduceBlock = 256;
 /// Device scratch for the tree's block results, of at least `count` Reals: one buffer, grown and never shrunk,
 /// so that a step allocates nothing. Kernels run in order, so one reduction's use ends before the next begins.
 Kokkos::View<Real*, MemSpace> reduce_scratch(std::size_t count);
+/// Device room for one root's values (kMaxReduceValues), apart from the scratch, for reductions whose root the
+/// host reads.
+constexpr int kMaxReduceValues = 16;
+Kokkos::View<Real*, MemSpace> reduce_root();
+/// Copies reduce_root's first `count` values to the host's `out`.
+void read_root(Real* out, int count);
 
 /// Exclusive scan of counts[0, n) into offsets[0, n] (offsets[n] the total, returned); `counts` may be `offsets`
 /// itself, each entry read before it is overwritten. Integer sums: the same for any order.
@@ -98,27 +104,37 @@ void tree_level(const char* label, int n, const F& f, Real* out) {
 
 /// Reduces the values f(i, count, vals) of items [0, n), W at a time: vals[k] gets item i + k's values, k < count
 /// <= W; vals[.][0, NSUM) are summed and vals[.][NSUM, NSUM + NMAX) maximised (from 0: non-negative quantities).
-/// The tree of the header; only the root's NSUM + NMAX values come back to the host.
+/// The tree of the header; its root's NSUM + NMAX values go to `root`, in device memory, and the host waits for
+/// nothing: a step's statistics stay on the device until the host reads them (host/engine/step_rows.hpp).
+template <int NSUM, int NMAX, int W, class F>
+void deterministic_reduce_lanes_to(const char* label, int n, const F& f, Real* root) {
+  constexpr int NV = NSUM + NMAX;
+  if (n <= 0) {
+    Kokkos::parallel_for(label, RangePolicy(0, NV), KOKKOS_LAMBDA(const int q) { root[q] = 0; });
+    return;
+  }
+  const auto blocks = [](int items) { return (items + kReduceBlock - 1) / kReduceBlock; };
+  std::size_t total = 0;  // the levels below the root
+  for (int m = blocks(n); m > 1; m = blocks(m)) total += static_cast<std::size_t>(m) * NV;
+  Real* level = total > 0 ? reduce_scratch(total).data() : nullptr;
+  int m = blocks(n);
+  detail::tree_level<NSUM, NMAX, W>(label, n, f, m == 1 ? root : level);
+  while (m > 1) {
+    const int up = blocks(m);
+    Real* next = up == 1 ? root : level + static_cast<std::size_t>(m) * NV;
+    detail::tree_level<NSUM, NMAX, 1>(label, m, detail::LevelItems<NV>{level, m}, next);
+    level = next;
+    m = up;
+  }
+}
+
+/// The same, with the root's values copied to the host's `out`.
 template <int NSUM, int NMAX, int W, class F>
 void deterministic_reduce_lanes(const char* label, int n, const F& f, Real (&out)[NSUM + NMAX]) {
   constexpr int NV = NSUM + NMAX;
-  for (int q = 0; q < NV; ++q) out[q] = 0;
-  if (n <= 0) return;
-  const auto blocks = [](int items) { return (items + kReduceBlock - 1) / kReduceBlock; };
-  std::size_t total = 0;
-  for (int m = blocks(n);; m = blocks(m)) {
-    total += static_cast<std::size_t>(m) * NV;
-    if (m == 1) break;
-  }
-  Real* level = reduce_scratch(total).data();
-  detail::tree_level<NSUM, NMAX, W>(label, n, f, level);
-  for (int m = blocks(n); m > 1; m = blocks(m)) {
-    Real* next = level + static_cast<std::size_t>(m) * NV;
-    detail::tree_level<NSUM, NMAX, 1>(label, m, detail::LevelItems<NV>{level, m}, next);
-    level = next;
-  }
-  Kokkos::deep_copy(Kokkos::View<Real*, HostSpace, Kokkos::MemoryUnmanaged>(out, NV),
-                    Kokkos::View<Real*, MemSpace, Kokkos::MemoryUnmanaged>(level, NV));
+  static_assert(NV <= kMaxReduceValues, "reduce_root holds kMaxReduceValues values");
+  deterministic_reduce_lanes_to<NSUM, NMAX, W>(label, n, f, reduce_root().data());
+  read_root(out, NV);
 }
 
 /// An item function f(i, vals) as one of W = 1 item at a time.
@@ -133,6 +149,12 @@ struct OneAtATime {
 template <int NSUM, int NMAX, class F>
 void deterministic_reduce(const char* label, int n, const F& f, Real (&out)[NSUM + NMAX]) {
   deterministic_reduce_lanes<NSUM, NMAX, 1>(label, n, OneAtATime<F, NSUM + NMAX>{f}, out);
+}
+
+/// The same, with the root's values left in device memory at `root`.
+template <int NSUM, int NMAX, class F>
+void deterministic_reduce_to(const char* label, int n, const F& f, Real* root) {
+  deterministic_reduce_lanes_to<NSUM, NMAX, 1>(label, n, OneAtATime<F, NSUM + NMAX>{f}, root);
 }
 
 }  // namespace dem

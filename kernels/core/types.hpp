@@ -32,6 +32,24 @@ using FlagView = Kokkos::View<std::uint8_t*, MemSpace>;             ///< per-con
 using Index2View = Kokkos::View<int* [2], Layout, MemSpace>;         ///< pair of local indices
 using Index3View = Kokkos::View<int* [3], Layout, MemSpace>;         ///< facet vertex indices
 
+/// Largest overlap / radius of a step's contacts and where it happened (for blow-up detection).
+struct OverlapStat {
+  Real ratio = 0;
+  int contact = -1;
+};
+
+/// A step's statistics, kept on the device, a row per step of a ring of steps (host/engine/step_rows.hpp): the
+/// reductions' roots as Reals, and the largest overlaps of the ball-ball and ball-wall contacts.
+using StepRowsView = Kokkos::View<Real**, Kokkos::LayoutRight, MemSpace>;
+/// Steps such a ring holds: the most steps between two reads.
+constexpr int kStepRowSlots = 64;
+using OverlapRowsView = Kokkos::View<OverlapStat* [2], Kokkos::LayoutRight, MemSpace>;
+/// One overlap of such a row, where a reduction leaves its result without the host waiting for it.
+using OverlapResultView = Kokkos::View<OverlapStat, MemSpace, Kokkos::MemoryUnmanaged>;
+/// Ends the label of a parallel_reduce whose result stays in device memory, so that the sync counter
+/// (host/util/sync_counts.hpp) tells it from one whose value the host waits for.
+#define TRIAXDEM_DEVICE_RESULT "@device"
+
 /// Contact parameters per pair of material indices (contact_law.hpp).
 using ParamTableView = Kokkos::View<ContactParams**, MemSpace>;
 

@@ -4,25 +4,39 @@
 
 namespace dem {
 
-StepStats integrate(Particles& p, const IntegrateParams& prm, const Gather& gather) {
+void integrate_to(Particles& p, const IntegrateParams& prm, const Gather& gather, Real* values) {
   const Leapfrog lf{p.x, p.v, p.w, p.f, p.m, p.x_ref, p.mass, p.inertia, p.radius, gather, prm};
-  Real sums[Leapfrog::kValues];
-  deterministic_reduce_lanes<Leapfrog::kSums, Leapfrog::kMaxima, Leapfrog::W>("dem::integrate::leapfrog", p.n, lf, sums);
+  deterministic_reduce_lanes_to<Leapfrog::kSums, Leapfrog::kMaxima, Leapfrog::W>("dem::integrate::leapfrog", p.n, lf,
+                                                                                 values);
+}
+
+StepStats step_stats(const Real* values) {
   StepStats st;
-  st.unbalanced = sums[0];
-  st.kinetic = sums[1];
-  st.max_disp2 = sums[3];
-  st.max_move2 = sums[4];
+  st.unbalanced = values[0];
+  st.kinetic = values[1];
+  st.max_disp2 = values[3];
+  st.max_move2 = values[4];
+  st.max_step2 = values[5];
+  return st;
+}
+
+int non_finite_particle(const Particles& p) {
   auto x = p.x;
-  if (sums[2] > 0) {
-    int bad = -1;
-    Kokkos::parallel_reduce("dem::integrate::find_bad", RangePolicy(0, p.n),
-        KOKKOS_LAMBDA(const int i, int& acc) {
-          const Vec3 xi = load(x, i);
-          if (!(kc::isfinite(xi.x) && kc::isfinite(xi.y) && kc::isfinite(xi.z)) && i > acc) acc = i;
-        }, Kokkos::Max<int>(bad));
-    st.bad = bad;
-  }
+  int bad = -1;
+  Kokkos::parallel_reduce("dem::integrate::find_bad", RangePolicy(0, p.n),
+      KOKKOS_LAMBDA(const int i, int& acc) {
+        const Vec3 xi = load(x, i);
+        if (!(kc::isfinite(xi.x) && kc::isfinite(xi.y) && kc::isfinite(xi.z)) && i > acc) acc = i;
+      }, Kokkos::Max<int>(bad));
+  return bad;
+}
+
+StepStats integrate(Particles& p, const IntegrateParams& prm, const Gather& gather) {
+  integrate_to(p, prm, gather, reduce_root().data());
+  Real values[Leapfrog::kValues];
+  read_root(values, Leapfrog::kValues);
+  StepStats st = step_stats(values);
+  if (values[2] > 0) st.bad = non_finite_particle(p);
   return st;
 }
 

@@ -31,6 +31,7 @@ struct StepStats {
   Real kinetic = 0;       ///< translational + rotational kinetic energy (J), at t + dt/2, on measured steps
   Real max_disp2 = 0;     ///< largest squared displacement since the last rebuild (m^2)
   Real max_move2 = 0;     ///< largest (distance moved this step / radius)^2
+  Real max_step2 = 0;     ///< largest squared distance moved this step (m^2)
   int bad = -1;           ///< a particle with a non-finite position, or -1
 };
 
@@ -60,8 +61,8 @@ KOKKOS_INLINE_FUNCTION Vec3T<T> damped_velocity(const IntegrateParams& prm, cons
 /// the leapfrog update. Every lane does the IEEE operations of one particle, so the lanes change no bit.
 struct Leapfrog {
   /// A particle's values: {|F + m g|, kinetic energy, non-finite flag | displacement^2 since rebuild,
-  /// (move this step / radius)^2}; the first kSums are summed, the last kMaxima maximised (reduce_block).
-  static constexpr int kSums = 3, kMaxima = 2, kValues = kSums + kMaxima;
+  /// (move this step / radius)^2, move this step^2}; the first kSums are summed, the last kMaxima maximised.
+  static constexpr int kSums = 3, kMaxima = 3, kValues = kSums + kMaxima;
   static constexpr int W = kContactLanes;
   Vec3View x, v, w, f, m;
   ConstVec3View x_ref;
@@ -110,7 +111,8 @@ struct Leapfrog {
     const T unbalanced = prm.measure ? norm(force) : T(0);
     const T kinetic = prm.measure ? T(Real(0.5)) * (mi * norm2(vi) + ii * norm2(wi)) : T(0);
     const T disp2 = norm2(xi - load_lanes<T>(x_ref, i0, id, full));
-    const T move2 = norm2(vi) * T(prm.dt * prm.dt) / (ri * ri);
+    const T step2 = norm2(vi) * T(prm.dt * prm.dt);
+    const T move2 = step2 / (ri * ri);
     TRIAXDEM_UNROLL_LANES
     for (int k = 0; k < W; ++k) {
       if (k == count) break;
@@ -120,6 +122,7 @@ struct Leapfrog {
       vals[k][2] = (kc::isfinite(xk.x) && kc::isfinite(xk.y) && kc::isfinite(xk.z)) ? Real(0) : Real(1);
       vals[k][3] = lane(disp2, k);
       vals[k][4] = lane(move2, k);
+      vals[k][5] = lane(step2, k);
     }
   }
 };
@@ -127,5 +130,11 @@ struct Leapfrog {
 /// Completes each particle's force and moment (gather), stores them in p.f, p.m, and advances all
 /// particles one step. Returns the step's sums (deterministic: fixed-order reduction).
 StepStats integrate(Particles& p, const IntegrateParams& prm, const Gather& gather);
+/// The same, with the step's Leapfrog::kValues values left in device memory at `values` (step_stats reads them).
+void integrate_to(Particles& p, const IntegrateParams& prm, const Gather& gather, Real* values);
+/// The statistics in a step's values; `bad` is left at -1 (non_finite_particle finds it where values[2] > 0).
+StepStats step_stats(const Real* values);
+/// The highest index of a particle with a non-finite position, or -1.
+int non_finite_particle(const Particles& p);
 
 }  // namespace dem

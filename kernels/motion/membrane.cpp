@@ -287,22 +287,31 @@ void membrane_forces(const Membrane& m, Real p, const FacetContacts& fc, Vec3Vie
   node_forces(m, true, p, &fc, out);
 }
 
-MembraneStepStats membrane_integrate(Membrane& m, const Vec3View& force, const MembraneIntegrateParams& prm) {
+void membrane_integrate_to(Membrane& m, const Vec3View& force, const MembraneIntegrateParams& prm, Real* values) {
   if (static_cast<int>(force.extent(0)) != m.nnode)
     throw std::invalid_argument("membrane_integrate: force has " + std::to_string(force.extent(0)) +
                                 " rows, the membrane " + std::to_string(m.nnode) + " nodes");
   const NodeLeapfrog lf{m.mesh.node_x, m.mesh.node_v, force, m.node_mass, m.fixed, prm};
-  Real sums[4];
   // Functors go in through a lambda: the reduction template then launches its
   // kernel on an extended-lambda closure type, which CUDA accepts in any translation unit.
-  deterministic_reduce<3, 1>("dem::membrane::leapfrog", m.nnode, KOKKOS_LAMBDA(const int n, Real* v) { lf(n, v); },
-                             sums);
+  deterministic_reduce_to<3, 1>("dem::membrane::leapfrog", m.nnode, KOKKOS_LAMBDA(const int n, Real* v) { lf(n, v); },
+                                values);
+}
+
+MembraneStepStats membrane_stats(const Real* values) {
   MembraneStepStats st;
-  st.unbalanced = sums[0];
-  st.kinetic = sums[1];
-  st.finite = sums[2] == 0;
-  st.max_speed = sums[3];
+  st.unbalanced = values[0];
+  st.kinetic = values[1];
+  st.finite = values[2] == 0;
+  st.max_speed = values[3];
   return st;
+}
+
+MembraneStepStats membrane_integrate(Membrane& m, const Vec3View& force, const MembraneIntegrateParams& prm) {
+  membrane_integrate_to(m, force, prm, reduce_root().data());
+  Real values[kMembraneValues];
+  read_root(values, kMembraneValues);
+  return membrane_stats(values);
 }
 
 Real enclosed_volume(const Membrane& m, Real z_bottom, Real z_top) {

@@ -93,6 +93,10 @@ struct MembraneStepStats {
 /// Centred differences with local damping for free nodes; fixed nodes keep the velocity the caller
 /// set in node_v (the platen's). Forces in `force` (N, per node), e.g. from membrane_forces.
 MembraneStepStats membrane_integrate(Membrane& m, const Vec3View& force, const MembraneIntegrateParams& prm);
+/// The same, with the step's kMembraneValues values left in device memory at `values` (membrane_stats reads them).
+constexpr int kMembraneValues = 4;
+void membrane_integrate_to(Membrane& m, const Vec3View& force, const MembraneIntegrateParams& prm, Real* values);
+MembraneStepStats membrane_stats(const Real* values);
 
 /// Volume (m^3) enclosed by the membrane and the two platen planes z = z_bottom, z = z_top (the
 /// specimen axis is along z). Signed tetrahedra from a point on the axis over the lateral facets and
