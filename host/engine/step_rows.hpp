@@ -35,9 +35,14 @@ struct StepRows {
         host_overlaps(Kokkos::create_mirror_view(overlaps)) {}
 
   static int slot(long step) { return static_cast<int>(step % kSlots); }
-  /// Device address of step `step`'s first value in column `c`.
-  Real* at(long step, Column c) const { return &rows(slot(step), c); }
-  OverlapResultView overlap(long step, Overlap o) const { return OverlapResultView(&overlaps(slot(step), o)); }
+  /// Device address of step `step`'s first value in column `c` (through subviews: the host may not index device
+  /// memory).
+  Real* at(long step, Column c) const {
+    return Kokkos::subview(rows, slot(step), std::make_pair(static_cast<int>(c), static_cast<int>(kColumns))).data();
+  }
+  OverlapResultView overlap(long step, Overlap o) const {
+    return OverlapResultView(Kokkos::subview(overlaps, slot(step), static_cast<int>(o)).data());
+  }
   /// The rows of steps [from, to) to the host (to - from <= kSlots): two copies, four where they wrap around.
   void read(long from, long to) const {
     const int a = slot(from), b = slot(to - 1) + 1;
