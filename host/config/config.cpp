@@ -4,7 +4,6 @@
 #include "host/util/fnv1a.hpp"
 #include "host/config/noise_model.hpp"
 #include "host/config/toml_reader.hpp"
-#include "kernels/core/types.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -107,7 +106,7 @@ void read_solver(const Tables& read, Config& c) {
   sv.number("mass_scale", c.solver.mass_scale, 1, 1e12);
   sv.number("skin", c.solver.skin, 0, 2, 1, true);
   sv.number("overlap_limit", c.solver.overlap_limit, 0, 1, 1, true);
-  sv.integer("stats_every", c.solver.stats_every, 0, kStepRowSlots);
+  sv.integer("stats_every", c.solver.stats_every, 0, kMaxStatsEvery);
   sv.finish();
 }
 

@@ -46,6 +46,10 @@ struct BoxConfig {
   Real lattice_spacing = 1.0;    ///< lattice pitch / largest diameter (< 1 presses neighbours together)
 };
 
+/// The most steps between the host's reads of the step statistics: the ring of steps on the device holds this many
+/// (host/engine/step_rows.hpp).
+constexpr long kMaxStatsEvery = 64;
+
 struct SolverConfig {
   Real damping = 0.7;                       ///< local damping alpha
   std::array<Real, 3> gravity{0, 0, -9.81}; ///< m/s^2

@@ -4,6 +4,7 @@
 /// node, the largest overlaps). On a GPU, reading them at every step would hold the host at every step; the
 /// Simulation reads them every few steps instead (SimParams::stats_every), and whenever a decision needs them
 /// (host/engine/step_reads.cpp says how a rebuild is decided between reads with the same outcome).
+#include "host/config/config.hpp"
 #include "kernels/motion/integrate.hpp"
 #include "kernels/motion/membrane.hpp"
 
@@ -11,7 +12,7 @@ namespace dem {
 
 struct StepRows {
   /// Steps the ring holds: the most that SimParams::stats_every may ask for.
-  static constexpr int kSlots = kStepRowSlots;
+  static constexpr int kSlots = static_cast<int>(kMaxStatsEvery);
   /// A row's columns: the leapfrog's values (Leapfrog), the membrane's (membrane_integrate_to), the fastest
   /// membrane node (m/s).
   enum Column : int {

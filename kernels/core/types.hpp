@@ -41,8 +41,6 @@ struct OverlapStat {
 /// A step's statistics, kept on the device, a row per step of a ring of steps (host/engine/step_rows.hpp): the
 /// reductions' roots as Reals, and the largest overlaps of the ball-ball and ball-wall contacts.
 using StepRowsView = Kokkos::View<Real**, Kokkos::LayoutRight, MemSpace>;
-/// Steps such a ring holds: the most steps between two reads.
-constexpr int kStepRowSlots = 64;
 using OverlapRowsView = Kokkos::View<OverlapStat* [2], Kokkos::LayoutRight, MemSpace>;
 /// One overlap of such a row, where a reduction leaves its result without the host waiting for it.
 using OverlapResultView = Kokkos::View<OverlapStat, MemSpace, Kokkos::MemoryUnmanaged>;
