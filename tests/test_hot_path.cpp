@@ -173,3 +173,31 @@ TEST(HotPath, ABallThatOutrunsTheBoundIsALateRebuild) {
   EXPECT_GT(sim->times().rebuilds, rebuilds);
   EXPECT_NE(said.find("found expired some steps late"), std::string::npos) << said;
 }
+
+// A state taken between two reads (state() reads first) and restored into a simulation built alike starts from the
+// last step's statistics and goes on bit for bit as the one it was taken from: the restored one reads every step
+// until its first read bounds the balls' speed.
+TEST(HotPath, AStateTakenBetweenReadsResumesBitForBit) {
+  Config cfg = load_config(std::string(TRIAXDEM_SOURCE_DIR) + "/configs/default.toml");
+  cfg.solver.stats_every = 16;
+  auto sim = build_simulation(cfg, false);
+  for (int k = 0; k < 37; ++k) sim->step(false);  // 37: in the middle of a read's 16 steps
+  const SimState state = sim->state();
+  const long rebuilds_before = sim->times().rebuilds;
+  auto resumed = build_simulation(cfg, false);
+  resumed->restore(state);
+  // The statistics it starts from are step 37's, read by state(), not those of the read before.
+  EXPECT_EQ(resumed->stats().max_disp2, sim->stats().max_disp2);
+  EXPECT_GT(resumed->stats().max_disp2, 0);
+  // On until the restored one has rebuilt twice: its first rebuild is decided from the restored state.
+  for (int k = 0; k < 20000 && resumed->times().rebuilds < 2; ++k) {
+    sim->step(false);
+    resumed->step(false);
+  }
+  ASSERT_GT(resumed->times().rebuilds, 0) << "no rebuild after the restore: the test would show little";
+  EXPECT_EQ(sim->times().rebuilds - rebuilds_before, resumed->times().rebuilds);
+  const SimState a = sim->state(), b = resumed->state();
+  ASSERT_EQ(a.x.size(), b.x.size());
+  for (std::size_t k = 0; k < a.x.size(); ++k) ASSERT_EQ(a.x[k], b.x[k]) << "coordinate " << k;
+  EXPECT_EQ(a.wall_disp, b.wall_disp);
+}

@@ -178,6 +178,7 @@ void check_state(const SimState& s, std::size_t walls, std::size_t facets, int m
 }
 
 SimState Simulation::state() const {
+  read_rows();  // the statistics and the boundaries' travel as of the last step
   SimState s;
   s.step = step_;
   s.time = time_;
@@ -250,6 +251,11 @@ void Simulation::restore(const SimState& s) {
   stats_ = s.stats;
   fresh_ = s.fresh;
   if (!fresh_) index_contacts();
+  // Every step of the state has been read (state() reads them first). How fast the balls went is not stored: the
+  // rows are read every step until the first read gives it.
+  read_to_ = step_;
+  step_bound_ = 0;
+  node_bound_ = 0;
 }
 
 }  // namespace dem
