@@ -22,20 +22,20 @@ using namespace dem;
 
 namespace {
 
+SyncCounts part_of(const StageTiming& t, SyncPart part) { return t.syncs[static_cast<int>(part)]; }
+
 void print_stage(const StageTiming& t) {
   const double n = std::max(1L, t.steps);
-  const SyncCounts control = t.syncs[static_cast<int>(SyncPart::kControl)];
-  const SyncCounts step = t.syncs[static_cast<int>(SyncPart::kStep)];
+  const SyncCounts control = part_of(t, SyncPart::kControl);
+  const SyncCounts step = part_of(t, SyncPart::kStep);
   std::printf("%-16s %6ld steps | step: %.2f launches %.3f allocations %.3f copies %.3f results %.3f fences | "
               "control: %.2f launches %.3f copies %.3f results | %.1f syncs per rebuild, %.3f record syncs per step\n",
               t.name.c_str(), t.steps, step.launches / n, step.allocations / n, step.copies / n,
               step.host_results / n, step.fences / n, control.launches / n, control.copies / n,
               control.host_results / n,
-              t.syncs[static_cast<int>(SyncPart::kRebuild)].syncs() / std::max(1.0, double(t.parts.rebuilds)),
-              t.syncs[static_cast<int>(SyncPart::kRecord)].syncs() / n);
+              part_of(t, SyncPart::kRebuild).syncs() / std::max(1.0, double(t.parts.rebuilds)),
+              part_of(t, SyncPart::kRecord).syncs() / n);
 }
-
-SyncCounts part_of(const StageTiming& t, SyncPart part) { return t.syncs[static_cast<int>(part)]; }
 
 /// The tiny membrane test, specimen and triaxial stages, reading the statistics every `every` steps.
 struct MembraneRun {

@@ -256,6 +256,7 @@ void Simulation::restore(const SimState& s) {
   read_to_ = step_;
   step_bound_ = 0;
   node_bound_ = 0;
+  unread_travel_ = 0;
 }
 
 }  // namespace dem

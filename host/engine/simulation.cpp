@@ -12,13 +12,6 @@
 namespace dem {
 
 namespace {
-double seconds_since(Kokkos::Timer& t) {
-  Kokkos::fence();
-  count_fence();
-  const double s = t.seconds();
-  t.reset();
-  return s;
-}
 
 // The kernels of this file are free functions: nvcc allows no device lambda in a constructor or a private member.
 
@@ -165,34 +158,37 @@ constexpr long kTimedEvery = 16;
 class PartClock {
  public:
   explicit PartClock(long weight) : weight_(static_cast<double>(weight)) {
-    if (weight_ > 0) restart();
+    if (weight_ > 0) fenced_seconds();  // the device's work queued before is not the first lap's
   }
   void lap(double& into) {
-    if (weight_ > 0) into += weight_ * seconds_since(t_);
+    if (weight_ > 0) into += weight_ * fenced_seconds();
   }
-  /// A lap taken whatever the weight, counted once: a rebuild, which waits for the device anyway.
-  void lap_always(double& into) { into += seconds_since(t_); }
-  /// From now, behind a fence: the device's work queued before is not the next lap's.
-  void restart() {
-    Kokkos::fence();
-    count_fence();
-    t_.reset();
+  /// `part` timed whatever the weight, counted once: a rebuild, which waits for the device anyway.
+  template <class F>
+  void always(double& into, F&& part) {
+    if (weight_ == 0) fenced_seconds();
+    part();
+    into += fenced_seconds();
   }
 
  private:
   double weight_;
   Kokkos::Timer t_;
+  /// Seconds since the last reading, behind a fence.
+  double fenced_seconds() {
+    Kokkos::fence();
+    count_fence();
+    const double s = t_.seconds();
+    t_.reset();
+    return s;
+  }
 };
 
 }  // namespace
 
 void Simulation::step(bool measure) {
   PartClock clock(step_ % kTimedEvery == 0 ? kTimedEvery : 0);
-  if (rebuild_due()) {
-    if (step_ % kTimedEvery != 0) clock.restart();
-    rebuild();
-    clock.lap_always(times_.rebuild);
-  }
+  if (rebuild_due()) clock.always(times_.rebuild, [this] { rebuild(); });
   const Real dt = prm_.integ.dt;
   compute_ball_forces(p_, balls_, params_, prm_.domain, dt, rows_.overlap(step_, StepRows::kBalls));
   clock.lap(times_.forces);
@@ -241,7 +237,7 @@ void Simulation::move_boundaries() {
   }
   // The membrane nodes' speed joins vmax when the row is read (read_rows).
   if (mesh_.ntri > 0) move_nodes(mesh_, dt, rows_.at(step_, StepRows::kNodeSpeed));
-  boundary_steps_[static_cast<std::size_t>(StepRows::slot(step_))] = {vmax, dt};
+  boundary_step(vmax, dt);
 }
 
 void Simulation::set_membrane(const Membrane& m, const MembraneIntegrateParams& prm) {
@@ -287,11 +283,15 @@ std::array<Real, 3> Simulation::contact_stress_diagonal(Real volume) const {
   return love_weber_stress<3>("dem::sim::contact_stress_diagonal", balls_, p_.x, prm_.domain, volume);
 }
 
-void Simulation::set_wall_velocity(int w, const Vec3& v) {
+bool Simulation::store_wall_velocity(int w, const Vec3& v) {
   const Vec3 now = load(hwall_vel_, w);
-  if (v.x == now.x && v.y == now.y && v.z == now.z) return;  // a constant speed costs no copy a step
+  if (v.x == now.x && v.y == now.y && v.z == now.z) return false;
   store(hwall_vel_, w, v);
-  Kokkos::deep_copy(walls_.velocity, hwall_vel_);
+  return true;
+}
+
+void Simulation::set_wall_velocity(int w, const Vec3& v) {
+  if (store_wall_velocity(w, v)) Kokkos::deep_copy(walls_.velocity, hwall_vel_);  // a constant speed: no copy
 }
 
 void Simulation::set_wall_velocities(const std::vector<Vec3>& v) {
@@ -299,11 +299,7 @@ void Simulation::set_wall_velocities(const std::vector<Vec3>& v) {
     throw std::invalid_argument("set_wall_velocities: " + std::to_string(v.size()) + " velocities for " +
                                 std::to_string(walls_.n) + " walls");
   bool changed = false;
-  for (int w = 0; w < walls_.n; ++w) {
-    const Vec3 now = load(hwall_vel_, w), to = v[static_cast<std::size_t>(w)];
-    changed = changed || to.x != now.x || to.y != now.y || to.z != now.z;
-    store(hwall_vel_, w, to);
-  }
+  for (int w = 0; w < walls_.n; ++w) changed = store_wall_velocity(w, v[static_cast<std::size_t>(w)]) || changed;
   if (changed) Kokkos::deep_copy(walls_.velocity, hwall_vel_);
 }
 

@@ -186,6 +186,7 @@ class Simulation {
   mutable Real wall_disp_ = 0;       ///< how far a wall, the cell or a membrane node has moved since the rebuild (m)
   mutable Real step_bound_ = 0;      ///< the farthest one ball moved in a step of the last read (m); 0: no read yet
   mutable Real node_bound_ = 0;      ///< the fastest membrane node of the last read (m/s)
+  mutable Real unread_travel_ = 0;   ///< bound on the boundaries' travel in the steps not yet read (m)
   /// The host-known part of each step's boundary speed (walls, the cell's stretch; m/s) and its dt, by ring slot.
   struct BoundaryStep {
     Real speed = 0, dt = 0;
@@ -198,6 +199,8 @@ class Simulation {
   bool fresh_ = true;
 
   bool rebuild_due();
+  /// Records the step's host-known boundary speed (m/s) and dt, and adds to the bound on the unread steps' travel.
+  void boundary_step(Real speed, Real dt);
   /// Reads the rows of the steps not yet read: their blow-up checks, displacements and statistics.
   void read_rows() const;
   /// Whether the neighbour lists must be rebuilt after a step with largest displacement^2 `disp2` since the last
@@ -206,6 +209,8 @@ class Simulation {
   void rebuild();
   void index_contacts();  ///< owner ranges, adjacency and object offsets of the contact lists
   void move_boundaries();
+  /// Sets the host's copy of wall w's velocity; false where it was v already.
+  bool store_wall_velocity(int w, const Vec3& v);
   /// Throws BlowUp where step `step`'s statistics and overlaps show one.
   void check_blowup(long step, const StepStats& st, const OverlapStat& ob, const OverlapStat& ow) const;
 };

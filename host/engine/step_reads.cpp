@@ -37,17 +37,17 @@ bool Simulation::rebuild_due() {
   if (fresh_) return true;
   const long unread = step_ - read_to_;
   if (unread > 0 && step_bound_ > 0) {
-    Real walls = wall_disp_;
-    for (long s = read_to_; s < step_; ++s) {
-      const BoundaryStep& b = boundary_steps_[static_cast<std::size_t>(StepRows::slot(s))];
-      walls += std::max(b.speed, mesh_.ntri > 0 ? kSpeedGrowth * node_bound_ : Real(0)) * b.dt;
-    }
     const Real d = std::sqrt(stats_.max_disp2) + static_cast<Real>(unread) * kSpeedGrowth * step_bound_;
     const Real margin = 1 + kBoundMargin;
-    if (!lists_expired(d * d * margin * margin, walls * margin)) return false;
+    if (!lists_expired(d * d * margin * margin, (wall_disp_ + unread_travel_) * margin)) return false;
   }
   read_rows();
   return lists_expired(stats_.max_disp2, wall_disp_);
+}
+
+void Simulation::boundary_step(Real speed, Real dt) {
+  boundary_steps_[static_cast<std::size_t>(StepRows::slot(step_))] = {speed, dt};
+  unread_travel_ += std::max(speed, mesh_.ntri > 0 ? kSpeedGrowth * node_bound_ : Real(0)) * dt;
 }
 
 void Simulation::read_rows() const {
@@ -74,6 +74,7 @@ void Simulation::read_rows() const {
     if (s + 1 < step_ && lists_expired(st.max_disp2, wall_disp_)) late = true;
   }
   read_to_ = step_;
+  unread_travel_ = 0;
   step_bound_ = std::sqrt(step_max2);
   node_bound_ = node_max;
   if (late) {

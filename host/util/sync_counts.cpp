@@ -1,7 +1,7 @@
 #include "host/util/sync_counts.hpp"
 
 #include <cstdint>
-#include <string>
+#include <cstring>
 
 #include "kernels/core/types.hpp"
 
@@ -19,9 +19,8 @@ SyncCounts& now() { return tally[static_cast<int>(current)]; }
 void on_for(const char*, std::uint32_t, std::uint64_t*) { ++now().launches; }
 void on_reduce(const char* name, std::uint32_t, std::uint64_t*) {
   ++now().launches;
-  const std::string label(name);
-  const std::string device(TRIAXDEM_DEVICE_RESULT);
-  const bool on_device = label.size() >= device.size() && label.compare(label.size() - device.size(), device.size(), device) == 0;
+  const std::size_t n = std::strlen(name), tag = std::strlen(TRIAXDEM_DEVICE_RESULT);
+  const bool on_device = n >= tag && std::strcmp(name + n - tag, TRIAXDEM_DEVICE_RESULT) == 0;
   if (!on_device) ++now().host_results;
 }
 void on_scan(const char*, std::uint32_t, std::uint64_t*) {
