@@ -87,4 +87,41 @@ TEST(Reduce, LaneGroupsGiveTheBitsOfOneItemAtATime) {
   }
 }
 
+/// Segments side by side (a batch's specimens) give each the root it gets alone, to the bit: empty segments, one
+/// item, a block, a block and one, and three levels beside one that ends at the first.
+TEST(Reduce, SegmentsGiveEachTheBitsOfItsOwnReduction) {
+  const std::vector<int> sizes = {0, 1, 3, kReduceBlock, kReduceBlock + 1, 5000, 0, kReduceBlock * kReduceBlock + 1, 7};
+  std::vector<int> offsets = {0};
+  for (int n : sizes) offsets.push_back(offsets.back() + n);
+  const std::vector<double> all = awkward_values(offsets.back(), 11u);
+  const ScalarView d = device_copy(all);
+  SegmentedTree tree;
+  tree.plan(offsets);
+  EXPECT_EQ(tree.levels(), 3);
+  const int S = static_cast<int>(sizes.size());
+  Kokkos::View<Real*, MemSpace> roots("roots", 2 * S), lanes("lanes", S);
+  Kokkos::deep_copy(roots, 5.0);  // every root must be written, the empty segments' too
+  segmented_reduce_lanes_to<1, 1, 1>("test::segments", tree, OneAtATime<ValueAndMagnitude, 2>{{d}}, roots.data());
+  segmented_reduce_lanes_to<1, 0, 4>("test::segments4", tree, Squares{d}, lanes.data());
+  auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), roots);
+  auto hl = Kokkos::create_mirror_view_and_copy(HostSpace(), lanes);
+  for (int s = 0; s < S; ++s) {
+    const std::vector<double> mine(all.begin() + offsets[s], all.begin() + offsets[s + 1]);
+    const ScalarView ds = device_copy(mine.empty() ? std::vector<double>{0.0} : mine);
+    Real alone[2], squares[1];
+    deterministic_reduce<1, 1>("test::alone", sizes[s], ValueAndMagnitude{ds}, alone);
+    deterministic_reduce_lanes<1, 0, 1>("test::alone1", sizes[s], Squares{ds}, squares);
+    EXPECT_TRUE(same_bits(h(2 * s), alone[0])) << "segment " << s << " of " << sizes[s] << " items";
+    EXPECT_TRUE(same_bits(h(2 * s + 1), alone[1])) << "segment " << s;
+    EXPECT_TRUE(same_bits(hl(s), squares[0])) << "segment " << s << ", four lanes";
+    EXPECT_TRUE(same_bits(h(2 * s), test::tree_sum(mine))) << "segment " << s;
+  }
+}
+
+TEST(Reduce, SegmentOffsetsThatDecreaseAreRefused) {
+  SegmentedTree tree;
+  EXPECT_THROW(tree.plan({0, 5, 3}), std::invalid_argument);
+  EXPECT_THROW(tree.plan({}), std::invalid_argument);
+}
+
 }  // namespace

@@ -1,6 +1,50 @@
 #include "kernels/core/reduce.hpp"
 
+#include <algorithm>
+#include <stdexcept>
+
 namespace dem {
+
+void SegmentedTree::plan(const std::vector<int>& offsets) {
+  if (offsets.empty()) throw std::invalid_argument("SegmentedTree: no segment offsets");
+  segments_ = static_cast<int>(offsets.size()) - 1;
+  levels_.clear();
+  slots_ = 0;
+  // Each segment still being reduced: its items at this level, [begin, end) in the level's input.
+  struct Open {
+    int segment, begin, end;
+  };
+  std::vector<Open> open;
+  for (int s = 0; s < segments_; ++s) {
+    if (offsets[s + 1] < offsets[s]) throw std::invalid_argument("SegmentedTree: offsets must not decrease");
+    open.push_back({s, offsets[s], offsets[s + 1]});
+  }
+  while (!open.empty()) {
+    std::vector<ReduceBlock> list;
+    std::vector<Open> next;
+    int slot = 0;
+    for (const Open& o : open) {
+      const int n = o.end - o.begin;
+      if (n <= kReduceBlock) {  // one block: the segment's root (no items: zeros)
+        list.push_back({o.begin, o.end, -1 - o.segment});
+        continue;
+      }
+      const int first = slot;
+      for (int b = o.begin; b < o.end; b += kReduceBlock)
+        list.push_back({b, std::min(o.end, b + kReduceBlock), slot++});
+      next.push_back({o.segment, first, slot});
+    }
+    Level level;
+    level.count = static_cast<int>(list.size());
+    level.first_slot = slots_;
+    level.blocks = ReduceBlockView(Kokkos::view_alloc(Kokkos::WithoutInitializing, "dem::reduce::blocks"), list.size());
+    Kokkos::deep_copy(level.blocks,
+                      Kokkos::View<const ReduceBlock*, HostSpace, Kokkos::MemoryUnmanaged>(list.data(), list.size()));
+    levels_.push_back(level);
+    slots_ += static_cast<std::size_t>(slot);
+    open.swap(next);
+  }
+}
 
 int exclusive_scan(const char* label, const IndexView& counts, const IndexView& offsets, int n) {
   int total = 0;

@@ -7,6 +7,12 @@
 /// halving tree, past-the-end items as zeros); the block results are items of the next level, until one is left.
 /// A GPU reduces a block with a team of B threads in shared memory, a CPU with one thread in a loop: the same
 /// operations on the same operands, so the same bits, and every item is computed by its own thread on a GPU.
+///
+/// Segments (a batch of specimens, each its own range of items) reduce in one launch per level, each segment by the
+/// tree it would get alone: its blocks start at its first item, and its root is written at the level where it is
+/// one block (SegmentedTree).
+#include <vector>
+
 #include "kernels/core/simd.hpp"
 #include "kernels/core/types.hpp"
 
@@ -28,36 +34,60 @@ void read_root(Real* out, int count);
 /// itself, each entry read before it is overwritten. Integer sums: the same for any order.
 int exclusive_scan(const char* label, const IndexView& counts, const IndexView& offsets, int n);
 
+/// One block of a level of the tree: its items [begin, end) (end - begin <= kReduceBlock; none gives zeros), and
+/// where its values go: slot `out` of the level's results, or, with out < 0, the root of segment -1 - out.
+struct ReduceBlock {
+  int begin = 0, end = 0, out = 0;
+};
+using ReduceBlockView = Kokkos::View<ReduceBlock*, MemSpace>;
+
 namespace detail {
 
 using ReduceTeam = Kokkos::TeamPolicy<ExecSpace>::member_type;
 using TeamScratch = Kokkos::View<Real*, ExecSpace::scratch_memory_space, Kokkos::MemoryUnmanaged>;
 
-/// Level > 0 of the tree: item i's values are block i's results of the level below (value q at in[q * n + i]).
+/// Level > 0 of the tree: item i's values are a result of the level below (value q at in[i * NV + q]).
 template <int NV>
 struct LevelItems {
   const Real* in;
-  int n;
   KOKKOS_INLINE_FUNCTION void operator()(const int i, int, Real (*vals)[NV]) const {
-    for (int q = 0; q < NV; ++q) vals[0][q] = in[q * n + i];
+    for (int q = 0; q < NV; ++q) vals[0][q] = in[i * NV + q];
   }
 };
 
-/// One level: team b reduces items [b B, (b + 1) B) of f (W at a time) to out[q * nblock + b].
-template <int NSUM, int NMAX, int W, class F>
+/// The blocks of one segment of n items: block b holds items [b B, (b + 1) B), its result goes to slot b, or to the
+/// root where it is the level's only block.
+struct EvenBlocks {
+  int n;
+  KOKKOS_INLINE_FUNCTION ReduceBlock operator()(const int b) const {
+    const int begin = b * kReduceBlock, end = n - begin < kReduceBlock ? n : begin + kReduceBlock;
+    return {begin, end, n <= kReduceBlock ? -1 : b};
+  }
+};
+
+/// The blocks of a level of a SegmentedTree, listed.
+struct ListedBlocks {
+  Kokkos::View<const ReduceBlock*, MemSpace> list;
+  KOKKOS_INLINE_FUNCTION ReduceBlock operator()(const int b) const { return list(b); }
+};
+
+/// One level: team b reduces the items of blocks(b) (W at a time) to its result slot or root, value q at
+/// [slot * NV + q].
+template <int NSUM, int NMAX, int W, class F, class Blocks>
 struct TreeLevel {
   static constexpr int NV = NSUM + NMAX, B = kReduceBlock;
   static_assert(B % W == 0, "a group of W items stays in one block");
   F f;
-  int n, nblock;
+  Blocks blocks;
   Real* out;
+  Real* roots;
 
   KOKKOS_INLINE_FUNCTION void operator()(const ReduceTeam& t) const {
     const TeamScratch s(t.team_scratch(0), NV * B);
-    const int base = t.league_rank() * B;
+    const ReduceBlock blk = blocks(t.league_rank());
     Kokkos::parallel_for(Kokkos::TeamThreadRange(t, B / W), [&](const int g) {
-      const int i = base + g * W;
-      const int count = n - i < W ? (n - i > 0 ? n - i : 0) : W;
+      const int i = blk.begin + g * W;
+      const int count = blk.end - i < W ? (blk.end - i > 0 ? blk.end - i : 0) : W;
       Real v[W][NV] = {};
       if (count > 0) f(i, count, v);
       for (int k = 0; k < W; ++k)
@@ -81,15 +111,15 @@ struct TreeLevel {
 #endif
     }
     Kokkos::single(Kokkos::PerTeam(t), [&]() {
-      for (int q = 0; q < NV; ++q) out[q * nblock + t.league_rank()] = s(q * B);
+      Real* to = blk.out >= 0 ? out + blk.out * NV : roots + (-1 - blk.out) * NV;
+      for (int q = 0; q < NV; ++q) to[q] = s(q * B);
     });
   }
 };
 
-template <int NSUM, int NMAX, int W, class F>
-void tree_level(const char* label, int n, const F& f, Real* out) {
-  using Level = TreeLevel<NSUM, NMAX, W, F>;
-  const int nblock = (n + kReduceBlock - 1) / kReduceBlock;
+template <int NSUM, int NMAX, int W, class F, class Blocks>
+void tree_level(const char* label, int nblock, const F& f, const Blocks& blocks, Real* out, Real* roots) {
+  using Level = TreeLevel<NSUM, NMAX, W, F, Blocks>;
 #ifdef TRIAXDEM_HOST_PACKS
   const int team = 1;  // a CPU thread walks its block: teams of threads would only add barriers
 #else
@@ -97,10 +127,56 @@ void tree_level(const char* label, int n, const F& f, Real* out) {
 #endif
   const auto policy = Kokkos::TeamPolicy<ExecSpace>(nblock, team)
                           .set_scratch_size(0, Kokkos::PerTeam(TeamScratch::shmem_size(Level::NV * kReduceBlock)));
-  Kokkos::parallel_for(label, policy, Level{f, n, nblock, out});
+  Kokkos::parallel_for(label, policy, Level{f, blocks, out, roots});
 }
 
 }  // namespace detail
+
+/// The tree of each of several segments of items, reduced side by side: segment s is items [offsets[s],
+/// offsets[s + 1]). The host lays out the levels' blocks from the segments' sizes (plan: a copy to the device, so
+/// once per change of sizes, at a rebuild), and each reduction then launches one kernel per level.
+class SegmentedTree {
+ public:
+  /// offsets: segments() + 1 non-decreasing item offsets.
+  void plan(const std::vector<int>& offsets);
+  int segments() const { return segments_; }
+  int levels() const { return static_cast<int>(levels_.size()); }
+  /// Level l's blocks, their count, and where its results start in the scratch (slots, each of NV values).
+  const ReduceBlockView& blocks(int l) const { return levels_[static_cast<std::size_t>(l)].blocks; }
+  int block_count(int l) const { return levels_[static_cast<std::size_t>(l)].count; }
+  std::size_t first_slot(int l) const { return levels_[static_cast<std::size_t>(l)].first_slot; }
+  /// Result slots of all levels.
+  std::size_t slots() const { return slots_; }
+
+ private:
+  struct Level {
+    ReduceBlockView blocks;
+    int count = 0;
+    std::size_t first_slot = 0;
+  };
+  std::vector<Level> levels_;
+  int segments_ = 0;
+  std::size_t slots_ = 0;
+};
+
+/// Reduces f's values over each segment of `tree` as deterministic_reduce_lanes_to does over one range of items:
+/// segment s's root, bit for bit the one it would get alone, goes to roots[s * (NSUM + NMAX) + q], in device
+/// memory. f(i, count, vals) is called with i the item's index among all the segments' items.
+template <int NSUM, int NMAX, int W, class F>
+void segmented_reduce_lanes_to(const char* label, const SegmentedTree& tree, const F& f, Real* roots) {
+  constexpr int NV = NSUM + NMAX;
+  Real* scratch = tree.slots() > 0 ? reduce_scratch(tree.slots() * NV).data() : nullptr;
+  for (int l = 0; l < tree.levels(); ++l) {
+    Real* out = scratch + tree.first_slot(l) * NV;
+    const detail::ListedBlocks blocks{tree.blocks(l)};
+    if (l == 0) {
+      detail::tree_level<NSUM, NMAX, W>(label, tree.block_count(l), f, blocks, out, roots);
+    } else {
+      const Real* in = scratch + tree.first_slot(l - 1) * NV;
+      detail::tree_level<NSUM, NMAX, 1>(label, tree.block_count(l), detail::LevelItems<NV>{in}, blocks, out, roots);
+    }
+  }
+}
 
 /// Reduces the values f(i, count, vals) of items [0, n), W at a time: vals[k] gets item i + k's values, k < count
 /// <= W; vals[.][0, NSUM) are summed and vals[.][NSUM, NSUM + NMAX) maximised (from 0: non-negative quantities).
@@ -109,20 +185,20 @@ void tree_level(const char* label, int n, const F& f, Real* out) {
 template <int NSUM, int NMAX, int W, class F>
 void deterministic_reduce_lanes_to(const char* label, int n, const F& f, Real* root) {
   constexpr int NV = NSUM + NMAX;
-  if (n <= 0) {
-    Kokkos::parallel_for(label, RangePolicy(0, NV), KOKKOS_LAMBDA(const int q) { root[q] = 0; });
+  const auto blocks = [](int items) { return (items + kReduceBlock - 1) / kReduceBlock; };
+  if (n <= 0) {  // one block of no items: zeros
+    detail::tree_level<NSUM, NMAX, W>(label, 1, f, detail::EvenBlocks{0}, nullptr, root);
     return;
   }
-  const auto blocks = [](int items) { return (items + kReduceBlock - 1) / kReduceBlock; };
   std::size_t total = 0;  // the levels below the root
   for (int m = blocks(n); m > 1; m = blocks(m)) total += static_cast<std::size_t>(m) * NV;
   Real* level = total > 0 ? reduce_scratch(total).data() : nullptr;
   int m = blocks(n);
-  detail::tree_level<NSUM, NMAX, W>(label, n, f, m == 1 ? root : level);
+  detail::tree_level<NSUM, NMAX, W>(label, m, f, detail::EvenBlocks{n}, level, root);
   while (m > 1) {
     const int up = blocks(m);
-    Real* next = up == 1 ? root : level + static_cast<std::size_t>(m) * NV;
-    detail::tree_level<NSUM, NMAX, 1>(label, m, detail::LevelItems<NV>{level, m}, next);
+    Real* next = level + static_cast<std::size_t>(m) * NV;
+    detail::tree_level<NSUM, NMAX, 1>(label, up, detail::LevelItems<NV>{level}, detail::EvenBlocks{m}, next, root);
     level = next;
     m = up;
   }
