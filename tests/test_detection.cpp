@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <map>
 #include <numeric>
 #include <random>
@@ -125,8 +126,8 @@ void check_against_oracle(const Packing& pk) {
   double rmax = 0;
   for (const BallSpec& b : pk.balls) rmax = std::max(rmax, b.radius);
   CellList cells;
-  bin_particles(p, pk.dom, 2 * rmax + pk.skin, cells);  // the cut-off Simulation uses
-  const std::vector<std::uint64_t> pairs = to_vector(detect_pairs(p, pk.dom, cells, pk.skin));
+  bin_particles(p, pk.dom, 2 * rmax + pk.skin, pk.skin, cells);  // the cut-off Simulation uses
+  const std::vector<std::uint64_t> pairs = to_vector(detect_pairs(p, cells));
   FacetBins fb;
   if (mesh.ntri > 0) fb = bin_facets(mesh, cells.grid, rmax + pk.skin);
   const std::vector<std::uint64_t> wpairs = to_vector(detect_wall_pairs(p, walls, mesh, fb, cells, pk.skin));
@@ -207,6 +208,116 @@ TEST(Detection, BinnedEqualsBruteForcePeriodic) {
 // History survives a rebuild with the particles in another order: history is keyed by global ids,
 // so remapping it onto a list built from permuted particles must give every surviving contact
 // bit-identical shear force, rolling moment and flags, and resolve local indices to the right balls.
+/// A batch's specimen binned and searched beside others, in one pass: what it gets alone, to the bit.
+struct Binned {
+  std::vector<std::uint32_t> order;  ///< gids in the binned order
+  std::vector<double> x;             ///< positions in that order
+  std::vector<std::uint64_t> keys;
+};
+
+/// Specimen s of the batch's particles and keys (gids less `first`), or the whole of a simulation of one.
+Binned binned(const Particles& p, const std::vector<std::uint64_t>& keys, int first, int count) {
+  auto g = Kokkos::create_mirror_view_and_copy(HostSpace(), p.gid);
+  auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), p.x);
+  Binned b;
+  for (int i = first; i < first + count; ++i) {
+    b.order.push_back(g(i) - static_cast<std::uint32_t>(first));
+    for (int d = 0; d < 3; ++d) b.x.push_back(x(i, d));
+  }
+  for (std::uint64_t k : keys)
+    if (key_hi(k) >= static_cast<std::uint32_t>(first) && key_hi(k) < static_cast<std::uint32_t>(first + count))
+      b.keys.push_back(pair_key(key_hi(k) - first, key_lo(k) - first));
+  return b;
+}
+
+double max_radius(const std::vector<BallSpec>& balls) {
+  double r = 0;
+  for (const BallSpec& b : balls) r = std::max(r, b.radius);
+  return r;
+}
+
+/// Moves every ball by up to `step` (m) along each axis, by its specimen and its gid less the specimen's `first`:
+/// the same way in the batch and alone (`as`: the specimen a simulation of one holds).
+void jiggle(Particles& p, double step, unsigned seed, const std::vector<int>& first, int as = -1) {
+  auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), p.x);
+  auto g = Kokkos::create_mirror_view_and_copy(HostSpace(), p.gid);
+  auto spec = Kokkos::create_mirror_view_and_copy(HostSpace(), p.specimen);
+  for (int i = 0; i < p.n; ++i) {
+    const int sp = as >= 0 ? as : spec(i);
+    std::mt19937_64 rng(seed + 7919u * (g(i) - (as >= 0 ? 0u : static_cast<unsigned>(first[sp]))) + 104729u * sp);
+    std::uniform_real_distribution<double> u(-step, step);
+    for (int d = 0; d < 3; ++d) x(i, d) += u(rng);
+  }
+  Kokkos::deep_copy(p.x, x);
+}
+
+TEST(Detection, ABatchBinsAndSearchesEachSpecimenAsItWouldAlone) {
+  // Three specimens of other sizes and boxes (the third open along z, so its grid is sized to its balls).
+  const std::vector<Packing> packs = {random_packing(300, 12e-3, true, true, false, 3),
+                                      random_packing(200, 10e-3, true, true, false, 4),
+                                      random_packing(250, 11e-3, true, false, false, 5)};
+  std::vector<BallSpec> all;
+  std::vector<int> first;
+  for (std::size_t s = 0; s < packs.size(); ++s) {
+    first.push_back(static_cast<int>(all.size()));
+    for (BallSpec b : packs[s].balls) {
+      b.specimen = static_cast<int>(s);
+      all.push_back(b);
+    }
+  }
+  Particles batch = make_particles(all);  // gid = place in `all`: each specimen's gids start at its first ball
+  std::vector<Particles> alone;
+  std::vector<SpecimenBin> bins;
+  for (std::size_t s = 0; s < packs.size(); ++s) {
+    const Packing& pk = packs[s];
+    alone.push_back(make_particles(pk.balls));
+    bins.push_back({first[s], static_cast<int>(pk.balls.size()), pk.dom, 2 * max_radius(pk.balls) + pk.skin, pk.skin,
+                    true});
+  }
+  // Twice: all rebuilt; then the balls moved, and the second specimen kept as it was.
+  std::vector<std::vector<std::uint64_t>> kept_alone(packs.size());
+  PairKeyView batch_keys;
+  for (int round = 0; round < 2; ++round) {
+    if (round == 1) {
+      jiggle(batch, 0.1e-3, 17u, first);
+      for (std::size_t s = 0; s < packs.size(); ++s) jiggle(alone[s], 0.1e-3, 17u, first, static_cast<int>(s));
+      bins[1].rebuild = false;
+    }
+    CellList cells;
+    PairKeyView kept;
+    Index2View kept_own;
+    if (round == 1) {
+      ContactList old(static_cast<int>(batch_keys.extent(0)));
+      Kokkos::deep_copy(old.key, batch_keys);
+      kept = batch_keys;
+      kept_own = owner_ranges(batch, old);
+    }
+    bin_specimens(batch, bins, cells);
+    batch_keys = detect_pairs(batch, cells, kept, kept_own);
+    const std::vector<std::uint64_t> keys = to_vector(batch_keys);
+    for (std::size_t s = 0; s < packs.size(); ++s) {
+      const Packing& pk = packs[s];
+      const int n = static_cast<int>(pk.balls.size());
+      Binned want;
+      if (bins[s].rebuild) {
+        CellList own;
+        bin_particles(alone[s], pk.dom, bins[s].cell_min, pk.skin, own);
+        want = binned(alone[s], to_vector(detect_pairs(alone[s], own)), 0, n);
+        if (round == 0) kept_alone[s] = want.keys;
+      } else {
+        // Not rebuilt: its balls (moved) stay where they were, and its contacts are the list before.
+        want = binned(alone[s], kept_alone[s], 0, n);
+      }
+      const Binned got = binned(batch, keys, first[s], n);
+      EXPECT_EQ(got.order, want.order) << "specimen " << s << ", round " << round;
+      EXPECT_TRUE(std::memcmp(got.x.data(), want.x.data(), got.x.size() * sizeof(double)) == 0)
+          << "specimen " << s << ", round " << round;
+      EXPECT_EQ(got.keys, want.keys) << "specimen " << s << ", round " << round;
+      EXPECT_GT(got.keys.size(), 100u) << "specimen " << s;
+    }
+  }
+}
+
 TEST(Detection, HistoryUnchangedByPermutedRebuild) {
   // A jittered cubic stack of 5 x 5 x 5 balls, spacing a = 1.96 mm, radii 0.96-1.00 mm: neighbours
   // overlap by up to 4% of a radius or have small gaps. Periodic in x and y, plane walls below and
@@ -282,8 +393,8 @@ TEST(Detection, HistoryUnchangedByPermutedRebuild) {
   for (const BallSpec& b : balls) rmax = std::max(rmax, b.radius);
   // A wider skin than the simulation's brings in candidates the old lists lack: they must start empty.
   const double skin2 = 10 * prm.skin;  // reaches the lattice diagonals (2.77 mm apart)
-  bin_particles(r, prm.domain, 2 * rmax + skin2, cells);
-  const PairKeyView bkeys = detect_pairs(r, prm.domain, cells, skin2);
+  bin_particles(r, prm.domain, 2 * rmax + skin2, skin2, cells);
+  const PairKeyView bkeys = detect_pairs(r, cells);
   const WallSet ws = make_walls(walls);
   const PairKeyView wkeys = detect_wall_pairs(r, ws, FacetMesh(), FacetBins(), cells, skin2);
   const IndexView g2l = gid_to_local(q);

@@ -127,9 +127,9 @@ void Simulation::rebuild() {
            "or stiffen the wall material";
     throw BlowUp(msg.str());
   }
-  bin_particles(p_, prm_.domain, 2 * rmax_ + prm_.skin, cells_);
+  bin_particles(p_, prm_.domain, 2 * rmax_ + prm_.skin, prm_.skin, cells_);
   const IndexView g2l = gid_to_local(p_);
-  balls_ = remap_history(detect_pairs(p_, prm_.domain, cells_, prm_.skin), balls_, g2l, true);
+  balls_ = remap_history(detect_pairs(p_, cells_), balls_, g2l, true);
   FacetBins fb;
   if (mesh_.ntri > 0) fb = bin_facets(mesh_, cells_.grid, rmax_ + prm_.skin);
   wall_c_ = remap_history(detect_wall_pairs(p_, walls_, mesh_, fb, cells_, prm_.skin), wall_c_, g2l, false);

@@ -9,19 +9,21 @@ namespace dem {
 namespace {
 
 
-CellGrid make_grid(const Particles& p, const Domain& dom, Real cell_min) {
-  Real mn[3], mx[3];
+/// The grid of a specimen's particles [first, first + count): their bounds are read only along an open axis.
+CellGrid make_grid(const Particles& p, int first, int count, const Domain& dom, Real cell_min) {
+  Real mn[3] = {0, 0, 0}, mx[3] = {0, 0, 0};
   auto x = p.x;
   for (int d = 0; d < 3; ++d) {
+    if (dom.periodic[d] || count == 0) continue;
     Kokkos::MinMaxScalar<Real> r;
-    Kokkos::parallel_reduce("dem::binning::bounds", RangePolicy(0, p.n),
+    Kokkos::parallel_reduce("dem::binning::bounds", RangePolicy(first, first + count),
         KOKKOS_LAMBDA(const int i, Kokkos::MinMaxScalar<Real>& acc) {
           acc.min_val = x(i, d) < acc.min_val ? x(i, d) : acc.min_val;
           acc.max_val = x(i, d) > acc.max_val ? x(i, d) : acc.max_val;
         },
         Kokkos::MinMax<Real>(r));
-    mn[d] = p.n > 0 ? r.min_val : 0;
-    mx[d] = p.n > 0 ? r.max_val : 0;
+    mn[d] = r.min_val;
+    mx[d] = r.max_val;
   }
   CellGrid g;
   long total = 1;
@@ -44,7 +46,7 @@ CellGrid make_grid(const Particles& p, const Domain& dom, Real cell_min) {
   }
   // A stray particle far away (or a sparse periodic box) would blow up the cell count; coarser cells
   // stay correct, only slower. Periodic axes keep at least 3 cells for the minimum image.
-  const long cap = 8L * p.n + 4096;
+  const long cap = 8L * count + 4096;
   bool coarsened = true;
   while (total > cap && coarsened) {
     coarsened = false;
@@ -67,18 +69,50 @@ CellGrid make_grid(const Particles& p, const Domain& dom, Real cell_min) {
 
 }  // namespace
 
-void bin_particles(Particles& p, const Domain& dom, Real cell_min, CellList& cells) {
-  auto x = p.x;
-  if (dom.periodic[0] || dom.periodic[1] || dom.periodic[2]) {
-    Kokkos::parallel_for("dem::binning::wrap", RangePolicy(0, p.n),
-                         KOKKOS_LAMBDA(const int i) { store(x, i, dom.wrap(load(x, i))); });
+void bin_particles(Particles& p, const Domain& dom, Real cell_min, Real skin, CellList& cells) {
+  bin_specimens(p, {SpecimenBin{0, p.n, dom, cell_min, skin, true}}, cells);
+}
+
+void bin_specimens(Particles& p, const std::vector<SpecimenBin>& specimens, CellList& cells) {
+  const int ns = static_cast<int>(specimens.size());
+  if (ns == 0) throw std::invalid_argument("bin_specimens: no specimen");
+  if (static_cast<int>(cells.specimens.extent(0)) != ns)
+    cells.specimens = SpecimenCellsView("dem::binning::specimens", ns);
+  auto hs = Kokkos::create_mirror_view(cells.specimens);
+  int nc = 0;
+  bool wrap = false;
+  for (int s = 0; s < ns; ++s) {
+    const SpecimenBin& b = specimens[static_cast<std::size_t>(s)];
+    SpecimenCells& c = hs(s);
+    c.dom = b.dom;
+    c.first = b.first;
+    c.count = b.count;
+    c.skin = b.skin;
+    c.rebuild = b.rebuild;
+    c.first_cell = nc;
+    if (b.rebuild) {
+      c.grid = make_grid(p, b.first, b.count, b.dom, b.cell_min);
+      nc += c.grid.ncell();
+      wrap = wrap || b.dom.periodic[0] || b.dom.periodic[1] || b.dom.periodic[2];
+    } else {
+      nc += b.count;  // a cell for each particle: they keep their order
+    }
   }
-  const CellGrid g = make_grid(p, dom, cell_min);
-  const int nc = g.ncell();
+  Kokkos::deep_copy(cells.specimens, hs);
+  const SpecimenCellsView spec = cells.specimens;
+  auto x = p.x;
+  auto owner = p.specimen;
+  if (wrap) {
+    Kokkos::parallel_for("dem::binning::wrap", RangePolicy(0, p.n), KOKKOS_LAMBDA(const int i) {
+      const SpecimenCells& c = spec(owner(i));
+      if (c.rebuild) store(x, i, c.dom.wrap(load(x, i)));
+    });
+  }
   IndexView cell("dem::binning::cell", p.n);
   IndexView start("dem::binning::cell_start", nc + 1);
   Kokkos::parallel_for("dem::binning::count", RangePolicy(0, p.n), KOKKOS_LAMBDA(const int i) {
-    cell(i) = g.cell_of(load(x, i));
+    const SpecimenCells& c = spec(owner(i));
+    cell(i) = c.first_cell + (c.rebuild ? c.grid.cell_of(load(x, i)) : i - c.first);
     Kokkos::atomic_increment(&start(cell(i)));
   });
   Kokkos::parallel_scan("dem::binning::scan", RangePolicy(0, nc + 1),
@@ -104,7 +138,7 @@ void bin_particles(Particles& p, const Domain& dom, Real cell_min, CellList& cel
     }
   });
   p.permute(perm);
-  cells.grid = g;
+  cells.grid = hs(0).grid;
   cells.cell_start = start;
 }
 

@@ -1,6 +1,8 @@
 #pragma once
 /// Cell list by counting sort. Particles are re-sorted by cell (memory locality), ties broken by
 /// global id so that the order, and everything computed from it, is the same for any thread count.
+#include <vector>
+
 #include "kernels/core/domain.hpp"
 #include "kernels/core/particles.hpp"
 
@@ -31,16 +33,45 @@ struct CellGrid {
   }
 };
 
-/// The binned particles: cell_start(c) .. cell_start(c+1) are the particles of cell c, in sorted order.
+/// One specimen of a batch as the binning and the pair search see it (a simulation of one specimen has one): its
+/// particles [first, first + count), its cell, its grid and first cell, its Verlet skin, and whether it is rebuilt
+/// now. A specimen not rebuilt keeps its particles' order (a cell of its own for each) and its contact list.
+struct SpecimenCells {
+  Domain dom;
+  CellGrid grid;
+  int first = 0, count = 0;
+  int first_cell = 0;
+  Real skin = 0;  ///< m
+  bool rebuild = true;
+};
+using SpecimenCellsView = Kokkos::View<SpecimenCells*, MemSpace>;
+
+/// The binned particles: cell_start(c) .. cell_start(c+1) are the particles of cell c, in sorted order. The cells
+/// of specimen s start at specimens(s).first_cell; `grid` is the first specimen's (for facets and walls, which
+/// only a simulation of one specimen has).
 struct CellList {
   CellGrid grid;
+  SpecimenCellsView specimens;
   IndexView cell_start;
 };
 
+/// A specimen to bin: its particles, its cell, the cut-off its cells must hold (m) and its skin (m); rebuild as in
+/// SpecimenCells.
+struct SpecimenBin {
+  int first = 0, count = 0;
+  Domain dom;
+  Real cell_min = 0, skin = 0;
+  bool rebuild = true;
+};
+
 /// Wraps periodic coordinates, builds a grid with cells of at least `cell_min`, sorts the particles by
-/// cell (permuting every per-particle View) and fills the cell list. Throws std::runtime_error when a
-/// periodic length holds fewer than 3 cells (the minimum image would then be ambiguous).
-void bin_particles(Particles& p, const Domain& dom, Real cell_min, CellList& cells);
+/// cell (permuting every per-particle View) and fills the cell list, for a pair search within `skin`. Throws
+/// std::runtime_error when a periodic length holds fewer than 3 cells (the minimum image would then be ambiguous).
+void bin_particles(Particles& p, const Domain& dom, Real cell_min, Real skin, CellList& cells);
+/// The same for the specimens of a batch, side by side, in one pass: each rebuilt specimen is binned in its own
+/// grid as it would be alone (the same order, bit for bit), and the others keep their particles where they are.
+/// Particle i must belong to specimen p.specimen(i), whose range holds it; there is at least one specimen.
+void bin_specimens(Particles& p, const std::vector<SpecimenBin>& specimens, CellList& cells);
 
 /// A ball whose centre lies more than `margin` times its radius outside the domain along a non-periodic axis
 /// that has bounds (hi > lo; an axis without them is sized to the balls): its local index (the largest

@@ -16,8 +16,8 @@ int scan_counts(const IndexView& count, IndexView& offset) {
   return exclusive_scan("dem::detect::scan", count, offset, n);
 }
 
-/// The count and fill passes shared by the searches. Derived provides visit(i, f), calling f(other)
-/// for each candidate of particle i, and key(i, other).
+/// The count and fill passes shared by the searches. Derived provides visit(i, f), calling f(key) for each
+/// candidate of particle i.
 template <class Derived>
 struct CountFill {
   struct TagCount {};
@@ -28,27 +28,36 @@ struct CountFill {
   KOKKOS_INLINE_FUNCTION const Derived& self() const { return static_cast<const Derived&>(*this); }
   KOKKOS_INLINE_FUNCTION void operator()(TagCount, const int i) const {
     int n = 0;
-    self().visit(i, [&](int) { ++n; });
+    self().visit(i, [&](std::uint64_t) { ++n; });
     count(i) = n;
   }
   KOKKOS_INLINE_FUNCTION void operator()(TagFill, const int i) const {
     int k = offset(i);
-    self().visit(i, [&](int other) { keys(k++) = self().key(i, other); });
+    self().visit(i, [&](std::uint64_t key) { keys(k++) = key; });
   }
 };
 
-/// Ball-ball search over the 27 neighbour cells; each pair found once, from its lower local index.
+/// Ball-ball search over the 27 neighbour cells of the particle's specimen's grid; each pair found once, from its
+/// lower local index. A specimen not rebuilt gives its kept keys.
 struct PairSearch : CountFill<PairSearch> {
   ConstVec3View x;
   ConstScalarView radius;
   GidView gid;
+  ConstIndexView owner;
   IndexView cell_start;
-  CellGrid g;
-  MinImage image;
-  Real skin;
+  SpecimenCellsView specimens;
+  PairKeyView kept;
+  Index2View kept_own;
 
   template <class Visit>
   KOKKOS_INLINE_FUNCTION void visit(const int i, Visit&& f) const {
+    const SpecimenCells& sc = specimens(owner(i));
+    if (!sc.rebuild) {
+      for (int k = kept_own(i, 0); k < kept_own(i, 1); ++k) f(kept(k));
+      return;
+    }
+    const CellGrid& g = sc.grid;
+    const MinImage image(sc.dom);
     const Vec3 xi = load(x, i);
     const int c[3] = {g.coord(0, xi.x), g.coord(1, xi.y), g.coord(2, xi.z)};
     for (int dz = -1; dz <= 1; ++dz) {
@@ -60,17 +69,16 @@ struct PairSearch : CountFill<PairSearch> {
         for (int dx = -1; dx <= 1; ++dx) {
           const int cx = g.shift(0, c[0], dx);
           if (cx < 0) continue;
-          const int cell = g.index(cx, cy, cz);
+          const int cell = sc.first_cell + g.index(cx, cy, cz);
           for (int j = cell_start(cell); j < cell_start(cell + 1); ++j) {
             if (j <= i) continue;
-            const Real reach = radius(i) + radius(j) + skin;
-            if (norm2(image(load(x, j) - xi)) < reach * reach) f(j);
+            const Real reach = radius(i) + radius(j) + sc.skin;
+            if (norm2(image(load(x, j) - xi)) < reach * reach) f(pair_key(gid(i), gid(j)));
           }
         }
       }
     }
   }
-  KOKKOS_INLINE_FUNCTION std::uint64_t key(const int i, const int j) const { return pair_key(gid(i), gid(j)); }
 };
 
 /// Ball-wall search: every analytic wall, plus the facets binned into the ball's cell.
@@ -93,16 +101,15 @@ struct WallSearch : CountFill<WallSearch> {
       Real dist;
       if (wall_contact(walls.kind(w), load(walls.point, w), load(walls.normal, w), walls.radius(w), xi, n, dist, cp) &&
           dist < reach)
-        f(w);
+        f(wall_key(w, gid(i)));
     }
     if (mesh.ntri == 0) return;
     const int cell = g.cell_of(xi);
     for (int k = fstart(cell); k < fstart(cell + 1); ++k) {
       const int t = ffacet(k);
-      if (norm2(facet_hit(mesh, t, xi).cp - xi) < reach * reach) f(walls.n + t);
+      if (norm2(facet_hit(mesh, t, xi).cp - xi) < reach * reach) f(wall_key(walls.n + t, gid(i)));
     }
   }
-  KOKKOS_INLINE_FUNCTION std::uint64_t key(const int i, const int obj) const { return wall_key(obj, gid(i)); }
 };
 
 template <class Search>
@@ -155,10 +162,11 @@ FacetBins bin_facets(const FacetMesh& mesh, const CellGrid& g, Real reach) {
   return b;
 }
 
-PairKeyView detect_pairs(const Particles& p, const Domain& dom, const CellList& cells, Real skin) {
+PairKeyView detect_pairs(const Particles& p, const CellList& cells, const PairKeyView& kept,
+                         const Index2View& kept_own) {
   PairSearch s;
-  s.x = p.x; s.radius = p.radius; s.gid = p.gid; s.cell_start = cells.cell_start;
-  s.g = cells.grid; s.image = MinImage(dom); s.skin = skin;
+  s.x = p.x; s.radius = p.radius; s.gid = p.gid; s.owner = p.specimen; s.cell_start = cells.cell_start;
+  s.specimens = cells.specimens; s.kept = kept; s.kept_own = kept_own;
   return run_search(s, p.n, "dem::detect::pairs");
 }
 

@@ -17,8 +17,11 @@ struct FacetBins {
 /// Bins the mesh's facets into the cells of `grid` (on the host: a membrane has a few thousand facets).
 FacetBins bin_facets(const FacetMesh& mesh, const CellGrid& grid, Real reach);
 
-/// Keys of all ball-ball pairs whose centres are closer than r_i + r_j + skin, sorted.
-PairKeyView detect_pairs(const Particles& p, const Domain& dom, const CellList& cells, Real skin);
+/// Keys of all ball-ball pairs whose centres are closer than r_i + r_j + skin, sorted: the cells' specimens' pairs,
+/// each in its cell with its skin. A specimen that is not rebuilt keeps its keys of the list `kept`, whose owner
+/// ranges for the particles' present order are `kept_own` (owner_ranges).
+PairKeyView detect_pairs(const Particles& p, const CellList& cells, const PairKeyView& kept = PairKeyView(),
+                         const Index2View& kept_own = Index2View());
 
 /// Keys of all ball-wall pairs (analytic walls, then facets as objects walls.n + f) within skin, sorted.
 PairKeyView detect_wall_pairs(const Particles& p, const WallSet& walls, const FacetMesh& mesh,
