@@ -27,13 +27,26 @@ struct BallForce : MaxOverlap {
   ConstIndexView material;
   ContactList c;
   ParamTableView params;
-  Domain dom;
-  MinImage image;
-  Real dt;
+  SpecimenTable spec;
+  ContactItems items;
 
   KOKKOS_INLINE_FUNCTION void operator()(const int item, value_type& worst) const {
-    const int s0 = item * W;
-    const int lanes = c.n - s0 < W ? c.n - s0 : W;
+    int sp = 0, s0 = item * W, end = c.n;
+    if (items.specimens > 0) {  // the specimen whose items hold this one: the last to start at or before it
+      int lo = 0, hi = items.specimens - 1;
+      while (lo < hi) {
+        const int mid = (lo + hi + 1) / 2;
+        if (items.item_first(mid) <= item) lo = mid; else hi = mid - 1;
+      }
+      sp = lo;
+      s0 = items.contact_first(sp) + (item - items.item_first(sp)) * W;
+      end = items.contact_first(sp + 1);
+    }
+    const int lanes = end - s0 < W ? end - s0 : W;
+    const SpecimenParams& specimen = spec(sp);
+    const MinImage image(specimen.dom);
+    const Real dt = specimen.integ.dt;
+    const int row = specimen.material_row;
     // Lanes past the end repeat the last contact; their results are not stored.
     int cs[W], ci[W], cj[W];
     const ContactParams* pair[W];
@@ -43,7 +56,7 @@ struct BallForce : MaxOverlap {
       cs[k] = s0 + (k < lanes ? k : lanes - 1);
       ci[k] = c.i(cs[k]);
       cj[k] = c.j(cs[k]);
-      pair[k] = &params(material(ci[k]), material(cj[k]));
+      pair[k] = &params(row + material(ci[k]), material(cj[k]));
       one_pair = one_pair && pair[k] == pair[0];
     }
     const Vec3T<T> d = image(vec_of_lanes<T>([&](int k) { return load(x, cj[k]); }) -
@@ -72,7 +85,7 @@ struct BallForce : MaxOverlap {
     // Branch vectors from the centres to the contact point: r1 = a n, r2 = -b n (both along n),
     // which folds the two spin terms of the relative velocity into one cross product.
     const T a = ri - Real(0.5) * overlap, b = rj - Real(0.5) * overlap;
-    kin.vrel = vj - vi - cross(a * wi + b * wj, kin.n) + dom.affine_velocity(d);
+    kin.vrel = vj - vi - cross(a * wi + b * wj, kin.n) + specimen.dom.affine_velocity(d);
     kin.dtheta = dt * (wj - wi);
     kin.dt = dt;
     kin.kn = RRLinear::stiffness(prm, ri, rj);
@@ -219,9 +232,18 @@ void compute_ball_forces(const Particles& p, ContactList& c, const ParamTableVie
                          const OverlapResultView& worst) {
   BallForce k;
   bind_particles(k, p);
-  k.c = c; k.params = params; k.dom = dom; k.image = MinImage(dom); k.dt = dt;
+  k.c = c; k.params = params; k.spec.one.dom = dom; k.spec.one.integ.dt = dt;
   const int items = (c.n + BallForce::W - 1) / BallForce::W;
   Kokkos::parallel_reduce("dem::force::balls" TRIAXDEM_DEVICE_RESULT, RangePolicy(0, items), k, worst);
+}
+
+void compute_ball_forces(const Particles& p, ContactList& c, const ParamTableView& params,
+                         const SpecimenParamsView& specimens, const ContactItems& items,
+                         const OverlapResultView& worst) {
+  BallForce k;
+  bind_particles(k, p);
+  k.c = c; k.params = params; k.spec.many = specimens; k.items = items;
+  Kokkos::parallel_reduce("dem::force::balls" TRIAXDEM_DEVICE_RESULT, RangePolicy(0, items.items), k, worst);
 }
 
 OverlapStat compute_ball_forces(const Particles& p, ContactList& c, const ParamTableView& params, const Domain& dom,

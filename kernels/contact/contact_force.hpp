@@ -4,6 +4,7 @@
 #include "kernels/contact/accumulate.hpp"
 #include "kernels/contact/contact_law.hpp"
 #include "kernels/core/domain.hpp"
+#include "kernels/core/specimen.hpp"
 #include "kernels/core/walls.hpp"
 
 namespace dem {
@@ -12,6 +13,20 @@ namespace dem {
 /// force and moments on both sides (fc, mo, mt) for the gather (accumulate.hpp), and the largest overlap ratio to
 /// `worst`, in device memory: the host does not wait.
 void compute_ball_forces(const Particles& p, ContactList& c, const ParamTableView& params, const Domain& dom, Real dt,
+                         const OverlapResultView& worst);
+
+/// A batch's ball-ball contacts cut into work items of kContactLanes that stay within one specimen: specimen s's
+/// contacts [contact_first(s), contact_first(s + 1)) are items [item_first(s), item_first(s + 1)) (S + 1 entries
+/// each, on the device).
+struct ContactItems {
+  IndexView contact_first, item_first;
+  int specimens = 0;
+  int items = 0;
+};
+/// The same forces for the specimens of a batch at once: each contact with its specimen's cell, time step and
+/// row of the material-pair table (SpecimenParams), bit for bit what the specimen gets alone.
+void compute_ball_forces(const Particles& p, ContactList& c, const ParamTableView& params,
+                         const SpecimenParamsView& specimens, const ContactItems& items,
                          const OverlapResultView& worst);
 /// The same, returning the largest overlap ratio to the host.
 OverlapStat compute_ball_forces(const Particles& p, ContactList& c, const ParamTableView& params, const Domain& dom,

@@ -81,6 +81,7 @@ struct TreeLevel {
   Blocks blocks;
   Real* out;
   Real* roots;
+  int root_stride;  ///< Reals from one segment's root to the next's
 
   KOKKOS_INLINE_FUNCTION void operator()(const ReduceTeam& t) const {
     const TeamScratch s(t.team_scratch(0), NV * B);
@@ -111,14 +112,15 @@ struct TreeLevel {
 #endif
     }
     Kokkos::single(Kokkos::PerTeam(t), [&]() {
-      Real* to = blk.out >= 0 ? out + blk.out * NV : roots + (-1 - blk.out) * NV;
+      Real* to = blk.out >= 0 ? out + blk.out * NV : roots + (-1 - blk.out) * root_stride;
       for (int q = 0; q < NV; ++q) to[q] = s(q * B);
     });
   }
 };
 
 template <int NSUM, int NMAX, int W, class F, class Blocks>
-void tree_level(const char* label, int nblock, const F& f, const Blocks& blocks, Real* out, Real* roots) {
+void tree_level(const char* label, int nblock, const F& f, const Blocks& blocks, Real* out, Real* roots,
+                int root_stride = NSUM + NMAX) {
   using Level = TreeLevel<NSUM, NMAX, W, F, Blocks>;
 #ifdef TRIAXDEM_HOST_PACKS
   const int team = 1;  // a CPU thread walks its block: teams of threads would only add barriers
@@ -127,7 +129,7 @@ void tree_level(const char* label, int nblock, const F& f, const Blocks& blocks,
 #endif
   const auto policy = Kokkos::TeamPolicy<ExecSpace>(nblock, team)
                           .set_scratch_size(0, Kokkos::PerTeam(TeamScratch::shmem_size(Level::NV * kReduceBlock)));
-  Kokkos::parallel_for(label, policy, Level{f, blocks, out, roots});
+  Kokkos::parallel_for(label, policy, Level{f, blocks, out, roots, root_stride});
 }
 
 }  // namespace detail
@@ -160,20 +162,22 @@ class SegmentedTree {
 };
 
 /// Reduces f's values over each segment of `tree` as deterministic_reduce_lanes_to does over one range of items:
-/// segment s's root, bit for bit the one it would get alone, goes to roots[s * (NSUM + NMAX) + q], in device
-/// memory. f(i, count, vals) is called with i the item's index among all the segments' items.
+/// segment s's root, bit for bit the one it would get alone, goes to roots[s * stride + q] (stride 0: NSUM + NMAX),
+/// in device memory. f(i, count, vals) is called with i the item's index among all the segments' items.
 template <int NSUM, int NMAX, int W, class F>
-void segmented_reduce_lanes_to(const char* label, const SegmentedTree& tree, const F& f, Real* roots) {
+void segmented_reduce_lanes_to(const char* label, const SegmentedTree& tree, const F& f, Real* roots, int stride = 0) {
   constexpr int NV = NSUM + NMAX;
+  if (stride == 0) stride = NV;
   Real* scratch = tree.slots() > 0 ? reduce_scratch(tree.slots() * NV).data() : nullptr;
   for (int l = 0; l < tree.levels(); ++l) {
     Real* out = scratch + tree.first_slot(l) * NV;
     const detail::ListedBlocks blocks{tree.blocks(l)};
     if (l == 0) {
-      detail::tree_level<NSUM, NMAX, W>(label, tree.block_count(l), f, blocks, out, roots);
+      detail::tree_level<NSUM, NMAX, W>(label, tree.block_count(l), f, blocks, out, roots, stride);
     } else {
       const Real* in = scratch + tree.first_slot(l - 1) * NV;
-      detail::tree_level<NSUM, NMAX, 1>(label, tree.block_count(l), detail::LevelItems<NV>{in}, blocks, out, roots);
+      detail::tree_level<NSUM, NMAX, 1>(label, tree.block_count(l), detail::LevelItems<NV>{in}, blocks, out, roots,
+                                        stride);
     }
   }
 }

@@ -5,9 +5,20 @@
 namespace dem {
 
 void integrate_to(Particles& p, const IntegrateParams& prm, const Gather& gather, Real* values) {
-  const Leapfrog lf{p.x, p.v, p.w, p.f, p.m, p.x_ref, p.mass, p.inertia, p.radius, gather, prm};
+  SpecimenTable one;
+  one.one.integ = prm;
+  const Leapfrog lf{p.x, p.v, p.w, p.f, p.m, p.x_ref, p.mass, p.inertia, p.radius, gather, one, p.specimen};
   deterministic_reduce_lanes_to<Leapfrog::kSums, Leapfrog::kMaxima, Leapfrog::W>("dem::integrate::leapfrog", p.n, lf,
                                                                                  values);
+}
+
+void integrate_batch_to(Particles& p, const SpecimenParamsView& specimens, const SegmentedTree& tree,
+                        const Gather& gather, Real* values, int stride) {
+  SpecimenTable many;
+  many.many = specimens;
+  const Leapfrog lf{p.x, p.v, p.w, p.f, p.m, p.x_ref, p.mass, p.inertia, p.radius, gather, many, p.specimen};
+  segmented_reduce_lanes_to<Leapfrog::kSums, Leapfrog::kMaxima, Leapfrog::W>("dem::integrate::leapfrog", tree, lf,
+                                                                             values, stride);
 }
 
 StepStats step_stats(const Real* values) {

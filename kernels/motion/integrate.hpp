@@ -5,25 +5,13 @@
 ///   v(t + dt/2) = v(t - dt/2) + (F + F_d) / m dt,   x(t + dt) = x(t) + v(t + dt/2) dt.
 /// Density scaling multiplies inertial mass and moment of inertia (not weight) by `mass_scale`.
 #include "kernels/contact/accumulate.hpp"
+#include "kernels/core/reduce.hpp"
 #include "kernels/core/particles.hpp"
+#include "kernels/core/specimen.hpp"
 #include "kernels/core/vec3.hpp"
 
 namespace dem {
 
-struct IntegrateParams {
-  Vec3 gravity;           ///< m/s^2
-  Real alpha = 0.7;       ///< local damping coefficient
-  Real mass_scale = 1.0;  ///< density scaling factor for quasi-static runs (1 = physical)
-  Real dt = 0;            ///< s
-  bool measure = true;    ///< fill StepStats::unbalanced and ::kinetic (skipped on unmeasured steps)
-  /// With about_flow, local damping acts on v - flow_rate (x - flow_origin), component by component: the
-  /// velocity about the test's imposed mean flow. On the absolute velocity (PFC, the default) a steady flow
-  /// turns the damping of the balls' fluctuating forces into a net drag against it (docs/performance.md: The
-  /// triaxial test).
-  bool about_flow = false;
-  Vec3 flow_rate;         ///< 1/s, diagonal of the mean flow's velocity gradient
-  Vec3 flow_origin;       ///< m, where the mean flow is at rest
-};
 
 /// Per-step sums over particles, for the unbalanced-force ratio and energy.
 struct StepStats {
@@ -68,11 +56,14 @@ struct Leapfrog {
   ConstVec3View x_ref;
   ConstScalarView mass, inertia, radius;
   Gather gather;
-  IntegrateParams prm;
+  SpecimenTable spec;
+  ConstIndexView owner;  ///< the particles' specimens (Particles::specimen), read where spec is a batch's
 
   /// Particles i0 .. i0 + count - 1 (count <= W); vals[k] gets particle i0 + k's values.
   KOKKOS_INLINE_FUNCTION void operator()(const int i0, const int count, Real (*vals)[kValues]) const {
     using T = ContactPack;
+    // A group of W particles lies in one specimen: the blocks of a batch's reduction start at its specimens' first.
+    const IntegrateParams& prm = spec(spec.batched() ? owner(i0) : 0).integ;
     // Lanes past count repeat the last particle; their results are not stored.
     int id[W];
     Vec3 fk[W], mk[W];
@@ -132,6 +123,11 @@ struct Leapfrog {
 StepStats integrate(Particles& p, const IntegrateParams& prm, const Gather& gather);
 /// The same, with the step's Leapfrog::kValues values left in device memory at `values` (step_stats reads them).
 void integrate_to(Particles& p, const IntegrateParams& prm, const Gather& gather, Real* values);
+/// The same for the specimens of a batch at once (specimens(s) holding specimen s's particles and time integration,
+/// `tree` segmented by their particles): specimen s's values go to values[s * stride + q], bit for bit those of
+/// integrate_to on the specimen alone.
+void integrate_batch_to(Particles& p, const SpecimenParamsView& specimens, const SegmentedTree& tree,
+                        const Gather& gather, Real* values, int stride);
 /// The statistics in a step's values; `bad` is left at -1 (non_finite_particle finds it where values[2] > 0).
 StepStats step_stats(const Real* values);
 /// The highest index of a particle with a non-finite position, or -1.
