@@ -95,8 +95,10 @@ TEST(Reduce, SegmentsGiveEachTheBitsOfItsOwnReduction) {
   for (int n : sizes) offsets.push_back(offsets.back() + n);
   const std::vector<double> all = awkward_values(offsets.back(), 11u);
   const ScalarView d = device_copy(all);
+  std::vector<std::pair<int, int>> ranges;
+  for (std::size_t s = 0; s < sizes.size(); ++s) ranges.emplace_back(offsets[s], offsets[s + 1]);
   SegmentedTree tree;
-  tree.plan(offsets);
+  tree.plan(ranges);
   EXPECT_EQ(tree.levels(), 3);
   const int S = static_cast<int>(sizes.size());
   Kokkos::View<Real*, MemSpace> roots("roots", 2 * S), lanes("lanes", S);
@@ -118,10 +120,10 @@ TEST(Reduce, SegmentsGiveEachTheBitsOfItsOwnReduction) {
   }
 }
 
-TEST(Reduce, SegmentOffsetsThatDecreaseAreRefused) {
+TEST(Reduce, ASegmentThatEndsBeforeItStartsIsRefused) {
   SegmentedTree tree;
-  EXPECT_THROW(tree.plan({0, 5, 3}), std::invalid_argument);
-  EXPECT_THROW(tree.plan({}), std::invalid_argument);
+  EXPECT_THROW(tree.plan({{0, 5}, {5, 3}}), std::invalid_argument);
+  EXPECT_THROW(tree.plan({{-1, 3}}), std::invalid_argument);
 }
 
 }  // namespace

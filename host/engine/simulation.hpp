@@ -53,6 +53,16 @@ struct StageTimes {
   }
 };
 
+/// What a BlowUp says (step_reads.cpp): a contact's overlap beyond `limit` (a fraction of the radius), a non-finite
+/// position, a ball that moved more than `limit` of its radius in one step (`move`). Each names the step, the
+/// particle by its gid, the likely cause and a fix.
+std::string overlap_blowup(long step, std::uint32_t gid, bool wall, Real ratio, Real limit);
+std::string nonfinite_blowup(long step, std::uint32_t gid, Real dt, Real critical);
+std::string fast_blowup(long step, std::uint32_t gid, Real move, Real limit, Real dt, Real critical);
+/// The local index of the ball of particles [first, first + count) that moves farthest in a step of dt, relative
+/// to its radius (a copy of the velocities to the host: for a blow-up's message).
+int fastest_ball(const Particles& p, int first, int count, Real dt);
+
 /// One line for a log: seconds per stage, rebuild count and particle-steps per second of the time loop.
 std::string describe(const StageTimes& t, long particles, long steps);
 
@@ -81,6 +91,8 @@ class Simulation {
   /// The stage times of the run segments before a resume, so that reports cover the whole run.
   void set_times(const StageTimes& t) { times_ = t; }
   const SimParams& params() const { return prm_; }
+  /// The material-pair table of the contact laws, on the device (nmat x nmat).
+  const ParamTableView& contact_table() const { return params_; }
   long step_count() const { return step_; }
   Real time() const { return time_; }
   int num_walls() const { return walls_.n; }

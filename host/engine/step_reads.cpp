@@ -88,49 +88,65 @@ void Simulation::read_rows() const {
   }
 }
 
+std::string overlap_blowup(long step, std::uint32_t gid, bool wall, Real ratio, Real limit) {
+  std::ostringstream msg;
+  msg << "blow-up at step " << step << ": particle " << gid << " overlaps " << (wall ? "a wall" : "another particle")
+      << " by " << ratio * 100 << "% of its radius (limit " << limit * 100
+      << "%). Likely cause: stiffness too low for the load, a wall or servo moving too fast, or too large a time "
+         "step; suggested fix: raise emod, lower the wall speed or servo gain, or lower [solver] dt_safety";
+  return msg.str();
+}
+
+std::string nonfinite_blowup(long step, std::uint32_t gid, Real dt, Real critical) {
+  std::ostringstream msg;
+  msg << "blow-up at step " << step << ": particle " << gid
+      << " has a non-finite position. Likely cause: time step above the critical one or a servo gain too high; "
+         "suggested fix: lower [solver] dt_safety (now dt = "
+      << dt << " s, critical " << critical << " s)";
+  return msg.str();
+}
+
+std::string fast_blowup(long step, std::uint32_t gid, Real move, Real limit, Real dt, Real critical) {
+  std::ostringstream msg;
+  msg << "blow-up at step " << step << ": particle " << gid << " moved " << move * 100
+      << "% of its radius in one step (limit " << limit * 100
+      << "%, the overlap limit): its kinetic energy jumped beyond what the loads can give. Likely cause: a time "
+         "step above the critical one for the stiffness reached, or a servo gain or wall speed too high; "
+         "suggested fix: lower [solver] dt_safety (now dt = "
+      << dt << " s, critical " << critical << " s) or the servo gain";
+  return msg.str();
+}
+
+int fastest_ball(const Particles& p, int first, int count, Real dt) {
+  auto hv = Kokkos::create_mirror_view_and_copy(HostSpace(), p.v);
+  auto hr = Kokkos::create_mirror_view_and_copy(HostSpace(), p.radius);
+  int fast = first;
+  Real worst_move = -1;
+  for (int i = first; i < first + count; ++i) {
+    const Real move = norm(load(hv, i)) * dt / hr(i);
+    if (move > worst_move) worst_move = move, fast = i;
+  }
+  return fast;
+}
+
 void Simulation::check_blowup(long step, const StepStats& st, const OverlapStat& ob, const OverlapStat& ow) const {
   const OverlapStat& worst = ob.ratio >= ow.ratio ? ob : ow;
   const Real limit2 = prm_.overlap_limit * prm_.overlap_limit;
   if (worst.ratio <= prm_.overlap_limit && st.bad < 0 && st.max_move2 <= limit2) return;
-  std::ostringstream msg;
-  msg << "blow-up at step " << step << ": particle ";
   if (worst.ratio > prm_.overlap_limit) {
     // The contact lists have not changed since the step: a rebuild waits for the rows to be read.
     const bool wall = ow.ratio > ob.ratio;
     const ContactList& c = wall ? wall_c_ : balls_;
     auto hi = Kokkos::create_mirror_view_and_copy(HostSpace(), Kokkos::subview(c.i, std::make_pair(worst.contact, worst.contact + 1)));
     auto hg = Kokkos::create_mirror_view_and_copy(HostSpace(), Kokkos::subview(p_.gid, std::make_pair(hi(0), hi(0) + 1)));
-    msg << hg(0) << " overlaps " << (wall ? "a wall" : "another particle") << " by " << worst.ratio * 100
-        << "% of its radius (limit " << prm_.overlap_limit * 100
-        << "%). Likely cause: stiffness too low for the load, a wall or servo moving too fast, or too large a time "
-           "step; suggested fix: raise emod, lower the wall speed or servo gain, or lower [solver] dt_safety";
-    throw BlowUp(msg.str());
+    throw BlowUp(overlap_blowup(step, hg(0), wall, worst.ratio, prm_.overlap_limit));
   }
   auto hg = Kokkos::create_mirror_view_and_copy(HostSpace(), p_.gid);
-  if (st.bad >= 0) {
-    msg << hg(st.bad)
-        << " has a non-finite position. Likely cause: time step above the critical one or a servo gain too high; "
-           "suggested fix: lower [solver] dt_safety (now dt = "
-        << prm_.integ.dt << " s, critical " << critical_dt() << " s)";
-    throw BlowUp(msg.str());
-  }
+  if (st.bad >= 0) throw BlowUp(nonfinite_blowup(step, hg(st.bad), prm_.integ.dt, critical_dt()));
   // A ball that moves this far in one step would overlap anything it meets by more than the overlap limit. The
   // fastest ball now (the rows are read up to stats_every steps after the step) is named.
-  auto hv = Kokkos::create_mirror_view_and_copy(HostSpace(), p_.v);
-  auto hr = Kokkos::create_mirror_view_and_copy(HostSpace(), p_.radius);
-  int fast = 0;
-  Real worst_move = -1;
-  for (int i = 0; i < p_.n; ++i) {
-    const Real move = norm(load(hv, i)) * prm_.integ.dt / hr(i);
-    if (move > worst_move) worst_move = move, fast = i;
-  }
-  msg << hg(fast) << " moved " << std::sqrt(st.max_move2) * 100 << "% of its radius in one step (limit "
-      << prm_.overlap_limit * 100
-      << "%, the overlap limit): its kinetic energy jumped beyond what the loads can give. Likely cause: a time "
-         "step above the critical one for the stiffness reached, or a servo gain or wall speed too high; "
-         "suggested fix: lower [solver] dt_safety (now dt = "
-      << prm_.integ.dt << " s, critical " << critical_dt() << " s) or the servo gain";
-  throw BlowUp(msg.str());
+  const int fast = fastest_ball(p_, 0, p_.n, prm_.integ.dt);
+  throw BlowUp(fast_blowup(step, hg(fast), std::sqrt(st.max_move2), prm_.overlap_limit, prm_.integ.dt, critical_dt()));
 }
 
 }  // namespace dem

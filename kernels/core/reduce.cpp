@@ -2,12 +2,12 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <string>
 
 namespace dem {
 
-void SegmentedTree::plan(const std::vector<int>& offsets) {
-  if (offsets.empty()) throw std::invalid_argument("SegmentedTree: no segment offsets");
-  segments_ = static_cast<int>(offsets.size()) - 1;
+void SegmentedTree::plan(const std::vector<std::pair<int, int>>& ranges) {
+  segments_ = static_cast<int>(ranges.size());
   levels_.clear();
   slots_ = 0;
   // Each segment still being reduced: its items at this level, [begin, end) in the level's input.
@@ -16,8 +16,11 @@ void SegmentedTree::plan(const std::vector<int>& offsets) {
   };
   std::vector<Open> open;
   for (int s = 0; s < segments_; ++s) {
-    if (offsets[s + 1] < offsets[s]) throw std::invalid_argument("SegmentedTree: offsets must not decrease");
-    open.push_back({s, offsets[s], offsets[s + 1]});
+    const auto& r = ranges[static_cast<std::size_t>(s)];
+    if (r.second < r.first || r.first < 0)
+      throw std::invalid_argument("SegmentedTree: segment " + std::to_string(s) + " has items [" +
+                                  std::to_string(r.first) + ", " + std::to_string(r.second) + ")");
+    open.push_back({s, r.first, r.second});
   }
   while (!open.empty()) {
     std::vector<ReduceBlock> list;

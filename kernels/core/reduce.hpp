@@ -11,6 +11,7 @@
 /// Segments (a batch of specimens, each its own range of items) reduce in one launch per level, each segment by the
 /// tree it would get alone: its blocks start at its first item, and its root is written at the level where it is
 /// one block (SegmentedTree).
+#include <utility>
 #include <vector>
 
 #include "kernels/core/simd.hpp"
@@ -134,13 +135,13 @@ void tree_level(const char* label, int nblock, const F& f, const Blocks& blocks,
 
 }  // namespace detail
 
-/// The tree of each of several segments of items, reduced side by side: segment s is items [offsets[s],
-/// offsets[s + 1]). The host lays out the levels' blocks from the segments' sizes (plan: a copy to the device, so
+/// The tree of each of several segments of items, reduced side by side: segment s is items [ranges[s].first,
+/// ranges[s].second). The host lays out the levels' blocks from the segments' sizes (plan: a copy to the device, so
 /// once per change of sizes, at a rebuild), and each reduction then launches one kernel per level.
 class SegmentedTree {
  public:
-  /// offsets: segments() + 1 non-decreasing item offsets.
-  void plan(const std::vector<int>& offsets);
+  /// ranges: each segment's items [first, second), in any order, apart or not.
+  void plan(const std::vector<std::pair<int, int>>& ranges);
   int segments() const { return segments_; }
   int levels() const { return static_cast<int>(levels_.size()); }
   /// Level l's blocks, their count, and where its results start in the scratch (slots, each of NV values).

@@ -31,10 +31,10 @@ StepStats step_stats(const Real* values) {
   return st;
 }
 
-int non_finite_particle(const Particles& p) {
+int non_finite_particle(const Particles& p, int first, int count) {
   auto x = p.x;
   int bad = -1;
-  Kokkos::parallel_reduce("dem::integrate::find_bad", RangePolicy(0, p.n),
+  Kokkos::parallel_reduce("dem::integrate::find_bad", RangePolicy(first, count < 0 ? p.n : first + count),
       KOKKOS_LAMBDA(const int i, int& acc) {
         const Vec3 xi = load(x, i);
         if (!(kc::isfinite(xi.x) && kc::isfinite(xi.y) && kc::isfinite(xi.z)) && i > acc) acc = i;

@@ -130,7 +130,7 @@ void integrate_batch_to(Particles& p, const SpecimenParamsView& specimens, const
                         const Gather& gather, Real* values, int stride);
 /// The statistics in a step's values; `bad` is left at -1 (non_finite_particle finds it where values[2] > 0).
 StepStats step_stats(const Real* values);
-/// The highest index of a particle with a non-finite position, or -1.
-int non_finite_particle(const Particles& p);
+/// The highest index of a particle with a non-finite position among [first, first + count) (count < 0: all), or -1.
+int non_finite_particle(const Particles& p, int first = 0, int count = -1);
 
 }  // namespace dem

@@ -17,7 +17,8 @@ ContactList remap_history(const PairKeyView& keys, const ContactList& old, const
   c.key = keys;
   const int nold = old.n;
   auto okey = old.key;
-  auto ofs = old.fs, omr = old.mr;
+  auto ofs = old.fs, omr = old.mr, ofc = old.fc, omo = old.mo, omt = old.mt;
+  auto ofn = old.fn;
   auto oflags = old.flags;
   Kokkos::parallel_for("dem::remap::history", RangePolicy(0, n), KOKKOS_LAMBDA(const int k) {
     const std::uint64_t key = keys(k);
@@ -33,7 +34,11 @@ ContactList remap_history(const PairKeyView& keys, const ContactList& old, const
     for (int d = 0; d < 3; ++d) {
       c.fs(k, d) = o >= 0 ? ofs(o, d) : Real(0);
       c.mr(k, d) = o >= 0 ? omr(o, d) : Real(0);
+      c.fc(k, d) = o >= 0 ? ofc(o, d) : Real(0);
+      c.mo(k, d) = o >= 0 ? omo(o, d) : Real(0);
+      c.mt(k, d) = o >= 0 ? omt(o, d) : Real(0);
     }
+    c.fn(k) = o >= 0 ? ofn(o) : Real(0);
     c.flags(k) = o >= 0 ? oflags(o) : std::uint8_t(0);
     for (int s = 0; s < kHistorySlots; ++s) c.slot[s](k) = o >= 0 ? old.slot[s](o) : Real(0);
   });

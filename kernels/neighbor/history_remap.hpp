@@ -1,6 +1,7 @@
 #pragma once
 /// Carries contact history across a rebuild: each new key looks itself up among the previous sorted
-/// keys (binary search) and takes that contact's shear force, rolling moment and flags; new contacts
+/// keys (binary search) and takes that contact's shear force, rolling moment and flags, and its last step's
+/// results (a batch's specimen that is stopped keeps its stress through the others' rebuilds); new contacts
 /// start from zero. Keys are global ids, so re-sorting particles never loses history.
 #include "kernels/neighbor/contact_list.hpp"
 #include "kernels/core/particles.hpp"

@@ -1,0 +1,337 @@
+#include "host/engine/cell_batch.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "host/engine/builder.hpp"
+#include "kernels/neighbor/history_remap.hpp"
+
+namespace dem {
+
+namespace {
+
+// The kernels of this file are free functions: nvcc allows no device lambda in a constructor or a private member.
+
+/// Specimen s's particles copied into the batch's at `first`, its gids moved up by `first` (unique in the batch, in
+/// the same order as alone: each specimen's contact keys sort as its own), tagged with s.
+void place_specimen(const Particles& from, Particles& to, int first, int s) {
+  const auto range = std::make_pair(first, first + from.n);
+  const auto all = Kokkos::ALL;
+  Kokkos::deep_copy(Kokkos::subview(to.x, range, all), from.x);
+  Kokkos::deep_copy(Kokkos::subview(to.v, range, all), from.v);
+  Kokkos::deep_copy(Kokkos::subview(to.w, range, all), from.w);
+  Kokkos::deep_copy(Kokkos::subview(to.x_ref, range, all), from.x_ref);
+  Kokkos::deep_copy(Kokkos::subview(to.radius, range), from.radius);
+  Kokkos::deep_copy(Kokkos::subview(to.mass, range), from.mass);
+  Kokkos::deep_copy(Kokkos::subview(to.inertia, range), from.inertia);
+  Kokkos::deep_copy(Kokkos::subview(to.material, range), from.material);
+  auto gid = to.gid;
+  auto spec = to.specimen;
+  auto g0 = from.gid;
+  Kokkos::parallel_for("dem::batch::place", RangePolicy(0, from.n), KOKKOS_LAMBDA(const int i) {
+    gid(first + i) = g0(i) + static_cast<std::uint32_t>(first);
+    spec(first + i) = s;
+  });
+}
+
+/// Positions at the last rebuild: the rebuilt specimens' set to their positions now.
+void mark_rebuilt(const Particles& p, const SpecimenCellsView& cells) {
+  auto x = p.x, xr = p.x_ref;
+  auto owner = p.specimen;
+  Kokkos::parallel_for("dem::batch::x_ref", RangePolicy(0, p.n), KOKKOS_LAMBDA(const int i) {
+    if (!cells(owner(i)).rebuild) return;
+    for (int d = 0; d < 3; ++d) xr(i, d) = x(i, d);
+  });
+}
+
+/// Each specimen's first contact in the key-sorted list: its first gid's keys start there (S + 1 entries).
+IndexView contact_starts(const ContactList& c, const SpecimenParamsView& spec, int count) {
+  IndexView first("dem::batch::contact_first", count + 1);
+  auto key = c.key;
+  const int n = c.n;
+  Kokkos::parallel_for("dem::batch::contact_first", RangePolicy(0, count + 1), KOKKOS_LAMBDA(const int s) {
+    first(s) = s < count ? key_lower_bound(key, n, std::uint64_t(spec(s).first) << 32) : n;
+  });
+  return first;
+}
+
+/// The periodic cell's affine step of every running specimen with a strain rate (Simulation's stretch_about): each
+/// factor 1 + rate dt worked out as the host works it out for the cell (no contraction, CMakeLists.txt).
+void stretch_specimens(const Particles& p, const SpecimenParamsView& spec, const Kokkos::View<const char*, MemSpace>& on) {
+  auto x = p.x, xr = p.x_ref;
+  auto owner = p.specimen;
+  Kokkos::parallel_for("dem::batch::affine", RangePolicy(0, p.n), KOKKOS_LAMBDA(const int i) {
+    const int s = owner(i);
+    if (!on(s)) return;
+    const SpecimenParams& sp = spec(s);
+    for (int d = 0; d < 3; ++d) {
+      const Real f = 1 + sp.dom.strain_rate[d] * sp.integ.dt, l = sp.dom.lo[d];
+      x(i, d) = l + (x(i, d) - l) * f;
+      xr(i, d) = l + (xr(i, d) - l) * f;
+    }
+  });
+}
+
+/// The Love-Weber diagonal of each specimen's contacts (Simulation::contact_stress_diagonal's sums), to roots.
+struct LoveWeberDiagonal {
+  ContactList c;
+  ConstVec3View x;
+  ConstIndexView owner;
+  SpecimenParamsView spec;
+  KOKKOS_INLINE_FUNCTION void operator()(const int k, Real* v) const {
+    const MinImage image(spec(owner(c.i(k))).dom);
+    const Vec3 f = load(c.fc, k);
+    const Vec3 l = image(load(x, c.j(k)) - load(x, c.i(k)));
+    for (int q = 0; q < 3; ++q) v[q] = -f[q] * l[q];
+  }
+};
+
+}  // namespace
+
+CellBatch::CellBatch(const std::vector<const Simulation*>& specimens) {
+  if (specimens.empty()) throw std::invalid_argument("cell batch: no specimen");
+  int total = 0;
+  for (std::size_t s = 0; s < specimens.size(); ++s) {
+    const Simulation& sim = *specimens[s];
+    const auto bad = [&](const std::string& why) {
+      throw std::invalid_argument("cell batch: specimen " + std::to_string(s) + ": " + why);
+    };
+    const Domain& dom = sim.domain();
+    if (!(dom.periodic[0] && dom.periodic[1] && dom.periodic[2])) bad("its cell is not periodic along x, y and z");
+    if (sim.num_walls() > 0 || sim.mesh().ntri > 0) bad("it has walls or facets");
+    if (sim.step_count() > 0) bad("it has taken steps already; a batch starts from specimens not yet stepped");
+    if (!(sim.params().integ.dt > 0)) bad("its time step is not set");
+    const int nmat = static_cast<int>(sim.contact_table().extent(0));
+    if (s == 0) nmat_ = nmat;
+    if (nmat != nmat_)
+      bad("it has " + std::to_string(nmat) + " materials and specimen 0 has " + std::to_string(nmat_) +
+          ": the batch's material-pair table has the same rows for each");
+    Specimen sp;
+    sp.prm = sim.params();
+    sp.critical_dt = sim.critical_dt();
+    sp.first = total;
+    sp.count = static_cast<int>(const_cast<Simulation&>(sim).particles().n);
+    total += sp.count;
+    spec_.push_back(sp);
+  }
+  p_ = Particles(total);
+  params_ = ParamTableView("dem::batch::params", spec_.size() * nmat_, nmat_);
+  for (std::size_t s = 0; s < specimens.size(); ++s) {
+    Simulation& sim = const_cast<Simulation&>(*specimens[s]);
+    Specimen& sp = spec_[s];
+    place_specimen(sim.particles(), p_, sp.first, static_cast<int>(s));
+    const int row = static_cast<int>(s) * nmat_;
+    Kokkos::deep_copy(Kokkos::subview(params_, std::make_pair(row, row + nmat_), Kokkos::ALL), sim.contact_table());
+    auto r = Kokkos::create_mirror_view_and_copy(HostSpace(), sim.particles().radius);
+    for (int i = 0; i < sp.count; ++i) sp.rmax = std::max(sp.rmax, r(i));
+  }
+  dev_spec_ = SpecimenParamsView("dem::batch::specimens", spec_.size());
+  host_spec_ = Kokkos::create_mirror_view(dev_spec_);
+  rows_ = StepRowsView("dem::batch::rows", spec_.size(), Leapfrog::kValues);
+  host_rows_ = Kokkos::create_mirror_view(rows_);
+  worst_ = Kokkos::View<OverlapStat, MemSpace>("dem::batch::worst");
+  stretching_ = Kokkos::View<char*, MemSpace>("dem::batch::stretching", spec_.size());
+  host_stretching_ = Kokkos::create_mirror_view(stretching_);
+  walls_ = ContactList(0);
+  adj_walls_ = build_adjacency(p_.n, walls_, walls_.i);
+}
+
+int CellBatch::running_count() const {
+  int n = 0;
+  for (const Specimen& sp : spec_) n += sp.running ? 1 : 0;
+  return n;
+}
+
+void CellBatch::set_strain_rate(int s, const Vec3& rate) {
+  Domain& dom = spec_.at(static_cast<std::size_t>(s)).prm.domain;
+  dom.strain_rate[0] = rate.x;
+  dom.strain_rate[1] = rate.y;
+  dom.strain_rate[2] = rate.z;
+}
+
+void CellBatch::stop(int s) {
+  Specimen& sp = spec_.at(static_cast<std::size_t>(s));
+  if (!sp.running) return;
+  sp.running = false;
+  if (!fresh_) plan();
+}
+
+void CellBatch::upload() {
+  for (std::size_t s = 0; s < spec_.size(); ++s) {
+    const Specimen& sp = spec_[s];
+    SpecimenParams& h = host_spec_(s);
+    h.dom = sp.prm.domain;
+    h.integ = sp.prm.integ;
+    h.first = sp.first;
+    h.count = sp.count;
+    h.material_row = static_cast<int>(s) * nmat_;
+  }
+  Kokkos::deep_copy(dev_spec_, host_spec_);
+}
+
+void CellBatch::rebuild(const std::vector<char>& due) {
+  std::vector<SpecimenBin> bins;
+  for (std::size_t s = 0; s < spec_.size(); ++s) {
+    const Specimen& sp = spec_[s];
+    bins.push_back({sp.first, sp.count, sp.prm.domain, 2 * sp.rmax + sp.prm.skin, sp.prm.skin, due[s] != 0});
+  }
+  bin_specimens(p_, bins, cells_);
+  const IndexView g2l = gid_to_local(p_);
+  balls_ = remap_history(detect_pairs(p_, cells_, balls_.key, own_), balls_, g2l, true);
+  own_ = owner_ranges(p_, balls_);
+  adj_balls_ = build_adjacency(p_.n, balls_, balls_.j);
+  mark_rebuilt(p_, cells_.specimens);
+  for (std::size_t s = 0; s < spec_.size(); ++s) {
+    if (!due[s]) continue;
+    spec_[s].wall_disp = 0;
+    ++spec_[s].rebuilds;
+  }
+  const IndexView first = contact_starts(balls_, dev_spec_, size());
+  auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), first);
+  contact_first_.assign(h.data(), h.data() + h.extent(0));
+  fresh_ = false;
+  plan();
+}
+
+void CellBatch::plan() {
+  std::vector<std::pair<int, int>> particles, contacts;
+  std::vector<int> item_first(spec_.size() + 1, 0);
+  for (std::size_t s = 0; s < spec_.size(); ++s) {
+    const Specimen& sp = spec_[s];
+    const int c0 = contact_first_[s], c1 = contact_first_[s + 1];
+    // A stopped specimen has no items: nothing of it is computed or moved.
+    particles.emplace_back(sp.first, sp.running ? sp.first + sp.count : sp.first);
+    contacts.emplace_back(c0, c1);  // a stopped specimen's stress is that of its state
+    const int items = sp.running ? (c1 - c0 + kContactLanes - 1) / kContactLanes : 0;
+    item_first[s + 1] = item_first[s] + items;
+  }
+  particle_tree_.plan(particles);
+  contact_tree_.plan(contacts);
+  items_.specimens = size();
+  items_.items = item_first.back();
+  items_.contact_first = IndexView("dem::batch::contact_first", contact_first_.size());
+  items_.item_first = IndexView("dem::batch::item_first", item_first.size());
+  Kokkos::deep_copy(items_.contact_first,
+                    Kokkos::View<const int*, HostSpace, Kokkos::MemoryUnmanaged>(contact_first_.data(), contact_first_.size()));
+  Kokkos::deep_copy(items_.item_first,
+                    Kokkos::View<const int*, HostSpace, Kokkos::MemoryUnmanaged>(item_first.data(), item_first.size()));
+}
+
+void CellBatch::step(const std::vector<char>& measure) {
+  for (std::size_t s = 0; s < spec_.size(); ++s) spec_[s].prm.integ.measure = measure.empty() || measure[s];
+  upload();
+  // Each specimen's rebuild, decided as its Simulation decides it (Simulation::lists_expired, read every step).
+  std::vector<char> due(spec_.size(), 0);
+  bool any = false;
+  for (std::size_t s = 0; s < spec_.size(); ++s) {
+    const Specimen& sp = spec_[s];
+    if (!sp.running) continue;
+    const Real d = std::sqrt(sp.stats.max_disp2);
+    due[s] = fresh_ || 2 * d > sp.prm.skin || d + sp.wall_disp > sp.prm.skin;
+    any = any || due[s];
+  }
+  if (any) rebuild(due);
+  compute_ball_forces(p_, balls_, params_, dev_spec_, items_, OverlapResultView(worst_.data()));
+  integrate_batch_to(p_, dev_spec_, particle_tree_, make_gather(balls_, own_, adj_balls_, walls_, adj_walls_),
+                     rows_.data(), Leapfrog::kValues);
+  // The cells' stretch, on the device and on the host alike (Simulation::move_boundaries).
+  auto& hon = host_stretching_;
+  bool stretch = false;
+  std::vector<Real> speed(spec_.size(), 0);
+  for (std::size_t s = 0; s < spec_.size(); ++s) {
+    Specimen& sp = spec_[s];
+    const Real* rate = sp.prm.domain.strain_rate;
+    hon(s) = sp.running && (rate[0] != 0 || rate[1] != 0 || rate[2] != 0);
+    if (!hon(s)) continue;
+    stretch = true;
+    const Real dt = sp.prm.integ.dt;
+    Domain& dom = sp.prm.domain;
+    const Real f[3] = {1 + rate[0] * dt, 1 + rate[1] * dt, 1 + rate[2] * dt};
+    for (int d = 0; d < 3; ++d) dom.hi[d] = dom.lo[d] + (dom.hi[d] - dom.lo[d]) * f[d];
+    const Real rate_max = std::max({std::fabs(rate[0]), std::fabs(rate[1]), std::fabs(rate[2])});
+    speed[s] = rate_max * (2 * sp.rmax + sp.prm.skin);
+  }
+  if (stretch) {
+    Kokkos::deep_copy(stretching_, hon);
+    stretch_specimens(p_, dev_spec_, stretching_);
+  }
+  Kokkos::deep_copy(host_rows_, rows_);
+  OverlapStat worst;
+  Kokkos::deep_copy(worst, worst_);
+  for (std::size_t s = 0; s < spec_.size(); ++s) {
+    Specimen& sp = spec_[s];
+    if (!sp.running) continue;
+    sp.time += sp.prm.integ.dt;
+    ++sp.steps;
+    sp.wall_disp += speed[s] * sp.prm.integ.dt;
+    take_row(static_cast<int>(s), worst);
+  }
+}
+
+void CellBatch::take_row(int s, const OverlapStat& worst) {
+  Specimen& sp = spec_[static_cast<std::size_t>(s)];
+  const Real* row = &host_rows_(s, 0);
+  sp.stats = step_stats(row);
+  const long step = sp.steps - 1;
+  std::string why;
+  // The largest overlap of all the specimens' contacts is this specimen's own where it lies among its contacts
+  // (the same contact, ties going to the later one in both). A specimen whose overlap passed its limit in the same
+  // step as another's larger one is stopped at its next step, if it still does.
+  const bool mine = worst.contact >= contact_first_[s] && worst.contact < contact_first_[s + 1];
+  auto gid_of = [&](int i) {
+    auto g = Kokkos::create_mirror_view_and_copy(HostSpace(), Kokkos::subview(p_.gid, std::make_pair(i, i + 1)));
+    return g(0) - static_cast<std::uint32_t>(sp.first);
+  };
+  const Real limit = sp.prm.overlap_limit;
+  if (mine && worst.ratio > limit) {
+    auto hi = Kokkos::create_mirror_view_and_copy(
+        HostSpace(), Kokkos::subview(balls_.i, std::make_pair(worst.contact, worst.contact + 1)));
+    why = overlap_blowup(step, gid_of(hi(0)), false, worst.ratio, limit);
+  } else if (row[2] > 0) {
+    why = nonfinite_blowup(step, gid_of(non_finite_particle(p_, sp.first, sp.count)), sp.prm.integ.dt, sp.critical_dt);
+  } else if (sp.stats.max_move2 > limit * limit) {
+    why = fast_blowup(step, gid_of(fastest_ball(p_, sp.first, sp.count, sp.prm.integ.dt)),
+                      std::sqrt(sp.stats.max_move2), limit, sp.prm.integ.dt, sp.critical_dt);
+  }
+  if (why.empty()) return;
+  sp.blowup = why;
+  stop(s);
+}
+
+std::vector<std::array<Real, 3>> CellBatch::contact_stress_diagonals() const {
+  std::vector<std::array<Real, 3>> out(spec_.size());
+  if (fresh_) return out;
+  const_cast<CellBatch*>(this)->upload();  // the cells as they are now: a step stretched them after its upload
+  Kokkos::View<Real**, Kokkos::LayoutRight, MemSpace> roots("dem::batch::stress", spec_.size(), 3);
+  segmented_reduce_lanes_to<3, 0, 1>("dem::batch::contact_stress_diagonal", contact_tree_,
+                                     OneAtATime<LoveWeberDiagonal, 3>{{balls_, p_.x, p_.specimen, dev_spec_}},
+                                     roots.data());
+  auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), roots);
+  for (std::size_t s = 0; s < spec_.size(); ++s) {
+    const Real V = spec_[s].prm.domain.volume();
+    for (int q = 0; q < 3; ++q) out[s][static_cast<std::size_t>(q)] = h(s, q) / V;
+  }
+  return out;
+}
+
+HostParticles CellBatch::balls_of(int s) const {
+  const Specimen& sp = spec_.at(static_cast<std::size_t>(s));
+  auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), p_.x);
+  auto v = Kokkos::create_mirror_view_and_copy(HostSpace(), p_.v);
+  auto w = Kokkos::create_mirror_view_and_copy(HostSpace(), p_.w);
+  auto g = Kokkos::create_mirror_view_and_copy(HostSpace(), p_.gid);
+  HostParticles h;
+  h.x.resize(sp.count);
+  h.v.resize(sp.count);
+  h.w.resize(sp.count);
+  for (int i = sp.first; i < sp.first + sp.count; ++i) {
+    const std::size_t k = g(i) - static_cast<std::uint32_t>(sp.first);
+    h.x[k] = load(x, i);
+    h.v[k] = load(v, i);
+    h.w[k] = load(w, i);
+  }
+  return h;
+}
+
+}  // namespace dem

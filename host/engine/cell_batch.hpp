@@ -1,0 +1,100 @@
+#pragma once
+/// Independent periodic cells stepped side by side: a calibration's or a diagnosis's many small cells as one set of
+/// particles and contacts, one launch per kernel for all of them, where each alone would use a sliver of a GPU.
+///
+/// Each specimen's steps are bit for bit those of its own Simulation:
+///  - the kernels are the same, each work item with its specimen's cell, time step and laws (kernels/core/specimen.hpp);
+///  - each specimen's sums are its own tree, as alone (segmented reductions, kernels/core/reduce.hpp);
+///  - each specimen's neighbour lists are rebuilt at the steps its own Simulation rebuilds them, by the same test,
+///    and the other specimens' particles and lists are kept as they are meanwhile (bin_specimens): the order of a
+///    specimen's particles and contacts, on which its sums' rounding depends, is the one it has alone.
+/// The statistics are read every step (stats_every 1), for every specimen in one copy.
+#include <array>
+#include <string>
+#include <vector>
+
+#include "host/engine/builder.hpp"
+#include "host/engine/simulation.hpp"
+
+namespace dem {
+
+class CellBatch {
+ public:
+  /// The specimens: Simulations of a periodic cell (make_periodic_simulation) not yet stepped, fully periodic,
+  /// without walls or facets, all with the same number of materials. Their particles, laws and settings are copied;
+  /// the Simulations are not used after. Throws std::invalid_argument naming the specimen and what is wrong.
+  explicit CellBatch(const std::vector<const Simulation*>& specimens);
+
+  int size() const { return static_cast<int>(spec_.size()); }
+  long balls() const { return p_.n; }
+  /// One step of every running specimen. measure[s]: whether specimen s's step fills its unbalanced force and
+  /// kinetic energy (Simulation::step's `measure`); empty: every one. A specimen whose step blows up is stopped
+  /// (blowup() says why) and the others go on.
+  void step(const std::vector<char>& measure = {});
+
+  /// Stops specimen s: its state stays as it is, and the steps leave it out.
+  void stop(int s);
+  bool running(int s) const { return spec_.at(static_cast<std::size_t>(s)).running; }
+  int running_count() const;
+  /// Why specimen s stopped with a blow-up (the message its own Simulation's BlowUp gives), or "".
+  const std::string& blowup(int s) const { return spec_.at(static_cast<std::size_t>(s)).blowup; }
+
+  const Domain& domain(int s) const { return spec_.at(static_cast<std::size_t>(s)).prm.domain; }
+  /// As Simulation::set_strain_rate, for specimen s.
+  void set_strain_rate(int s, const Vec3& rate);
+  /// Steps specimen s has taken, and its time (s).
+  long step_count(int s) const { return spec_.at(static_cast<std::size_t>(s)).steps; }
+  Real time(int s) const { return spec_.at(static_cast<std::size_t>(s)).time; }
+  /// Specimen s's last step's statistics.
+  const StepStats& stats(int s) const { return spec_.at(static_cast<std::size_t>(s)).stats; }
+  long rebuilds(int s) const { return spec_.at(static_cast<std::size_t>(s)).rebuilds; }
+  /// Every specimen's Love-Weber stress diagonal (xx, yy, zz; Pa) over its cell's volume: what
+  /// Simulation::contact_stress_diagonal gives each alone, in one launch and one copy.
+  std::vector<std::array<Real, 3>> contact_stress_diagonals() const;
+  /// Specimen s's balls by their gid in its own Simulation: positions, velocities and spins (for comparisons).
+  HostParticles balls_of(int s) const;
+
+ private:
+  struct Specimen {
+    SimParams prm;
+    int first = 0, count = 0;
+    Real rmax = 0;
+    Real critical_dt = 0;  ///< s, its Simulation's critical_dt (for a blow-up's message)
+    Real time = 0;
+    long steps = 0;
+    long rebuilds = 0;
+    StepStats stats;
+    Real wall_disp = 0;  ///< the cell's travel since the specimen's last rebuild (m), as Simulation's
+    bool running = true;
+    std::string blowup;
+  };
+  Particles p_;
+  ParamTableView params_;
+  int nmat_ = 0;
+  std::vector<Specimen> spec_;
+  SpecimenParamsView dev_spec_;
+  decltype(Kokkos::create_mirror_view(SpecimenParamsView())) host_spec_;
+  CellList cells_;
+  ContactList balls_, walls_;
+  Index2View own_;
+  Adjacency adj_balls_, adj_walls_;
+  ContactItems items_;
+  std::vector<int> contact_first_;  ///< S + 1 offsets of the specimens' contacts (host copy)
+  SegmentedTree particle_tree_, contact_tree_;
+  StepRowsView rows_;  ///< a row of Leapfrog values per specimen
+  decltype(Kokkos::create_mirror_view(StepRowsView())) host_rows_;
+  Kokkos::View<OverlapStat, MemSpace> worst_;
+  Kokkos::View<char*, MemSpace> stretching_;  ///< which specimens' cells stretch this step
+  decltype(Kokkos::create_mirror_view(Kokkos::View<char*, MemSpace>())) host_stretching_;
+  bool fresh_ = true;
+
+  /// Rebuilds the lists of the specimens marked in `due`, keeping the others'.
+  void rebuild(const std::vector<char>& due);
+  /// The work items and trees of the running specimens' particles and contacts.
+  void plan();
+  /// Specimen s's statistics after a step: its blow-up checks (it stops on one), and its cell's travel.
+  void take_row(int s, const OverlapStat& worst);
+  void upload();
+};
+
+}  // namespace dem

@@ -1,0 +1,185 @@
+// Periodic cells stepped side by side (host/engine/cell_batch.hpp): each specimen's steps bit for bit those of its
+// own Simulation, whatever the others do (other sizes, laws, rates, a stop, a blow-up). Specimens of 100-140 balls
+// of 2 mm from a gas (solid fraction 0.1), compressed at fixed strain rates through first contact into a dense
+// packing and then sheared: the neighbour lists are rebuilt dozens of times, at other steps in each specimen.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "host/engine/cell_batch.hpp"
+#include "host/engine/packing.hpp"
+#include "host/triax/periodic_triaxial.hpp"
+#include "test_util.hpp"
+
+using namespace dem;
+
+namespace {
+
+/// A specimen's recipe: balls and seed, its law's friction and stiffness, and its program's strains over the steps
+/// of each phase (rates from its own time step).
+struct Recipe {
+  int balls;
+  unsigned seed;
+  Real mu_s, emod;
+  Real squeeze, shear;  ///< isotropic compression, then axial compression (lateral extension at half)
+};
+
+std::unique_ptr<Simulation> make_cell(const Recipe& r) {
+  Config cfg = test::tiny_cell_config();
+  cfg.particles.count = r.balls;
+  const Real L = std::cbrt(r.balls * M_PI / 6 * 8e-9 / 0.1);
+  cfg.box.size = {L, L, L};
+  cfg.run.seed = r.seed;
+  ContactParams law = cfg.ball.base();
+  law.mu_s = r.mu_s;
+  law.emod = r.emod;
+  return make_periodic_simulation(make_packing(cfg), cfg.box.size, law, cfg.solver);
+}
+
+constexpr long kSteps = 9000, kSqueeze = 6000;
+
+/// The program's strain rate (1/s) at step n, for a specimen of time step dt.
+Vec3 rate_at(const Recipe& r, long n, Real dt) {
+  if (n < kSqueeze) {
+    const Real e = r.squeeze / (kSqueeze * dt);
+    return Vec3(-e, -e, -e);
+  }
+  const Real e = r.shear / ((kSteps - kSqueeze) * dt);
+  return Vec3(0.5 * e, 0.5 * e, -e);
+}
+
+bool same_bits(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(Vec3)) == 0;
+}
+
+/// What a specimen's run leaves: its balls, its stress, its steps and rebuilds, and the blow-up that stopped it.
+struct Outcome {
+  HostParticles balls;
+  std::array<Real, 3> stress{};
+  long steps = 0, rebuilds = 0;
+  std::string blowup;
+};
+
+/// Steps 0 .. `steps` - 1 of the program alone, until a blow-up; every 7th step measured. The time step times
+/// `dt_factor`, the rates those of the time step made.
+Outcome alone(const Recipe& r, long steps, Real dt_factor = 1) {
+  auto sim = make_cell(r);
+  const Real dt = sim->params().integ.dt;
+  sim->set_dt(dt_factor * dt);
+  Outcome o;
+  try {
+    for (long n = 0; n < steps; ++n) {
+      sim->set_strain_rate(rate_at(r, n, dt));
+      sim->step(n % 7 == 0);
+    }
+  } catch (const BlowUp& e) {
+    o.blowup = e.what();
+  }
+  o.balls = to_host_by_gid(sim->particles());
+  o.stress = sim->contact_stress_diagonal(sim->domain().volume());
+  o.steps = sim->step_count();
+  o.rebuilds = sim->times().rebuilds;
+  return o;
+}
+
+void expect_same(const Outcome& want, const CellBatch& batch, int s, const std::array<Real, 3>& stress) {
+  const HostParticles got = batch.balls_of(s);
+  EXPECT_TRUE(same_bits(got.x, want.balls.x)) << "specimen " << s << ": positions";
+  EXPECT_TRUE(same_bits(got.v, want.balls.v)) << "specimen " << s << ": velocities";
+  EXPECT_TRUE(same_bits(got.w, want.balls.w)) << "specimen " << s << ": spins";
+  EXPECT_EQ(batch.rebuilds(s), want.rebuilds) << "specimen " << s;
+  EXPECT_EQ(batch.blowup(s), want.blowup) << "specimen " << s;
+  if (want.blowup.empty()) {
+    EXPECT_EQ(batch.step_count(s), want.steps) << "specimen " << s;
+    EXPECT_EQ(std::memcmp(stress.data(), want.stress.data(), sizeof stress), 0)
+        << "specimen " << s << ": stress " << stress[2] << " vs " << want.stress[2];
+  }
+}
+
+const std::vector<Recipe> kRecipes = {
+    {100, 11u, 0.3, 1e8, 0.55, 0.03},
+    {140, 12u, 0.5, 1e8, 0.54, 0.04},  // more balls, more friction, other strains
+    {100, 13u, 0.3, 2e8, 0.55, 0.03},  // stiffer: another time step
+};
+
+TEST(CellBatch, EachSpecimenStepsBitForBitAsItsOwnSimulation) {
+  std::vector<std::unique_ptr<Simulation>> made;
+  std::vector<const Simulation*> sims;
+  for (const Recipe& r : kRecipes) {
+    made.push_back(make_cell(r));
+    sims.push_back(made.back().get());
+  }
+  CellBatch batch(sims);
+  std::vector<char> measure(kRecipes.size());
+  for (long n = 0; n < kSteps; ++n) {
+    for (int s = 0; s < batch.size(); ++s) batch.set_strain_rate(s, rate_at(kRecipes[s], n, sims[s]->params().integ.dt));
+    std::fill(measure.begin(), measure.end(), n % 7 == 0);
+    batch.step(measure);
+  }
+  const auto stress = batch.contact_stress_diagonals();
+  for (int s = 0; s < batch.size(); ++s) {
+    const Outcome want = alone(kRecipes[s], kSteps);
+    ASSERT_TRUE(want.blowup.empty()) << want.blowup;
+    // The program makes a packing that carries load (0.4-3 kPa axially) and rebuilds the lists many times.
+    EXPECT_GT(want.stress[2], 100) << "specimen " << s;
+    EXPECT_GT(want.rebuilds, 20) << "specimen " << s;
+    expect_same(want, batch, s, stress[s]);
+    EXPECT_TRUE(batch.running(s));
+  }
+  // Rebuilt at other steps: each specimen's lists are its own.
+  EXPECT_FALSE(batch.rebuilds(0) == batch.rebuilds(1) && batch.rebuilds(1) == batch.rebuilds(2));
+}
+
+// A specimen stopped part way keeps its state; one whose time step is five times too large blows up, is stopped
+// with its own Simulation's message, and the others finish as they would alone.
+TEST(CellBatch, AStoppedOrBlownUpSpecimenLeavesTheOthersAsTheyWouldBeAlone) {
+  std::vector<std::unique_ptr<Simulation>> made;
+  std::vector<const Simulation*> sims;
+  std::vector<Real> dt;  // the rates': the time steps made
+  for (std::size_t s = 0; s < kRecipes.size(); ++s) {
+    made.push_back(make_cell(kRecipes[s]));
+    dt.push_back(made.back()->params().integ.dt);
+    if (s == 2) made.back()->set_dt(5 * dt.back());
+    sims.push_back(made.back().get());
+  }
+  CellBatch batch(sims);
+  const long stop_at = 4000;
+  for (long n = 0; n < kSteps; ++n) {
+    if (n == stop_at) batch.stop(1);
+    for (int s = 0; s < batch.size(); ++s) batch.set_strain_rate(s, rate_at(kRecipes[s], n, dt[s]));
+    batch.step(std::vector<char>(kRecipes.size(), n % 7 == 0));
+  }
+  const auto stress = batch.contact_stress_diagonals();
+  expect_same(alone(kRecipes[0], kSteps), batch, 0, stress[0]);
+  const Outcome stopped = alone(kRecipes[1], stop_at);
+  expect_same(stopped, batch, 1, stress[1]);
+  EXPECT_FALSE(batch.running(1));
+  const Outcome blown = alone(kRecipes[2], kSteps, 5);
+  ASSERT_FALSE(blown.blowup.empty()) << "the time step five times too large must blow up alone";
+  expect_same(blown, batch, 2, stress[2]);
+  EXPECT_FALSE(batch.running(2));
+  EXPECT_EQ(batch.running_count(), 1);
+}
+
+TEST(CellBatch, SpecimensThatCannotShareABatchAreRefusedByIndexAndReason) {
+  auto periodic = make_cell(kRecipes[0]);
+  Config walled = test::tiny_cell_config();
+  auto cuboid = make_periodic_simulation(make_packing(walled), walled.box.size, walled.ball, walled.solver,
+                                         CellBoundary::walls);
+  try {
+    CellBatch batch({periodic.get(), cuboid.get()});
+    FAIL() << "a walled cuboid was taken into a batch of periodic cells";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("specimen 1"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("periodic"), std::string::npos) << e.what();
+  }
+  periodic->step();
+  EXPECT_THROW(CellBatch({periodic.get()}), std::invalid_argument);
+  EXPECT_THROW(CellBatch(std::vector<const Simulation*>{}), std::invalid_argument);
+}
+
+}  // namespace
