@@ -87,6 +87,35 @@ struct LoveWeberDiagonal {
   }
 };
 
+/// Each specimen's servo stiffness sums (cell_stiffness's).
+struct StiffnessSums {
+  ContactList c;
+  ConstVec3View x;
+  ConstScalarView r;
+  ConstIndexView owner;
+  SpecimenParamsView spec;
+  KOKKOS_INLINE_FUNCTION void operator()(const int s, Real* v) const {
+    const Real fn = c.fn(s);
+    if (!(fn > 0)) return;
+    const Vec3 l = spec(owner(c.i(s))).dom.min_image(load(x, c.j(s)) - load(x, c.i(s)));
+    const Real overlap = r(c.i(s)) + r(c.j(s)) - norm(l);
+    if (!(overlap > 0)) return;
+    const Real kn = fn / overlap;
+    v[0] = kn * l.x * l.x;
+    v[1] = kn * l.y * l.y;
+    v[2] = kn * l.z * l.z;
+  }
+};
+
+/// Each specimen's contact force sums (Simulation::unbalanced_ratio's): sum |f| and the touching contacts.
+struct ForceSums {
+  ContactList c;
+  KOKKOS_INLINE_FUNCTION void operator()(const int k, Real* v) const {
+    v[0] = norm(load(c.fc, k));
+    v[1] = c.fn(k) > 0 ? Real(1) : Real(0);
+  }
+};
+
 }  // namespace
 
 CellBatch::CellBatch(const std::vector<const Simulation*>& specimens) {
@@ -256,6 +285,7 @@ void CellBatch::step(const std::vector<char>& measure) {
     Kokkos::deep_copy(stretching_, hon);
     stretch_specimens(p_, dev_spec_, stretching_);
   }
+  ++batch_steps_;
   Kokkos::deep_copy(host_rows_, rows_);
   OverlapStat worst;
   Kokkos::deep_copy(worst, worst_);
@@ -299,20 +329,66 @@ void CellBatch::take_row(int s, const OverlapStat& worst) {
   stop(s);
 }
 
-std::vector<std::array<Real, 3>> CellBatch::contact_stress_diagonals() const {
-  std::vector<std::array<Real, 3>> out(spec_.size());
-  if (fresh_) return out;
-  const_cast<CellBatch*>(this)->upload();  // the cells as they are now: a step stretched them after its upload
-  Kokkos::View<Real**, Kokkos::LayoutRight, MemSpace> roots("dem::batch::stress", spec_.size(), 3);
-  segmented_reduce_lanes_to<3, 0, 1>("dem::batch::contact_stress_diagonal", contact_tree_,
-                                     OneAtATime<LoveWeberDiagonal, 3>{{balls_, p_.x, p_.specimen, dev_spec_}},
-                                     roots.data());
+namespace {
+/// Each segment's NV roots of f over `tree`, to the host: one launch per level and one copy.
+template <int NV, class F>
+std::vector<std::array<Real, NV>> segment_sums(const char* label, const SegmentedTree& tree, const F& f) {
+  Kokkos::View<Real**, Kokkos::LayoutRight, MemSpace> roots(std::string(label), tree.segments(), NV);
+  segmented_reduce_lanes_to<NV, 0, 1>(label, tree, OneAtATime<F, NV>{f}, roots.data());
   auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), roots);
+  std::vector<std::array<Real, NV>> out(static_cast<std::size_t>(tree.segments()));
+  for (int s = 0; s < tree.segments(); ++s)
+    for (int q = 0; q < NV; ++q) out[static_cast<std::size_t>(s)][static_cast<std::size_t>(q)] = h(s, q);
+  return out;
+}
+}  // namespace
+
+const std::vector<std::array<Real, 3>>& CellBatch::contact_stress_diagonals() const {
+  if (stress_at_ == batch_steps_) return stress_;
+  stress_.assign(spec_.size(), {});
+  stress_at_ = batch_steps_;
+  if (fresh_) return stress_;
+  const_cast<CellBatch*>(this)->upload();  // the cells as they are now: a step stretched them after its upload
+  stress_ = segment_sums<3>("dem::batch::contact_stress_diagonal", contact_tree_,
+                            LoveWeberDiagonal{balls_, p_.x, p_.specimen, dev_spec_});
   for (std::size_t s = 0; s < spec_.size(); ++s) {
     const Real V = spec_[s].prm.domain.volume();
-    for (int q = 0; q < 3; ++q) out[s][static_cast<std::size_t>(q)] = h(s, q) / V;
+    for (Real& x : stress_[s]) x /= V;
   }
-  return out;
+  return stress_;
+}
+
+const std::vector<std::array<Real, 3>>& CellBatch::cell_stiffnesses() const {
+  if (stiffness_at_ == batch_steps_) return stiffness_;
+  stiffness_.assign(spec_.size(), {});
+  stiffness_at_ = batch_steps_;
+  if (fresh_) return stiffness_;
+  const_cast<CellBatch*>(this)->upload();
+  stiffness_ = segment_sums<3>("dem::batch::cell_stiffness", contact_tree_,
+                               StiffnessSums{balls_, p_.x, p_.radius, p_.specimen, dev_spec_});
+  for (std::size_t s = 0; s < spec_.size(); ++s) {
+    const Real V = spec_[s].prm.domain.volume();
+    for (Real& x : stiffness_[s]) x /= V;
+  }
+  return stiffness_;
+}
+
+Real CellBatch::unbalanced_ratio(int s) const {
+  const Specimen& sp = spec_.at(static_cast<std::size_t>(s));
+  if (sp.count == 0) return 0;
+  if (force_sums_at_ != batch_steps_) {
+    force_sums_.assign(spec_.size(), {});
+    force_sums_at_ = batch_steps_;
+    if (!fresh_) force_sums_ = segment_sums<2>("dem::batch::contact_force_sum", contact_tree_, ForceSums{balls_});
+  }
+  const std::array<Real, 2>& f = force_sums_[static_cast<std::size_t>(s)];
+  if (f[1] == 0) return 1;
+  return (sp.stats.unbalanced / sp.count) / (f[0] / f[1]);
+}
+
+long CellBatch::touching(int s) const {
+  unbalanced_ratio(s);  // the sums of the step, taken once
+  return static_cast<long>(force_sums_[static_cast<std::size_t>(s)][1]);
 }
 
 HostParticles CellBatch::balls_of(int s) const {

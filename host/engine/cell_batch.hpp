@@ -27,6 +27,8 @@ class CellBatch {
 
   int size() const { return static_cast<int>(spec_.size()); }
   long balls() const { return p_.n; }
+  int balls(int s) const { return spec_.at(static_cast<std::size_t>(s)).count; }
+  Real dt(int s) const { return spec_.at(static_cast<std::size_t>(s)).prm.integ.dt; }
   /// One step of every running specimen. measure[s]: whether specimen s's step fills its unbalanced force and
   /// kinetic energy (Simulation::step's `measure`); empty: every one. A specimen whose step blows up is stopped
   /// (blowup() says why) and the others go on.
@@ -49,8 +51,14 @@ class CellBatch {
   const StepStats& stats(int s) const { return spec_.at(static_cast<std::size_t>(s)).stats; }
   long rebuilds(int s) const { return spec_.at(static_cast<std::size_t>(s)).rebuilds; }
   /// Every specimen's Love-Weber stress diagonal (xx, yy, zz; Pa) over its cell's volume: what
-  /// Simulation::contact_stress_diagonal gives each alone, in one launch and one copy.
-  std::vector<std::array<Real, 3>> contact_stress_diagonals() const;
+  /// Simulation::contact_stress_diagonal gives each alone, in one launch and one copy (kept until the next step).
+  const std::vector<std::array<Real, 3>>& contact_stress_diagonals() const;
+  /// Every specimen's servo stiffness K_dd (Pa): what cell_stiffness gives each alone (kept until the next step).
+  const std::vector<std::array<Real, 3>>& cell_stiffnesses() const;
+  /// Specimen s's unbalanced-force ratio and touching ball-ball contacts: Simulation::unbalanced_ratio and
+  /// touching()[0] alone (all specimens' sums in one launch, kept until the next step).
+  Real unbalanced_ratio(int s) const;
+  long touching(int s) const;
   /// Specimen s's balls by their gid in its own Simulation: positions, velocities and spins (for comparisons).
   HostParticles balls_of(int s) const;
 
@@ -84,6 +92,11 @@ class CellBatch {
   StepRowsView rows_;  ///< a row of Leapfrog values per specimen
   decltype(Kokkos::create_mirror_view(StepRowsView())) host_rows_;
   Kokkos::View<OverlapStat, MemSpace> worst_;
+  long batch_steps_ = 0;
+  /// The per-specimen sums of the last step, and the batch step they were taken after (-1: none).
+  mutable std::vector<std::array<Real, 3>> stress_, stiffness_;
+  mutable std::vector<std::array<Real, 2>> force_sums_;  ///< sum |f| and touching count of the ball-ball contacts
+  mutable long stress_at_ = -1, stiffness_at_ = -1, force_sums_at_ = -1;
   Kokkos::View<char*, MemSpace> stretching_;  ///< which specimens' cells stretch this step
   decltype(Kokkos::create_mirror_view(Kokkos::View<char*, MemSpace>())) host_stretching_;
   bool fresh_ = true;

@@ -9,7 +9,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "host/engine/cell_batch.hpp"
 #include "host/triax/cell_boundary.hpp"
+#include "host/triax/cell_control.hpp"
 #include "host/data/measured.hpp"
 #include "kernels/core/reduce.hpp"
 #include "host/engine/setup.hpp"
@@ -49,10 +51,10 @@ class CellServo {
   CellServo(const PeriodicTriaxialParams& prm, Real max_rate) : prm_(prm), max_rate_(max_rate) {}
 
   /// servo[d]: axis d is servoed to target[d] (Pa); otherwise its rate is fixed[d] (1/s, extension positive).
-  void update(Simulation& sim, const bool servo[3], const Real fixed[3], const Real target[3]) {
-    if (calls_++ % prm_.stiffness_every == 0) k_ = boundary_stiffness(sim);
-    stress_ = cell_stress(sim);
-    const Real dt = sim.params().integ.dt;
+  void update(CellControl& cell, const bool servo[3], const Real fixed[3], const Real target[3]) {
+    if (calls_++ % prm_.stiffness_every == 0) k_ = cell.stiffness();
+    stress_ = cell.stress();
+    const Real dt = cell.dt();
     Real rate[3];
     for (int d = 0; d < 3; ++d) {
       if (!servo[d]) { rate[d] = fixed[d]; continue; }
@@ -62,11 +64,11 @@ class CellServo {
                                : (err > 0 ? max_rate_ : (err < 0 ? -max_rate_ : Real(0)));
       rate[d] = std::clamp(r, -max_rate_, max_rate_);
     }
-    set_cell_rates(sim, Vec3(rate[0], rate[1], rate[2]));
+    cell.set_rates(Vec3(rate[0], rate[1], rate[2]));
   }
 
  private:
-  const PeriodicTriaxialParams& prm_;
+  PeriodicTriaxialParams prm_;
   Real max_rate_;
   long calls_ = 0;
   std::array<Real, 3> k_{};
@@ -82,14 +84,14 @@ std::array<Real, 3> lateral_targets(const std::array<Real, 3>& lengths, const Pe
   return t;
 }
 
-PeriodicTriaxialRecord measure_row(Simulation& sim, const PeriodicTriaxialParams& prm, const GrainScales& g,
+PeriodicTriaxialRecord measure_row(CellControl& cell, const PeriodicTriaxialParams& prm, const GrainScales& g,
                                    Real h0, Real V0, const std::array<Real, 3>& L0) {
   PeriodicTriaxialRecord r;
-  const std::array<Real, 3> lengths = cell_lengths(sim);
-  const Real V = cell_volume(sim);
-  const std::array<Real, 3> s = cell_stress(sim);
-  r.step = sim.step_count();
-  r.time = sim.time();
+  const std::array<Real, 3> lengths = cell.lengths();
+  const Real V = cell.volume();
+  const std::array<Real, 3> s = cell.stress();
+  r.step = cell.step_count();
+  r.time = cell.time();
   r.eps_a = (h0 - lengths[2]) / h0;
   r.eps_v = -(V - V0) / V0;
   r.sigma1 = s[2];
@@ -103,12 +105,12 @@ PeriodicTriaxialRecord measure_row(Simulation& sim, const PeriodicTriaxialParams
   const Real sum = r.sigma1 + lateral;
   r.phi_mob_deg = sum > 0 ? std::asin(std::clamp(r.q / sum, Real(-1), Real(1))) * 180 / kPi : 0;
   r.void_ratio = V / g.v_solid - 1;
-  const int n = sim.particles().n;
-  r.coordination = n > 0 ? 2.0 * static_cast<Real>(sim.touching()[0]) / n : 0;
-  r.unbalanced = sim.unbalanced_ratio();
-  r.kinetic = sim.stats().kinetic;
+  const int n = cell.balls();
+  r.coordination = n > 0 ? 2.0 * static_cast<Real>(cell.touching()) / n : 0;
+  r.unbalanced = cell.unbalanced_ratio();
+  r.kinetic = cell.kinetic();
   r.inertial = r.p > 0 ? prm.axial_rate * g.d * std::sqrt(g.rho_eff / r.p) : std::numeric_limits<Real>::infinity();
-  const Vec3 rates = cell_rates(sim);
+  const Vec3 rates = cell.rates();
   r.rate_x = rates.x;
   r.rate_y = rates.y;
   return r;
@@ -192,56 +194,72 @@ PeriodicTriaxialParams resolve_periodic_params(Simulation& sim, PeriodicTriaxial
   return prm;
 }
 
-StageEnd consolidate_isotropic(Simulation& sim, const PeriodicTriaxialParams& prm_in) {
-  const PeriodicTriaxialParams prm = resolve_periodic_params(sim, prm_in);  // idempotent
-  CellServo servo(prm, prm.consolidation_rate);
-  const bool all[3] = {true, true, true};
-  const Real none[3] = {0, 0, 0};
-  Progress progress(prm.name + " consolidation (ETA to the step cap)", prm.max_consolidation_steps);
-  Real err = 0, ratio = 1;
-  std::array<Real, 3> s{};
-  StageSteps stage;
-  stage.last = prm.max_consolidation_steps;
-  stage.before = [&](long n) {
-    const Real target[3] = {prm.sigma3, prm.sigma3, prm.sigma3};
-    servo.update(sim, all, none, target);
-    return StepPlan{false, n % prm.check_every == 0};
-  };
-  stage.after = [&](long n, bool measured) {
-    if (!measured) return false;
-    s = cell_stress(sim);
-    err = 0;
-    for (int d = 0; d < 3; ++d) err = std::max(err, std::fabs(s[d] - prm.sigma3) / prm.sigma3);
-    ratio = sim.unbalanced_ratio();
-    if (prm.verbose) {
-      char extra[128];
-      std::snprintf(extra, sizeof extra, "p %.1f kPa, stress error %.2e, unbalanced %.2e",
-                    1e-3 * (s[0] + s[1] + s[2]) / 3, err, ratio);
-      progress.update(n, extra);
-    }
-    return err < prm.stress_tolerance && ratio < prm.unbalanced_tolerance;
-  };
-  StageEnd end = run_stage(sim, stage, nullptr);
-  set_cell_rates(sim, Vec3());
-  if (end.done) {
-    if (prm.verbose) progress.finish("(converged after " + std::to_string(end.step) + " steps)");
-    end.timing.name = "consolidation";
-    return end;
-  }
-  std::ostringstream msg;
-  msg << "periodic triaxial: isotropic consolidation to sigma3 = " << 1e-3 * prm.sigma3 << " kPa did not converge in "
-      << prm.max_consolidation_steps << " steps: stresses (xx, yy, zz) = (" << 1e-3 * s[0] << ", " << 1e-3 * s[1]
-      << ", " << 1e-3 * s[2] << ") kPa, largest error " << err << " (tolerance " << prm.stress_tolerance
-      << "), unbalanced-force ratio " << ratio << " (tolerance " << prm.unbalanced_tolerance
-      << "). Raise max_consolidation_steps, or loosen unbalanced_tolerance if the ratio is still falling";
-  throw std::runtime_error(msg.str());
-}
-
 namespace {
+
+/// Stage (a), isotropic consolidation, on a cell: its servo, its progress line, and the state it reached.
+class Consolidation {
+ public:
+  Consolidation(CellControl& cell, const PeriodicTriaxialParams& prm)
+      : cell_(cell), prm_(prm), servo_(prm, prm.consolidation_rate),
+        progress_(prm.name + " consolidation (ETA to the step cap)", prm.max_consolidation_steps) {}
+
+  StageSteps steps() {
+    StageSteps stage;
+    stage.last = prm_.max_consolidation_steps;
+    stage.before = [this](long n) {
+      const bool all[3] = {true, true, true};
+      const Real none[3] = {0, 0, 0};
+      const Real target[3] = {prm_.sigma3, prm_.sigma3, prm_.sigma3};
+      servo_.update(cell_, all, none, target);
+      return StepPlan{false, n % prm_.check_every == 0};
+    };
+    stage.after = [this](long n, bool measured) {
+      if (!measured) return false;
+      s_ = cell_.stress();
+      err_ = 0;
+      for (int d = 0; d < 3; ++d) err_ = std::max(err_, std::fabs(s_[d] - prm_.sigma3) / prm_.sigma3);
+      ratio_ = cell_.unbalanced_ratio();
+      if (prm_.verbose) {
+        char extra[128];
+        std::snprintf(extra, sizeof extra, "p %.1f kPa, stress error %.2e, unbalanced %.2e",
+                      1e-3 * (s_[0] + s_[1] + s_[2]) / 3, err_, ratio_);
+        progress_.update(n, extra);
+      }
+      return err_ < prm_.stress_tolerance && ratio_ < prm_.unbalanced_tolerance;
+    };
+    return stage;
+  }
+
+  /// After the stage: the cell's rates zeroed; "" where it converged, else why not (the error's message).
+  std::string end(StageEnd& e) {
+    cell_.set_rates(Vec3());
+    if (e.done) {
+      if (prm_.verbose) progress_.finish("(converged after " + std::to_string(e.step) + " steps)");
+      e.timing.name = "consolidation";
+      return "";
+    }
+    std::ostringstream msg;
+    msg << "periodic triaxial: isotropic consolidation to sigma3 = " << 1e-3 * prm_.sigma3
+        << " kPa did not converge in " << prm_.max_consolidation_steps << " steps: stresses (xx, yy, zz) = ("
+        << 1e-3 * s_[0] << ", " << 1e-3 * s_[1] << ", " << 1e-3 * s_[2] << ") kPa, largest error " << err_
+        << " (tolerance " << prm_.stress_tolerance << "), unbalanced-force ratio " << ratio_ << " (tolerance "
+        << prm_.unbalanced_tolerance << "). Raise max_consolidation_steps, or loosen unbalanced_tolerance if the "
+        << "ratio is still falling";
+    return msg.str();
+  }
+
+ private:
+  CellControl& cell_;
+  PeriodicTriaxialParams prm_;
+  CellServo servo_;
+  Progress progress_;
+  Real err_ = 0, ratio_ = 1;
+  std::array<Real, 3> s_{};
+};
 
 /// The result's curve values and checks (the lateral stress's largest error, the largest kinetic energy), and the
 /// closing lines when verbose; `wall_seconds` is set.
-void finish_result(const Simulation& sim, PeriodicTriaxialResult& res, Progress& progress, double wall_seconds) {
+void finish_result(CellControl& cell, PeriodicTriaxialResult& res, Progress& progress, double wall_seconds) {
   const PeriodicTriaxialParams& prm = res.params;
   take_curve_values(res, summarised(res.series, prm.sigma3));
   for (const PeriodicTriaxialRecord& r : res.series) {
@@ -258,7 +276,7 @@ void finish_result(const Simulation& sim, PeriodicTriaxialResult& res, Progress&
     progress.finish("");
     std::printf("periodic triaxial: consolidated in %ld steps to void ratio %.4f (Z = %.2f); sheared to eps_a = %.2f%% "
                 "in %ld steps\n", res.consolidation_steps, res.void_ratio0, res.series.front().coordination,
-                100 * f.eps_a, sim.step_count() - res.series.front().step);
+                100 * f.eps_a, cell.step_count() - res.series.front().step);
     std::printf("peak q = %.2f kPa at eps_a = %.2f%% (moving mean over +-%.2f%% strain); peak friction angle "
                 "phi = asin((s1-s3)/(s1+s3)) = %.2f deg\n",
                 1e-3 * res.q_peak, 100 * res.eps_a_peak, 100 * kSmoothHalfWidth, res.phi_peak_deg);
@@ -278,10 +296,10 @@ void announce(const PeriodicTriaxialParams& prm, Real inertial, Real dt) {
 }
 
 /// Snapshots at the configured axial strains within the test, each written once, when the strain first reaches it
-/// (several passed in one step give one snapshot, labelled with the largest).
+/// (several passed in one step give one snapshot, labelled with the largest). None without an output.
 class SnapshotSchedule {
  public:
-  SnapshotSchedule(const PeriodicTriaxialParams& prm, Simulation& sim, io::Output* out) : sim_(sim), out_(out) {
+  SnapshotSchedule(const PeriodicTriaxialParams& prm, Simulation* sim, io::Output* out) : sim_(sim), out_(out) {
     for (Real e : prm.snapshot_strains)
       if (e >= 0 && e <= prm.target_strain + 1e-12) strains_.push_back(e);
     std::sort(strains_.begin(), strains_.end());
@@ -290,91 +308,214 @@ class SnapshotSchedule {
   void at(Real eps) {
     Real nominal = -1;
     while (next_ < strains_.size() && eps >= strains_[next_] - 1e-9) nominal = strains_[next_++];
-    if (nominal >= 0 && out_) {
+    if (nominal >= 0 && out_ && sim_) {
       out_->flush_series();
-      out_->write_snapshot(take_snapshot(sim_, pct_label(nominal)));
+      out_->write_snapshot(take_snapshot(*sim_, pct_label(nominal)));
     }
   }
 
  private:
-  Simulation& sim_;
+  Simulation* sim_;
   io::Output* out_;
   std::vector<Real> strains_;
   std::size_t next_ = 0;
 };
 
-}  // namespace
+/// Stage (b), drained shear, on a consolidated cell: the servo of the lateral axes, the records, the snapshots.
+/// Constructed at the stage's start: records the first row.
+class Shear {
+ public:
+  Shear(CellControl& cell, PeriodicTriaxialResult& res, const GrainScales& g, io::Output* out, Simulation* sim)
+      : cell_(cell), res_(res), prm_(res.params), g_(g), out_(out), snapshots_(prm_, sim, out),
+        servo_(prm_, prm_.max_lateral_rate),
+        total_(static_cast<long>(std::ceil(-std::log(1 - prm_.target_strain) / (prm_.axial_rate * cell.dt())))),
+        progress_(prm_.name + " shear", total_), next_record_(prm_.record_strain) {
+    L0_ = cell_.lengths();
+    res_.h0 = L0_[2];
+    res_.V0 = cell_.volume();
+    res_.void_ratio0 = res_.V0 / g_.v_solid - 1;
+    if (out_) out_->set_series_columns(kSeriesColumns);
+    record();
+    snapshots_.at(0);
+  }
 
-PeriodicTriaxialResult run_periodic_triaxial(Simulation& sim, const PeriodicTriaxialParams& prm_in, io::Output* out) {
-  const auto t0 = std::chrono::steady_clock::now();
+  StageSteps steps() {
+    StageSteps stage;
+    stage.last = std::numeric_limits<long>::max();  // until the target strain
+    stage.before = [this](long) {
+      const bool lateral[3] = {true, true, false};
+      const Real axial[3] = {0, 0, -prm_.axial_rate};
+      const std::array<Real, 3> lengths = cell_.lengths();
+      const std::array<Real, 3> target = lateral_targets(lengths, prm_, L0_);
+      servo_.update(cell_, lateral, axial, target.data());
+      const Real h = lengths[2];
+      const Real eps_next = (res_.h0 - h * (1 - prm_.axial_rate * cell_.dt())) / res_.h0;
+      last_ = eps_next >= prm_.target_strain;
+      return StepPlan{false, last_ || eps_next >= next_record_ - 1e-12};  // a recorded step measures
+    };
+    stage.after = [this](long n, bool recorded) {
+      if (recorded) {
+        record();
+        while (next_record_ <= res_.series.back().eps_a + 1e-12) next_record_ += prm_.record_strain;
+        const PeriodicTriaxialRecord& r = res_.series.back();
+        if (prm_.verbose) {
+          char extra[160];
+          std::snprintf(extra, sizeof extra, "eps_a %.2f%%, q %.1f kPa, eps_v %.2f%%, lateral %.1f/%.1f kPa",
+                        100 * r.eps_a, 1e-3 * r.q, 100 * r.eps_v, 1e-3 * r.sigma2, 1e-3 * r.sigma3);
+          progress_.update(std::min(n, total_), extra);
+        }
+        if (out_ && res_.series.size() % 50 == 0) out_->flush_series();
+      }
+      snapshots_.at((res_.h0 - cell_.lengths()[2]) / res_.h0);
+      return last_;
+    };
+    return stage;
+  }
+
+  /// After the stage: its timing named, the cell's rates zeroed, the series flushed, the result summarised.
+  void end(StageTiming timing, double wall_seconds) {
+    timing.name = "shear";
+    res_.stages.push_back(timing);
+    cell_.set_rates(Vec3());
+    if (out_) out_->flush_series();
+    finish_result(cell_, res_, progress_, wall_seconds);
+  }
+
+ private:
+  CellControl& cell_;
+  PeriodicTriaxialResult& res_;
+  const PeriodicTriaxialParams& prm_;
+  GrainScales g_;
+  io::Output* out_;
+  SnapshotSchedule snapshots_;
+  CellServo servo_;
+  long total_;
+  Progress progress_;
+  Real next_record_;
+  bool last_ = false;  // the step ends the test
+  std::array<Real, 3> L0_{};
+
+  void record() {
+    res_.series.push_back(measure_row(cell_, prm_, g_, res_.h0, res_.V0, L0_));
+    if (out_) out_->append_series(series_row(res_.series.back()));
+  }
+};
+
+/// The result's parameters and grain figures before the test, and its first line when verbose.
+PeriodicTriaxialResult start_result(Simulation& sim, const PeriodicTriaxialParams& prm_in, GrainScales& g) {
   PeriodicTriaxialResult res;
   res.params = resolve_periodic_params(sim, prm_in);
   const PeriodicTriaxialParams& prm = res.params;
-  const GrainScales g = grain_scales(sim);
+  g = grain_scales(sim);
   res.mean_diameter = g.d;
   res.density_eff = g.rho_eff;
   res.inertial = prm.axial_rate * g.d * std::sqrt(g.rho_eff / prm.sigma3);
-  const Real dt = sim.params().integ.dt;
-  if (prm.verbose) announce(prm, res.inertial, dt);
+  if (prm.verbose) announce(prm, res.inertial, sim.params().integ.dt);
+  return res;
+}
 
-  const StageEnd consolidated = consolidate_isotropic(sim, prm);
+}  // namespace
+
+StageEnd consolidate_isotropic(Simulation& sim, const PeriodicTriaxialParams& prm_in) {
+  const PeriodicTriaxialParams prm = resolve_periodic_params(sim, prm_in);  // idempotent
+  const auto cell = cell_of(sim);
+  Consolidation stage(*cell, prm);
+  StageEnd end = run_stage(sim, stage.steps(), nullptr);
+  const std::string failure = stage.end(end);
+  if (!failure.empty()) throw std::runtime_error(failure);
+  return end;
+}
+
+PeriodicTriaxialResult run_periodic_triaxial(Simulation& sim, const PeriodicTriaxialParams& prm_in, io::Output* out) {
+  const auto t0 = std::chrono::steady_clock::now();
+  GrainScales g;
+  PeriodicTriaxialResult res = start_result(sim, prm_in, g);
+  const StageEnd consolidated = consolidate_isotropic(sim, res.params);
   res.consolidation_steps = consolidated.step;
   res.stages.push_back(consolidated.timing);
-
-  const std::array<Real, 3> L0 = cell_lengths(sim);
-  res.h0 = L0[2];
-  res.V0 = cell_volume(sim);
-  res.void_ratio0 = res.V0 / g.v_solid - 1;
-  if (out) out->set_series_columns(kSeriesColumns);
-  auto record = [&]() {
-    res.series.push_back(measure_row(sim, prm, g, res.h0, res.V0, L0));
-    if (out) out->append_series(series_row(res.series.back()));
-  };
-  SnapshotSchedule snapshots(prm, sim, out);
-  record();
-  snapshots.at(0);
-
-  CellServo servo(prm, prm.max_lateral_rate);
-  const bool lateral[3] = {true, true, false};
-  const Real axial[3] = {0, 0, -prm.axial_rate};
-  const long total = static_cast<long>(std::ceil(-std::log(1 - prm.target_strain) / (prm.axial_rate * dt)));
-  Progress progress(prm.name + " shear", total);
-  Real next_record = prm.record_strain;
-  bool last = false;  // the step ends the test
-  StageSteps stage;
-  stage.last = std::numeric_limits<long>::max();  // until the target strain
-  stage.before = [&](long) {
-    const std::array<Real, 3> lengths = cell_lengths(sim);
-    const std::array<Real, 3> target = lateral_targets(lengths, prm, L0);
-    servo.update(sim, lateral, axial, target.data());
-    const Real h = lengths[2];
-    const Real eps_next = (res.h0 - h * (1 - prm.axial_rate * dt)) / res.h0;
-    last = eps_next >= prm.target_strain;
-    return StepPlan{false, last || eps_next >= next_record - 1e-12};  // a recorded step measures
-  };
-  stage.after = [&](long n, bool recorded) {
-    if (recorded) {
-      record();
-      while (next_record <= res.series.back().eps_a + 1e-12) next_record += prm.record_strain;
-      const PeriodicTriaxialRecord& r = res.series.back();
-      if (prm.verbose) {
-        char extra[160];
-        std::snprintf(extra, sizeof extra, "eps_a %.2f%%, q %.1f kPa, eps_v %.2f%%, lateral %.1f/%.1f kPa",
-                      100 * r.eps_a, 1e-3 * r.q, 100 * r.eps_v, 1e-3 * r.sigma2, 1e-3 * r.sigma3);
-        progress.update(std::min(n, total), extra);
-      }
-      if (out && res.series.size() % 50 == 0) out->flush_series();
-    }
-    snapshots.at((res.h0 - cell_lengths(sim)[2]) / res.h0);
-    return last;
-  };
-  res.stages.push_back(run_stage(sim, stage, nullptr).timing);
-  res.stages.back().name = "shear";
-  set_cell_rates(sim, Vec3());
-  if (out) out->flush_series();
-
-  finish_result(sim, res, progress, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  const auto cell = cell_of(sim);
+  Shear shear(*cell, res, g, out, &sim);
+  const StageTiming sheared = run_stage(sim, shear.steps(), nullptr).timing;
+  shear.end(sheared, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   return res;
+}
+
+std::vector<BatchedTest> run_periodic_batch(const std::vector<Simulation*>& sims,
+                                            const std::vector<PeriodicTriaxialParams>& prms, bool consolidate_only) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::size_t S = sims.size();
+  if (prms.size() != S) throw std::invalid_argument("run_periodic_batch: a parameter set per specimen");
+  std::vector<BatchedTest> out(S);
+  std::vector<GrainScales> g(S);
+  for (std::size_t s = 0; s < S; ++s) out[s].result = start_result(*sims[s], prms[s], g[s]);
+  CellBatch batch(std::vector<const Simulation*>(sims.begin(), sims.end()));
+  // Each specimen's program: consolidation, then (unless consolidate_only) shear; a stage's steps numbered from 1.
+  struct Member {
+    std::unique_ptr<CellControl> cell;
+    std::unique_ptr<Consolidation> consolidation;
+    std::unique_ptr<Shear> shear;
+    StageSteps stage;
+    long n = 1;
+    long first_step = 0;  ///< the specimen's step count at the stage's start
+  };
+  std::vector<Member> m(S);
+  for (std::size_t s = 0; s < S; ++s) {
+    m[s].cell = cell_of(batch, static_cast<int>(s));
+    m[s].consolidation = std::make_unique<Consolidation>(*m[s].cell, out[s].result.params);
+    m[s].stage = m[s].consolidation->steps();
+  }
+  const auto seconds = [&]() { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+  // The stage of specimen s ended (run_stage's StageEnd): on to its next stage, or stopped.
+  const auto end_stage = [&](std::size_t s, StageEnd e) {
+    Member& me = m[s];
+    BatchedTest& t = out[s];
+    e.timing.balls = batch.balls(static_cast<int>(s));
+    e.timing.steps = batch.step_count(static_cast<int>(s)) - me.first_step;
+    me.first_step = batch.step_count(static_cast<int>(s));
+    if (!me.shear) {
+      t.failure = me.consolidation->end(e);
+      t.consolidation = e;
+      t.result.consolidation_steps = e.step;
+      t.result.stages.push_back(e.timing);
+      if (!t.failure.empty() || consolidate_only) {
+        batch.stop(static_cast<int>(s));
+        return;
+      }
+      me.shear = std::make_unique<Shear>(*me.cell, t.result, g[s], nullptr, nullptr);
+      me.stage = me.shear->steps();
+      me.n = 1;
+      return;
+    }
+    me.shear->end(e.timing, seconds());
+    batch.stop(static_cast<int>(s));
+  };
+  std::vector<char> measure(S, 0), stepping(S, 0);
+  while (batch.running_count() > 0) {
+    for (std::size_t s = 0; s < S; ++s) {
+      stepping[s] = 0;
+      if (!batch.running(static_cast<int>(s))) continue;
+      StepPlan plan = m[s].stage.before(m[s].n);
+      while (plan.done && batch.running(static_cast<int>(s))) {
+        end_stage(s, {m[s].n - 1, true, {}});
+        if (batch.running(static_cast<int>(s))) plan = m[s].stage.before(m[s].n);
+      }
+      measure[s] = plan.measure;
+      stepping[s] = batch.running(static_cast<int>(s));
+    }
+    if (batch.running_count() == 0) break;
+    batch.step(measure);
+    for (std::size_t s = 0; s < S; ++s) {
+      if (!stepping[s]) continue;
+      if (!batch.running(static_cast<int>(s))) {  // blown up
+        out[s].blowup = batch.blowup(static_cast<int>(s));
+        continue;
+      }
+      Member& me = m[s];
+      if (me.stage.after(me.n, measure[s] != 0)) end_stage(s, {me.n, true, {}});
+      else if (++me.n > me.stage.last) end_stage(s, {me.n - 1, false, {}});
+    }
+  }
+  return out;
 }
 
 Real membrane_confinement(Real stiffness, Real eps) { return stiffness * std::max(eps, Real(0)); }

@@ -88,6 +88,24 @@ StageEnd consolidate_isotropic(Simulation& sim, const PeriodicTriaxialParams& pr
 PeriodicTriaxialResult run_periodic_triaxial(Simulation& sim, const PeriodicTriaxialParams& prm,
                                              io::Output* out = nullptr);
 
+/// One specimen's outcome in a batch (run_periodic_batch): its result as run_periodic_triaxial gives it, its
+/// consolidation's end as consolidate_isotropic gives it, or why it stopped: a blow-up (the BlowUp's message), or a
+/// consolidation that did not converge (the std::runtime_error's message).
+struct BatchedTest {
+  PeriodicTriaxialResult result;
+  StageEnd consolidation;
+  std::string blowup, failure;
+};
+
+/// The periodic test of each specimen, side by side in one CellBatch (host/engine/cell_batch.hpp): stage (a), and
+/// unless consolidate_only stage (b), each specimen with its own parameters. Each outcome is bit for bit that of
+/// the specimen's own run (consolidate_isotropic, run_periodic_triaxial), without output or progress lines; a
+/// specimen that blows up or fails to converge stops and the others go on. The Simulations must be fresh (as
+/// CellBatch takes them) and are not stepped.
+std::vector<BatchedTest> run_periodic_batch(const std::vector<Simulation*>& sims,
+                                            const std::vector<PeriodicTriaxialParams>& prms,
+                                            bool consolidate_only = false);
+
 /// Membrane extension: the extra lateral confinement (Pa) of a membrane of stiffness E_m t / R0 (Pa, its
 /// modulus times thickness over the specimen's radius) at lateral strain eps (extension positive): the hoop
 /// tension E_m t eps of a thin cylinder acting on the radius R0. None in contraction: latex buckles rather
