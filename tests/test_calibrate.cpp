@@ -185,6 +185,36 @@ TEST(Calibrate, MeasuredCurvesRoundTrip) {
 // children are those the parent would pack.
 // It runs at one thread only (tests/CMakeLists.txt): with two, set_workers refuses (forking a multithreaded OpenMP
 // process is unsafe) and both paths would be the in-process one.
+// Runs and specimen preparations side by side in one batch ([calibrate] batch) give the runs and specimens of one
+// at a time, bit for bit: the packings (prepared with a friction of their own, so consolidated), the curves.
+TEST(Calibrate, BatchedRunsEqualRunsOneAtATime) {
+  Config cfg = test::tiny_cell_config();
+  ASSERT_NE(cfg.periodic.prep_mu_s, cfg.ball.mu_s) << "the preparation must consolidate for the packings to compare";
+  cfg.calibrate.batch = 1;
+  PeriodicLab apart(cfg, false, 3, 1);
+  cfg.calibrate.batch = 8;
+  PeriodicLab together(cfg, false, 3, 1);
+  ASSERT_EQ(together.batch(), 8);
+  Model m;
+  m.law = cfg.ball;
+  std::vector<TriaxialTest> like(2);
+  for (int k = 0; k < 2; ++k) like[k].sigma3 = 100e3 * (k + 1);
+  const Ensemble one = apart.run_ensemble(m, like), side = together.run_ensemble(m, like);
+  for (int j = 0; j < 3; ++j) EXPECT_EQ(together.prepared_void_ratio(j), apart.prepared_void_ratio(j)) << j;
+  ASSERT_EQ(side.size(), 2u);
+  for (int k = 0; k < 2; ++k) {
+    ASSERT_EQ(side[k].size(), 3u);
+    for (int j = 0; j < 3; ++j) {
+      ASSERT_GT(one[k][j].q.size(), 5u);
+      EXPECT_EQ(side[k][j].q, one[k][j].q) << "sigma3 " << like[k].sigma3 << " member " << j;
+      EXPECT_EQ(side[k][j].eps_v, one[k][j].eps_v);
+      EXPECT_EQ(side[k][j].void_ratio, one[k][j].void_ratio);
+      EXPECT_EQ(side[k][j].sigma3, like[k].sigma3);
+    }
+  }
+  EXPECT_EQ(together.runs(), 6);
+}
+
 TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
   const Config cfg = test::tiny_cell_config();
   PeriodicLab lab(cfg, false, 2, 1);

@@ -253,6 +253,7 @@ void read_calibrate(const Tables& read, Config& c) {
   cal.integer("scatter_specimens", c.calibrate.scatter_specimens, 1, 64);
   if (!cal.word("cell_factor", "auto", c.calibrate.cell_factor, kAutoCell))
     cal.integer("cell_factor", c.calibrate.cell_factor, 1, 16);
+  if (!cal.word("batch", "auto", c.calibrate.batch, kAutoBatch)) cal.integer("batch", c.calibrate.batch, 1, 4096);
   cal.string("predict", c.calibrate.predict);
   cal.integer("predict_specimens", c.calibrate.predict_specimens, 1, 16);
   cal.string("reference_test", c.calibrate.reference_test, {"periodic", "walls", "two_fidelity"});

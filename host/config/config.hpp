@@ -138,6 +138,7 @@ struct PeriodicTriaxialParams {
 inline constexpr long kMinRecords = 20;
 inline constexpr long kAutoEnsemble = 0;
 inline constexpr long kAutoCell = 0;
+inline constexpr long kAutoBatch = 0;
 
 /// [calibrate]: the parameters `triaxdem calibrate` and `diagnose` free (host/fit/calibrate.hpp lists the names).
 struct CalibrateConfig {
@@ -154,6 +155,11 @@ struct CalibrateConfig {
   /// file's "auto"): the config's cell, grown (host/fit/misfit.hpp, measure_misfit) only where an "auto" ensemble of
   /// all the scatter specimens still misses half the data's noise.
   long cell_factor = kAutoCell;
+  /// Simulator runs (and specimen preparations) stepped side by side in one process (host/engine/cell_batch.hpp), at
+  /// most this many at once: each bit for bit as alone. kAutoBatch (the file's "auto"): every run of a call at once on
+  /// a GPU build, where one small cell uses a sliver of the device; 1 on a CPU, whose cores the runs share as child
+  /// processes of one thread each (docs/performance.md measures both).
+  long batch = kAutoBatch;
   /// The membrane test that `calibrate` and `diagnose` end with, at the calibrated parameters and the data's
   /// pressures (host/fit/prediction.hpp): a config with [specimen] and [triaxial], its path as the file gives it
   /// (relative to that file's folder); "" for none. `predict_specimens`: specimens (packing seeds) per pressure.

@@ -62,7 +62,14 @@ Config larger_cell(const Config& base, int factor) {
 PeriodicLab::PeriodicLab(const Config& base, bool verbose, int members, unsigned first_seed, int specimens, int workers)
     : cfg_(base), members_(std::max(members, 1)), first_seed_(first_seed) {
   set_workers(workers);
+  set_batch(base.calibrate.batch);
   pack(std::max(members_, specimens), verbose);
+}
+
+int PeriodicLab::set_batch(long batch) {
+  if (batch == kAutoBatch) batch = kOnDevice ? 4096 : 1;
+  if (cfg_.periodic.boundary == CellBoundary::walls) batch = 1;  // CellBatch takes periodic cells
+  return batch_ = static_cast<int>(std::max(1L, batch));
 }
 
 namespace {
@@ -78,6 +85,26 @@ void PeriodicLab::pack(int count, bool verbose) {
     ~Clock() { time_so_far.packing += seconds_since(t0); }
   } clock{t0};
   specimens_.assign(static_cast<std::size_t>(count), PackedCell{});
+  if (batch_ > 1 && count > 1) {
+    if (verbose)
+      std::printf("triaxdem: preparation: %d specimens of %ld balls, side by side in batches of up to %d\n", count,
+                  cfg_.particles.count, batch_);
+    for (int first = 0; first < count; first += batch_) {
+      std::vector<Config> cfgs;
+      for (int k = first; k < std::min(count, first + batch_); ++k) {
+        cfgs.push_back(cfg_);
+        cfgs.back().run.seed = first_seed_ + static_cast<unsigned>(k);
+      }
+      const std::vector<PreparedCell> made = prepare_periodic_specimens(cfgs);
+      for (std::size_t j = 0; j < made.size(); ++j) {
+        PackedCell& s = specimens_[static_cast<std::size_t>(first) + j];
+        s.balls = made[j].balls;
+        s.cell = made[j].cell;
+        s.void_ratio = void_ratio_of(s.balls, s.cell);
+      }
+    }
+    return;
+  }
   auto prepare = [&](std::size_t k) {
     Config c = cfg_;
     c.run.seed = first_seed_ + static_cast<unsigned>(k);
@@ -153,15 +180,20 @@ void PeriodicLab::set_members(int k) {
   members_ = k;
 }
 
-TriaxialTest PeriodicLab::run(const Model& m, Real sigma3, const std::string& material, int member) {
-  const auto t0 = std::chrono::steady_clock::now();
-  const PackedCell& sp = specimens_.at(static_cast<std::size_t>(member));
-  TriaxialTest t;
+PeriodicTriaxialParams PeriodicLab::test_params(const Model& m, Real sigma3) const {
   PeriodicTriaxialParams p = cfg_.periodic.triax;
   p.sigma3 = sigma3;
   p.membrane_stiffness = m.membrane;
   p.verbose = false;
   p.snapshot_strains.clear();
+  return p;
+}
+
+TriaxialTest PeriodicLab::run(const Model& m, Real sigma3, const std::string& material, int member) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const PackedCell& sp = specimens_.at(static_cast<std::size_t>(member));
+  TriaxialTest t;
+  const PeriodicTriaxialParams p = test_params(m, sigma3);
   try {
     auto sim = make_periodic_simulation(sp.balls, sp.cell, m.law, cfg_.solver, cfg_.periodic.boundary);
     const PeriodicTriaxialResult r = run_periodic_triaxial(*sim, p);
@@ -289,6 +321,27 @@ std::vector<TriaxialTest> PeriodicLab::run_or_read(const Model& m, const std::ve
       todo.push_back(j);
     }
   }
+  if (batch_ > 1 && todo.size() > 1) {
+    const auto t0 = std::chrono::steady_clock::now();
+    for (std::size_t first = 0; first < todo.size(); first += static_cast<std::size_t>(batch_)) {
+      std::vector<Case> chunk;
+      for (std::size_t k = first; k < std::min(todo.size(), first + static_cast<std::size_t>(batch_)); ++k)
+        chunk.push_back(cases[todo[k]]);
+      const std::vector<TriaxialTest> done = run_batch(m, chunk);
+      for (std::size_t k = 0; k < done.size(); ++k) {
+        const std::size_t j = todo[first + k];
+        out[j] = done[k];
+        store_run(paths[j], out[j]);
+        one_done();
+      }
+    }
+    runs_ += static_cast<long>(todo.size());
+    const double s = seconds_since(t0);
+    seconds_ += s;
+    time_so_far.runs += s;
+    time_so_far.ran += static_cast<long>(todo.size());
+    return out;
+  }
   if (workers_ <= 1 || todo.size() <= 1) {
     for (const std::size_t j : todo) {
       out[j] = run(m, cases[j].sigma3, cases[j].material, cases[j].member);
@@ -319,6 +372,34 @@ std::vector<TriaxialTest> PeriodicLab::run_or_read(const Model& m, const std::ve
   seconds_ += s;
   time_so_far.runs += s;
   time_so_far.ran += static_cast<long>(todo.size());
+  return out;
+}
+
+std::vector<TriaxialTest> PeriodicLab::run_batch(const Model& m, const std::vector<Case>& cases) {
+  std::vector<std::unique_ptr<Simulation>> made;
+  std::vector<Simulation*> sims;
+  std::vector<PeriodicTriaxialParams> prms;
+  for (const Case& c : cases) {
+    const PackedCell& sp = specimens_.at(static_cast<std::size_t>(c.member));
+    made.push_back(make_periodic_simulation(sp.balls, sp.cell, m.law, cfg_.solver, cfg_.periodic.boundary));
+    sims.push_back(made.back().get());
+    prms.push_back(test_params(m, c.sigma3));
+  }
+  const std::vector<BatchedTest> runs = run_periodic_batch(sims, prms);
+  std::vector<TriaxialTest> out(cases.size());
+  for (std::size_t j = 0; j < cases.size(); ++j) {
+    // As run() meets them: a consolidation that does not converge is the job's error, a blow-up a missing test.
+    if (!runs[j].failure.empty()) throw std::runtime_error(runs[j].failure);
+    TriaxialTest& t = out[j];
+    if (runs[j].blowup.empty()) {
+      t = summarised(runs[j].result.series, cases[j].sigma3);
+      t.void_ratio = runs[j].result.void_ratio0;
+    } else {
+      t.sigma3 = cases[j].sigma3;
+      mark_failed(t);
+    }
+    t.material = cases[j].material;
+  }
   return out;
 }
 

@@ -57,6 +57,11 @@ class PeriodicLab {
   /// the runs go one at a time with all threads. Returns the value in effect.
   int set_workers(int workers);
   int workers() const { return workers_; }
+  /// Runs stepped side by side in this process, at most `batch` at once ([calibrate] batch; kAutoBatch: all of a
+  /// call on a GPU build, 1 on a CPU); 1 runs them one at a time or forked (set_workers). A cell between walls is
+  /// never batched. Returns the value in effect.
+  int set_batch(long batch);
+  int batch() const { return batch_; }
   int members() const { return members_; }
   /// Makes the first k specimens the ensemble (1 <= k <= specimens()).
   void set_members(int k);
@@ -105,6 +110,7 @@ class PeriodicLab {
   std::string store_;
   long stored_read_ = 0;
   int workers_ = 1;
+  int batch_ = 1;
   int members_ = 1;
   int cell_factor_ = 1;
   unsigned first_seed_ = 0;
@@ -119,6 +125,10 @@ class PeriodicLab {
   std::vector<TriaxialTest> run_cases(const Model& m, const std::vector<Case>& cases);
   /// The cases in order, up to workers() at once; those in the run store are read.
   std::vector<TriaxialTest> run_or_read(const Model& m, const std::vector<Case>& cases);
+  /// The cases side by side in one batch (run_periodic_batch), each as run() gives it.
+  std::vector<TriaxialTest> run_batch(const Model& m, const std::vector<Case>& cases);
+  /// The test parameters of a run at sigma3 (Pa) of model m.
+  PeriodicTriaxialParams test_params(const Model& m, Real sigma3) const;
   /// The run store's file of a case ("" without a store).
   std::string stored_path(const Model& m, const Case& c) const;
 };

@@ -54,17 +54,17 @@ std::unique_ptr<Simulation> make_periodic_simulation(const std::vector<BallSpec>
   return sim;
 }
 
-std::vector<BallSpec> extract_balls(Simulation& sim, std::array<Real, 3>& cell) {
-  Particles& p = sim.particles();
-  const HostParticles h = to_host_by_gid(p);
+namespace {
+
+/// The balls in gid order: the constants of `p` (radius, density from the mass, specimen, material) and the state
+/// `h` (by gid), positions wrapped into `dom` (a periodic cell) and taken from `corner`.
+std::vector<BallSpec> balls_by_gid(const Particles& p, const HostParticles& h, const Domain& dom, bool walls,
+                                   const Vec3& corner) {
   auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), p.gid);
   auto rad = Kokkos::create_mirror_view_and_copy(HostSpace(), p.radius);
   auto mass = Kokkos::create_mirror_view_and_copy(HostSpace(), p.mass);
   auto spec = Kokkos::create_mirror_view_and_copy(HostSpace(), p.specimen);
   auto mat = Kokkos::create_mirror_view_and_copy(HostSpace(), p.material);
-  const Domain& dom = sim.domain();
-  const bool walls = walled(sim);
-  const Vec3 corner = cell_corner(sim);
   std::vector<BallSpec> out(p.n);
   for (int i = 0; i < p.n; ++i) {
     BallSpec& b = out[gid(i)];
@@ -78,8 +78,14 @@ std::vector<BallSpec> extract_balls(Simulation& sim, std::array<Real, 3>& cell) 
     out[k].v = h.v[k];
     out[k].w = h.w[k];
   }
-  cell = cell_lengths(sim);
   return out;
+}
+
+}  // namespace
+
+std::vector<BallSpec> extract_balls(Simulation& sim, std::array<Real, 3>& cell) {
+  cell = cell_lengths(sim);
+  return balls_by_gid(sim.particles(), to_host_by_gid(sim.particles()), sim.domain(), walled(sim), cell_corner(sim));
 }
 
 void check_periodic_config(const Config& cfg) {
@@ -111,8 +117,12 @@ void check_periodic_config(const Config& cfg) {
   }
 }
 
-void prepare_periodic_specimen(const Config& cfg, std::vector<BallSpec>& balls, std::array<Real, 3>& cell,
-                               bool verbose) {
+namespace {
+
+/// A specimen's packing (of [particles]/[box]) and, where the preparation's friction differs from the material's,
+/// the Simulation that consolidates it and the stage's parameters; `balls` and `cell` receive the packing.
+std::unique_ptr<Simulation> packing_of(const Config& cfg, std::vector<BallSpec>& balls, std::array<Real, 3>& cell,
+                                       PeriodicTriaxialParams& pp, bool verbose) {
   check_periodic_config(cfg);
   const PeriodicConfig& pc = cfg.periodic;
   Config inside = cfg;  // between walls every ball starts inside the box
@@ -122,19 +132,65 @@ void prepare_periodic_specimen(const Config& cfg, std::vector<BallSpec>& balls, 
   ContactParams prep = cfg.ball.base();
   if (pc.prep_mu_s >= 0) prep.mu_s = pc.prep_mu_s;
   if (pc.prep_mu_r >= 0) prep.mu_r = pc.prep_mu_r;
-  if (prep.mu_s == cfg.ball.mu_s && prep.mu_r == cfg.ball.mu_r) return;
+  if (prep.mu_s == cfg.ball.mu_s && prep.mu_r == cfg.ball.mu_r) return nullptr;
   auto sim = make_periodic_simulation(balls, cell, prep, cfg.solver, pc.boundary);
   if (verbose)
     std::printf("triaxdem: preparation: %zu balls in %s %.2f x %.2f x %.2f mm, consolidated with "
                 "mu_s = %g, mu_r = %g; dt %.3e s\n", balls.size(), cell_name(pc.boundary), 1e3 * cell[0],
                 1e3 * cell[1], 1e3 * cell[2], prep.mu_s, prep.mu_r, sim->params().integ.dt);
-  PeriodicTriaxialParams pp = resolve_periodic_params(*sim, pc.triax);
+  pp = resolve_periodic_params(*sim, pc.triax);
   pp.name = cfg.run.name + " preparation";
   pp.verbose = verbose;
   pp.unbalanced_tolerance = pc.prep_unbalanced_tolerance;
+  return sim;
+}
+
+}  // namespace
+
+void prepare_periodic_specimen(const Config& cfg, std::vector<BallSpec>& balls, std::array<Real, 3>& cell,
+                               bool verbose) {
+  PeriodicTriaxialParams pp;
+  auto sim = packing_of(cfg, balls, cell, pp, verbose);
+  if (!sim) return;
   consolidate_isotropic(*sim, pp);
   balls = extract_balls(*sim, cell);
 }
 
+std::vector<PreparedCell> prepare_periodic_specimens(const std::vector<Config>& cfgs) {
+  std::vector<PreparedCell> out(cfgs.size());
+  std::vector<std::unique_ptr<Simulation>> made(cfgs.size());
+  std::vector<Simulation*> sims;
+  std::vector<PeriodicTriaxialParams> prms;
+  std::vector<std::size_t> consolidated;  // the specimens with a preparation stage
+  for (std::size_t k = 0; k < cfgs.size(); ++k) {
+    PeriodicTriaxialParams pp;
+    made[k] = packing_of(cfgs[k], out[k].balls, out[k].cell, pp, false);
+    if (!made[k]) continue;
+    pp.verbose = false;
+    sims.push_back(made[k].get());
+    prms.push_back(pp);
+    consolidated.push_back(k);
+  }
+  if (sims.empty()) return out;
+  // Walls are not batched (CellBatch takes periodic cells): each such specimen consolidates alone.
+  if (cfgs.front().periodic.boundary == CellBoundary::walls) {
+    for (std::size_t j = 0; j < consolidated.size(); ++j) {
+      const std::size_t k = consolidated[j];
+      consolidate_isotropic(*made[k], prms[j]);
+      out[k].balls = extract_balls(*made[k], out[k].cell);
+    }
+    return out;
+  }
+  const std::vector<BatchedTest> runs = run_periodic_batch(sims, prms, true);
+  for (std::size_t j = 0; j < runs.size(); ++j) {  // the first failure, as one at a time would meet it
+    if (!runs[j].blowup.empty()) throw BlowUp(runs[j].blowup);
+    if (!runs[j].failure.empty()) throw std::runtime_error(runs[j].failure);
+    const std::size_t k = consolidated[j];
+    const Domain& dom = runs[j].domain;
+    out[k].cell = {dom.length(0), dom.length(1), dom.length(2)};
+    out[k].balls = balls_by_gid(made[k]->particles(), runs[j].balls, dom, false, Vec3(dom.lo[0], dom.lo[1], dom.lo[2]));
+  }
+  return out;
+}
 
 }  // namespace dem

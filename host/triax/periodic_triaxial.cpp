@@ -478,6 +478,10 @@ std::vector<BatchedTest> run_periodic_batch(const std::vector<Simulation*>& sims
       t.result.consolidation_steps = e.step;
       t.result.stages.push_back(e.timing);
       if (!t.failure.empty() || consolidate_only) {
+        if (consolidate_only && t.failure.empty()) {
+          t.balls = batch.balls_of(static_cast<int>(s));
+          t.domain = batch.domain(static_cast<int>(s));
+        }
         batch.stop(static_cast<int>(s));
         return;
       }

@@ -95,6 +95,9 @@ struct BatchedTest {
   PeriodicTriaxialResult result;
   StageEnd consolidation;
   std::string blowup, failure;
+  /// With consolidate_only, the balls (by gid in the specimen's Simulation) and the cell at the stage's end.
+  HostParticles balls;
+  Domain domain;
 };
 
 /// The periodic test of each specimen, side by side in one CellBatch (host/engine/cell_batch.hpp): stage (a), and
@@ -142,5 +145,15 @@ void check_periodic_config(const Config& cfg);
 /// model extensions. `balls` and `cell` receive it.
 void prepare_periodic_specimen(const Config& cfg, std::vector<BallSpec>& balls, std::array<Real, 3>& cell,
                                bool verbose);
+
+/// A specimen prepared: its balls in their cell.
+struct PreparedCell {
+  std::vector<BallSpec> balls;
+  std::array<Real, 3> cell{};
+};
+/// The specimens of several configs (seeds), their preparations side by side in one batch (run_periodic_batch):
+/// each bit for bit what prepare_periodic_specimen gives it. Throws the first specimen's error (in their order), as
+/// one at a time would. Without progress lines.
+std::vector<PreparedCell> prepare_periodic_specimens(const std::vector<Config>& cfgs);
 
 }  // namespace dem
