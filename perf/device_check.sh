@@ -24,13 +24,14 @@ if [ "$mode" = pack ]; then
   # and C++ runtimes, which it has), and in DIR/build wrappers that look like a build folder to the run mode.
   from="$ref"; dir="$(realpath -m "${3:?usage: perf/device_check.sh pack BUILD DIR}")"
   rm -rf "$dir"; mkdir -p "$dir/bin" "$dir/lib" "$dir/build/tests"
-  progs=("$from/triaxdem"); for t in "$from"/tests/triaxdem_tests_*; do [ -x "$t" ] && [ -f "$t" ] && progs+=("$t"); done
+  progs=("$from/triaxdem"); for t in "$from"/tests/triaxdem_tests_* "$from/perf/bench_engine"; do [ -x "$t" ] && [ -f "$t" ] && progs+=("$t"); done
+  mkdir -p "$dir/build/perf"
   for p in "${progs[@]}"; do
     cp "$p" "$dir/bin/"; strip "$dir/bin/$(basename "$p")" 2>/dev/null || true  # symbols are a tenth of the size
     ldd "$p" | awk '$3 ~ /^\// { print $3 }' | grep -Ev '/(libc|libm|libstdc\+\+|libgcc_s|ld-linux[^/]*|libcuda)\.so' |
       xargs -r cp -Lu -t "$dir/lib/"
     name="$(basename "$p")"
-    case "$name" in triaxdem) rel=build; up=.. ;; *) rel=build/tests; up=../.. ;; esac
+    case "$name" in triaxdem) rel=build; up=.. ;; bench_engine) rel=build/perf; up=../.. ;; *) rel=build/tests; up=../.. ;; esac
     printf '#!/usr/bin/env bash\nhere="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"\nLD_LIBRARY_PATH="$here/%s/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}" exec "$here/%s/bin/%s" "$@"\n' \
       "$up" "$up" "$name" > "$dir/$rel/$name"
     chmod +x "$dir/$rel/$name"
@@ -106,6 +107,15 @@ cat "$out"/cells_*.log | sed -n 's/^time loop.*: \([0-9]*\) steps.*; \([0-9.e+]*
          printf "%d cells of %d balls (%d finished): %.1f s wall for %d steps in all, %.3g particle-steps/s " \
            "together; each time loop %.3g particle-steps/s on average\n", c, n, k, w, s, s * n / w, r / k }'
 rm -rf "$out/cells"
+
+# The same cells' way after issue 43 item 3: one process, one batch (host/engine/cell_batch.hpp), one launch per kernel
+# for all; bench_engine's BM_CellBatch against one cell alone (BM_TimeLoop/9/1), 729 balls each.
+if [ -x "$build/perf/bench_engine" ]; then
+  batches='BM_TimeLoop/9/1|BM_CellBatch/(1|64|512)/9'; [ "$tiny" = 1 ] && batches='BM_CellBatch/4/5'
+  stage "calibration cells as one batch ($batches)"
+  timeout -k 5 "$([ "$tiny" = 1 ] && echo 60 || echo 150)" "$build/perf/bench_engine" --benchmark_filter="$batches" \
+    --benchmark_min_time=0.5 2>&1 | grep -E "^BM_" || failed+=" batch"
+fi
 
 if [ "$tiny" != 1 ]; then
   stage "membrane triaxial test against the CPU's (steps $small_start-$small_stop)"

@@ -93,7 +93,7 @@ ran+=(perf/instruction_count.sh)
 check perf/specimen_scatter.sh env BUILD="$build" WORK="$work/scatter" SEEDS=2 FACTORS="1 2" \
   bash "$root/perf/specimen_scatter.sh"
 check tools/specimen_scatter.py "$py" "$root/tools/specimen_scatter.py" "$work/scatter"
-check perf/bench_engine "$build/perf/bench_engine" --benchmark_filter='BM_TimeLoop/12/1' --benchmark_min_time=0.01
+check perf/bench_engine "$build/perf/bench_engine" --benchmark_filter='BM_TimeLoop/12/1|BM_CellBatch/4/5' --benchmark_min_time=0.01
 # The data on a cell of the simulator's size: the generator's larger cell is the sweep's default, not what this checks.
 check perf/hidden_sweep "$build/perf/hidden_sweep" --config "$base" --seeds 1 --hidden none -j 1 --data-cell-factor 1 \
   -o "$work/sweep.csv"

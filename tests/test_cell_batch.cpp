@@ -211,7 +211,9 @@ TEST(CellBatch, PeriodicTestsSideBySideGiveEachItsOwnRunsRecords) {
     sims.push_back(made.back().get());
     prms.push_back(tiny_test(sigma3[s]));
   }
-  const std::vector<BatchedTest> batch = run_periodic_batch(sims, prms);
+  std::array<long, 2> steps{};
+  const std::vector<BatchedTest> batch = run_periodic_batch(sims, prms, false, &steps);
+  std::printf("the batch: %ld steps, %ld of them with a rebuild\n", steps[0], steps[1]);
   for (std::size_t s = 0; s < seeds.size(); ++s) {
     auto sim = tiny_cell(seeds[s], mu[s]);
     const PeriodicTriaxialResult want = run_periodic_triaxial(*sim, prms[s]);

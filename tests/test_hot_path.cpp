@@ -10,6 +10,7 @@
 
 #include "host/cli/job.hpp"
 #include "host/config/config.hpp"
+#include "host/engine/cell_batch.hpp"
 #include "host/engine/packing.hpp"
 #include "host/engine/setup.hpp"
 #include "host/engine/simulation.hpp"
@@ -200,4 +201,46 @@ TEST(HotPath, AStateTakenBetweenReadsResumesBitForBit) {
   ASSERT_EQ(a.x.size(), b.x.size());
   for (std::size_t k = 0; k < a.x.size(); ++k) ASSERT_EQ(a.x[k], b.x[k]) << "coordinate " << k;
   EXPECT_EQ(a.wall_disp, b.wall_disp);
+}
+
+namespace {
+
+/// A batch step's waits: `cells` periodic lattices of 125 balls, steps 20-35 (no rebuild), counted per step.
+SyncCounts batch_step_waits(int cells) {
+  std::vector<std::unique_ptr<Simulation>> made;
+  std::vector<const Simulation*> sims;
+  for (int s = 0; s < cells; ++s) {
+    Config c = test::tiny_cell_config();
+    c.run.seed = 1 + static_cast<unsigned>(s);
+    made.push_back(build_simulation(packed_lattice(c, 5, true), false));
+    sims.push_back(made.back().get());
+  }
+  CellBatch batch(sims);
+  for (int k = 0; k < 20; ++k) batch.step();
+  const long rebuilds = batch.rebuild_steps();
+  const SyncTally before = sync_tally();
+  {
+    const SyncScope part(SyncPart::kStep);
+    for (int k = 0; k < 16; ++k) batch.step();
+  }
+  EXPECT_EQ(batch.rebuild_steps(), rebuilds) << "a rebuild in the counted steps";
+  return sync_tally()[static_cast<int>(SyncPart::kStep)] - before[static_cast<int>(SyncPart::kStep)];
+}
+
+}  // namespace
+
+// A batch's step waits for the host as often whatever the number of its cells: one launch per kernel and one copy
+// of the statistics for all of them, and no allocation.
+TEST(HotPath, ABatchStepWaitsAsOftenForSixCellsAsForTwo) {
+  ASSERT_TRUE(count_syncs()) << "a profiling tool holds Kokkos' callbacks";
+  const SyncCounts two = batch_step_waits(2), six = batch_step_waits(6);
+  std::printf("a batch step: %.2f launches, %.2f copies, %.2f results, %.2f allocations (2 cells); %.2f, %.2f, %.2f, "
+              "%.2f (6 cells)\n", two.launches / 16.0, two.copies / 16.0, two.host_results / 16.0,
+              two.allocations / 16.0, six.launches / 16.0, six.copies / 16.0, six.host_results / 16.0,
+              six.allocations / 16.0);
+  EXPECT_EQ(six.launches, two.launches);
+  EXPECT_EQ(six.copies, two.copies);
+  EXPECT_EQ(six.host_results, two.host_results);
+  EXPECT_EQ(six.allocations, 0);
+  EXPECT_LE(six.copies + six.host_results, 3 * 16) << "the statistics and the largest overlap, at most one more";
 }

@@ -161,6 +161,8 @@ CellBatch::CellBatch(const std::vector<const Simulation*>& specimens) {
   host_rows_ = Kokkos::create_mirror_view(rows_);
   worst_ = Kokkos::View<OverlapStat, MemSpace>("dem::batch::worst");
   stretching_ = Kokkos::View<char*, MemSpace>("dem::batch::stretching", spec_.size());
+  sums_ = Kokkos::View<Real**, Kokkos::LayoutRight, MemSpace>("dem::batch::sums", spec_.size(), 3);
+  host_sums_ = Kokkos::create_mirror_view(sums_);
   host_stretching_ = Kokkos::create_mirror_view(stretching_);
   walls_ = ContactList(0);
   adj_walls_ = build_adjacency(p_.n, walls_, walls_.i);
@@ -174,6 +176,7 @@ int CellBatch::running_count() const {
 
 void CellBatch::set_strain_rate(int s, const Vec3& rate) {
   Domain& dom = spec_.at(static_cast<std::size_t>(s)).prm.domain;
+  dirty_ = dirty_ || dom.strain_rate[0] != rate.x || dom.strain_rate[1] != rate.y || dom.strain_rate[2] != rate.z;
   dom.strain_rate[0] = rate.x;
   dom.strain_rate[1] = rate.y;
   dom.strain_rate[2] = rate.z;
@@ -187,6 +190,8 @@ void CellBatch::stop(int s) {
 }
 
 void CellBatch::upload() {
+  if (!dirty_) return;
+  dirty_ = false;
   for (std::size_t s = 0; s < spec_.size(); ++s) {
     const Specimen& sp = spec_[s];
     SpecimenParams& h = host_spec_(s);
@@ -220,6 +225,7 @@ void CellBatch::rebuild(const std::vector<char>& due) {
   auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), first);
   contact_first_.assign(h.data(), h.data() + h.extent(0));
   fresh_ = false;
+  ++rebuild_steps_;
   plan();
 }
 
@@ -248,7 +254,11 @@ void CellBatch::plan() {
 }
 
 void CellBatch::step(const std::vector<char>& measure) {
-  for (std::size_t s = 0; s < spec_.size(); ++s) spec_[s].prm.integ.measure = measure.empty() || measure[s];
+  for (std::size_t s = 0; s < spec_.size(); ++s) {
+    const bool m = measure.empty() || measure[s];
+    dirty_ = dirty_ || spec_[s].prm.integ.measure != m;
+    spec_[s].prm.integ.measure = m;
+  }
   upload();
   // Each specimen's rebuild, decided as its Simulation decides it (Simulation::lists_expired, read every step).
   std::vector<char> due(spec_.size(), 0);
@@ -278,6 +288,7 @@ void CellBatch::step(const std::vector<char>& measure) {
     Domain& dom = sp.prm.domain;
     const Real f[3] = {1 + rate[0] * dt, 1 + rate[1] * dt, 1 + rate[2] * dt};
     for (int d = 0; d < 3; ++d) dom.hi[d] = dom.lo[d] + (dom.hi[d] - dom.lo[d]) * f[d];
+    dirty_ = true;
     const Real rate_max = std::max({std::fabs(rate[0]), std::fabs(rate[1]), std::fabs(rate[2])});
     speed[s] = rate_max * (2 * sp.rmax + sp.prm.skin);
   }
@@ -329,19 +340,16 @@ void CellBatch::take_row(int s, const OverlapStat& worst) {
   stop(s);
 }
 
-namespace {
-/// Each segment's NV roots of f over `tree`, to the host: one launch per level and one copy.
 template <int NV, class F>
-std::vector<std::array<Real, NV>> segment_sums(const char* label, const SegmentedTree& tree, const F& f) {
-  Kokkos::View<Real**, Kokkos::LayoutRight, MemSpace> roots(std::string(label), tree.segments(), NV);
-  segmented_reduce_lanes_to<NV, 0, 1>(label, tree, OneAtATime<F, NV>{f}, roots.data());
-  auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), roots);
-  std::vector<std::array<Real, NV>> out(static_cast<std::size_t>(tree.segments()));
-  for (int s = 0; s < tree.segments(); ++s)
-    for (int q = 0; q < NV; ++q) out[static_cast<std::size_t>(s)][static_cast<std::size_t>(q)] = h(s, q);
+std::vector<std::array<Real, NV>> CellBatch::contact_sums(const char* label, const F& f) const {
+  static_assert(NV <= 3, "sums_ holds three values a specimen");
+  segmented_reduce_lanes_to<NV, 0, 1>(label, contact_tree_, OneAtATime<F, NV>{f}, sums_.data(), 3);
+  Kokkos::deep_copy(host_sums_, sums_);
+  std::vector<std::array<Real, NV>> out(spec_.size());
+  for (std::size_t s = 0; s < spec_.size(); ++s)
+    for (int q = 0; q < NV; ++q) out[s][static_cast<std::size_t>(q)] = host_sums_(s, q);
   return out;
 }
-}  // namespace
 
 const std::vector<std::array<Real, 3>>& CellBatch::contact_stress_diagonals() const {
   if (stress_at_ == batch_steps_) return stress_;
@@ -349,7 +357,7 @@ const std::vector<std::array<Real, 3>>& CellBatch::contact_stress_diagonals() co
   stress_at_ = batch_steps_;
   if (fresh_) return stress_;
   const_cast<CellBatch*>(this)->upload();  // the cells as they are now: a step stretched them after its upload
-  stress_ = segment_sums<3>("dem::batch::contact_stress_diagonal", contact_tree_,
+  stress_ = contact_sums<3>("dem::batch::contact_stress_diagonal",
                             LoveWeberDiagonal{balls_, p_.x, p_.specimen, dev_spec_});
   for (std::size_t s = 0; s < spec_.size(); ++s) {
     const Real V = spec_[s].prm.domain.volume();
@@ -364,7 +372,7 @@ const std::vector<std::array<Real, 3>>& CellBatch::cell_stiffnesses() const {
   stiffness_at_ = batch_steps_;
   if (fresh_) return stiffness_;
   const_cast<CellBatch*>(this)->upload();
-  stiffness_ = segment_sums<3>("dem::batch::cell_stiffness", contact_tree_,
+  stiffness_ = contact_sums<3>("dem::batch::cell_stiffness",
                                StiffnessSums{balls_, p_.x, p_.radius, p_.specimen, dev_spec_});
   for (std::size_t s = 0; s < spec_.size(); ++s) {
     const Real V = spec_[s].prm.domain.volume();
@@ -379,7 +387,7 @@ Real CellBatch::unbalanced_ratio(int s) const {
   if (force_sums_at_ != batch_steps_) {
     force_sums_.assign(spec_.size(), {});
     force_sums_at_ = batch_steps_;
-    if (!fresh_) force_sums_ = segment_sums<2>("dem::batch::contact_force_sum", contact_tree_, ForceSums{balls_});
+    if (!fresh_) force_sums_ = contact_sums<2>("dem::batch::contact_force_sum", ForceSums{balls_});
   }
   const std::array<Real, 2>& f = force_sums_[static_cast<std::size_t>(s)];
   if (f[1] == 0) return 1;

@@ -50,6 +50,10 @@ class CellBatch {
   /// Specimen s's last step's statistics.
   const StepStats& stats(int s) const { return spec_.at(static_cast<std::size_t>(s)).stats; }
   long rebuilds(int s) const { return spec_.at(static_cast<std::size_t>(s)).rebuilds; }
+  /// Steps the batch has taken, and of them those with a rebuild (of any of its specimens: each costs a pass over
+  /// all the batch's particles and contacts).
+  long steps() const { return batch_steps_; }
+  long rebuild_steps() const { return rebuild_steps_; }
   /// Every specimen's Love-Weber stress diagonal (xx, yy, zz; Pa) over its cell's volume: what
   /// Simulation::contact_stress_diagonal gives each alone, in one launch and one copy (kept until the next step).
   const std::vector<std::array<Real, 3>>& contact_stress_diagonals() const;
@@ -92,7 +96,13 @@ class CellBatch {
   StepRowsView rows_;  ///< a row of Leapfrog values per specimen
   decltype(Kokkos::create_mirror_view(StepRowsView())) host_rows_;
   Kokkos::View<OverlapStat, MemSpace> worst_;
-  long batch_steps_ = 0;
+  long batch_steps_ = 0, rebuild_steps_ = 0;
+  bool dirty_ = true;  ///< the host's specimen table differs from the device's (upload)
+  Kokkos::View<Real**, Kokkos::LayoutRight, MemSpace> sums_;  ///< the per-specimen sums' roots, S x 3
+  decltype(Kokkos::create_mirror_view(Kokkos::View<Real**, Kokkos::LayoutRight, MemSpace>())) host_sums_;
+  /// Each specimen's NV sums of f over its contacts (the contact tree), to the host: one launch per level, one copy.
+  template <int NV, class F>
+  std::vector<std::array<Real, NV>> contact_sums(const char* label, const F& f) const;
   /// The per-specimen sums of the last step, and the batch step they were taken after (-1: none).
   mutable std::vector<std::array<Real, 3>> stress_, stiffness_;
   mutable std::vector<std::array<Real, 2>> force_sums_;  ///< sum |f| and touching count of the ball-ball contacts
@@ -107,6 +117,7 @@ class CellBatch {
   void plan();
   /// Specimen s's statistics after a step: its blow-up checks (it stops on one), and its cell's travel.
   void take_row(int s, const OverlapStat& worst);
+  /// The host's specimen table to the device, where it changed.
   void upload();
 };
 

@@ -441,7 +441,8 @@ PeriodicTriaxialResult run_periodic_triaxial(Simulation& sim, const PeriodicTria
 }
 
 std::vector<BatchedTest> run_periodic_batch(const std::vector<Simulation*>& sims,
-                                            const std::vector<PeriodicTriaxialParams>& prms, bool consolidate_only) {
+                                            const std::vector<PeriodicTriaxialParams>& prms, bool consolidate_only,
+                                            std::array<long, 2>* steps) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::size_t S = sims.size();
   if (prms.size() != S) throw std::invalid_argument("run_periodic_batch: a parameter set per specimen");
@@ -519,6 +520,7 @@ std::vector<BatchedTest> run_periodic_batch(const std::vector<Simulation*>& sims
       else if (++me.n > me.stage.last) end_stage(s, {me.n - 1, false, {}});
     }
   }
+  if (steps) *steps = {batch.steps(), batch.rebuild_steps()};
   return out;
 }
 

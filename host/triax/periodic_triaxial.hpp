@@ -105,9 +105,10 @@ struct BatchedTest {
 /// the specimen's own run (consolidate_isotropic, run_periodic_triaxial), without output or progress lines; a
 /// specimen that blows up or fails to converge stops and the others go on. The Simulations must be fresh (as
 /// CellBatch takes them) and are not stepped.
+/// `steps` receives the batch's steps and those of them with a rebuild (CellBatch::rebuild_steps).
 std::vector<BatchedTest> run_periodic_batch(const std::vector<Simulation*>& sims,
                                             const std::vector<PeriodicTriaxialParams>& prms,
-                                            bool consolidate_only = false);
+                                            bool consolidate_only = false, std::array<long, 2>* steps = nullptr);
 
 /// Membrane extension: the extra lateral confinement (Pa) of a membrane of stiffness E_m t / R0 (Pa, its
 /// modulus times thickness over the specimen's radius) at lateral strain eps (extension positive): the hoop
