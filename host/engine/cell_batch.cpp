@@ -56,19 +56,17 @@ IndexView contact_starts(const ContactList& c, const SpecimenParamsView& spec, i
   return first;
 }
 
-/// The periodic cell's affine step of every running specimen with a strain rate (Simulation's stretch_about): each
-/// factor 1 + rate dt worked out as the host works it out for the cell (no contraction, CMakeLists.txt).
+/// The periodic cell's affine step of every specimen marked in `on` (Simulation's, CellStretch), on the device.
 void stretch_specimens(const Particles& p, const SpecimenParamsView& spec, const Kokkos::View<const char*, MemSpace>& on) {
   auto x = p.x, xr = p.x_ref;
   auto owner = p.specimen;
   Kokkos::parallel_for("dem::batch::affine", RangePolicy(0, p.n), KOKKOS_LAMBDA(const int i) {
     const int s = owner(i);
     if (!on(s)) return;
-    const SpecimenParams& sp = spec(s);
+    const CellStretch st(spec(s).dom, spec(s).integ.dt);
     for (int d = 0; d < 3; ++d) {
-      const Real f = 1 + sp.dom.strain_rate[d] * sp.integ.dt, l = sp.dom.lo[d];
-      x(i, d) = l + (x(i, d) - l) * f;
-      xr(i, d) = l + (xr(i, d) - l) * f;
+      x(i, d) = st(d, x(i, d));
+      xr(i, d) = st(d, xr(i, d));
     }
   });
 }
@@ -140,14 +138,14 @@ CellBatch::CellBatch(const std::vector<const Simulation*>& specimens) {
     sp.prm = sim.params();
     sp.critical_dt = sim.critical_dt();
     sp.first = total;
-    sp.count = static_cast<int>(const_cast<Simulation&>(sim).particles().n);
+    sp.count = sim.particles().n;
     total += sp.count;
     spec_.push_back(sp);
   }
   p_ = Particles(total);
   params_ = ParamTableView("dem::batch::params", spec_.size() * nmat_, nmat_);
   for (std::size_t s = 0; s < specimens.size(); ++s) {
-    Simulation& sim = const_cast<Simulation&>(*specimens[s]);
+    const Simulation& sim = *specimens[s];
     Specimen& sp = spec_[s];
     place_specimen(sim.particles(), p_, sp.first, static_cast<int>(s));
     const int row = static_cast<int>(s) * nmat_;
@@ -189,7 +187,7 @@ void CellBatch::stop(int s) {
   if (!fresh_) plan();
 }
 
-void CellBatch::upload() {
+void CellBatch::upload() const {
   if (!dirty_) return;
   dirty_ = false;
   for (std::size_t s = 0; s < spec_.size(); ++s) {
@@ -266,8 +264,7 @@ void CellBatch::step(const std::vector<char>& measure) {
   for (std::size_t s = 0; s < spec_.size(); ++s) {
     const Specimen& sp = spec_[s];
     if (!sp.running) continue;
-    const Real d = std::sqrt(sp.stats.max_disp2);
-    due[s] = fresh_ || 2 * d > sp.prm.skin || d + sp.wall_disp > sp.prm.skin;
+    due[s] = fresh_ || lists_expired(sp.stats.max_disp2, sp.wall_disp, sp.prm.skin);
     any = any || due[s];
   }
   if (any) rebuild(due);
@@ -280,17 +277,12 @@ void CellBatch::step(const std::vector<char>& measure) {
   std::vector<Real> speed(spec_.size(), 0);
   for (std::size_t s = 0; s < spec_.size(); ++s) {
     Specimen& sp = spec_[s];
-    const Real* rate = sp.prm.domain.strain_rate;
-    hon(s) = sp.running && (rate[0] != 0 || rate[1] != 0 || rate[2] != 0);
+    hon(s) = sp.running && stretching(sp.prm.domain);
     if (!hon(s)) continue;
     stretch = true;
-    const Real dt = sp.prm.integ.dt;
-    Domain& dom = sp.prm.domain;
-    const Real f[3] = {1 + rate[0] * dt, 1 + rate[1] * dt, 1 + rate[2] * dt};
-    for (int d = 0; d < 3; ++d) dom.hi[d] = dom.lo[d] + (dom.hi[d] - dom.lo[d]) * f[d];
+    CellStretch(sp.prm.domain, sp.prm.integ.dt).apply(sp.prm.domain);
     dirty_ = true;
-    const Real rate_max = std::max({std::fabs(rate[0]), std::fabs(rate[1]), std::fabs(rate[2])});
-    speed[s] = rate_max * (2 * sp.rmax + sp.prm.skin);
+    speed[s] = stretch_speed(sp.prm.domain, 2 * sp.rmax + sp.prm.skin);
   }
   if (stretch) {
     Kokkos::deep_copy(stretching_, hon);
@@ -356,7 +348,7 @@ const std::vector<std::array<Real, 3>>& CellBatch::contact_stress_diagonals() co
   stress_.assign(spec_.size(), {});
   stress_at_ = batch_steps_;
   if (fresh_) return stress_;
-  const_cast<CellBatch*>(this)->upload();  // the cells as they are now: a step stretched them after its upload
+  upload();  // the cells as they are now: a step stretched them after its upload
   stress_ = contact_sums<3>("dem::batch::contact_stress_diagonal",
                             LoveWeberDiagonal{balls_, p_.x, p_.specimen, dev_spec_});
   for (std::size_t s = 0; s < spec_.size(); ++s) {
@@ -371,7 +363,7 @@ const std::vector<std::array<Real, 3>>& CellBatch::cell_stiffnesses() const {
   stiffness_.assign(spec_.size(), {});
   stiffness_at_ = batch_steps_;
   if (fresh_) return stiffness_;
-  const_cast<CellBatch*>(this)->upload();
+  upload();
   stiffness_ = contact_sums<3>("dem::batch::cell_stiffness",
                                StiffnessSums{balls_, p_.x, p_.radius, p_.specimen, dev_spec_});
   for (std::size_t s = 0; s < spec_.size(); ++s) {

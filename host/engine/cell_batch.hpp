@@ -85,7 +85,7 @@ class CellBatch {
   int nmat_ = 0;
   std::vector<Specimen> spec_;
   SpecimenParamsView dev_spec_;
-  decltype(Kokkos::create_mirror_view(SpecimenParamsView())) host_spec_;
+  mutable decltype(Kokkos::create_mirror_view(SpecimenParamsView())) host_spec_;
   CellList cells_;
   ContactList balls_, walls_;
   Index2View own_;
@@ -97,7 +97,7 @@ class CellBatch {
   decltype(Kokkos::create_mirror_view(StepRowsView())) host_rows_;
   Kokkos::View<OverlapStat, MemSpace> worst_;
   long batch_steps_ = 0, rebuild_steps_ = 0;
-  bool dirty_ = true;  ///< the host's specimen table differs from the device's (upload)
+  mutable bool dirty_ = true;  ///< the host's specimen table differs from the device's (upload)
   Kokkos::View<Real**, Kokkos::LayoutRight, MemSpace> sums_;  ///< the per-specimen sums' roots, S x 3
   decltype(Kokkos::create_mirror_view(Kokkos::View<Real**, Kokkos::LayoutRight, MemSpace>())) host_sums_;
   /// Each specimen's NV sums of f over its contacts (the contact tree), to the host: one launch per level, one copy.
@@ -117,8 +117,8 @@ class CellBatch {
   void plan();
   /// Specimen s's statistics after a step: its blow-up checks (it stops on one), and its cell's travel.
   void take_row(int s, const OverlapStat& worst);
-  /// The host's specimen table to the device, where it changed.
-  void upload();
+  /// The host's specimen table to the device, where it changed (a cache of the host's: so const).
+  void upload() const;
 };
 
 }  // namespace dem

@@ -33,15 +33,13 @@ void move_walls(const WallSet& walls, Real dt) {
   });
 }
 
-/// The periodic cell's affine step: positions, and the positions of the last rebuild, stretched by s about lo.
-void stretch_about(const Particles& p, const Real (&lo)[3], const Real (&s)[3]) {
+/// The periodic cell's affine step: positions, and the positions of the last rebuild, stretched by `st`.
+void stretch_particles(const Particles& p, const CellStretch& st) {
   auto x = p.x, xr = p.x_ref;
-  const Real l0 = lo[0], l1 = lo[1], l2 = lo[2], s0 = s[0], s1 = s[1], s2 = s[2];
   Kokkos::parallel_for("dem::sim::affine", RangePolicy(0, p.n), KOKKOS_LAMBDA(const int i) {
-    const Real l[3] = {l0, l1, l2}, f[3] = {s0, s1, s2};
     for (int d = 0; d < 3; ++d) {
-      x(i, d) = l[d] + (x(i, d) - l[d]) * f[d];
-      xr(i, d) = l[d] + (xr(i, d) - l[d]) * f[d];
+      x(i, d) = st(d, x(i, d));
+      xr(i, d) = st(d, xr(i, d));
     }
   });
 }
@@ -224,16 +222,12 @@ void Simulation::move_boundaries() {
   // The device moves its copy of the walls by the same arithmetic (no contraction, CMakeLists.txt): the host's
   // stays equal to it bit for bit, with no copy between them.
   if (vmax > 0) move_walls(walls_, dt);
-  const Real* rate = prm_.domain.strain_rate;
-  if (rate[0] != 0 || rate[1] != 0 || rate[2] != 0) {
-    Domain& dom = prm_.domain;
-    const Real s[3] = {1 + rate[0] * dt, 1 + rate[1] * dt, 1 + rate[2] * dt};
-    const Real lo[3] = {dom.lo[0], dom.lo[1], dom.lo[2]};
-    stretch_about(p_, lo, s);
-    for (int d = 0; d < 3; ++d) dom.hi[d] = lo[d] + (dom.hi[d] - lo[d]) * s[d];
+  if (stretching(prm_.domain)) {
+    const CellStretch st(prm_.domain, dt);
+    stretch_particles(p_, st);
+    st.apply(prm_.domain);
     // Neighbours within the cut-off drift apart (or together) by at most |rate| dt times the cut-off.
-    const Real rate_max = std::max({std::fabs(rate[0]), std::fabs(rate[1]), std::fabs(rate[2])});
-    vmax = std::max(vmax, rate_max * (2 * rmax_ + prm_.skin));
+    vmax = std::max(vmax, stretch_speed(prm_.domain, 2 * rmax_ + prm_.skin));
   }
   // The membrane nodes' speed joins vmax when the row is read (read_rows).
   if (mesh_.ntri > 0) move_nodes(mesh_, dt, rows_.at(step_, StepRows::kNodeSpeed));

@@ -63,6 +63,11 @@ std::string fast_blowup(long step, std::uint32_t gid, Real move, Real limit, Rea
 /// to its radius (a copy of the velocities to the host: for a blow-up's message).
 int fastest_ball(const Particles& p, int first, int count, Real dt);
 
+/// Whether neighbour lists of Verlet skin `skin` (m) must be rebuilt after a step with largest squared displacement
+/// `disp2` (m^2) since the last rebuild and boundaries moved by `walls` (m): a ball moved half the skin, or a ball and
+/// a boundary together the whole skin.
+bool lists_expired(Real disp2, Real walls, Real skin);
+
 /// One line for a log: seconds per stage, rebuild count and particle-steps per second of the time loop.
 std::string describe(const StageTimes& t, long particles, long steps);
 
@@ -80,6 +85,7 @@ class Simulation {
   void run(long nsteps) { for (long s = 0; s < nsteps; ++s) step(s + 1 == nsteps); }
 
   Particles& particles() { return p_; }
+  const Particles& particles() const { return p_; }
   const ContactList& ball_contacts() const { return balls_; }
   const ContactList& wall_contacts() const { return wall_c_; }
   /// The last step's statistics (read from the device where they wait).

@@ -28,10 +28,12 @@ constexpr Real kSpeedGrowth = 2;
 constexpr Real kBoundMargin = 1e-9;
 }  // namespace
 
-bool Simulation::lists_expired(Real disp2, Real walls) const {
+bool lists_expired(Real disp2, Real walls, Real skin) {
   const Real d = std::sqrt(disp2);
-  return 2 * d > prm_.skin || d + walls > prm_.skin;
+  return 2 * d > skin || d + walls > skin;
 }
+
+bool Simulation::lists_expired(Real disp2, Real walls) const { return dem::lists_expired(disp2, walls, prm_.skin); }
 
 bool Simulation::rebuild_due() {
   if (fresh_) return true;

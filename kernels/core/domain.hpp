@@ -37,6 +37,41 @@ struct Domain {
   }
 };
 
+/// The periodic cell's affine step over dt: each axis stretched about lo by 1 + rate dt. One formula for the cell's
+/// bounds on the host and the particles on the device, which stay consistent bit for bit (no contraction anywhere,
+/// CMakeLists.txt).
+struct CellStretch {
+  Real lo[3] = {0, 0, 0};
+  Real f[3] = {1, 1, 1};
+
+  CellStretch() = default;
+  KOKKOS_INLINE_FUNCTION CellStretch(const Domain& dom, Real dt) {
+    for (int d = 0; d < 3; ++d) {
+      lo[d] = dom.lo[d];
+      f[d] = 1 + dom.strain_rate[d] * dt;
+    }
+  }
+  /// Coordinate x along axis d after the step.
+  KOKKOS_INLINE_FUNCTION Real operator()(int d, Real x) const { return lo[d] + (x - lo[d]) * f[d]; }
+  /// The cell's bounds after the step.
+  void apply(Domain& dom) const {
+    for (int d = 0; d < 3; ++d) dom.hi[d] = (*this)(d, dom.hi[d]);
+  }
+};
+
+/// Whether the cell deforms (any strain rate).
+inline bool stretching(const Domain& dom) {
+  return dom.strain_rate[0] != 0 || dom.strain_rate[1] != 0 || dom.strain_rate[2] != 0;
+}
+
+/// How fast the cell's stretch moves two balls within `reach` (m) of each other apart or together (m/s): the cell's
+/// share of the neighbour lists' travel (the largest rate times the reach).
+inline Real stretch_speed(const Domain& dom, Real reach) {
+  Real rate = 0;
+  for (int d = 0; d < 3; ++d) rate = kc::fabs(dom.strain_rate[d]) > rate ? kc::fabs(dom.strain_rate[d]) : rate;
+  return rate * reach;
+}
+
 /// The minimum-image shift of a domain, with the cell lengths worked out once: pair loops build one per
 /// launch instead of re-reading the bounds for every pair (same arithmetic, same bits). Positions are
 /// wrapped at every rebuild and move less than the skin in between, so one shift always suffices (no floor
