@@ -209,10 +209,10 @@ void CellBatch::rebuild(const std::vector<char>& due) {
     bins.push_back({sp.first, sp.count, sp.prm.domain, 2 * sp.rmax + sp.prm.skin, sp.prm.skin, due[s] != 0});
   }
   bin_specimens(p_, bins, cells_);
-  const IndexView g2l = gid_to_local(p_);
-  balls_ = remap_history(detect_pairs(p_, cells_, balls_.key, own_), balls_, g2l, true);
-  own_ = owner_ranges(p_, balls_);
-  adj_balls_ = build_adjacency(p_.n, balls_, balls_.j);
+  gid_to_local(p_, g2l_);
+  balls_ = remap_history(detect_pairs(p_, cells_, balls_.key, own_), balls_, g2l_, true);
+  owner_ranges(p_, balls_, own_);
+  build_adjacency(p_.n, balls_, balls_.j, adj_balls_);
   mark_rebuilt(p_, cells_.specimens);
   for (std::size_t s = 0; s < spec_.size(); ++s) {
     if (!due[s]) continue;

@@ -89,6 +89,7 @@ class CellBatch {
   CellList cells_;
   ContactList balls_, walls_;
   Index2View own_;
+  IndexView g2l_;
   Adjacency adj_balls_, adj_walls_;
   ContactItems items_;
   std::vector<int> contact_first_;  ///< S + 1 offsets of the specimens' contacts (host copy)

@@ -126,7 +126,8 @@ void Simulation::rebuild() {
     throw BlowUp(msg.str());
   }
   bin_particles(p_, prm_.domain, 2 * rmax_ + prm_.skin, prm_.skin, cells_);
-  const IndexView g2l = gid_to_local(p_);
+  gid_to_local(p_, g2l_);
+  const IndexView g2l = g2l_;
   balls_ = remap_history(detect_pairs(p_, cells_), balls_, g2l, true);
   FacetBins fb;
   if (mesh_.ntri > 0) fb = bin_facets(mesh_, cells_.grid, rmax_ + prm_.skin);
@@ -139,10 +140,10 @@ void Simulation::rebuild() {
 }
 
 void Simulation::index_contacts() {
-  own_ = owner_ranges(p_, balls_);
-  adj_balls_ = build_adjacency(p_.n, balls_, balls_.j);
-  adj_walls_ = build_adjacency(p_.n, wall_c_, wall_c_.i);
-  obj_offsets_ = object_offsets(wall_c_, walls_.n + mesh_.ntri);
+  owner_ranges(p_, balls_, own_);
+  build_adjacency(p_.n, balls_, balls_.j, adj_balls_);
+  build_adjacency(p_.n, wall_c_, wall_c_.i, adj_walls_);
+  object_offsets(wall_c_, walls_.n + mesh_.ntri, obj_offsets_);
 }
 
 namespace {

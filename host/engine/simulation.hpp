@@ -184,7 +184,7 @@ class Simulation {
   ContactList balls_, wall_c_;
   Adjacency adj_balls_, adj_walls_;
   Index2View own_;
-  IndexView obj_offsets_;
+  IndexView obj_offsets_, g2l_;
   // wall_loads' device scratch and the host's copies of it: a copy of their own even where the device is the host,
   // so that a read is a copy there too and the sync counts (sync_counts.hpp) are the GPU's.
   mutable Vec3View wall_force_;

@@ -1,18 +1,26 @@
 #include "kernels/contact/accumulate.hpp"
 
+#include "kernels/core/buffers.hpp"
 #include "kernels/core/reduce.hpp"
 
 namespace dem {
 
 Adjacency build_adjacency(int n, const ContactList& c, const IndexView& side) {
-  Adjacency a{IndexView("dem::accumulate::offset", n + 1), IndexView("dem::accumulate::entry", 0)};
-  auto off = a.offset;
+  Adjacency a;
+  build_adjacency(n, c, side, a);
+  return a;
+}
+
+void build_adjacency(int n, const ContactList& c, const IndexView& side, Adjacency& a) {
+  const IndexView off = same_size(a.offset, static_cast<std::size_t>(n) + 1, "dem::accumulate::offset");
+  zero(off, "dem::accumulate::zero");
   Kokkos::parallel_for("dem::accumulate::count", RangePolicy(0, c.n),
                        KOKKOS_LAMBDA(const int k) { Kokkos::atomic_increment(&off(side(k))); });
   const int total = exclusive_scan("dem::accumulate::scan", off, off, n);
-  a.entry = IndexView("dem::accumulate::entry", total);
-  auto entry = a.entry;
-  IndexView cursor("dem::accumulate::cursor", n);
+  a.entry = room(a.entry_buf, static_cast<std::size_t>(total), "dem::accumulate::entry");
+  const IndexView entry = a.entry;
+  const IndexView cursor = same_size(a.cursor, static_cast<std::size_t>(n), "dem::accumulate::cursor");
+  zero(cursor, "dem::accumulate::zero");
   Kokkos::parallel_for("dem::accumulate::fill", RangePolicy(0, c.n), KOKKOS_LAMBDA(const int k) {
     entry(off(side(k)) + Kokkos::atomic_fetch_add(&cursor(side(k)), 1)) = k;
   });
@@ -25,11 +33,16 @@ Adjacency build_adjacency(int n, const ContactList& c, const IndexView& side) {
       entry(b + 1) = v;
     }
   });
-  return a;
 }
 
 Index2View owner_ranges(const Particles& p, const ContactList& balls) {
-  Index2View own("dem::accumulate::owner_ranges", p.n);
+  Index2View own;
+  owner_ranges(p, balls, own);
+  return own;
+}
+
+void owner_ranges(const Particles& p, const ContactList& balls, Index2View& own_out) {
+  const Index2View own = same_size(own_out, static_cast<std::size_t>(p.n), "dem::accumulate::owner_ranges");
   auto key = balls.key;
   auto gid = p.gid;
   const int n = balls.n;
@@ -37,7 +50,6 @@ Index2View owner_ranges(const Particles& p, const ContactList& balls) {
     own(i, 0) = key_lower_bound(key, n, std::uint64_t(gid(i)) << 32);
     own(i, 1) = key_lower_bound(key, n, (std::uint64_t(gid(i)) + 1) << 32);
   });
-  return own;
 }
 
 Gather make_gather(const ContactList& balls, const Index2View& own, const Adjacency& ab, const ContactList& walls,
@@ -46,13 +58,18 @@ Gather make_gather(const ContactList& balls, const Index2View& own, const Adjace
 }
 
 IndexView object_offsets(const ContactList& walls, int nobj) {
-  IndexView off("dem::accumulate::object_offsets", nobj + 1);
+  IndexView off;
+  object_offsets(walls, nobj, off);
+  return off;
+}
+
+void object_offsets(const ContactList& walls, int nobj, IndexView& off_out) {
+  const IndexView off = same_size(off_out, static_cast<std::size_t>(nobj) + 1, "dem::accumulate::object_offsets");
   auto key = walls.key;
   const int n = walls.n;
   Kokkos::parallel_for("dem::accumulate::object_offsets", RangePolicy(0, nobj + 1), KOKKOS_LAMBDA(const int o) {
     off(o) = key_lower_bound(key, n, std::uint64_t(o) << 32);
   });
-  return off;
 }
 
 void wall_loads_into(const ContactList& walls, const IndexView& offsets, int nobj, Vec3View& force,

@@ -16,15 +16,20 @@ namespace dem {
 struct Adjacency {
   IndexView offset;   ///< n + 1
   IndexView entry;    ///< contact index
+  IndexView entry_buf, cursor;  ///< scratch kept for the next build (kernels/core/buffers.hpp)
 };
 
 /// Adjacency of n particles to the contacts whose gathering side is `side(k)` (c.j for ball-ball
 /// reactions, c.i for ball-wall contacts).
 Adjacency build_adjacency(int n, const ContactList& c, const IndexView& side);
+/// The same into `a`, whose Views are reused where they are large enough.
+void build_adjacency(int n, const ContactList& c, const IndexView& side, Adjacency& a);
 
 /// Contacts owned by each particle: [own(i,0), own(i,1)) in the key-sorted ball-ball list. Contiguous
 /// because keys start with the owner's gid.
 Index2View owner_ranges(const Particles& p, const ContactList& balls);
+/// The same into `own`, reused where it has p.n rows.
+void owner_ranges(const Particles& p, const ContactList& balls, Index2View& own);
 
 /// A particle's force and moment: the owner's side of the ball-ball contacts it owns (contiguous, in key order),
 /// minus the reactions of those it is particle 2 of, plus its wall contacts.
@@ -56,6 +61,8 @@ Gather make_gather(const ContactList& balls, const Index2View& own, const Adjace
 
 /// Offsets of each wall object's contacts in the (key-sorted) ball-wall list: nobj + 1 entries.
 IndexView object_offsets(const ContactList& walls, int nobj);
+/// The same into `off`, reused where it has nobj + 1 entries.
+void object_offsets(const ContactList& walls, int nobj, IndexView& off);
 
 /// Force on each of the first `nobj` wall objects (N), the reaction of its contacts summed in key order, and its
 /// touching contacts; `force` and `touching` are (re)allocated only where they are too short.

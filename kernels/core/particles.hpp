@@ -18,8 +18,14 @@ struct Particles {
 
   Particles() = default;
   explicit Particles(int count);
-  /// Reorders every per-particle View so that new row k holds old row perm(k).
-  void permute(const IndexView& perm);
+  /// Reorders every per-particle View so that new row k holds old row perm(k): into `spare`'s Views (allocated only
+  /// where they are not of n rows), which then swap with these; `spare` keeps the old ones for the next time.
+  void permute(const IndexView& perm, Particles& spare);
+  /// The same with a spare of its own (an allocation of every View).
+  void permute(const IndexView& perm) {
+    Particles spare;
+    permute(perm, spare);
+  }
   /// Largest global id + 1 (sizes the gid -> local index map).
   std::uint32_t gid_bound() const;
 };

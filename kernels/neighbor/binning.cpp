@@ -1,5 +1,7 @@
 #include "kernels/neighbor/binning.hpp"
 
+#include "kernels/core/buffers.hpp"
+
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -108,8 +110,9 @@ void bin_specimens(Particles& p, const std::vector<SpecimenBin>& specimens, Cell
       if (c.rebuild) store(x, i, c.dom.wrap(load(x, i)));
     });
   }
-  IndexView cell("dem::binning::cell", p.n);
-  IndexView start("dem::binning::cell_start", nc + 1);
+  const IndexView cell = room(cells.cell_buf, p.n, "dem::binning::cell");
+  const IndexView start = room(cells.start_buf, nc + 1, "dem::binning::cell_start");
+  zero(start, "dem::binning::zero");
   Kokkos::parallel_for("dem::binning::count", RangePolicy(0, p.n), KOKKOS_LAMBDA(const int i) {
     const SpecimenCells& c = spec(owner(i));
     cell(i) = c.first_cell + (c.rebuild ? c.grid.cell_of(load(x, i)) : i - c.first);
@@ -121,8 +124,9 @@ void bin_specimens(Particles& p, const std::vector<SpecimenBin>& specimens, Cell
         if (final) start(c) = acc;
         acc += cnt;
       });
-  IndexView cursor("dem::binning::cursor", nc);
-  IndexView perm("dem::binning::perm", p.n);
+  const IndexView cursor = room(cells.cursor_buf, nc, "dem::binning::cursor");
+  zero(cursor, "dem::binning::zero");
+  const IndexView perm = room(cells.perm_buf, p.n, "dem::binning::perm");
   Kokkos::parallel_for("dem::binning::fill", RangePolicy(0, p.n), KOKKOS_LAMBDA(const int i) {
     const int c = cell(i);
     perm(start(c) + Kokkos::atomic_fetch_add(&cursor(c), 1)) = i;
@@ -137,7 +141,7 @@ void bin_specimens(Particles& p, const std::vector<SpecimenBin>& specimens, Cell
       perm(b + 1) = v;
     }
   });
-  p.permute(perm);
+  p.permute(perm, cells.spare);
   cells.grid = hs(0).grid;
   cells.cell_start = start;
 }

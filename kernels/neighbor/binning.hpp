@@ -53,6 +53,10 @@ struct CellList {
   CellGrid grid;
   SpecimenCellsView specimens;
   IndexView cell_start;
+  /// The binning's scratch, kept for the next rebuild (buffers.hpp): cells, counts, cursors, the permutation, and
+  /// the particles' other set of Views that the permutation writes to.
+  IndexView cell_buf, start_buf, cursor_buf, perm_buf;
+  Particles spare;
 };
 
 /// A specimen to bin: its particles, its cell, the cut-off its cells must hold (m) and its skin (m); rebuild as in

@@ -1,13 +1,21 @@
 #include "kernels/neighbor/history_remap.hpp"
 
+#include "kernels/core/buffers.hpp"
+
 namespace dem {
 
 IndexView gid_to_local(const Particles& p) {
-  IndexView map("dem::remap::gid2local", p.gid_bound());
-  Kokkos::deep_copy(map, -1);
-  auto gid = p.gid;
-  Kokkos::parallel_for("dem::remap::gid2local", RangePolicy(0, p.n), KOKKOS_LAMBDA(const int i) { map(gid(i)) = i; });
+  IndexView map;
+  gid_to_local(p, map);
   return map;
+}
+
+void gid_to_local(const Particles& p, IndexView& map_out) {
+  const IndexView map = same_size(map_out, p.gid_bound(), "dem::remap::gid2local");
+  auto gid = p.gid;
+  Kokkos::parallel_for("dem::remap::clear", RangePolicy(0, static_cast<int>(map.extent(0))),
+                       KOKKOS_LAMBDA(const int g) { map(g) = -1; });
+  Kokkos::parallel_for("dem::remap::gid2local", RangePolicy(0, p.n), KOKKOS_LAMBDA(const int i) { map(gid(i)) = i; });
 }
 
 ContactList remap_history(const PairKeyView& keys, const ContactList& old, const IndexView& gid2local,

@@ -10,6 +10,8 @@ namespace dem {
 
 /// gid -> current local index (-1 for unused gids).
 IndexView gid_to_local(const Particles& p);
+/// The same into `map`, reused where it has the gids' bound of entries.
+void gid_to_local(const Particles& p, IndexView& map);
 
 /// A contact list over `keys` with local indices resolved through gid2local and history from `old`.
 ContactList remap_history(const PairKeyView& keys, const ContactList& old, const IndexView& gid2local,

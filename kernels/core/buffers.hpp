@@ -1,0 +1,35 @@
+#pragma once
+/// Scratch kept between rebuilds, so that a rebuild after the first allocates nothing where it can: on a GPU an
+/// allocation and its free each hold the host until the device is idle.
+#include <cstddef>
+#include <string>
+#include <utility>
+
+#include "kernels/core/types.hpp"
+
+namespace dem {
+
+/// The first n entries of a rank-1 buffer kept by the caller: grown to a quarter more than asked when too short,
+/// never shrunk. The entries hold what was there before: zero them where needed.
+template <class View>
+View room(View& buffer, std::size_t n, const char* label) {
+  static_assert(View::rank == 1, "a rank-1 buffer: a range of its entries is a View of the same layout");
+  if (buffer.extent(0) < n) buffer = View(Kokkos::view_alloc(Kokkos::WithoutInitializing, std::string(label)), n + n / 4 + 16);
+  return Kokkos::subview(buffer, std::make_pair(std::size_t(0), n));
+}
+
+/// `kept`, of exactly n rows: reallocated only where its row count differs (any rank; a View of fixed extents past
+/// the first, as Vec3View).
+template <class View>
+View same_size(View& kept, std::size_t n, const char* label) {
+  if (kept.extent(0) != n) kept = View(Kokkos::view_alloc(Kokkos::WithoutInitializing, std::string(label)), n);
+  return kept;
+}
+
+/// Sets a rank-1 View's entries to zero in a kernel (a deep_copy of a value waits for the device).
+template <class View>
+void zero(const View& v, const char* label) {
+  Kokkos::parallel_for(label, RangePolicy(0, static_cast<int>(v.extent(0))), KOKKOS_LAMBDA(const int i) { v(i) = 0; });
+}
+
+}  // namespace dem
