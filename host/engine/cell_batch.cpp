@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "host/engine/builder.hpp"
+#include "kernels/contact/contact_sums.hpp"
 #include "kernels/neighbor/history_remap.hpp"
 
 namespace dem {
@@ -71,17 +72,14 @@ void stretch_specimens(const Particles& p, const SpecimenParamsView& spec, const
   });
 }
 
-/// The Love-Weber diagonal of each specimen's contacts (Simulation::contact_stress_diagonal's sums), to roots.
+/// The Love-Weber diagonal of each specimen's contacts (Simulation::contact_stress_diagonal's sums).
 struct LoveWeberDiagonal {
   ContactList c;
   ConstVec3View x;
   ConstIndexView owner;
   SpecimenParamsView spec;
   KOKKOS_INLINE_FUNCTION void operator()(const int k, Real* v) const {
-    const MinImage image(spec(owner(c.i(k))).dom);
-    const Vec3 f = load(c.fc, k);
-    const Vec3 l = image(load(x, c.j(k)) - load(x, c.i(k)));
-    for (int q = 0; q < 3; ++q) v[q] = -f[q] * l[q];
+    love_weber_terms<3>(c, k, x, MinImage(spec(owner(c.i(k))).dom), v);
   }
 };
 
@@ -92,26 +90,15 @@ struct StiffnessSums {
   ConstScalarView r;
   ConstIndexView owner;
   SpecimenParamsView spec;
-  KOKKOS_INLINE_FUNCTION void operator()(const int s, Real* v) const {
-    const Real fn = c.fn(s);
-    if (!(fn > 0)) return;
-    const Vec3 l = spec(owner(c.i(s))).dom.min_image(load(x, c.j(s)) - load(x, c.i(s)));
-    const Real overlap = r(c.i(s)) + r(c.j(s)) - norm(l);
-    if (!(overlap > 0)) return;
-    const Real kn = fn / overlap;
-    v[0] = kn * l.x * l.x;
-    v[1] = kn * l.y * l.y;
-    v[2] = kn * l.z * l.z;
+  KOKKOS_INLINE_FUNCTION void operator()(const int k, Real* v) const {
+    stiffness_terms(c, k, x, r, MinImage(spec(owner(c.i(k))).dom), v);
   }
 };
 
 /// Each specimen's contact force sums (Simulation::unbalanced_ratio's): sum |f| and the touching contacts.
 struct ForceSums {
   ContactList c;
-  KOKKOS_INLINE_FUNCTION void operator()(const int k, Real* v) const {
-    v[0] = norm(load(c.fc, k));
-    v[1] = c.fn(k) > 0 ? Real(1) : Real(0);
-  }
+  KOKKOS_INLINE_FUNCTION void operator()(const int k, Real* v) const { force_terms(c, k, v); }
 };
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "kernels/contact/contact_sums.hpp"
 #include "kernels/neighbor/history_remap.hpp"
 #include "kernels/core/reduce.hpp"
 #include "host/util/sync_counts.hpp"
@@ -256,13 +257,10 @@ namespace {
 template <int N>
 std::array<Real, N> love_weber_stress(const char* label, const ContactList& c, const Vec3View& x, const Domain& dom,
                                       Real volume) {
-  static_assert(N == 9 || N == 3, "the whole tensor or its diagonal");
   Real s[N];
   const MinImage image(dom);  // worked out once per launch, as the pair loops do
   deterministic_reduce<N, 0>(label, c.n, KOKKOS_LAMBDA(const int k, Real* v) {
-    const Vec3 f = load(c.fc, k);
-    const Vec3 l = image(load(x, c.j(k)) - load(x, c.i(k)));
-    for (int q = 0; q < N; ++q) v[q] = -f[N == 9 ? q / 3 : q] * l[N == 9 ? q % 3 : q];
+    love_weber_terms<N>(c, k, x, image, v);
   }, s);
   std::array<Real, N> out;
   for (int q = 0; q < N; ++q) out[q] = s[q] / volume;
@@ -335,10 +333,8 @@ Real Simulation::unbalanced_ratio() const {
   const ContactList b = balls_, w = wall_c_;
   const int nb = b.n;
   deterministic_reduce<2, 0>("dem::sim::contact_force_sum", b.n + w.n, KOKKOS_LAMBDA(const int k, Real* v) {
-    const Vec3 f = k < nb ? load(b.fc, k) : load(w.fc, k - nb);
-    const Real fn = k < nb ? b.fn(k) : w.fn(k - nb);
-    v[0] = norm(f);
-    v[1] = fn > 0 ? Real(1) : Real(0);
+    if (k < nb) force_terms(b, k, v);
+    else force_terms(w, k - nb, v);
   }, s);
   if (s[1] == 0) return 1;
   return (stats().unbalanced / p_.n) / (s[0] / s[1]);

@@ -335,11 +335,7 @@ std::vector<TriaxialTest> PeriodicLab::run_or_read(const Model& m, const std::ve
         one_done();
       }
     }
-    runs_ += static_cast<long>(todo.size());
-    const double s = seconds_since(t0);
-    seconds_ += s;
-    time_so_far.runs += s;
-    time_so_far.ran += static_cast<long>(todo.size());
+    count_runs(todo.size(), t0);
     return out;
   }
   if (workers_ <= 1 || todo.size() <= 1) {
@@ -367,12 +363,16 @@ std::vector<TriaxialTest> PeriodicLab::run_or_read(const Model& m, const std::ve
         return received;
       },
       "calibration");
-  runs_ += static_cast<long>(todo.size());
+  count_runs(todo.size(), t0);
+  return out;
+}
+
+void PeriodicLab::count_runs(std::size_t n, std::chrono::steady_clock::time_point t0) {
+  runs_ += static_cast<long>(n);
   const double s = seconds_since(t0);
   seconds_ += s;
   time_so_far.runs += s;
-  time_so_far.ran += static_cast<long>(todo.size());
-  return out;
+  time_so_far.ran += static_cast<long>(n);
 }
 
 std::vector<TriaxialTest> PeriodicLab::run_batch(const Model& m, const std::vector<Case>& cases) {

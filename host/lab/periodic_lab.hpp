@@ -5,6 +5,7 @@
 /// specimens'). Member k packs with seed first_seed + k; data made for tests draw their specimens from seeds
 /// outside that set (kForeignSeedOffset), as real data come from specimens the simulator never saw.
 #include <array>
+#include <chrono>
 #include <limits>
 #include <string>
 #include <utility>
@@ -127,6 +128,8 @@ class PeriodicLab {
   std::vector<TriaxialTest> run_or_read(const Model& m, const std::vector<Case>& cases);
   /// The cases side by side in one batch (run_periodic_batch), each as run() gives it.
   std::vector<TriaxialTest> run_batch(const Model& m, const std::vector<Case>& cases);
+  /// n runs made since t0: counted in runs() and seconds(), and in the process's lab_time().
+  void count_runs(std::size_t n, std::chrono::steady_clock::time_point t0);
   /// The test parameters of a run at sigma3 (Pa) of model m.
   PeriodicTriaxialParams test_params(const Model& m, Real sigma3) const;
   /// The run store's file of a case ("" without a store).

@@ -13,6 +13,7 @@
 #include "host/triax/cell_boundary.hpp"
 #include "host/triax/cell_control.hpp"
 #include "host/data/measured.hpp"
+#include "kernels/contact/contact_sums.hpp"
 #include "kernels/core/reduce.hpp"
 #include "host/engine/setup.hpp"
 #include "host/engine/stage_loop.hpp"
@@ -141,17 +142,10 @@ std::array<Real, 3> cell_stiffness(Simulation& sim) {
   auto x = p.x;
   auto r = p.radius;
   const Domain dom = sim.domain();
+  const MinImage image(dom);
   Real k[3];
   deterministic_reduce<3, 0>("dem::periodic::cell_stiffness", c.n, KOKKOS_LAMBDA(const int s, Real* v) {
-    const Real fn = c.fn(s);
-    if (!(fn > 0)) return;
-    const Vec3 l = dom.min_image(load(x, c.j(s)) - load(x, c.i(s)));
-    const Real overlap = r(c.i(s)) + r(c.j(s)) - norm(l);
-    if (!(overlap > 0)) return;
-    const Real kn = fn / overlap;
-    v[0] = kn * l.x * l.x;
-    v[1] = kn * l.y * l.y;
-    v[2] = kn * l.z * l.z;
+    stiffness_terms(c, s, x, r, image, v);
   }, k);
   const Real V = dom.volume();
   return {k[0] / V, k[1] / V, k[2] / V};
