@@ -6,6 +6,7 @@
 
 #include "host/engine/builder.hpp"
 #include "kernels/contact/contact_sums.hpp"
+#include "kernels/core/buffers.hpp"
 #include "kernels/neighbor/history_remap.hpp"
 
 namespace dem {
@@ -145,6 +146,7 @@ CellBatch::CellBatch(const std::vector<const Simulation*>& specimens) {
   rows_ = StepRowsView("dem::batch::rows", spec_.size(), Leapfrog::kValues);
   host_rows_ = Kokkos::create_mirror_view(rows_);
   worst_ = Kokkos::View<OverlapStat, MemSpace>("dem::batch::worst");
+  items_.exceeded_count = Kokkos::View<int, MemSpace>("dem::batch::exceeded_count");
   stretching_ = Kokkos::View<char*, MemSpace>("dem::batch::stretching", spec_.size());
   sums_ = Kokkos::View<Real**, Kokkos::LayoutRight, MemSpace>("dem::batch::sums", spec_.size(), 3);
   host_sums_ = Kokkos::create_mirror_view(sums_);
@@ -185,6 +187,7 @@ void CellBatch::upload() const {
     h.first = sp.first;
     h.count = sp.count;
     h.material_row = static_cast<int>(s) * nmat_;
+    h.overlap_limit = sp.prm.overlap_limit;
   }
   Kokkos::deep_copy(dev_spec_, host_spec_);
 }
@@ -230,6 +233,7 @@ void CellBatch::plan() {
   contact_tree_.plan(contacts);
   items_.specimens = size();
   items_.items = item_first.back();
+  items_.exceeded = room(exceeded_buf_, static_cast<std::size_t>(contact_first_.back()), "dem::batch::exceeded");
   items_.contact_first = IndexView("dem::batch::contact_first", contact_first_.size());
   items_.item_first = IndexView("dem::batch::item_first", item_first.size());
   Kokkos::deep_copy(items_.contact_first,
@@ -277,15 +281,29 @@ void CellBatch::step(const std::vector<char>& measure) {
   }
   ++batch_steps_;
   Kokkos::deep_copy(host_rows_, rows_);
-  OverlapStat worst;
-  Kokkos::deep_copy(worst, worst_);
+  // Each specimen's largest overlap past its limit: the contacts the force kernel listed (rarely any), each to its
+  // specimen, the larger kept and ties to the later contact (MaxOverlap's rule).
+  std::vector<OverlapStat> worst(spec_.size());
+  int exceeded = 0;
+  Kokkos::deep_copy(exceeded, items_.exceeded_count);
+  if (exceeded > 0) {
+    auto listed = Kokkos::create_mirror_view_and_copy(
+        HostSpace(), Kokkos::subview(items_.exceeded, std::make_pair(0, exceeded)));
+    Kokkos::deep_copy(items_.exceeded_count, 0);
+    for (int k = 0; k < exceeded; ++k) {
+      const OverlapStat& o = listed(k);
+      const auto owner = std::upper_bound(contact_first_.begin(), contact_first_.end(), o.contact) - 1;
+      OverlapStat& w = worst[static_cast<std::size_t>(owner - contact_first_.begin())];
+      if (o.ratio > w.ratio || (o.ratio == w.ratio && o.contact > w.contact)) w = o;
+    }
+  }
   for (std::size_t s = 0; s < spec_.size(); ++s) {
     Specimen& sp = spec_[s];
     if (!sp.running) continue;
     sp.time += sp.prm.integ.dt;
     ++sp.steps;
     sp.wall_disp += speed[s] * sp.prm.integ.dt;
-    take_row(static_cast<int>(s), worst);
+    take_row(static_cast<int>(s), worst[s]);
   }
 }
 
@@ -295,16 +313,12 @@ void CellBatch::take_row(int s, const OverlapStat& worst) {
   sp.stats = step_stats(row);
   const long step = sp.steps - 1;
   std::string why;
-  // The largest overlap of all the specimens' contacts is this specimen's own where it lies among its contacts
-  // (the same contact, ties going to the later one in both). A specimen whose overlap passed its limit in the same
-  // step as another's larger one is stopped at its next step, if it still does.
-  const bool mine = worst.contact >= contact_first_[s] && worst.contact < contact_first_[s + 1];
   auto gid_of = [&](int i) {
     auto g = Kokkos::create_mirror_view_and_copy(HostSpace(), Kokkos::subview(p_.gid, std::make_pair(i, i + 1)));
     return g(0) - static_cast<std::uint32_t>(sp.first);
   };
   const Real limit = sp.prm.overlap_limit;
-  if (mine && worst.ratio > limit) {
+  if (worst.contact >= 0 && worst.ratio > limit) {
     auto hi = Kokkos::create_mirror_view_and_copy(
         HostSpace(), Kokkos::subview(balls_.i, std::make_pair(worst.contact, worst.contact + 1)));
     why = overlap_blowup(step, gid_of(hi(0)), false, worst.ratio, limit);

@@ -96,7 +96,8 @@ class CellBatch {
   SegmentedTree particle_tree_, contact_tree_;
   StepRowsView rows_;  ///< a row of Leapfrog values per specimen
   decltype(Kokkos::create_mirror_view(StepRowsView())) host_rows_;
-  Kokkos::View<OverlapStat, MemSpace> worst_;
+  Kokkos::View<OverlapStat, MemSpace> worst_;  ///< the force kernel's largest overlap of all, not read: see exceeded
+  Kokkos::View<OverlapStat*, MemSpace> exceeded_buf_;  ///< room for ContactItems::exceeded
   long batch_steps_ = 0, rebuild_steps_ = 0;
   mutable bool dirty_ = true;  ///< the host's specimen table differs from the device's (upload)
   Kokkos::View<Real**, Kokkos::LayoutRight, MemSpace> sums_;  ///< the per-specimen sums' roots, S x 3
@@ -116,7 +117,8 @@ class CellBatch {
   void rebuild(const std::vector<char>& due);
   /// The work items and trees of the running specimens' particles and contacts.
   void plan();
-  /// Specimen s's statistics after a step: its blow-up checks (it stops on one), and its cell's travel.
+  /// Specimen s's statistics after a step: its blow-up checks (it stops on one; `worst`: its largest overlap past
+  /// its limit, if any), and its cell's travel.
   void take_row(int s, const OverlapStat& worst);
   /// The host's specimen table to the device, where it changed (a cache of the host's: so const).
   void upload() const;

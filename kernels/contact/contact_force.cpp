@@ -117,6 +117,14 @@ struct BallForce : MaxOverlap {
     }
     // A pack whose largest ratio is below the worst so far cannot change it (ties go to the later contact).
     const T ratio = select(touching, overlap / kc::min(ri, rj), T(0));
+    if (items.specimens > 0 && max_lane(ratio) > specimen.overlap_limit) {
+      TRIAXDEM_UNROLL_LANES
+      for (int k = 0; k < W; ++k) {
+        if (k == lanes) break;
+        if (!lane(touching, k) || !(lane(ratio, k) > specimen.overlap_limit)) continue;
+        items.exceeded(Kokkos::atomic_fetch_add(&items.exceeded_count(), 1)) = value_type{lane(ratio, k), s0 + k};
+      }
+    }
     if (max_lane(ratio) < worst.ratio) return;
     TRIAXDEM_UNROLL_LANES
     for (int k = 0; k < W; ++k) {

@@ -22,6 +22,10 @@ struct ContactItems {
   IndexView contact_first, item_first;
   int specimens = 0;
   int items = 0;
+  /// Every contact whose overlap passed its specimen's limit this step, `exceeded_count()` of them: each specimen's
+  /// largest (ties to the later contact, as the one-specimen reduction) is its blow-up, whatever the others'.
+  Kokkos::View<OverlapStat*, MemSpace> exceeded;
+  Kokkos::View<int, MemSpace> exceeded_count;
 };
 /// The same forces for the specimens of a batch at once: each contact with its specimen's cell, time step and
 /// row of the material-pair table (SpecimenParams), bit for bit what the specimen gets alone.

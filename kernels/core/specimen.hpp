@@ -27,6 +27,7 @@ struct SpecimenParams {
   IntegrateParams integ;
   int first = 0, count = 0;  ///< its particles [first, first + count)
   int material_row = 0;      ///< its materials' first row of the material-pair table
+  Real overlap_limit = 0;    ///< overlap / radius past which a contact is a blow-up (listed by a batch's force kernel)
 };
 using SpecimenParamsView = Kokkos::View<SpecimenParams*, MemSpace>;
 
