@@ -250,7 +250,8 @@ void CellBatch::step(const std::vector<char>& measure) {
   }
   upload();
   // Each specimen's rebuild, decided as its Simulation decides it (Simulation::lists_expired, read every step).
-  std::vector<char> due(spec_.size(), 0);
+  std::vector<char>& due = due_;
+  due.assign(spec_.size(), 0);
   bool any = false;
   for (std::size_t s = 0; s < spec_.size(); ++s) {
     const Specimen& sp = spec_[s];
@@ -265,7 +266,8 @@ void CellBatch::step(const std::vector<char>& measure) {
   // The cells' stretch, on the device and on the host alike (Simulation::move_boundaries).
   auto& hon = host_stretching_;
   bool stretch = false;
-  std::vector<Real> speed(spec_.size(), 0);
+  std::vector<Real>& speed = speed_;
+  speed.assign(spec_.size(), 0);
   for (std::size_t s = 0; s < spec_.size(); ++s) {
     Specimen& sp = spec_[s];
     hon(s) = sp.running && stretching(sp.prm.domain);
@@ -283,7 +285,8 @@ void CellBatch::step(const std::vector<char>& measure) {
   Kokkos::deep_copy(host_rows_, rows_);
   // Each specimen's largest overlap past its limit: the contacts the force kernel listed (rarely any), each to its
   // specimen, the larger kept and ties to the later contact (MaxOverlap's rule).
-  std::vector<OverlapStat> worst(spec_.size());
+  std::vector<OverlapStat>& worst = worst_of_;
+  worst.assign(spec_.size(), OverlapStat());
   int exceeded = 0;
   Kokkos::deep_copy(exceeded, items_.exceeded_count);
   if (exceeded > 0) {
@@ -344,34 +347,31 @@ std::vector<std::array<Real, NV>> CellBatch::contact_sums(const char* label, con
   return out;
 }
 
-const std::vector<std::array<Real, 3>>& CellBatch::contact_stress_diagonals() const {
-  if (stress_at_ == batch_steps_) return stress_;
-  stress_.assign(spec_.size(), {});
-  stress_at_ = batch_steps_;
-  if (fresh_) return stress_;
+template <class F>
+const std::vector<std::array<Real, 3>>& CellBatch::per_volume(const char* label, const F& f,
+                                                              std::vector<std::array<Real, 3>>& cache,
+                                                              long& at) const {
+  if (at == batch_steps_) return cache;
+  cache.assign(spec_.size(), {});
+  at = batch_steps_;
+  if (fresh_) return cache;
   upload();  // the cells as they are now: a step stretched them after its upload
-  stress_ = contact_sums<3>("dem::batch::contact_stress_diagonal",
-                            LoveWeberDiagonal{balls_, p_.x, p_.specimen, dev_spec_});
+  cache = contact_sums<3>(label, f);
   for (std::size_t s = 0; s < spec_.size(); ++s) {
     const Real V = spec_[s].prm.domain.volume();
-    for (Real& x : stress_[s]) x /= V;
+    for (Real& x : cache[s]) x /= V;
   }
-  return stress_;
+  return cache;
+}
+
+const std::vector<std::array<Real, 3>>& CellBatch::contact_stress_diagonals() const {
+  return per_volume("dem::batch::contact_stress_diagonal", LoveWeberDiagonal{balls_, p_.x, p_.specimen, dev_spec_},
+                    stress_, stress_at_);
 }
 
 const std::vector<std::array<Real, 3>>& CellBatch::cell_stiffnesses() const {
-  if (stiffness_at_ == batch_steps_) return stiffness_;
-  stiffness_.assign(spec_.size(), {});
-  stiffness_at_ = batch_steps_;
-  if (fresh_) return stiffness_;
-  upload();
-  stiffness_ = contact_sums<3>("dem::batch::cell_stiffness",
-                               StiffnessSums{balls_, p_.x, p_.radius, p_.specimen, dev_spec_});
-  for (std::size_t s = 0; s < spec_.size(); ++s) {
-    const Real V = spec_[s].prm.domain.volume();
-    for (Real& x : stiffness_[s]) x /= V;
-  }
-  return stiffness_;
+  return per_volume("dem::batch::cell_stiffness", StiffnessSums{balls_, p_.x, p_.radius, p_.specimen, dev_spec_},
+                    stiffness_, stiffness_at_);
 }
 
 Real CellBatch::unbalanced_ratio(int s) const {

@@ -105,6 +105,16 @@ class CellBatch {
   /// Each specimen's NV sums of f over its contacts (the contact tree), to the host: one launch per level, one copy.
   template <int NV, class F>
   std::vector<std::array<Real, NV>> contact_sums(const char* label, const F& f) const;
+  /// Each specimen's three sums of f over its contacts, over its cell's volume, kept in `cache` until the next step
+  /// (`at`: the batch step they were taken after).
+  template <class F>
+  const std::vector<std::array<Real, 3>>& per_volume(const char* label, const F& f,
+                                                     std::vector<std::array<Real, 3>>& cache, long& at) const;
+  /// A step's host scratch, kept so that a step allocates nothing on the host either: each specimen's rebuild
+  /// flag, its cell's travel speed, its largest overlap past its limit.
+  std::vector<char> due_;
+  std::vector<Real> speed_;
+  std::vector<OverlapStat> worst_of_;
   /// The per-specimen sums of the last step, and the batch step they were taken after (-1: none).
   mutable std::vector<std::array<Real, 3>> stress_, stiffness_;
   mutable std::vector<std::array<Real, 2>> force_sums_;  ///< sum |f| and touching count of the ball-ball contacts
