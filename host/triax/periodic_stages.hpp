@@ -1,0 +1,102 @@
+#pragma once
+/// The periodic test's stages as objects on a cell (host/triax/cell_control.hpp), so that one Simulation
+/// (periodic_triaxial.cpp, through run_stage) and a batch of them (periodic_batch.cpp) step the same code.
+/// Internal to host/triax/.
+#include <array>
+#include <string>
+#include <vector>
+
+#include "host/engine/stage_loop.hpp"
+#include "host/triax/cell_control.hpp"
+#include "host/triax/periodic_triaxial.hpp"
+#include "host/util/progress.hpp"
+
+namespace dem {
+
+/// Mean diameter (m), effective density (kg/m^3, x mass_scale) and solid volume (m^3) of the balls.
+struct GrainScales {
+  Real d = 0, rho_eff = 0, v_solid = 0;
+};
+
+GrainScales grain_scales(Simulation& sim);
+
+/// The result's parameters and grain figures before the test (`g` receives these), and its first line when verbose.
+PeriodicTriaxialResult start_result(Simulation& sim, const PeriodicTriaxialParams& prm, GrainScales& g);
+
+/// The strain-rate servo of the cell: each call measures the contact stress and sets the next step's rates.
+class CellServo {
+ public:
+  CellServo(const PeriodicTriaxialParams& prm, Real max_rate) : prm_(prm), max_rate_(max_rate) {}
+
+  /// servo[d]: axis d is servoed to target[d] (Pa); otherwise its rate is fixed[d] (1/s, extension positive).
+  void update(CellControl& cell, const bool servo[3], const Real fixed[3], const Real target[3]);
+
+ private:
+  PeriodicTriaxialParams prm_;
+  Real max_rate_;
+  long calls_ = 0;
+  std::array<Real, 3> k_{};
+  std::array<Real, 3> stress_{};
+};
+
+/// Stage (a), isotropic consolidation, on a cell: its servo, its progress line, and the state it reached.
+class Consolidation {
+ public:
+  Consolidation(CellControl& cell, const PeriodicTriaxialParams& prm);
+
+  StageSteps steps();
+  /// After the stage: the cell's rates zeroed; "" where it converged, else why not (the error's message).
+  std::string end(StageEnd& e);
+
+ private:
+  CellControl& cell_;
+  PeriodicTriaxialParams prm_;
+  CellServo servo_;
+  Progress progress_;
+  Real err_ = 0, ratio_ = 1;
+  std::array<Real, 3> s_{};
+};
+
+/// Snapshots at the configured axial strains within the test, each written once, when the strain first reaches it
+/// (several passed in one step give one snapshot, labelled with the largest). None without an output.
+class SnapshotSchedule {
+ public:
+  SnapshotSchedule(const PeriodicTriaxialParams& prm, Simulation* sim, io::Output* out);
+  /// The cell is at axial strain eps.
+  void at(Real eps);
+
+ private:
+  Simulation* sim_;
+  io::Output* out_;
+  std::vector<Real> strains_;
+  std::size_t next_ = 0;
+};
+
+/// Stage (b), drained shear, on a consolidated cell: the servo of the lateral axes, the records, the snapshots.
+/// Constructed at the stage's start: records the first row. `out` and `sim` (for the snapshots) may be null.
+class Shear {
+ public:
+  Shear(CellControl& cell, PeriodicTriaxialResult& res, const GrainScales& g, io::Output* out, Simulation* sim);
+
+  StageSteps steps();
+  /// After the stage: its timing named, the cell's rates zeroed, the series flushed, the result summarised.
+  void end(StageTiming timing, double wall_seconds);
+
+ private:
+  CellControl& cell_;
+  PeriodicTriaxialResult& res_;
+  const PeriodicTriaxialParams& prm_;
+  GrainScales g_;
+  io::Output* out_;
+  SnapshotSchedule snapshots_;
+  CellServo servo_;
+  long total_;
+  Progress progress_;
+  Real next_record_;
+  bool last_ = false;  // the step ends the test
+  std::array<Real, 3> L0_{};
+
+  void record();
+};
+
+}  // namespace dem
