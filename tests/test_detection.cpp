@@ -129,7 +129,7 @@ void check_against_oracle(const Packing& pk) {
   bin_particles(p, pk.dom, 2 * rmax + pk.skin, pk.skin, cells);  // the cut-off Simulation uses
   const std::vector<std::uint64_t> pairs = to_vector(detect_pairs(p, cells));
   FacetBins fb;
-  if (mesh.ntri > 0) fb = bin_facets(mesh, cells.grid, rmax + pk.skin);
+  if (mesh.ntri > 0) fb = bin_facets(mesh, cells.grid, rmax + pk.skin, fb);
   const std::vector<std::uint64_t> wpairs = to_vector(detect_wall_pairs(p, walls, mesh, fb, cells, pk.skin));
 
   // Oracle, from the binned (wrapped) positions by gid.

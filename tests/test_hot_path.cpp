@@ -125,10 +125,12 @@ TEST(HotPath, StatisticsReadEvery16StepsGiveTheSameStepsWithFewerWaits) {
     EXPECT_EQ(a.parts.rebuilds, b.parts.rebuilds) << a.name;
     EXPECT_EQ(b.parts.late_rebuilds, 0) << a.name;
     EXPECT_EQ(part_of(b, SyncPart::kStep).allocations, 0) << a.name;
-    // A rebuild reuses the binning's, the permutation's and the adjacency's buffers (kernels/core/buffers.hpp): 57-59
-    // allocations a rebuild before, about 31 now (the detection's, the key sort's and the new contact lists').
+    // A rebuild reuses the binning's, the permutation's, the adjacency's, the search's and the contact lists' buffers
+    // (kernels/core/buffers.hpp, ListBuffers): it allocates only where a buffer grows, by a quarter at a time, as the
+    // contacts of the layers and of a cell compressed from a gas grow (1-5 a rebuild, 0.3 in the membrane's shear).
+    // A list made afresh at each rebuild is 24 more, and the rest of the old way 57-59.
     if (b.parts.rebuilds >= 10)
-      EXPECT_LE(double(part_of(b, SyncPart::kRebuild).allocations) / double(b.parts.rebuilds), 33.0) << a.name;
+      EXPECT_LE(double(part_of(b, SyncPart::kRebuild).allocations) / double(b.parts.rebuilds), 6.0) << a.name;
     // Read every step: two copies a step. Every 16: two copies in 16 steps, and the reads the rebuilds ask for.
     EXPECT_NEAR(step_waits(a), 2.0, 0.01) << a.name;
     EXPECT_LT(step_waits(b), 0.25) << a.name;

@@ -200,7 +200,7 @@ void CellBatch::rebuild(const std::vector<char>& due) {
   }
   bin_specimens(p_, bins, cells_);
   gid_to_local(p_, g2l_);
-  balls_ = remap_history(detect_pairs(p_, cells_, balls_.key, own_), balls_, g2l_, true);
+  balls_ = remap_history(detect_pairs(p_, cells_, balls_.key, own_, &ball_bufs_), balls_, g2l_, true, &ball_bufs_);
   owner_ranges(p_, balls_, own_);
   build_adjacency(p_.n, balls_, balls_.j, adj_balls_);
   mark_rebuilt(p_, cells_.specimens);

@@ -88,6 +88,7 @@ class CellBatch {
   mutable decltype(Kokkos::create_mirror_view(SpecimenParamsView())) host_spec_;
   CellList cells_;
   ContactList balls_, walls_;
+  ListBuffers ball_bufs_;
   Index2View own_;
   IndexView g2l_;
   Adjacency adj_balls_, adj_walls_;

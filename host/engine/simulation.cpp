@@ -129,10 +129,11 @@ void Simulation::rebuild() {
   bin_particles(p_, prm_.domain, 2 * rmax_ + prm_.skin, prm_.skin, cells_);
   gid_to_local(p_, g2l_);
   const IndexView g2l = g2l_;
-  balls_ = remap_history(detect_pairs(p_, cells_), balls_, g2l, true);
+  balls_ = remap_history(detect_pairs(p_, cells_, {}, {}, &ball_bufs_), balls_, g2l, true, &ball_bufs_);
   FacetBins fb;
-  if (mesh_.ntri > 0) fb = bin_facets(mesh_, cells_.grid, rmax_ + prm_.skin);
-  wall_c_ = remap_history(detect_wall_pairs(p_, walls_, mesh_, fb, cells_, prm_.skin), wall_c_, g2l, false);
+  if (mesh_.ntri > 0) fb = bin_facets(mesh_, cells_.grid, rmax_ + prm_.skin, facet_bins_);
+  wall_c_ = remap_history(detect_wall_pairs(p_, walls_, mesh_, fb, cells_, prm_.skin, &wall_bufs_), wall_c_, g2l,
+                          false, &wall_bufs_);
   index_contacts();
   Kokkos::deep_copy(p_.x_ref, p_.x);
   wall_disp_ = 0;

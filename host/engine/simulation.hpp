@@ -182,6 +182,8 @@ class Simulation {
   SimParams prm_;
   CellList cells_;
   ContactList balls_, wall_c_;
+  ListBuffers ball_bufs_, wall_bufs_;
+  FacetBins facet_bins_;
   Adjacency adj_balls_, adj_walls_;
   Index2View own_;
   IndexView obj_offsets_, g2l_;

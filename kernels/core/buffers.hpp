@@ -18,6 +18,16 @@ View room(View& buffer, std::size_t n, const char* label) {
   return Kokkos::subview(buffer, std::make_pair(std::size_t(0), n));
 }
 
+/// A buffer of fixed extents past the first (as Vec3View) with at least n rows, grown as room grows, and returned
+/// whole: a range of rows of a LayoutLeft View (a GPU's) is not a View of the same layout. Rows n and after are
+/// spare room.
+template <class View>
+View room_rows(View& buffer, std::size_t n, const char* label) {
+  static_assert(View::rank == 2, "a buffer of rows");
+  if (buffer.extent(0) < n) buffer = View(Kokkos::view_alloc(Kokkos::WithoutInitializing, std::string(label)), n + n / 4 + 16);
+  return buffer;
+}
+
 /// `kept`, of exactly n rows: reallocated only where its row count differs (any rank; a View of fixed extents past
 /// the first, as Vec3View).
 template <class View>

@@ -3,18 +3,12 @@
 #include <algorithm>
 #include <vector>
 
+#include "kernels/core/buffers.hpp"
 #include "kernels/core/reduce.hpp"
 
 namespace dem {
 
 namespace {
-
-/// Exclusive scan of per-particle counts into offsets (n + 1 entries); returns the total.
-int scan_counts(const IndexView& count, IndexView& offset) {
-  const int n = static_cast<int>(count.extent(0));
-  offset = IndexView("dem::detect::offset", n + 1);
-  return exclusive_scan("dem::detect::scan", count, offset, n);
-}
 
 /// The count and fill passes shared by the searches. Derived provides visit(i, f), calling f(key) for each
 /// candidate of particle i.
@@ -112,12 +106,17 @@ struct WallSearch : CountFill<WallSearch> {
   }
 };
 
+/// Counts each particle's candidates, scans the counts into offsets, fills the keys (into the buffers' next set)
+/// and sorts them.
 template <class Search>
-PairKeyView run_search(Search s, int n, const char* label) {
-  s.count = IndexView("dem::detect::count", n);
+PairKeyView run_search(Search s, int n, const char* label, ListBuffers* buffers) {
+  ListBuffers own;
+  ListBuffers& b = buffers ? *buffers : own;
+  s.count = room(b.count, n, "dem::detect::count");
   Kokkos::parallel_for(label, Kokkos::RangePolicy<ExecSpace, typename Search::TagCount>(0, n), s);
-  const int total = scan_counts(s.count, s.offset);
-  s.keys = PairKeyView("dem::detect::keys", total);
+  s.offset = room(b.offset, n + 1, "dem::detect::offset");
+  const int total = exclusive_scan("dem::detect::scan", s.count, s.offset, n);
+  s.keys = room(b.set[b.next].key, total, "dem::detect::keys");
   Kokkos::parallel_for(label, Kokkos::RangePolicy<ExecSpace, typename Search::TagFill>(0, n), s);
   sort_keys(s.keys);
   return s.keys;
@@ -125,7 +124,7 @@ PairKeyView run_search(Search s, int n, const char* label) {
 
 }  // namespace
 
-FacetBins bin_facets(const FacetMesh& mesh, const CellGrid& g, Real reach) {
+FacetBins bin_facets(const FacetMesh& mesh, const CellGrid& g, Real reach, FacetBins& kept) {
   const int nc = g.ncell();
   auto hx = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.node_x);
   auto ht = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.tri);
@@ -149,7 +148,8 @@ FacetBins bin_facets(const FacetMesh& mesh, const CellGrid& g, Real reach) {
         for (int cx = lo[0]; cx <= hi[0]; ++cx) entries.emplace_back(g.index(cx, cy, cz), t);
   }
   std::sort(entries.begin(), entries.end());
-  FacetBins b{IndexView("dem::detect::facet_start", nc + 1), IndexView("dem::detect::facet", entries.size())};
+  FacetBins b{room(kept.start, nc + 1, "dem::detect::facet_start"),
+              room(kept.facet, entries.size(), "dem::detect::facet")};
   auto hs = Kokkos::create_mirror_view(b.start);
   auto hf = Kokkos::create_mirror_view(b.facet);
   std::size_t k = 0;
@@ -163,19 +163,19 @@ FacetBins bin_facets(const FacetMesh& mesh, const CellGrid& g, Real reach) {
 }
 
 PairKeyView detect_pairs(const Particles& p, const CellList& cells, const PairKeyView& kept,
-                         const Index2View& kept_own) {
+                         const Index2View& kept_own, ListBuffers* buffers) {
   PairSearch s;
   s.x = p.x; s.radius = p.radius; s.gid = p.gid; s.owner = p.specimen; s.cell_start = cells.cell_start;
   s.specimens = cells.specimens; s.kept = kept; s.kept_own = kept_own;
-  return run_search(s, p.n, "dem::detect::pairs");
+  return run_search(s, p.n, "dem::detect::pairs", buffers);
 }
 
 PairKeyView detect_wall_pairs(const Particles& p, const WallSet& walls, const FacetMesh& mesh,
-                              const FacetBins& bins, const CellList& cells, Real skin) {
+                              const FacetBins& bins, const CellList& cells, Real skin, ListBuffers* buffers) {
   WallSearch s;
   s.x = p.x; s.radius = p.radius; s.gid = p.gid; s.walls = walls; s.mesh = mesh;
   s.fstart = bins.start; s.ffacet = bins.facet; s.g = cells.grid; s.skin = skin;
-  return run_search(s, p.n, "dem::detect::walls");
+  return run_search(s, p.n, "dem::detect::walls", buffers);
 }
 
 }  // namespace dem

@@ -14,18 +14,21 @@ struct FacetBins {
   IndexView facet;
 };
 
-/// Bins the mesh's facets into the cells of `grid` (on the host: a membrane has a few thousand facets).
-FacetBins bin_facets(const FacetMesh& mesh, const CellGrid& grid, Real reach);
+/// Bins the mesh's facets into the cells of `grid` (on the host: a membrane has a few thousand facets), into the
+/// first entries of `kept`'s Views (grown where short: room).
+FacetBins bin_facets(const FacetMesh& mesh, const CellGrid& grid, Real reach, FacetBins& kept);
 
 /// Keys of all ball-ball pairs whose centres are closer than r_i + r_j + skin, sorted: the cells' specimens' pairs,
 /// each in its cell with its skin. A specimen that is not rebuilt keeps its keys of the list `kept`, whose owner
-/// ranges for the particles' present order are `kept_own` (owner_ranges).
+/// ranges for the particles' present order are `kept_own` (owner_ranges). With `buffers`, the search's scratch and
+/// the keys are those of the list's rebuilds (ListBuffers), for remap_history with the same buffers.
 PairKeyView detect_pairs(const Particles& p, const CellList& cells, const PairKeyView& kept = PairKeyView(),
-                         const Index2View& kept_own = Index2View());
+                         const Index2View& kept_own = Index2View(), ListBuffers* buffers = nullptr);
 
-/// Keys of all ball-wall pairs (analytic walls, then facets as objects walls.n + f) within skin, sorted.
+/// Keys of all ball-wall pairs (analytic walls, then facets as objects walls.n + f) within skin, sorted; `buffers`
+/// as detect_pairs.
 PairKeyView detect_wall_pairs(const Particles& p, const WallSet& walls, const FacetMesh& mesh,
-                              const FacetBins& bins, const CellList& cells, Real skin);
+                              const FacetBins& bins, const CellList& cells, Real skin, ListBuffers* buffers = nullptr);
 
 /// Centre-to-surface distance of a ball to facet f (closest point on the triangle).
 KOKKOS_INLINE_FUNCTION FacetHit facet_hit(const FacetMesh& mesh, int f, const Vec3& x) {

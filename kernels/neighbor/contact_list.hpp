@@ -57,4 +57,16 @@ struct ContactList {
   explicit ContactList(int count);
 };
 
+/// What a contact list's rebuild keeps for the next one, so that a rebuild after the first few allocates nothing:
+/// the search's counts and offsets, and two sets of the list's arrays with room to spare. The search writes its keys
+/// and the remap the new list into the set the present list does not use (both read the present list meanwhile),
+/// and the new list then takes that set: a list older than the present one must not be kept past a rebuild.
+/// The arrays of 3-vectors of a list made here have more rows than contacts (room_rows); those of one value a row
+/// have exactly n.
+struct ListBuffers {
+  IndexView count, offset;
+  ContactList set[2];
+  int next = 0;  ///< the set the next list is written into
+};
+
 }  // namespace dem

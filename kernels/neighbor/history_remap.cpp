@@ -18,10 +18,32 @@ void gid_to_local(const Particles& p, IndexView& map_out) {
   Kokkos::parallel_for("dem::remap::gid2local", RangePolicy(0, p.n), KOKKOS_LAMBDA(const int i) { map(gid(i)) = i; });
 }
 
+namespace {
+
+/// A list of n contacts over the arrays of `set`, grown where short.
+ContactList list_in(ContactList& set, int n) {
+  ContactList c;
+  c.n = n;
+  c.i = room(set.i, n, "dem::contacts::i");
+  c.j = room(set.j, n, "dem::contacts::j");
+  c.fs = room_rows(set.fs, n, "dem::contacts::fs");
+  c.mr = room_rows(set.mr, n, "dem::contacts::mr");
+  c.flags = room(set.flags, n, "dem::contacts::flags");
+  c.fc = room_rows(set.fc, n, "dem::contacts::fc");
+  c.mo = room_rows(set.mo, n, "dem::contacts::mo");
+  c.mt = room_rows(set.mt, n, "dem::contacts::mt");
+  c.fn = room(set.fn, n, "dem::contacts::fn");
+  for (int s = 0; s < kHistorySlots; ++s) c.slot[s] = room(set.slot[s], n, "dem::contacts::slot");
+  return c;
+}
+
+}  // namespace
+
 ContactList remap_history(const PairKeyView& keys, const ContactList& old, const IndexView& gid2local,
-                          bool ball_ball) {
+                          bool ball_ball, ListBuffers* buffers) {
   const int n = static_cast<int>(keys.extent(0));
-  ContactList c(n);
+  ContactList c = buffers ? list_in(buffers->set[buffers->next], n) : ContactList(n);
+  if (buffers) buffers->next = 1 - buffers->next;
   c.key = keys;
   const int nold = old.n;
   auto okey = old.key;

@@ -13,8 +13,10 @@ IndexView gid_to_local(const Particles& p);
 /// The same into `map`, reused where it has the gids' bound of entries.
 void gid_to_local(const Particles& p, IndexView& map);
 
-/// A contact list over `keys` with local indices resolved through gid2local and history from `old`.
+/// A contact list over `keys` with local indices resolved through gid2local and history from `old`. With `buffers`
+/// (those the keys were found with), the list is written into their next set, which it then takes; `old` must be
+/// the buffers' present list or none of theirs.
 ContactList remap_history(const PairKeyView& keys, const ContactList& old, const IndexView& gid2local,
-                          bool ball_ball);
+                          bool ball_ball, ListBuffers* buffers = nullptr);
 
 }  // namespace dem
