@@ -1,9 +1,10 @@
 // Periodic cells stepped side by side (host/engine/cell_batch.hpp): each specimen's steps bit for bit those of its
 // own Simulation, whatever the others do (other sizes, laws, rates, a stop, a blow-up). Specimens of 100-140 balls
 // of 2 mm from a gas (solid fraction 0.1), compressed at fixed strain rates through first contact into a dense
-// packing and then sheared: the neighbour lists are rebuilt dozens of times, at other steps in each specimen.
+// packing and then sheared: the neighbour lists are rebuilt dozens of times, at other steps in each specimen alone.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <memory>
@@ -91,7 +92,8 @@ void expect_same(const Outcome& want, const CellBatch& batch, int s, const std::
   EXPECT_TRUE(same_bits(got.x, want.balls.x)) << "specimen " << s << ": positions";
   EXPECT_TRUE(same_bits(got.v, want.balls.v)) << "specimen " << s << ": velocities";
   EXPECT_TRUE(same_bits(got.w, want.balls.w)) << "specimen " << s << ": spins";
-  EXPECT_EQ(batch.rebuilds(s), want.rebuilds) << "specimen " << s;
+  // Rebuilt with the others when one is due: as often as the fastest alone, which changes no bit.
+  if (batch.running(s)) EXPECT_GE(batch.rebuilds(s), want.rebuilds) << "specimen " << s;
   EXPECT_EQ(batch.blowup(s), want.blowup) << "specimen " << s;
   if (want.blowup.empty()) {
     EXPECT_EQ(batch.step_count(s), want.steps) << "specimen " << s;
@@ -121,8 +123,10 @@ TEST(CellBatch, EachSpecimenStepsBitForBitAsItsOwnSimulation) {
     batch.step(measure);
   }
   const auto stress = batch.contact_stress_diagonals();
+  std::vector<long> alone_rebuilds;
   for (int s = 0; s < batch.size(); ++s) {
     const Outcome want = alone(kRecipes[s], kSteps);
+    alone_rebuilds.push_back(want.rebuilds);
     ASSERT_TRUE(want.blowup.empty()) << want.blowup;
     // The program makes a packing that carries load (0.4-3 kPa axially) and rebuilds the lists many times.
     EXPECT_GT(want.stress[2], 100) << "specimen " << s;
@@ -130,8 +134,9 @@ TEST(CellBatch, EachSpecimenStepsBitForBitAsItsOwnSimulation) {
     expect_same(want, batch, s, stress[s]);
     EXPECT_TRUE(batch.running(s));
   }
-  // Rebuilt at other steps: each specimen's lists are its own.
-  EXPECT_FALSE(batch.rebuilds(0) == batch.rebuilds(1) && batch.rebuilds(1) == batch.rebuilds(2));
+  // Rebuilt together, and at other steps than some of them alone.
+  for (int s = 0; s < batch.size(); ++s) EXPECT_EQ(batch.rebuilds(s), batch.rebuild_steps()) << "specimen " << s;
+  EXPECT_GT(batch.rebuild_steps(), *std::min_element(alone_rebuilds.begin(), alone_rebuilds.end()));
 }
 
 // A specimen stopped part way keeps its state; two alike whose time step is five times too large blow up at the same

@@ -14,6 +14,8 @@
 #include <vector>
 
 #include "host/engine/builder.hpp"
+#include "host/engine/packing.hpp"
+#include "host/triax/periodic_triaxial.hpp"
 #include "host/triax/micro_report.hpp"
 #include "host/engine/simulation.hpp"
 #include "host/triax/triaxial.hpp"
@@ -238,4 +240,71 @@ TEST(Determinism, TriaxialJobSameBitsForOneAndTwoThreads) {
   EXPECT_EQ(one.touching, two.touching);
   EXPECT_EQ(one.rebuilds, two.rebuilds) << "time steps";
   EXPECT_EQ(one.hash, two.hash) << std::hex << "1 thread: " << one.hash << ", 2 threads: " << two.hash;
+}
+
+// A run's bits do not depend on when its neighbour lists were rebuilt, so a batch may rebuild all its cells when one
+// is due: the sums over particles go in gid order and those over contacts per owner in key order, past the open
+// candidates the skin adds (contact_sums.hpp, Leapfrog), and positions are wrapped into a periodic cell at every step,
+// not at a rebuild (step_wrap). Each test runs the same job with the default skin (0.2 mean diameters) and a quarter
+// of it, and fails if either did not rebuild several times as often, or if any bit of what they give differs.
+namespace {
+
+long rebuilds(const std::vector<StageTiming>& stages) {
+  long n = 0;
+  for (const StageTiming& t : stages) n += t.parts.rebuilds;
+  return n;
+}
+
+PeriodicTriaxialResult tiny_periodic_test(Real skin, HostParticles& balls) {
+  Config cfg = test::tiny_cell_config();
+  cfg.solver.skin = skin;
+  auto sim = make_periodic_simulation(make_packing(cfg), cfg.box.size, cfg.ball.base(), cfg.solver);
+  PeriodicTriaxialParams prm = cfg.periodic.triax;
+  prm.verbose = false;
+  const PeriodicTriaxialResult r = run_periodic_triaxial(*sim, prm);
+  balls = to_host_by_gid(sim->particles());
+  return r;
+}
+
+bool same_bits(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(Vec3)) == 0;
+}
+
+}  // namespace
+
+// The tiny periodic test: from a gas through the servoed consolidation and the shear to 1%.
+TEST(RebuildTiming, ASmallerSkinGivesAPeriodicTestsBits) {
+  HostParticles wide_balls, narrow_balls;
+  const PeriodicTriaxialResult wide = tiny_periodic_test(0.2, wide_balls), narrow = tiny_periodic_test(0.05, narrow_balls);
+  std::printf("rebuilds: %ld with the skin 0.2 d, %ld with 0.05 d\n", rebuilds(wide.stages), rebuilds(narrow.stages));
+  EXPECT_GT(rebuilds(narrow.stages), 2 * rebuilds(wide.stages));
+  EXPECT_EQ(narrow.consolidation_steps, wide.consolidation_steps);
+  ASSERT_EQ(narrow.series.size(), wide.series.size());
+  ASSERT_GT(wide.series.size(), 5u);
+  for (std::size_t k = 0; k < wide.series.size(); ++k)
+    EXPECT_EQ(std::memcmp(&narrow.series[k], &wide.series[k], sizeof(PeriodicTriaxialRecord)), 0)
+        << "record " << k << ": q " << narrow.series[k].q << " vs " << wide.series[k].q;
+  EXPECT_TRUE(same_bits(narrow_balls.x, wide_balls.x)) << "positions";
+  EXPECT_TRUE(same_bits(narrow_balls.v, wide_balls.v)) << "velocities";
+  EXPECT_TRUE(same_bits(narrow_balls.w, wide_balls.w)) << "spins";
+}
+
+// The tiny membrane test: layered specimen between platens, consolidation inside the membrane, shear to 1%.
+TEST(RebuildTiming, ASmallerSkinGivesAMembraneTestsBits) {
+  const auto run = [](Real skin) {
+    Config c = test::tiny_triaxial_config(0.3, 0.02);
+    c.triaxial.axial_strain_end = 0.01;
+    c.solver.skin = skin;
+    return run_triaxial(c, build_specimen(c, false), nullptr, false);
+  };
+  const TriaxialResult wide = run(0.2), narrow = run(0.05);
+  std::printf("rebuilds: %ld with the skin 0.2 d, %ld with 0.05 d\n", rebuilds(wide.stages), rebuilds(narrow.stages));
+  EXPECT_GT(rebuilds(narrow.stages), 2 * rebuilds(wide.stages));
+  EXPECT_EQ(narrow.steps, wide.steps);
+  ASSERT_EQ(narrow.records.size(), wide.records.size());
+  ASSERT_GT(wide.records.size(), 1u);
+  // Every field: the platens', the membrane's and the contacts' stresses (q_net summed over the balls by gid).
+  for (std::size_t k = 0; k < wide.records.size(); ++k)
+    EXPECT_EQ(std::memcmp(&narrow.records[k], &wide.records[k], sizeof(TriaxialRecord)), 0)
+        << "record " << k << ": q " << narrow.records[k].q << " vs " << wide.records[k].q;
 }

@@ -363,7 +363,7 @@ TEST(SimdLanes, LeapfrogLanesGiveTheScalarUpdatesBits) {
     for (int q = 3; q < 5; ++q) sums[q] = std::max(sums[q], vals[q]);
   }
   for (int q = 0; q < 3; ++q) sums[q] = test::tree_sum(summed[q]);
-  const StepStats st = integrate(p, prm, g);
+  const StepStats st = integrate(p, Domain(), prm, g);
   auto x1 = h(p.x), v1 = h(p.v), w1 = h(p.w), f1 = h(p.f), m1 = h(p.m);
   for (int i = 0; i < n; ++i) {
     ASSERT_TRUE(same_bits(load(f1, i), want[i].f) && same_bits(load(m1, i), want[i].m)) << "gather, particle " << i;

@@ -73,35 +73,6 @@ void stretch_specimens(const Particles& p, const SpecimenParamsView& spec, const
   });
 }
 
-/// The Love-Weber diagonal of each specimen's contacts (Simulation::contact_stress_diagonal's sums).
-struct LoveWeberDiagonal {
-  ContactList c;
-  ConstVec3View x;
-  ConstIndexView owner;
-  SpecimenParamsView spec;
-  KOKKOS_INLINE_FUNCTION void operator()(const int k, Real* v) const {
-    love_weber_terms<3>(c, k, x, MinImage(spec(owner(c.i(k))).dom), v);
-  }
-};
-
-/// Each specimen's servo stiffness sums (cell_stiffness's).
-struct StiffnessSums {
-  ContactList c;
-  ConstVec3View x;
-  ConstScalarView r;
-  ConstIndexView owner;
-  SpecimenParamsView spec;
-  KOKKOS_INLINE_FUNCTION void operator()(const int k, Real* v) const {
-    stiffness_terms(c, k, x, r, MinImage(spec(owner(c.i(k))).dom), v);
-  }
-};
-
-/// Each specimen's contact force sums (Simulation::unbalanced_ratio's): sum |f| and the touching contacts.
-struct ForceSums {
-  ContactList c;
-  KOKKOS_INLINE_FUNCTION void operator()(const int k, Real* v) const { force_terms(c, k, v); }
-};
-
 }  // namespace
 
 CellBatch::CellBatch(const std::vector<const Simulation*>& specimens) {
@@ -117,6 +88,9 @@ CellBatch::CellBatch(const std::vector<const Simulation*>& specimens) {
     if (sim.num_walls() > 0 || sim.mesh().ntri > 0) bad("it has walls or facets");
     if (sim.step_count() > 0) bad("it has taken steps already; a batch starts from specimens not yet stepped");
     if (!(sim.params().integ.dt > 0)) bad("its time step is not set");
+    // Its gids, moved up by its first particle, are its items of the trees of its sums (particle_tree_, owner_tree_).
+    if (sim.particles().gid_bound() != static_cast<std::uint32_t>(sim.particles().n))
+      bad("its ball ids are not 0 to n - 1");
     const int nmat = static_cast<int>(sim.contact_table().extent(0));
     if (s == 0) nmat_ = nmat;
     if (nmat != nmat_)
@@ -199,8 +173,8 @@ void CellBatch::rebuild(const std::vector<char>& due) {
     bins.push_back({sp.first, sp.count, sp.prm.domain, 2 * sp.rmax + sp.prm.skin, sp.prm.skin, due[s] != 0});
   }
   bin_specimens(p_, bins, cells_);
-  gid_to_local(p_, g2l_);
-  balls_ = remap_history(detect_pairs(p_, cells_, balls_.key, own_, &ball_bufs_), balls_, g2l_, true, &ball_bufs_);
+  integ_.renew(p_);
+  balls_ = remap_history(detect_pairs(p_, cells_, balls_.key, own_, &ball_bufs_), balls_, integ_.gid2local, true, &ball_bufs_);
   owner_ranges(p_, balls_, own_);
   build_adjacency(p_.n, balls_, balls_.j, adj_balls_);
   mark_rebuilt(p_, cells_.specimens);
@@ -218,19 +192,19 @@ void CellBatch::rebuild(const std::vector<char>& due) {
 }
 
 void CellBatch::plan() {
-  std::vector<std::pair<int, int>> particles, contacts;
+  std::vector<std::pair<int, int>> particles, gids;
   std::vector<int> item_first(spec_.size() + 1, 0);
   for (std::size_t s = 0; s < spec_.size(); ++s) {
     const Specimen& sp = spec_[s];
     const int c0 = contact_first_[s], c1 = contact_first_[s + 1];
     // A stopped specimen has no items: nothing of it is computed or moved.
     particles.emplace_back(sp.first, sp.running ? sp.first + sp.count : sp.first);
-    contacts.emplace_back(c0, c1);  // a stopped specimen's stress is that of its state
+    gids.emplace_back(sp.first, sp.first + sp.count);  // a stopped specimen's stress is that of its state
     const int items = sp.running ? (c1 - c0 + kContactLanes - 1) / kContactLanes : 0;
     item_first[s + 1] = item_first[s] + items;
   }
   particle_tree_.plan(particles);
-  contact_tree_.plan(contacts);
+  owner_tree_.plan(gids);
   items_.specimens = size();
   items_.items = item_first.back();
   items_.exceeded = room(exceeded_buf_, static_cast<std::size_t>(contact_first_.back()), "dem::batch::exceeded");
@@ -249,20 +223,22 @@ void CellBatch::step(const std::vector<char>& measure) {
     spec_[s].prm.integ.measure = m;
   }
   upload();
-  // Each specimen's rebuild, decided as its Simulation decides it (Simulation::lists_expired, read every step).
-  std::vector<char>& due = due_;
-  due.assign(spec_.size(), 0);
-  bool any = false;
-  for (std::size_t s = 0; s < spec_.size(); ++s) {
-    const Specimen& sp = spec_[s];
-    if (!sp.running) continue;
-    due[s] = fresh_ || lists_expired(sp.stats.max_disp2, sp.wall_disp, sp.prm.skin);
-    any = any || due[s];
+  // A specimen's lists expire as its Simulation's would (lists_expired, read every step). A rebuild changes no bit
+  // of a run (contact_sums.hpp, step_wrap), so every running specimen is rebuilt when one is due: their lists then
+  // expire together, at the pace of the fastest, where each on its own would have the batch rebuild at most steps.
+  bool any = fresh_;
+  for (const Specimen& sp : spec_)
+    any = any || (sp.running && lists_expired(sp.stats.max_disp2, sp.wall_disp, sp.prm.skin));
+  if (any) {
+    std::vector<char>& due = due_;
+    due.assign(spec_.size(), 0);
+    for (std::size_t s = 0; s < spec_.size(); ++s) due[s] = spec_[s].running;
+    rebuild(due);
   }
-  if (any) rebuild(due);
   compute_ball_forces(p_, balls_, params_, dev_spec_, items_, OverlapResultView(worst_.data()));
-  integrate_batch_to(p_, dev_spec_, particle_tree_, make_gather(balls_, own_, adj_balls_, walls_, adj_walls_),
-                     rows_.data(), Leapfrog::kValues);
+  integrate_batch_to(p_, dev_spec_, particle_tree_, make_gather(balls_, own_, adj_balls_, walls_, adj_walls_), integ_,
+                     rows_.data(), Leapfrog::kValues,
+                     measure.empty() || std::any_of(measure.begin(), measure.end(), [](char m) { return m != 0; }));
   // The cells' stretch, on the device and on the host alike (Simulation::move_boundaries).
   auto& hon = host_stretching_;
   bool stretch = false;
@@ -339,7 +315,7 @@ void CellBatch::take_row(int s, const OverlapStat& worst) {
 template <int NV, class F>
 std::vector<std::array<Real, NV>> CellBatch::contact_sums(const char* label, const F& f) const {
   static_assert(NV <= 3, "sums_ holds three values a specimen");
-  segmented_reduce_lanes_to<NV, 0, 1>(label, contact_tree_, OneAtATime<F, NV>{f}, sums_.data(), 3);
+  segmented_reduce_lanes_to<NV, 0, 1>(label, owner_tree_, OwnerSums<NV, F>{owners(), f}, sums_.data(), 3);
   Kokkos::deep_copy(host_sums_, sums_);
   std::vector<std::array<Real, NV>> out(spec_.size());
   for (std::size_t s = 0; s < spec_.size(); ++s)
@@ -365,13 +341,14 @@ const std::vector<std::array<Real, 3>>& CellBatch::per_volume(const char* label,
 }
 
 const std::vector<std::array<Real, 3>>& CellBatch::contact_stress_diagonals() const {
-  return per_volume("dem::batch::contact_stress_diagonal", LoveWeberDiagonal{balls_, p_.x, p_.specimen, dev_spec_},
-                    stress_, stress_at_);
+  return per_volume("dem::batch::contact_stress_diagonal",
+                    LoveWeberTerms<3, SpecimenImages>{p_.x, SpecimenImages{p_.specimen, dev_spec_}}, stress_, stress_at_);
 }
 
 const std::vector<std::array<Real, 3>>& CellBatch::cell_stiffnesses() const {
-  return per_volume("dem::batch::cell_stiffness", StiffnessSums{balls_, p_.x, p_.radius, p_.specimen, dev_spec_},
-                    stiffness_, stiffness_at_);
+  return per_volume("dem::batch::cell_stiffness",
+                    StiffnessTerms<SpecimenImages>{p_.x, p_.radius, SpecimenImages{p_.specimen, dev_spec_}}, stiffness_,
+                    stiffness_at_);
 }
 
 Real CellBatch::unbalanced_ratio(int s) const {
@@ -380,7 +357,7 @@ Real CellBatch::unbalanced_ratio(int s) const {
   if (force_sums_at_ != batch_steps_) {
     force_sums_.assign(spec_.size(), {});
     force_sums_at_ = batch_steps_;
-    if (!fresh_) force_sums_ = contact_sums<2>("dem::batch::contact_force_sum", ForceSums{balls_});
+    if (!fresh_) force_sums_ = contact_sums<2>("dem::batch::contact_force_sum", ForceTerms());
   }
   const std::array<Real, 2>& f = force_sums_[static_cast<std::size_t>(s)];
   if (f[1] == 0) return 1;

@@ -5,9 +5,9 @@
 /// Each specimen's steps are bit for bit those of its own Simulation:
 ///  - the kernels are the same, each work item with its specimen's cell, time step and laws (kernels/core/specimen.hpp);
 ///  - each specimen's sums are its own tree, as alone (segmented reductions, kernels/core/reduce.hpp);
-///  - each specimen's neighbour lists are rebuilt at the steps its own Simulation rebuilds them, by the same test,
-///    and the other specimens' particles and lists are kept as they are meanwhile (bin_specimens): the order of a
-///    specimen's particles and contacts, on which its sums' rounding depends, is the one it has alone.
+///  - a run's bits do not depend on when its neighbour lists are rebuilt (contact_sums.hpp, step_wrap), so all the
+///    running specimens are rebuilt together when one is due; a stopped one's particles and lists are kept as they
+///    are (bin_specimens).
 /// The statistics are read every step (stats_every 1), for every specimen in one copy.
 #include <array>
 #include <string>
@@ -49,9 +49,9 @@ class CellBatch {
   Real time(int s) const { return spec_.at(static_cast<std::size_t>(s)).time; }
   /// Specimen s's last step's statistics.
   const StepStats& stats(int s) const { return spec_.at(static_cast<std::size_t>(s)).stats; }
+  /// Rebuilds of specimen s's lists: every one of the batch's while it runs.
   long rebuilds(int s) const { return spec_.at(static_cast<std::size_t>(s)).rebuilds; }
-  /// Steps the batch has taken, and of them those with a rebuild (of any of its specimens: each costs a pass over
-  /// all the batch's particles and contacts).
+  /// Steps the batch has taken, and of them those with a rebuild.
   long steps() const { return batch_steps_; }
   long rebuild_steps() const { return rebuild_steps_; }
   /// Every specimen's Love-Weber stress diagonal (xx, yy, zz; Pa) over its cell's volume: what
@@ -90,11 +90,14 @@ class CellBatch {
   ContactList balls_, walls_;
   ListBuffers ball_bufs_;
   Index2View own_;
-  IndexView g2l_;
+  IntegrateScratch integ_;  ///< with the map from gid to the particles' order, renewed at each rebuild
   Adjacency adj_balls_, adj_walls_;
   ContactItems items_;
   std::vector<int> contact_first_;  ///< S + 1 offsets of the specimens' contacts (host copy)
-  SegmentedTree particle_tree_, contact_tree_;
+  /// The leapfrog's tree, of the running specimens' particles, and the contact sums' (OwnerSums), of every specimen's
+  /// gids (a stopped specimen's stress is that of its state).
+  SegmentedTree particle_tree_, owner_tree_;
+  ContactOwners owners() const { return {balls_, walls_, own_, IndexView(), IndexView(), integ_.gid2local}; }
   StepRowsView rows_;  ///< a row of Leapfrog values per specimen
   decltype(Kokkos::create_mirror_view(StepRowsView())) host_rows_;
   Kokkos::View<OverlapStat, MemSpace> worst_;  ///< the force kernel's largest overlap of all, not read: see exceeded
@@ -103,7 +106,8 @@ class CellBatch {
   mutable bool dirty_ = true;  ///< the host's specimen table differs from the device's (upload)
   Kokkos::View<Real**, Kokkos::LayoutRight, MemSpace> sums_;  ///< the per-specimen sums' roots, S x 3
   decltype(Kokkos::create_mirror_view(Kokkos::View<Real**, Kokkos::LayoutRight, MemSpace>())) host_sums_;
-  /// Each specimen's NV sums of f over its contacts (the contact tree), to the host: one launch per level, one copy.
+  /// Each specimen's NV sums of the terms of f (contact_sums.hpp: OwnerSums) over its contacts, to the host: one
+  /// launch per level, one copy.
   template <int NV, class F>
   std::vector<std::array<Real, NV>> contact_sums(const char* label, const F& f) const;
   /// Each specimen's three sums of f over its contacts, over its cell's volume, kept in `cache` until the next step

@@ -250,7 +250,10 @@ void Simulation::restore(const SimState& s) {
   wall_disp_ = s.wall_disp;
   stats_ = s.stats;
   fresh_ = s.fresh;
-  if (!fresh_) index_contacts();
+  if (!fresh_) {
+    integ_.renew(p_);
+    index_contacts();
+  }
   // Every step of the state has been read (state() reads them first). How fast the balls went is not stored: the
   // rows are read every step until the first read gives it.
   read_to_ = step_;

@@ -127,8 +127,8 @@ void Simulation::rebuild() {
     throw BlowUp(msg.str());
   }
   bin_particles(p_, prm_.domain, 2 * rmax_ + prm_.skin, prm_.skin, cells_);
-  gid_to_local(p_, g2l_);
-  const IndexView g2l = g2l_;
+  integ_.renew(p_);
+  const IndexView g2l = integ_.gid2local;
   balls_ = remap_history(detect_pairs(p_, cells_, {}, {}, &ball_bufs_), balls_, g2l, true, &ball_bufs_);
   FacetBins fb;
   if (mesh_.ntri > 0) fb = bin_facets(mesh_, cells_.grid, rmax_ + prm_.skin, facet_bins_);
@@ -203,7 +203,7 @@ void Simulation::step(bool measure) {
     clock.lap(times_.membrane);
   }
   prm_.integ.measure = measure;
-  integrate_to(p_, prm_.integ, make_gather(balls_, own_, adj_balls_, wall_c_, adj_walls_),
+  integrate_to(p_, prm_.domain, prm_.integ, make_gather(balls_, own_, adj_balls_, wall_c_, adj_walls_), integ_,
                rows_.at(step_, StepRows::kLeapfrog));
   clock.lap(times_.integrate);
   move_boundaries();
@@ -256,13 +256,10 @@ namespace {
 /// The Love-Weber sums of the ball-ball contacts over `volume`: all nine components (N = 9, row-major) or the
 /// diagonal alone (N = 3). Each component is summed in the same order either way, so it has the same bits.
 template <int N>
-std::array<Real, N> love_weber_stress(const char* label, const ContactList& c, const Vec3View& x, const Domain& dom,
-                                      Real volume) {
+std::array<Real, N> love_weber_stress(const char* label, const Simulation& sim, Real volume) {
   Real s[N];
-  const MinImage image(dom);  // worked out once per launch, as the pair loops do
-  deterministic_reduce<N, 0>(label, c.n, KOKKOS_LAMBDA(const int k, Real* v) {
-    love_weber_terms<N>(c, k, x, image, v);
-  }, s);
+  // The image worked out once per launch, as the pair loops do.
+  sim.owner_sums(label, LoveWeberTerms<N, OneImage>{sim.particles().x, OneImage{MinImage(sim.domain())}}, s);
   std::array<Real, N> out;
   for (int q = 0; q < N; ++q) out[q] = s[q] / volume;
   return out;
@@ -270,11 +267,11 @@ std::array<Real, N> love_weber_stress(const char* label, const ContactList& c, c
 }  // namespace
 
 std::array<Real, 9> Simulation::contact_stress(Real volume) const {
-  return love_weber_stress<9>("dem::sim::contact_stress", balls_, p_.x, prm_.domain, volume);
+  return love_weber_stress<9>("dem::sim::contact_stress", *this, volume);
 }
 
 std::array<Real, 3> Simulation::contact_stress_diagonal(Real volume) const {
-  return love_weber_stress<3>("dem::sim::contact_stress_diagonal", balls_, p_.x, prm_.domain, volume);
+  return love_weber_stress<3>("dem::sim::contact_stress_diagonal", *this, volume);
 }
 
 bool Simulation::store_wall_velocity(int w, const Vec3& v) {
@@ -331,12 +328,7 @@ Simulation::WallLoads Simulation::wall_loads(bool facets) const {
 Real Simulation::unbalanced_ratio() const {
   if (p_.n == 0) return 0;
   Real s[2];
-  const ContactList b = balls_, w = wall_c_;
-  const int nb = b.n;
-  deterministic_reduce<2, 0>("dem::sim::contact_force_sum", b.n + w.n, KOKKOS_LAMBDA(const int k, Real* v) {
-    if (k < nb) force_terms(b, k, v);
-    else force_terms(w, k - nb, v);
-  }, s);
+  owner_sums("dem::sim::contact_force_sum", ForceTerms(), s);
   if (s[1] == 0) return 1;
   return (stats().unbalanced / p_.n) / (s[0] / s[1]);
 }

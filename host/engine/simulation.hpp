@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "kernels/contact/accumulate.hpp"
+#include "kernels/contact/contact_sums.hpp"
+#include "kernels/core/reduce.hpp"
 #include "kernels/neighbor/binning.hpp"
 #include "kernels/neighbor/contact_detect.hpp"
 #include "kernels/contact/contact_force.hpp"
@@ -87,6 +89,16 @@ class Simulation {
   Particles& particles() { return p_; }
   const Particles& particles() const { return p_; }
   const ContactList& ball_contacts() const { return balls_; }
+  /// The contacts by their particles (contact_sums.hpp), for sums that do not depend on when the lists were rebuilt.
+  ContactOwners contact_owners() const {
+    return {balls_, wall_c_, own_, adj_walls_.offset, adj_walls_.entry, integ_.gid2local};
+  }
+  /// N sums of Terms' terms over the touching contacts, per particle and then in gid order (OwnerSums), to `out`.
+  template <int N, class Terms>
+  void owner_sums(const char* label, const Terms& terms, Real (&out)[N]) const {
+    deterministic_reduce_lanes<N, 0, 1>(label, static_cast<int>(integ_.gid2local.extent(0)), OwnerSums<N, Terms>{contact_owners(), terms},
+                                        out);
+  }
   const ContactList& wall_contacts() const { return wall_c_; }
   /// The last step's statistics (read from the device where they wait).
   const StepStats& stats() const {
@@ -186,7 +198,8 @@ class Simulation {
   FacetBins facet_bins_;
   Adjacency adj_balls_, adj_walls_;
   Index2View own_;
-  IndexView obj_offsets_, g2l_;
+  IndexView obj_offsets_;
+  IntegrateScratch integ_;  ///< with the map from gid to the particles' order, renewed at each rebuild
   // wall_loads' device scratch and the host's copies of it: a copy of their own even where the device is the host,
   // so that a read is a copy there too and the sync counts (sync_counts.hpp) are the GPU's.
   mutable Vec3View wall_force_;

@@ -7,6 +7,26 @@
 
 namespace dem {
 
+namespace {
+
+/// A touching ball-wall contact's share of its wall's stiffness, Fn / overlap (for the six walls of the cell: wall
+/// object o < 6 gets value o); no ball-ball terms.
+struct WallStiffnessTerms {
+  ConstVec3View x;
+  ConstScalarView r;
+  WallSet w;
+  KOKKOS_INLINE_FUNCTION void ball(const ContactList&, int, int, Real*) const {}
+  KOKKOS_INLINE_FUNCTION void wall(const ContactList& c, int s, int i, Real* v) const {
+    const Real fn = c.fn(s);
+    const int o = c.j(s);
+    if (!(fn > 0) || o >= 6) return;
+    const Real overlap = r(i) - dot(load(x, i) - load(w.point, o), load(w.normal, o));
+    if (overlap > 0) v[o] = fn / overlap;
+  }
+};
+
+}  // namespace
+
 bool walled(const Simulation& sim) { return sim.num_walls() == 6 && !sim.domain().periodic[0]; }
 
 std::vector<WallSpec> cell_walls(const std::array<Real, 3>& cell) {
@@ -50,19 +70,9 @@ std::array<Real, 3> cell_stress(Simulation& sim) {
 
 std::array<Real, 3> boundary_stiffness(Simulation& sim) {
   if (!walled(sim)) return cell_stiffness(sim);
-  const ContactList c = sim.wall_contacts();
-  const WallSet w = sim.walls();
-  Particles& p = sim.particles();
-  auto x = p.x;
-  auto r = p.radius;
   Real k[6];
-  deterministic_reduce<6, 0>("dem::cell::wall_stiffness", c.n, KOKKOS_LAMBDA(const int s, Real* v) {
-    const Real fn = c.fn(s);
-    if (!(fn > 0) || c.j(s) >= 6) return;
-    const int o = c.j(s);
-    const Real overlap = r(c.i(s)) - dot(load(x, c.i(s)) - load(w.point, o), load(w.normal, o));
-    if (overlap > 0) v[o] = fn / overlap;
-  }, k);
+  sim.owner_sums("dem::cell::wall_stiffness", WallStiffnessTerms{sim.particles().x, sim.particles().radius, sim.walls()},
+                 k);
   const std::array<Real, 3> l = cell_lengths(sim);
   std::array<Real, 3> out{};
   for (int d = 0; d < 3; ++d)

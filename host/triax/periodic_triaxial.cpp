@@ -14,16 +14,10 @@
 namespace dem {
 
 std::array<Real, 3> cell_stiffness(Simulation& sim) {
-  const ContactList c = sim.ball_contacts();
-  Particles& p = sim.particles();
-  auto x = p.x;
-  auto r = p.radius;
   const Domain dom = sim.domain();
-  const MinImage image(dom);
   Real k[3];
-  deterministic_reduce<3, 0>("dem::periodic::cell_stiffness", c.n, KOKKOS_LAMBDA(const int s, Real* v) {
-    stiffness_terms(c, s, x, r, image, v);
-  }, k);
+  sim.owner_sums("dem::periodic::cell_stiffness",
+                 StiffnessTerms<OneImage>{sim.particles().x, sim.particles().radius, OneImage{MinImage(dom)}}, k);
   const Real V = dom.volume();
   return {k[0] / V, k[1] / V, k[2] / V};
 }

@@ -35,7 +35,34 @@ struct Domain {
     }
     return Vec3(c[0], c[1], c[2]);
   }
+
+  /// wrap, for the coordinates outside [lo, hi] alone: the others (all of them after a step, step_wrap, and the cell's
+  /// stretch, which keeps them within [lo, hi]) keep their bits.
+  KOKKOS_INLINE_FUNCTION Vec3 contain(Vec3 p) const {
+    const Vec3 w = wrap(p);
+    Real c[3] = {p.x, p.y, p.z};
+    for (int k = 0; k < 3; ++k)
+      if (c[k] < lo[k] || c[k] > hi[k]) c[k] = w[k];
+    return Vec3(c[0], c[1], c[2]);
+  }
 };
+
+/// A step's wrap of positions into the periodic cell: a coordinate that left [lo, hi) in the step goes back by the
+/// cell's length (a ball moves less than its radius a step, so once is enough); returns what was added to each.
+/// Wrapped at every step, not at a rebuild, a ball's arithmetic does not depend on when its lists were rebuilt.
+/// Lane by lane for a pack.
+template <class T>
+KOKKOS_INLINE_FUNCTION Vec3T<T> step_wrap(const Domain& dom, Vec3T<T>& x) {
+  T c[3] = {x.x, x.y, x.z}, s[3] = {T(0), T(0), T(0)};
+  for (int d = 0; d < 3; ++d) {
+    if (!dom.periodic[d]) continue;
+    const Real L = dom.length(d);
+    s[d] = select(c[d] < T(dom.lo[d]), T(L), select(c[d] < T(dom.hi[d]), T(0), T(-L)));
+    c[d] = select(s[d] != T(0), c[d] + s[d], c[d]);
+  }
+  x = Vec3T<T>(c[0], c[1], c[2]);
+  return Vec3T<T>(s[0], s[1], s[2]);
+}
 
 /// The periodic cell's affine step over dt: each axis stretched about lo by 1 + rate dt. One formula for the cell's
 /// bounds on the host and the particles on the device, which stay consistent bit for bit (no contraction anywhere,
@@ -74,8 +101,7 @@ inline Real stretch_speed(const Domain& dom, Real reach) {
 
 /// The minimum-image shift of a domain, with the cell lengths worked out once: pair loops build one per
 /// launch instead of re-reading the bounds for every pair (same arithmetic, same bits). Positions are
-/// wrapped at every rebuild and move less than the skin in between, so one shift always suffices (no floor
-/// call).
+/// wrapped at every step (step_wrap), so one shift always suffices (no floor call).
 struct MinImage {
   Real len[3] = {0, 0, 0};   ///< cell length of a periodic axis, 0 on an open one
   Real half[3] = {0, 0, 0};  ///< len / 2

@@ -30,6 +30,7 @@ using GidView = Kokkos::View<std::uint32_t*, MemSpace>;             ///< global 
 using PairKeyView = Kokkos::View<std::uint64_t*, MemSpace>;         ///< sorted contact key (see contact_list.hpp)
 using FlagView = Kokkos::View<std::uint8_t*, MemSpace>;             ///< per-contact state bits
 using Index2View = Kokkos::View<int* [2], Layout, MemSpace>;         ///< pair of local indices
+using Real2View = Kokkos::View<Real* [2], Kokkos::LayoutRight, MemSpace>;  ///< two values per item
 using Index3View = Kokkos::View<int* [3], Layout, MemSpace>;         ///< facet vertex indices
 
 /// Largest overlap / radius of a step's contacts and where it happened (for blow-up detection).

@@ -1,24 +1,62 @@
 #include "kernels/motion/integrate.hpp"
 
+#include "kernels/core/buffers.hpp"
 #include "kernels/core/reduce.hpp"
+#include "kernels/neighbor/history_remap.hpp"
 
 namespace dem {
 
-void integrate_to(Particles& p, const IntegrateParams& prm, const Gather& gather, Real* values) {
+namespace {
+
+/// A measured step's |F + m g| and kinetic energy of the particle with gid g (none for a gid without one, or, in a
+/// batch, of a specimen whose step is not measured).
+struct MeasuredByGid {
+  Real2View measured;
+  ConstIndexView gid2local;
+  SpecimenTable spec;
+  ConstIndexView owner;
+  KOKKOS_INLINE_FUNCTION void operator()(const int g, int, Real (*vals)[2]) const {
+    const int i = gid2local(g);
+    if (i < 0 || (spec.batched() && !spec(owner(i)).integ.measure)) return;
+    vals[0][0] = measured(i, 0);
+    vals[0][1] = measured(i, 1);
+  }
+};
+
+Leapfrog leapfrog(Particles& p, const SpecimenTable& spec, const Gather& gather, const IntegrateScratch& scratch) {
+  return Leapfrog{p.x, p.v, p.w, p.f, p.m, p.x_ref, p.mass, p.inertia, p.radius, gather, spec, p.specimen,
+                  scratch.measured};
+}
+
+}  // namespace
+
+void IntegrateScratch::renew(const Particles& p) {
+  same_size(measured, static_cast<std::size_t>(p.n), "dem::integrate::measured");
+  gid_to_local(p, gid2local);
+}
+
+void integrate_to(Particles& p, const Domain& dom, const IntegrateParams& prm, const Gather& gather,
+                  const IntegrateScratch& scratch, Real* values) {
   SpecimenTable one;
+  one.one.dom = dom;
   one.one.integ = prm;
-  const Leapfrog lf{p.x, p.v, p.w, p.f, p.m, p.x_ref, p.mass, p.inertia, p.radius, gather, one, p.specimen};
-  deterministic_reduce_lanes_to<Leapfrog::kSums, Leapfrog::kMaxima, Leapfrog::W>("dem::integrate::leapfrog", p.n, lf,
-                                                                                 values);
+  deterministic_reduce_lanes_to<Leapfrog::kSums, Leapfrog::kMaxima, Leapfrog::W>(
+      "dem::integrate::leapfrog", p.n, leapfrog(p, one, gather, scratch), values);
+  if (!prm.measure) return;
+  // The gids' order, not the particles': it changes no bit where a rebuild reorders them.
+  deterministic_reduce_lanes_to<2, 0, 1>("dem::integrate::measured", static_cast<int>(scratch.gid2local.extent(0)),
+                                         MeasuredByGid{scratch.measured, scratch.gid2local, one, p.specimen}, values);
 }
 
 void integrate_batch_to(Particles& p, const SpecimenParamsView& specimens, const SegmentedTree& tree,
-                        const Gather& gather, Real* values, int stride) {
+                        const Gather& gather, const IntegrateScratch& scratch, Real* values, int stride, bool measured) {
   SpecimenTable many;
   many.many = specimens;
-  const Leapfrog lf{p.x, p.v, p.w, p.f, p.m, p.x_ref, p.mass, p.inertia, p.radius, gather, many, p.specimen};
-  segmented_reduce_lanes_to<Leapfrog::kSums, Leapfrog::kMaxima, Leapfrog::W>("dem::integrate::leapfrog", tree, lf,
-                                                                             values, stride);
+  segmented_reduce_lanes_to<Leapfrog::kSums, Leapfrog::kMaxima, Leapfrog::W>(
+      "dem::integrate::leapfrog", tree, leapfrog(p, many, gather, scratch), values, stride);
+  if (!measured) return;
+  segmented_reduce_lanes_to<2, 0, 1>("dem::integrate::measured", tree,
+                                     MeasuredByGid{scratch.measured, scratch.gid2local, many, p.specimen}, values, stride);
 }
 
 StepStats step_stats(const Real* values) {
@@ -42,8 +80,10 @@ int non_finite_particle(const Particles& p, int first, int count) {
   return bad;
 }
 
-StepStats integrate(Particles& p, const IntegrateParams& prm, const Gather& gather) {
-  integrate_to(p, prm, gather, reduce_root().data());
+StepStats integrate(Particles& p, const Domain& dom, const IntegrateParams& prm, const Gather& gather) {
+  IntegrateScratch scratch;
+  scratch.renew(p);
+  integrate_to(p, dom, prm, gather, scratch, reduce_root().data());
   Real values[Leapfrog::kValues];
   read_root(values, Leapfrog::kValues);
   StepStats st = step_stats(values);

@@ -50,20 +50,24 @@ KOKKOS_INLINE_FUNCTION Vec3T<T> damped_velocity(const IntegrateParams& prm, cons
 struct Leapfrog {
   /// A particle's values: {|F + m g|, kinetic energy, non-finite flag | displacement^2 since rebuild,
   /// (move this step / radius)^2, move this step^2}; the first kSums are summed, the last kMaxima maximised.
+  /// On a measured step the first two are also written to `measured` (row: the particle), whose sums in gid order
+  /// (measured_sums_to) replace the tree's: those do not depend on the particles' order, which a rebuild changes.
   static constexpr int kSums = 3, kMaxima = 3, kValues = kSums + kMaxima;
   static constexpr int W = kContactLanes;
   Vec3View x, v, w, f, m;
-  ConstVec3View x_ref;
+  Vec3View x_ref;        ///< moved with its particle where the particle is wrapped into the periodic cell
   ConstScalarView mass, inertia, radius;
   Gather gather;
   SpecimenTable spec;
   ConstIndexView owner;  ///< the particles' specimens (Particles::specimen), read where spec is a batch's
+  Real2View measured;
 
   /// Particles i0 .. i0 + count - 1 (count <= W); vals[k] gets particle i0 + k's values.
   KOKKOS_INLINE_FUNCTION void operator()(const int i0, const int count, Real (*vals)[kValues]) const {
     using T = ContactPack;
     // A group of W particles lies in one specimen: the blocks of a batch's reduction start at its specimens' first.
-    const IntegrateParams& prm = spec(spec.batched() ? owner(i0) : 0).integ;
+    const SpecimenParams& sp = spec(spec.batched() ? owner(i0) : 0);
+    const IntegrateParams& prm = sp.integ;
     // Lanes past count repeat the last particle; their results are not stored.
     int id[W];
     Vec3 fk[W], mk[W];
@@ -84,7 +88,8 @@ struct Leapfrog {
     const T a = prm.dt / (mi * prm.mass_scale), b = prm.dt / (ii * prm.mass_scale);
     vi = vi + a * damped(force, damped_velocity(prm, vi, x0), prm.alpha);
     wi = wi + b * damped(moment, wi, prm.alpha);
-    const Vec3T<T> xi = x0 + T(prm.dt) * vi;
+    Vec3T<T> xi = x0 + T(prm.dt) * vi;
+    const Vec3T<T> wrapped = step_wrap(sp.dom, xi);
     const auto put_all = [&](auto at) {
       put(f, at, fc);
       put(m, at, moment);
@@ -99,6 +104,12 @@ struct Leapfrog {
       for (int k = 0; k < W; ++k)
         if (k < count) put_all(LaneRow{id[k], k});
     }
+    TRIAXDEM_UNROLL_LANES
+    for (int k = 0; k < W; ++k) {
+      if (k == count) break;
+      const Vec3 s = lane(wrapped, k);
+      if (s.x != 0 || s.y != 0 || s.z != 0) store(x_ref, id[k], load(x_ref, id[k]) + s);
+    }
     const T unbalanced = prm.measure ? norm(force) : T(0);
     const T kinetic = prm.measure ? T(Real(0.5)) * (mi * norm2(vi) + ii * norm2(wi)) : T(0);
     const T disp2 = norm2(xi - load_lanes<T>(x_ref, i0, id, full));
@@ -110,6 +121,10 @@ struct Leapfrog {
       const Vec3 xk = lane(xi, k);
       vals[k][0] = lane(unbalanced, k);
       vals[k][1] = lane(kinetic, k);
+      if (prm.measure) {
+        measured(id[k], 0) = vals[k][0];
+        measured(id[k], 1) = vals[k][1];
+      }
       vals[k][2] = (kc::isfinite(xk.x) && kc::isfinite(xk.y) && kc::isfinite(xk.z)) ? Real(0) : Real(1);
       vals[k][3] = lane(disp2, k);
       vals[k][4] = lane(move2, k);
@@ -118,16 +133,27 @@ struct Leapfrog {
   }
 };
 
+/// What a step's integration keeps between steps: the measured step's values per particle (Leapfrog::measured) and
+/// the map from gid to the particles' present order to sum them by.
+struct IntegrateScratch {
+  Real2View measured;
+  IndexView gid2local;
+  /// For the particles' present order and count (at a rebuild: a step allocates nothing).
+  void renew(const Particles& p);
+};
+
 /// Completes each particle's force and moment (gather), stores them in p.f, p.m, and advances all
-/// particles one step. Returns the step's sums (deterministic: fixed-order reduction).
-StepStats integrate(Particles& p, const IntegrateParams& prm, const Gather& gather);
+/// particles one step in `dom` (wrapped into it where periodic). Returns the step's sums (deterministic: fixed-order
+/// reduction).
+StepStats integrate(Particles& p, const Domain& dom, const IntegrateParams& prm, const Gather& gather);
 /// The same, with the step's Leapfrog::kValues values left in device memory at `values` (step_stats reads them).
-void integrate_to(Particles& p, const IntegrateParams& prm, const Gather& gather, Real* values);
+void integrate_to(Particles& p, const Domain& dom, const IntegrateParams& prm, const Gather& gather,
+                  const IntegrateScratch& scratch, Real* values);
 /// The same for the specimens of a batch at once (specimens(s) holding specimen s's particles and time integration,
-/// `tree` segmented by their particles): specimen s's values go to values[s * stride + q], bit for bit those of
-/// integrate_to on the specimen alone.
+/// `tree` segmented by their particles, which are its gids too): specimen s's values go to values[s * stride + q],
+/// bit for bit those of integrate_to on the specimen alone. `measured`: some specimen's step is measured.
 void integrate_batch_to(Particles& p, const SpecimenParamsView& specimens, const SegmentedTree& tree,
-                        const Gather& gather, Real* values, int stride);
+                        const Gather& gather, const IntegrateScratch& scratch, Real* values, int stride, bool measured);
 /// The statistics in a step's values; `bad` is left at -1 (non_finite_particle finds it where values[2] > 0).
 StepStats step_stats(const Real* values);
 /// The highest index of a particle with a non-finite position among [first, first + count) (count < 0: all), or -1.

@@ -107,7 +107,7 @@ void bin_specimens(Particles& p, const std::vector<SpecimenBin>& specimens, Cell
   if (wrap) {
     Kokkos::parallel_for("dem::binning::wrap", RangePolicy(0, p.n), KOKKOS_LAMBDA(const int i) {
       const SpecimenCells& c = spec(owner(i));
-      if (c.rebuild) store(x, i, c.dom.wrap(load(x, i)));
+      if (c.rebuild) store(x, i, c.dom.contain(load(x, i)));
     });
   }
   const IndexView cell = room(cells.cell_buf, p.n, "dem::binning::cell");
