@@ -96,8 +96,8 @@ class Simulation {
   /// N sums of Terms' terms over the touching contacts, per particle and then in gid order (OwnerSums), to `out`.
   template <int N, class Terms>
   void owner_sums(const char* label, const Terms& terms, Real (&out)[N]) const {
-    deterministic_reduce_lanes<N, 0, 1>(label, static_cast<int>(integ_.gid2local.extent(0)), OwnerSums<N, Terms>{contact_owners(), terms},
-                                        out);
+    const int gids = static_cast<int>(integ_.gid2local.extent(0));
+    deterministic_reduce_lanes<N, 0, 1>(label, gids, OwnerSums<N, Terms>{contact_owners(), terms}, out);
   }
   const ContactList& wall_contacts() const { return wall_c_; }
   /// The last step's statistics (read from the device where they wait).
