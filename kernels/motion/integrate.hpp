@@ -50,8 +50,9 @@ KOKKOS_INLINE_FUNCTION Vec3T<T> damped_velocity(const IntegrateParams& prm, cons
 struct Leapfrog {
   /// A particle's values: {|F + m g|, kinetic energy, non-finite flag | displacement^2 since rebuild,
   /// (move this step / radius)^2, move this step^2}; the first kSums are summed, the last kMaxima maximised.
-  /// On a measured step the first two are also written to `measured` (row: the particle), whose sums in gid order
-  /// (measured_sums_to) replace the tree's: those do not depend on the particles' order, which a rebuild changes.
+  /// On a measured step the first two are also written to `measured` (row: the particle), and their sums in gid order
+  /// (integrate_to's second tree) replace this tree's: they do not depend on the particles' order, which a rebuild
+  /// changes.
   static constexpr int kSums = 3, kMaxima = 3, kValues = kSums + kMaxima;
   static constexpr int W = kContactLanes;
   Vec3View x, v, w, f, m;
@@ -89,7 +90,7 @@ struct Leapfrog {
     vi = vi + a * damped(force, damped_velocity(prm, vi, x0), prm.alpha);
     wi = wi + b * damped(moment, wi, prm.alpha);
     Vec3T<T> xi = x0 + T(prm.dt) * vi;
-    const Vec3T<T> wrapped = step_wrap(sp.dom, xi);
+    const Vec3T<T> shift = step_wrap(sp.dom, xi);
     const auto put_all = [&](auto at) {
       put(f, at, fc);
       put(m, at, moment);
@@ -107,7 +108,7 @@ struct Leapfrog {
     TRIAXDEM_UNROLL_LANES
     for (int k = 0; k < W; ++k) {
       if (k == count) break;
-      const Vec3 s = lane(wrapped, k);
+      const Vec3 s = lane(shift, k);
       if (s.x != 0 || s.y != 0 || s.z != 0) store(x_ref, id[k], load(x_ref, id[k]) + s);
     }
     const T unbalanced = prm.measure ? norm(force) : T(0);
