@@ -105,6 +105,9 @@ CellBatch::CellBatch(const std::vector<const Simulation*>& specimens) {
     spec_.push_back(sp);
   }
   p_ = Particles(total);
+  std::vector<std::pair<int, int>> gids;  // every specimen's, stopped or not: a stopped one's stress is its state's
+  for (const Specimen& sp : spec_) gids.emplace_back(sp.first, sp.first + sp.count);
+  owner_tree_.plan(gids);
   params_ = ParamTableView("dem::batch::params", spec_.size() * nmat_, nmat_);
   for (std::size_t s = 0; s < specimens.size(); ++s) {
     const Simulation& sim = *specimens[s];
@@ -166,22 +169,21 @@ void CellBatch::upload() const {
   Kokkos::deep_copy(dev_spec_, host_spec_);
 }
 
-void CellBatch::rebuild(const std::vector<char>& due) {
+void CellBatch::rebuild() {
   std::vector<SpecimenBin> bins;
-  for (std::size_t s = 0; s < spec_.size(); ++s) {
-    const Specimen& sp = spec_[s];
-    bins.push_back({sp.first, sp.count, sp.prm.domain, 2 * sp.rmax + sp.prm.skin, sp.prm.skin, due[s] != 0});
-  }
+  for (const Specimen& sp : spec_)
+    bins.push_back({sp.first, sp.count, sp.prm.domain, 2 * sp.rmax + sp.prm.skin, sp.prm.skin, sp.running});
   bin_specimens(p_, bins, cells_);
   integ_.renew(p_);
-  balls_ = remap_history(detect_pairs(p_, cells_, balls_.key, own_, &ball_bufs_), balls_, integ_.gid2local, true, &ball_bufs_);
+  balls_ = remap_history(detect_pairs(p_, cells_, balls_.key, own_, &ball_bufs_), balls_, integ_.gid2local, true,
+                         &ball_bufs_);
   owner_ranges(p_, balls_, own_);
   build_adjacency(p_.n, balls_, balls_.j, adj_balls_);
   mark_rebuilt(p_, cells_.specimens);
-  for (std::size_t s = 0; s < spec_.size(); ++s) {
-    if (!due[s]) continue;
-    spec_[s].wall_disp = 0;
-    ++spec_[s].rebuilds;
+  for (Specimen& sp : spec_) {
+    if (!sp.running) continue;
+    sp.wall_disp = 0;
+    ++sp.rebuilds;
   }
   const IndexView first = contact_starts(balls_, dev_spec_, size());
   auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), first);
@@ -192,19 +194,17 @@ void CellBatch::rebuild(const std::vector<char>& due) {
 }
 
 void CellBatch::plan() {
-  std::vector<std::pair<int, int>> particles, gids;
+  std::vector<std::pair<int, int>> particles;
   std::vector<int> item_first(spec_.size() + 1, 0);
   for (std::size_t s = 0; s < spec_.size(); ++s) {
     const Specimen& sp = spec_[s];
     const int c0 = contact_first_[s], c1 = contact_first_[s + 1];
     // A stopped specimen has no items: nothing of it is computed or moved.
     particles.emplace_back(sp.first, sp.running ? sp.first + sp.count : sp.first);
-    gids.emplace_back(sp.first, sp.first + sp.count);  // a stopped specimen's stress is that of its state
     const int items = sp.running ? (c1 - c0 + kContactLanes - 1) / kContactLanes : 0;
     item_first[s + 1] = item_first[s] + items;
   }
   particle_tree_.plan(particles);
-  owner_tree_.plan(gids);
   items_.specimens = size();
   items_.items = item_first.back();
   items_.exceeded = room(exceeded_buf_, static_cast<std::size_t>(contact_first_.back()), "dem::batch::exceeded");
@@ -229,12 +229,7 @@ void CellBatch::step(const std::vector<char>& measure) {
   bool any = fresh_;
   for (const Specimen& sp : spec_)
     any = any || (sp.running && lists_expired(sp.stats.max_disp2, sp.wall_disp, sp.prm.skin));
-  if (any) {
-    std::vector<char>& due = due_;
-    due.assign(spec_.size(), 0);
-    for (std::size_t s = 0; s < spec_.size(); ++s) due[s] = spec_[s].running;
-    rebuild(due);
-  }
+  if (any) rebuild();
   compute_ball_forces(p_, balls_, params_, dev_spec_, items_, OverlapResultView(worst_.data()));
   integrate_batch_to(p_, dev_spec_, particle_tree_, make_gather(balls_, own_, adj_balls_, walls_, adj_walls_), integ_,
                      rows_.data(), Leapfrog::kValues,

@@ -115,9 +115,8 @@ class CellBatch {
   template <class F>
   const std::vector<std::array<Real, 3>>& per_volume(const char* label, const F& f,
                                                      std::vector<std::array<Real, 3>>& cache, long& at) const;
-  /// A step's host scratch, kept so that a step allocates nothing on the host either: each specimen's rebuild
-  /// flag, its cell's travel speed, its largest overlap past its limit.
-  std::vector<char> due_;
+  /// A step's host scratch, kept so that a step allocates nothing on the host either: each specimen's cell's travel
+  /// speed, its largest overlap past its limit.
   std::vector<Real> speed_;
   std::vector<OverlapStat> worst_of_;
   /// The per-specimen sums of the last step, and the batch step they were taken after (-1: none).
@@ -128,8 +127,8 @@ class CellBatch {
   decltype(Kokkos::create_mirror_view(Kokkos::View<char*, MemSpace>())) host_stretching_;
   bool fresh_ = true;
 
-  /// Rebuilds the lists of the specimens marked in `due`, keeping the others'.
-  void rebuild(const std::vector<char>& due);
+  /// Rebuilds the running specimens' lists, keeping the stopped ones'.
+  void rebuild();
   /// The work items and trees of the running specimens' particles and contacts.
   void plan();
   /// Specimen s's statistics after a step: its blow-up checks (it stops on one; `worst`: its largest overlap past

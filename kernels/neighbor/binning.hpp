@@ -70,8 +70,8 @@ struct SpecimenBin {
 
 /// Wraps periodic coordinates outside the cell (Domain::contain: the steps keep them inside), builds a grid with
 /// cells of at least `cell_min`, sorts the particles by cell (permuting every per-particle View) and fills the cell
-/// list, for a pair search within `skin`. Throws
-/// std::runtime_error when a periodic length holds fewer than 3 cells (the minimum image would then be ambiguous).
+/// list, for a pair search within `skin`. Throws std::runtime_error when a periodic length holds fewer than 3 cells
+/// (the minimum image would then be ambiguous).
 void bin_particles(Particles& p, const Domain& dom, Real cell_min, Real skin, CellList& cells);
 /// The same for the specimens of a batch, side by side, in one pass: each rebuilt specimen is binned in its own
 /// grid as it would be alone (the same order, bit for bit), and the others keep their particles where they are.
