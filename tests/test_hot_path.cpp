@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -251,4 +252,73 @@ TEST(HotPath, ABatchStepWaitsAsOftenForSixCellsAsForTwo) {
   EXPECT_EQ(six.host_results, two.host_results);
   EXPECT_EQ(six.allocations, 0);
   EXPECT_LE(six.copies + six.host_results, 2 * 16) << "the statistics, and the count of overlaps past their limits";
+}
+
+namespace {
+
+/// Each particle's force and moment summed on the host from the contact lists, in the order Gather sums them
+/// (accumulate.hpp): its own ball-ball contacts in key order, the reactions of the others in list order, its wall
+/// contacts in list order.
+void host_gather(const Simulation& sim, std::vector<Vec3>& f, std::vector<Vec3>& m) {
+  const int n = sim.particles().n;
+  f.assign(n, Vec3());
+  m.assign(n, Vec3());
+  auto h = [](const auto& v) { return Kokkos::create_mirror_view_and_copy(HostSpace(), v); };
+  const ContactList &b = sim.ball_contacts(), &wc = sim.wall_contacts();
+  auto bi = h(b.i), bj = h(b.j);
+  auto fc = h(b.fc), mo = h(b.mo), mt = h(b.mt);
+  for (int s = 0; s < b.n; ++s) {
+    f[bi(s)] += load(fc, s);
+    m[bi(s)] += load(mo, s);
+  }
+  for (int s = 0; s < b.n; ++s) {
+    f[bj(s)] -= load(fc, s);
+    m[bj(s)] += load(mt, s);
+  }
+  auto wi = h(wc.i);
+  auto wfc = h(wc.fc), wmt = h(wc.mt);
+  for (int s = 0; s < wc.n; ++s) {
+    f[wi(s)] += load(wfc, s);
+    m[wi(s)] += load(wmt, s);
+  }
+}
+
+}  // namespace
+
+// A step does not store the balls' forces and moments (48 bytes a ball; only output and states read them):
+// particles_with_forces gathers the last step's on demand, the same bits as the contact lists summed in the gather's
+// order, and again after further steps (it fails where a step's forces are left stale, or a step still stores them).
+TEST(HotPath, AStepLeavesTheForcesToOutputWhichGathersTheLastStepsOnDemand) {
+  // The benchmark's packing between walls, 8^3 balls: about 6 contacts each, and wall contacts on the outer layers.
+  const Config cfg = packed_lattice(load_config(std::string(TRIAXDEM_SOURCE_DIR) + "/configs/default.toml"), 8, false);
+  auto sim = build_simulation(cfg, false);
+  const auto zero = [](const Vec3& a) { return a.x == 0 && a.y == 0 && a.z == 0; };
+  const auto same = [](const Vec3& a, const Vec3& b) { return std::memcmp(&a, &b, sizeof(Vec3)) == 0; };
+  const auto zeros = [&](const Vec3View& v) {
+    auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), v);
+    for (std::size_t i = 0; i < h.extent(0); ++i)
+      if (!zero(load(h, static_cast<int>(i)))) return false;
+    return true;
+  };
+  ASSERT_TRUE(zeros(sim->particles().f));
+  for (int round = 0; round < 2; ++round) {
+    sim->run(40);
+    EXPECT_TRUE(zeros(sim->particles().f)) << "a step stored the forces";
+    EXPECT_TRUE(zeros(sim->particles().m)) << "a step stored the moments";
+    std::vector<Vec3> f, m;
+    host_gather(*sim, f, m);
+    const Particles& p = sim->particles_with_forces();
+    auto hf = Kokkos::create_mirror_view_and_copy(HostSpace(), p.f);
+    auto hm = Kokkos::create_mirror_view_and_copy(HostSpace(), p.m);
+    int nonzero = 0;
+    for (int i = 0; i < p.n; ++i) {
+      ASSERT_TRUE(same(f[i], load(hf, i))) << "force, particle " << i;
+      ASSERT_TRUE(same(m[i], load(hm, i))) << "moment, particle " << i;
+      nonzero += !zero(f[i]);
+    }
+    EXPECT_GT(nonzero, p.n / 2) << "the balls carry forces";
+    // Gathered, then zeroed by hand: the next steps must not leave them at zero for output.
+    Kokkos::deep_copy(p.f, 0.0);
+    Kokkos::deep_copy(p.m, 0.0);
+  }
 }

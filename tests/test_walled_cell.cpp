@@ -122,7 +122,7 @@ TEST(WalledCell, WallStressIsLoveWebersOfAllContactsLessTheBallsNetForces) {
     for (int k = 0; k < 9; ++k)
       EXPECT_NEAR(lw[k], b[k] + net[k], 1e-4 * pressure) << "stage " << stage << ", component " << k;
     // The balls' net force along d and the centre of the box along d: the pair-mean's departure from b_dd.
-    const Particles& pt = sim->particles();
+    const Particles& pt = sim->particles_with_forces();
     auto f = Kokkos::create_mirror_view_and_copy(HostSpace(), pt.f);
     const std::array<Real, 3> s = cell_stress(*sim);
     for (int d = 0; d < 3; ++d) {

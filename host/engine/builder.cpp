@@ -83,10 +83,10 @@ FacetMesh make_mesh(const std::vector<Real>& nodes, const std::vector<int>& tris
 
 HostParticles to_host_by_gid(const Particles& p) {
   auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), p.gid);
-  const Vec3View* src[5] = {&p.x, &p.v, &p.w, &p.f, &p.m};
+  const Vec3View* src[3] = {&p.x, &p.v, &p.w};
   HostParticles out;
-  std::vector<Vec3>* dst[5] = {&out.x, &out.v, &out.w, &out.f, &out.m};
-  for (int q = 0; q < 5; ++q) {
+  std::vector<Vec3>* dst[3] = {&out.x, &out.v, &out.w};
+  for (int q = 0; q < 3; ++q) {
     auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), *src[q]);
     dst[q]->resize(p.n);
     for (int i = 0; i < p.n; ++i) (*dst[q])[gid(i)] = load(h, i);

@@ -41,7 +41,7 @@ FacetMesh make_mesh(const std::vector<Real>& nodes, const std::vector<int>& tris
 
 /// Copies of particle state to the host, indexed by gid (independent of the current sort order).
 struct HostParticles {
-  std::vector<Vec3> x, v, w, f, m;
+  std::vector<Vec3> x, v, w;
 };
 HostParticles to_host_by_gid(const Particles& p);
 

@@ -188,7 +188,7 @@ SimState Simulation::state() const {
   s.x = vec3_out(p_.x, n);
   s.v = vec3_out(p_.v, n);
   s.w = vec3_out(p_.w, n);
-  s.f = vec3_out(p_.f, n);
+  s.f = vec3_out(particles_with_forces().f, n);
   s.m = vec3_out(p_.m, n);
   s.x_ref = vec3_out(p_.x_ref, n);
   s.radius = scalar_out<double>(p_.radius, n);
@@ -231,6 +231,7 @@ void Simulation::restore(const SimState& s) {
   vec3_in(p_.w, s.w, p_.n);
   vec3_in(p_.f, s.f, p_.n);
   vec3_in(p_.m, s.m, p_.n);
+  forces_current_ = true;
   vec3_in(p_.x_ref, s.x_ref, p_.n);
   scalar_in(p_.radius, s.radius, p_.n);
   scalar_in(p_.mass, s.mass, p_.n);

@@ -203,14 +203,22 @@ void Simulation::step(bool measure) {
     clock.lap(times_.membrane);
   }
   prm_.integ.measure = measure;
-  integrate_to(p_, prm_.domain, prm_.integ, make_gather(balls_, own_, adj_balls_, wall_c_, adj_walls_), integ_,
-               rows_.at(step_, StepRows::kLeapfrog));
+  integrate_to(p_, prm_.domain, prm_.integ, gather(), integ_, rows_.at(step_, StepRows::kLeapfrog));
+  forces_current_ = false;
   clock.lap(times_.integrate);
   move_boundaries();
   clock.lap(times_.boundaries);
   time_ += dt;
   ++step_;
   if (measure || step_ - read_to_ >= prm_.stats_every) read_rows();
+}
+
+const Particles& Simulation::particles_with_forces() const {
+  if (!forces_current_) {
+    gather_forces(p_, gather());
+    forces_current_ = true;
+  }
+  return p_;
 }
 
 void Simulation::move_boundaries() {

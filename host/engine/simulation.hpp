@@ -86,8 +86,12 @@ class Simulation {
   /// nsteps steps; stats() describe the last one.
   void run(long nsteps) { for (long s = 0; s < nsteps; ++s) step(s + 1 == nsteps); }
 
+  /// The particles; their f and m are those of the last gather_forces (a step leaves them out).
   Particles& particles() { return p_; }
   const Particles& particles() const { return p_; }
+  /// The particles with the last step's contact force and moment of each ball in f and m, gathered at the first call
+  /// after a step: only output and states read them, so a step does not store them (integrate.hpp: gather_forces).
+  const Particles& particles_with_forces() const;
   const ContactList& ball_contacts() const { return balls_; }
   /// The contacts by their particles (contact_sums.hpp), for sums that do not depend on when the lists were rebuilt.
   ContactOwners contact_owners() const {
@@ -230,7 +234,9 @@ class Simulation {
   long step_ = 0;
   Real time_ = 0;
   bool fresh_ = true;
+  mutable bool forces_current_ = true;  ///< p_.f and p_.m hold the last step's gathered forces
 
+  Gather gather() const { return make_gather(balls_, own_, adj_balls_, wall_c_, adj_walls_); }
   bool rebuild_due();
   /// Records the step's host-known boundary speed (m/s) and dt, and adds to the bound on the unread steps' travel.
   void boundary_step(Real speed, Real dt);

@@ -73,7 +73,7 @@ Real membrane_hoop_stress(Real young, Real thickness, Real d0, Real eps_a, Real 
 }
 
 Tensor net_force_stress(Simulation& sim, Real volume) {
-  const Particles& p = sim.particles();
+  const Particles& p = sim.particles_with_forces();
   auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), p.x);
   auto f = Kokkos::create_mirror_view_and_copy(HostSpace(), p.f);
   auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), p.gid);

@@ -24,7 +24,7 @@ struct MeasuredByGid {
 };
 
 Leapfrog leapfrog(Particles& p, const SpecimenTable& spec, const Gather& gather, const IntegrateScratch& scratch) {
-  return Leapfrog{p.x, p.v, p.w, p.f, p.m, p.x_ref, p.mass, p.inertia, p.radius, gather, spec, p.specimen,
+  return Leapfrog{p.x, p.v, p.w, p.x_ref, p.mass, p.inertia, p.radius, gather, spec, p.specimen,
                   scratch.measured};
 }
 
@@ -59,6 +59,16 @@ void integrate_batch_to(Particles& p, const SpecimenParamsView& specimens, const
                                      MeasuredByGid{scratch.measured, scratch.gid2local, many, p.specimen}, values, stride);
 }
 
+void gather_forces(const Particles& p, const Gather& gather) {
+  auto f = p.f, m = p.m;
+  Kokkos::parallel_for("dem::integrate::gather_forces", RangePolicy(0, p.n), KOKKOS_LAMBDA(const int i) {
+    Vec3 fi, mi;
+    gather(i, fi, mi);
+    store(f, i, fi);
+    store(m, i, mi);
+  });
+}
+
 StepStats step_stats(const Real* values) {
   StepStats st;
   st.unbalanced = values[0];
@@ -84,6 +94,7 @@ StepStats integrate(Particles& p, const Domain& dom, const IntegrateParams& prm,
   IntegrateScratch scratch;
   scratch.renew(p);
   integrate_to(p, dom, prm, gather, scratch, reduce_root().data());
+  gather_forces(p, gather);
   Real values[Leapfrog::kValues];
   read_root(values, Leapfrog::kValues);
   StepStats st = step_stats(values);

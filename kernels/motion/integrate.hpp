@@ -46,7 +46,8 @@ KOKKOS_INLINE_FUNCTION Vec3T<T> damped_velocity(const IntegrateParams& prm, cons
 }
 
 /// The step of W particles at once, as the lanes of a pack (kContactLanes; one on a GPU): each one's gather, then
-/// the leapfrog update. Every lane does the IEEE operations of one particle, so the lanes change no bit.
+/// the leapfrog update. Every lane does the IEEE operations of one particle, so the lanes change no bit. The gathered
+/// force and moment are not stored: only output reads them, and gather_forces makes them again, bit for bit.
 struct Leapfrog {
   /// A particle's values: {|F + m g|, kinetic energy, non-finite flag | displacement^2 since rebuild,
   /// (move this step / radius)^2, move this step^2}; the first kSums are summed, the last kMaxima maximised.
@@ -55,7 +56,7 @@ struct Leapfrog {
   /// changes.
   static constexpr int kSums = 3, kMaxima = 3, kValues = kSums + kMaxima;
   static constexpr int W = kContactLanes;
-  Vec3View x, v, w, f, m;
+  Vec3View x, v, w;
   Vec3View x_ref;        ///< moved with its particle where the particle is wrapped into the periodic cell
   ConstScalarView mass, inertia, radius;
   Gather gather;
@@ -92,8 +93,6 @@ struct Leapfrog {
     Vec3T<T> xi = x0 + T(prm.dt) * vi;
     const Vec3T<T> shift = step_wrap(sp.dom, xi);
     const auto put_all = [&](auto at) {
-      put(f, at, fc);
-      put(m, at, moment);
       put(v, at, vi);
       put(w, at, wi);
       put(x, at, xi);
@@ -143,9 +142,9 @@ struct IntegrateScratch {
   void renew(const Particles& p);
 };
 
-/// Completes each particle's force and moment (gather), stores them in p.f, p.m, and advances all
-/// particles one step in `dom` (wrapped into it where periodic). Returns the step's sums (deterministic: fixed-order
-/// reduction).
+/// Completes each particle's force and moment (gather), advances all particles one step in `dom` (wrapped into it
+/// where periodic) and stores the forces and moments in p.f, p.m (gather_forces). Returns the step's sums
+/// (deterministic: fixed-order reduction).
 StepStats integrate(Particles& p, const Domain& dom, const IntegrateParams& prm, const Gather& gather);
 /// The same, with the step's Leapfrog::kValues values left in device memory at `values` (step_stats reads them).
 void integrate_to(Particles& p, const Domain& dom, const IntegrateParams& prm, const Gather& gather,
@@ -155,6 +154,9 @@ void integrate_to(Particles& p, const Domain& dom, const IntegrateParams& prm, c
 /// bit for bit those of integrate_to on the specimen alone. `measured`: some specimen's step is measured.
 void integrate_batch_to(Particles& p, const SpecimenParamsView& specimens, const SegmentedTree& tree,
                         const Gather& gather, const IntegrateScratch& scratch, Real* values, int stride, bool measured);
+/// Each particle's force and moment of the contact results in `gather` (the last step's), to p.f and p.m: the same
+/// bits the step's leapfrog summed, for output, which alone reads them.
+void gather_forces(const Particles& p, const Gather& gather);
 /// The statistics in a step's values; `bad` is left at -1 (non_finite_particle finds it where values[2] > 0).
 StepStats step_stats(const Real* values);
 /// The highest index of a particle with a non-finite position among [first, first + count) (count < 0: all), or -1.
