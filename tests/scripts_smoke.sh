@@ -1,11 +1,15 @@
 #!/usr/bin/env bash
-# Every script in perf/ and tools/ run on a tiny case, so that a change that breaks one fails the suite (ctest
-# Scripts.PerfAndToolsRunOnATinyCase). Each gets seconds of work on one core; a script passes when it exits 0 and
-# writes what it says it writes. A script added to perf/ or tools/ without a line here fails the check at the end.
-#   tests/scripts_smoke.sh [BUILD]                # default build
+# Every script in perf/ and tools/ run on a tiny case, so that a change that breaks one fails the suite. Each gets
+# seconds of work on one core; a script passes when it exits 0 and writes what it says it writes. A script in perf/ or
+# tools/ without a line here fails the check at the end.
+#   tests/scripts_smoke.sh [BUILD] [PART]         # default build; PART: all (default), tools or diagnoses
+# The two parts take about as long, so that ctest runs them side by side on two cores (Scripts.* in
+# tests/CMakeLists.txt): the tools, the benchmarks and the specimen scripts, then the scripts that run diagnoses.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="$(realpath "${1:-$root/build}")"
+part="${2:-all}"
+case "$part" in all|tools|diagnoses) ;; *) echo "scripts_smoke: PART is all, tools or diagnoses, not '$part'" >&2; exit 2 ;; esac
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 export OMP_NUM_THREADS=1 OMP_WAIT_POLICY=passive
@@ -31,83 +35,90 @@ exists() { for f in "$@"; do [ -s "$f" ] || { echo "scripts_smoke: $f not writte
 base="$work/base.toml"
 sed -e 's/^ensemble = .*/ensemble = 1/' -e 's/^scatter_specimens = .*/scatter_specimens = 2/' \
     -e 's/^target_axial_strain_pct = .*/target_axial_strain_pct = 1.0/' "$root/tests/data/hidden_effects.toml" > "$base"
-"$tdem" triaxial "$root/tests/data/tiny_triaxial.toml" -o "$work/tiny" > "$work/tiny.log" 2>&1
-"$tdem" synth --config "$base" -o "$work/data.csv" --extension none --seed 1 --pressures 100 > "$work/synth.log" 2>&1
-"$tdem" calibrate "$work/data.csv" --config "$base" --predict "$root/tests/data/tiny_triaxial.toml" -o "$work/cal" -j 1 \
-  > "$work/cal.log" 2>&1
-cal="$(ls -d "$work"/cal/calibrate_*)"
+if [ "$part" != diagnoses ]; then
+  "$tdem" triaxial "$root/tests/data/tiny_triaxial.toml" -o "$work/tiny" > "$work/tiny.log" 2>&1
+  "$tdem" synth --config "$base" -o "$work/data.csv" --extension none --seed 1 --pressures 100 > "$work/synth.log" 2>&1
+  "$tdem" calibrate "$work/data.csv" --config "$base" --predict "$root/tests/data/tiny_triaxial.toml" -o "$work/cal" -j 1 \
+    > "$work/cal.log" 2>&1
+  cal="$(ls -d "$work"/cal/calibrate_*)"
 
-check tools/schedule_projection.py "$py" "$root/tools/schedule_projection.py" "$cal/pools.csv" --ranks 2,64
-check tools/plot_triaxial.py "$py" "$root/tools/plot_triaxial.py" "$work/tiny" -o "$work/triaxial.png"
-exists "$work/triaxial.png"
-check tools/plot_micro.py "$py" "$root/tools/plot_micro.py" "$work/tiny"
-exists "$work/tiny/micro_anisotropy.png"
-check tools/stress_measures.py "$py" "$root/tools/stress_measures.py" "$work/tiny"
-check tools/compare_micro.py "$py" "$root/tools/compare_micro.py" "$work/tiny"
-check tools/compare_runs.py "$py" "$root/tools/compare_runs.py" "$work/tiny" "$work/tiny"
-"$tdem" study "$root/tests/data/tiny_triaxial.toml" -o "$work/study" -j 1 -t 1 > "$work/study.log" 2>&1
-check tools/plot_study.py "$py" "$root/tools/plot_study.py" "$work/study" -o "$work/study.png"
-exists "$work/study.png"
-printf '# doc\n<!-- docs_table tiny -->\nold\n<!-- /docs_table tiny -->\nkept\n' > "$work/doc.md"
-check tools/docs_table.py "$py" "$root/tools/docs_table.py" "$work/study" --doc "$work/doc.md" --block tiny
-grep -q "^| tiny_triaxial | " "$work/doc.md" && grep -q "^kept$" "$work/doc.md" && ! grep -q "^old$" "$work/doc.md" ||
-  { cat "$work/doc.md"; echo "scripts_smoke: docs_table did not replace its block" >&2; exit 1; }
-check tools/plot_calibration.py "$py" "$root/tools/plot_calibration.py" "$cal" -o "$work/calibration.png"
-check tools/plot_prediction.py "$py" "$root/tools/plot_prediction.py" "$cal" -o "$work/prediction.png"
-exists "$work/calibration.png" "$work/prediction.png"
-check tools/sweep_table.py "$py" "$root/tools/sweep_table.py" \
-  --level lab="$root/data/sweeps/hidden_sweep_lab_cellbias_seeds1-6.csv"
-grep -q "identifiable cases named right: \*\*14 of 14\*\*" "$work/sweep_table.py.log" ||
-  { cat "$work/sweep_table.py.log"; echo "scripts_smoke: sweep_table miscounted the shipped lab-like sweep" >&2; exit 1; }
+  check tools/schedule_projection.py "$py" "$root/tools/schedule_projection.py" "$cal/pools.csv" --ranks 2,64
+  check tools/plot_triaxial.py "$py" "$root/tools/plot_triaxial.py" "$work/tiny" -o "$work/triaxial.png"
+  exists "$work/triaxial.png"
+  check tools/plot_micro.py "$py" "$root/tools/plot_micro.py" "$work/tiny"
+  exists "$work/tiny/micro_anisotropy.png"
+  check tools/stress_measures.py "$py" "$root/tools/stress_measures.py" "$work/tiny"
+  check tools/compare_micro.py "$py" "$root/tools/compare_micro.py" "$work/tiny"
+  check tools/compare_runs.py "$py" "$root/tools/compare_runs.py" "$work/tiny" "$work/tiny"
+  "$tdem" study "$root/tests/data/tiny_triaxial.toml" -o "$work/study" -j 1 -t 1 > "$work/study.log" 2>&1
+  check tools/plot_study.py "$py" "$root/tools/plot_study.py" "$work/study" -o "$work/study.png"
+  exists "$work/study.png"
+  printf '# doc\n<!-- docs_table tiny -->\nold\n<!-- /docs_table tiny -->\nkept\n' > "$work/doc.md"
+  check tools/docs_table.py "$py" "$root/tools/docs_table.py" "$work/study" --doc "$work/doc.md" --block tiny
+  grep -q "^| tiny_triaxial | " "$work/doc.md" && grep -q "^kept$" "$work/doc.md" && ! grep -q "^old$" "$work/doc.md" ||
+    { cat "$work/doc.md"; echo "scripts_smoke: docs_table did not replace its block" >&2; exit 1; }
+  check tools/plot_calibration.py "$py" "$root/tools/plot_calibration.py" "$cal" -o "$work/calibration.png"
+  check tools/plot_prediction.py "$py" "$root/tools/plot_prediction.py" "$cal" -o "$work/prediction.png"
+  exists "$work/calibration.png" "$work/prediction.png"
+  check tools/sweep_table.py "$py" "$root/tools/sweep_table.py" \
+    --level lab="$root/data/sweeps/hidden_sweep_lab_cellbias_seeds1-6.csv"
+  grep -q "identifiable cases named right: \*\*14 of 14\*\*" "$work/sweep_table.py.log" ||
+    { cat "$work/sweep_table.py.log"; echo "scripts_smoke: sweep_table miscounted the shipped lab-like sweep" >&2; exit 1; }
 
-check perf/scaling.sh env BUILD="$build" WORK="$work/scaling" K=4 STEPS=20 bash "$root/perf/scaling.sh"
-check perf/specimen_settling.sh env BUILD="$build" WORK="$work/settling" CONFIG="$root/tests/data/tiny_triaxial.toml" \
-  SEEDS=1 NP=1 bash "$root/perf/specimen_settling.sh"
-grep -q "^q_peak kPa " "$work/specimen_settling.sh.log" ||
-  { cat "$work/specimen_settling.sh.log"; echo "scripts_smoke: specimen_settling compared nothing" >&2; exit 1; }
-check perf/stage_profile.sh env BUILD="$build" WORK="$work/profile" CONFIG="$root/tests/data/tiny_triaxial.toml" \
-  DIAG_CONFIG="$base" PRESSURES=100 BENCH_STEPS=20 NP=1 bash "$root/perf/stage_profile.sh"
-grep -q "^shear .* | " "$work/stage_profile.sh.log" && grep -q "^diagnose: .* runs" "$work/stage_profile.sh.log" ||
-  { cat "$work/stage_profile.sh.log"; echo "scripts_smoke: stage_profile gave no shear stage or no diagnosis" >&2; exit 1; }
-check perf/device_check.sh bash -c "TINY=1 CPU_BUILD='$build' bash '$root/perf/device_check.sh' prepare '$work/dc_ref' &&
-  bash '$root/perf/device_check.sh' pack '$build' '$work/dc_pack' &&
-  TINY=1 BUILD='$work/dc_pack/build' bash '$root/perf/device_check.sh' run '$work/dc_ref' '$work/dc'"
-# The peers' packing format and the instruction count, on a 216-ball packing, triaxdem alone (the peers are
-# Debian packages the CI does not install).
-sed -e 's/^count = .*/count = 216/' -e 's/^size_mm = .*/size_mm = [11.94, 11.94, 11.94]/' \
-    "$root/perf/configs/periodic_54k.toml" > "$work/packing.toml"
-check perf/peer_benchmark.sh env BUILD="$build" WORK="$work/peers" CONFIG="$work/packing.toml" PEERS= STEPS=20 REPS=1 \
-  NP=1 bash "$root/perf/peer_benchmark.sh"
-exists "$work/peers/packing.data"
-# Valgrind (Debian 12's 3.19) cannot decode AVX-512: on a machine whose build chose x86-64-v4 the script must say
-# so and stop, which is this tiny case's outcome there.
-echo "== perf/instruction_count.sh"
-if BUILD="$build" WORK="$work/peers" CONFIG="$work/packing.toml" PEERS= N1=2 N2=4 \
-     bash "$root/perf/instruction_count.sh" > "$work/instructions.log" 2>&1; then
-  awk '$1 == "triaxdem" && $2 > 0 { found = 1 } END { exit !found }' "$work/instructions.log" ||
-    { cat "$work/instructions.log"; echo "scripts_smoke: no instruction count" >&2; exit 1; }
-elif ! grep -q "valgrind cannot run triaxdem's AVX-512 code" "$work/instructions.log"; then
-  cat "$work/instructions.log"; echo "scripts_smoke: perf/instruction_count.sh failed" >&2; exit 1
+  check perf/scaling.sh env BUILD="$build" WORK="$work/scaling" K=4 STEPS=20 bash "$root/perf/scaling.sh"
+  check perf/specimen_settling.sh env BUILD="$build" WORK="$work/settling" CONFIG="$root/tests/data/tiny_triaxial.toml" \
+    SEEDS=1 NP=1 bash "$root/perf/specimen_settling.sh"
+  grep -q "^q_peak kPa " "$work/specimen_settling.sh.log" ||
+    { cat "$work/specimen_settling.sh.log"; echo "scripts_smoke: specimen_settling compared nothing" >&2; exit 1; }
+  check perf/device_check.sh bash -c "TINY=1 CPU_BUILD='$build' bash '$root/perf/device_check.sh' prepare '$work/dc_ref' &&
+    bash '$root/perf/device_check.sh' pack '$build' '$work/dc_pack' &&
+    TINY=1 BUILD='$work/dc_pack/build' bash '$root/perf/device_check.sh' run '$work/dc_ref' '$work/dc'"
+  # The peers' packing format and the instruction count, on a 216-ball packing, triaxdem alone (the peers are
+  # Debian packages the CI does not install).
+  sed -e 's/^count = .*/count = 216/' -e 's/^size_mm = .*/size_mm = [11.94, 11.94, 11.94]/' \
+      "$root/perf/configs/periodic_54k.toml" > "$work/packing.toml"
+  check perf/peer_benchmark.sh env BUILD="$build" WORK="$work/peers" CONFIG="$work/packing.toml" PEERS= STEPS=20 REPS=1 \
+    NP=1 bash "$root/perf/peer_benchmark.sh"
+  exists "$work/peers/packing.data"
+  # Valgrind (Debian 12's 3.19) cannot decode AVX-512: on a machine whose build chose x86-64-v4 the script must say
+  # so and stop, which is this tiny case's outcome there.
+  echo "== perf/instruction_count.sh"
+  if BUILD="$build" WORK="$work/peers" CONFIG="$work/packing.toml" PEERS= N1=2 N2=4 \
+       bash "$root/perf/instruction_count.sh" > "$work/instructions.log" 2>&1; then
+    awk '$1 == "triaxdem" && $2 > 0 { found = 1 } END { exit !found }' "$work/instructions.log" ||
+      { cat "$work/instructions.log"; echo "scripts_smoke: no instruction count" >&2; exit 1; }
+  elif ! grep -q "valgrind cannot run triaxdem's AVX-512 code" "$work/instructions.log"; then
+    cat "$work/instructions.log"; echo "scripts_smoke: perf/instruction_count.sh failed" >&2; exit 1
+  fi
+  ran+=(perf/instruction_count.sh)
+  check perf/specimen_scatter.sh env BUILD="$build" WORK="$work/scatter" SEEDS=2 FACTORS="1 2" \
+    bash "$root/perf/specimen_scatter.sh"
+  check tools/specimen_scatter.py "$py" "$root/tools/specimen_scatter.py" "$work/scatter"
+  check perf/bench_engine "$build/perf/bench_engine" --benchmark_filter='BM_TimeLoop/12/1|BM_CellBatch/4/5' \
+    --benchmark_min_time=0.01
 fi
-ran+=(perf/instruction_count.sh)
-check perf/specimen_scatter.sh env BUILD="$build" WORK="$work/scatter" SEEDS=2 FACTORS="1 2" \
-  bash "$root/perf/specimen_scatter.sh"
-check tools/specimen_scatter.py "$py" "$root/tools/specimen_scatter.py" "$work/scatter"
-check perf/bench_engine "$build/perf/bench_engine" --benchmark_filter='BM_TimeLoop/12/1|BM_CellBatch/4/5' --benchmark_min_time=0.01
-# The data on a cell of the simulator's size: the generator's larger cell is the sweep's default, not what this checks.
-check perf/hidden_sweep "$build/perf/hidden_sweep" --config "$base" --seeds 1 --hidden none -j 1 --data-cell-factor 1 \
-  -o "$work/sweep.csv"
-exists "$work/sweep.csv"
-check perf/inertial_scan "$build/perf/inertial_scan" --config "$base" --specimens 2 --pressures 100 \
-  --inertial 1e-3,4e-3 -j 1 -o "$work/inertial.csv"
-exists "$work/inertial.csv"
 
-# Every script and perf program has its line above.
+# The diagnoses (the second part).
+if [ "$part" != tools ]; then
+  check perf/stage_profile.sh env BUILD="$build" WORK="$work/profile" CONFIG="$root/tests/data/tiny_triaxial.toml" \
+    DIAG_CONFIG="$base" PRESSURES=100 BENCH_STEPS=20 NP=1 bash "$root/perf/stage_profile.sh"
+  grep -q "^shear .* | " "$work/stage_profile.sh.log" && grep -q "^diagnose: .* runs" "$work/stage_profile.sh.log" ||
+    { cat "$work/stage_profile.sh.log"; echo "scripts_smoke: stage_profile gave no shear stage or no diagnosis" >&2; exit 1; }
+  # The data on a cell of the simulator's size: the generator's larger cell is the sweep's default, not what this checks.
+  check perf/hidden_sweep "$build/perf/hidden_sweep" --config "$base" --seeds 1 --hidden none -j 1 --data-cell-factor 1 \
+    -o "$work/sweep.csv"
+  exists "$work/sweep.csv"
+  check perf/inertial_scan "$build/perf/inertial_scan" --config "$base" --specimens 2 --pressures 100 \
+    --inertial 1e-3,4e-3 -j 1 -o "$work/inertial.csv"
+  exists "$work/inertial.csv"
+fi
+
+# Every script and perf program has its line above, in one part or the other.
 missing=""
 for f in "$root"/perf/*.sh "$root"/perf/*.cpp "$root"/tools/*.py; do
   [[ "$(basename "$f")" == _* ]] && continue  # a module the tools import, not a script
   name="$(basename "$(dirname "$f")")/$(basename "$f")"; name="${name%.cpp}"
-  [[ " ${ran[*]} " == *" $name "* ]] || missing+=" $name"
+  grep -Eq "^ *(check $name |ran\+=\($name\))" "${BASH_SOURCE[0]}" || missing+=" $name"
 done
 [ -z "$missing" ] || { echo "scripts_smoke: no tiny case for:$missing (add one to tests/scripts_smoke.sh)" >&2; exit 1; }
-echo "scripts_smoke: ${#ran[@]} scripts ran on tiny cases"
+echo "scripts_smoke ($part): ${#ran[@]} scripts ran on tiny cases"
