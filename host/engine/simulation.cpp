@@ -318,17 +318,14 @@ Simulation::WallLoads Simulation::wall_loads(bool facets) const {
   const int nobj = walls_.n + (facets ? mesh_.ntri : 0);
   WallLoads out{std::vector<Vec3>(static_cast<std::size_t>(nobj)), std::vector<int>(static_cast<std::size_t>(nobj), 0)};
   if (fresh_ || nobj == 0) return out;
-  wall_loads_into(wall_c_, obj_offsets_, nobj, wall_force_, wall_touching_);
-  if (hwall_force_.extent(0) != wall_force_.extent(0)) {
-    hwall_force_ = Kokkos::create_mirror(HostSpace(), wall_force_);
-    hwall_touching_ = Kokkos::create_mirror(HostSpace(), wall_touching_);
-  }
+  wall_loads_into(wall_c_, obj_offsets_, nobj, wall_load_);
+  if (hwall_load_.extent(0) != wall_load_.extent(0)) hwall_load_ = Kokkos::create_mirror(HostSpace(), wall_load_);
   const auto first = std::make_pair(0, nobj);
-  Kokkos::deep_copy(Kokkos::subview(hwall_force_, first, Kokkos::ALL), Kokkos::subview(wall_force_, first, Kokkos::ALL));
-  Kokkos::deep_copy(Kokkos::subview(hwall_touching_, first), Kokkos::subview(wall_touching_, first));
+  Kokkos::deep_copy(Kokkos::subview(hwall_load_, first), Kokkos::subview(wall_load_, first));
   for (int k = 0; k < nobj; ++k) {
-    out.force[static_cast<std::size_t>(k)] = load(hwall_force_, k);
-    out.touching[static_cast<std::size_t>(k)] = hwall_touching_(k);
+    const WallLoad& w = hwall_load_(k);
+    out.force[static_cast<std::size_t>(k)] = Vec3(w.force[0], w.force[1], w.force[2]);
+    out.touching[static_cast<std::size_t>(k)] = w.touching;
   }
   return out;
 }

@@ -165,7 +165,7 @@ class Simulation {
   void set_wall_point(int w, const Vec3& p);
   /// What the balls load each wall object with: the force (N) and the touching contacts, analytic walls first,
   /// then the facets where `facets` (a servo needs its wall alone, and a membrane has thousands of facets). One
-  /// launch and two copies to the host.
+  /// launch and one copy to the host.
   struct WallLoads {
     std::vector<Vec3> force;
     std::vector<int> touching;
@@ -206,10 +206,8 @@ class Simulation {
   IntegrateScratch integ_;  ///< with the map from gid to the particles' order, renewed at each rebuild
   // wall_loads' device scratch and the host's copies of it: a copy of their own even where the device is the host,
   // so that a read is a copy there too and the sync counts (sync_counts.hpp) are the GPU's.
-  mutable Vec3View wall_force_;
-  mutable IndexView wall_touching_;
-  mutable decltype(Kokkos::create_mirror(Vec3View())) hwall_force_;
-  mutable decltype(Kokkos::create_mirror(IndexView())) hwall_touching_;
+  mutable WallLoadView wall_load_;
+  mutable decltype(Kokkos::create_mirror(WallLoadView())) hwall_load_;
   Membrane membrane_;
   MembraneIntegrateParams membrane_prm_;
   Vec3View membrane_f_;

@@ -72,14 +72,11 @@ void object_offsets(const ContactList& walls, int nobj, IndexView& off_out) {
   });
 }
 
-void wall_loads_into(const ContactList& walls, const IndexView& offsets, int nobj, Vec3View& force,
-                     IndexView& touching) {
-  if (static_cast<int>(force.extent(0)) < nobj) force = Vec3View("dem::accumulate::wall_force", nobj);
-  if (static_cast<int>(touching.extent(0)) < nobj) touching = IndexView("dem::accumulate::wall_touching", nobj);
+void wall_loads_into(const ContactList& walls, const IndexView& offsets, int nobj, WallLoadView& loads) {
+  if (static_cast<int>(loads.extent(0)) < nobj) loads = WallLoadView("dem::accumulate::wall_loads", nobj);
   auto fc = walls.fc;
   auto fn = walls.fn;
-  auto res = force;
-  auto count = touching;
+  auto res = loads;
   Kokkos::parallel_for("dem::accumulate::wall_force", RangePolicy(0, nobj), KOKKOS_LAMBDA(const int o) {
     Vec3 s;
     int c = 0;
@@ -87,8 +84,11 @@ void wall_loads_into(const ContactList& walls, const IndexView& offsets, int nob
       s -= load(fc, k);
       c += fn(k) > 0 ? 1 : 0;
     }
-    store(res, o, s);
-    count(o) = c;
+    WallLoad& w = res(o);
+    w.force[0] = s.x;
+    w.force[1] = s.y;
+    w.force[2] = s.z;
+    w.touching = c;
   });
 }
 

@@ -64,9 +64,8 @@ IndexView object_offsets(const ContactList& walls, int nobj);
 /// The same into `off`, reused where it has nobj + 1 entries.
 void object_offsets(const ContactList& walls, int nobj, IndexView& off);
 
-/// Force on each of the first `nobj` wall objects (N), the reaction of its contacts summed in key order, and its
-/// touching contacts; `force` and `touching` are (re)allocated only where they are too short.
-void wall_loads_into(const ContactList& walls, const IndexView& offsets, int nobj, Vec3View& force,
-                     IndexView& touching);
+/// Load of each of the first `nobj` wall objects: the force (N), the reaction of its contacts summed in key order,
+/// and its touching contacts; `loads` is (re)allocated only where it is too short.
+void wall_loads_into(const ContactList& walls, const IndexView& offsets, int nobj, WallLoadView& loads);
 
 }  // namespace dem

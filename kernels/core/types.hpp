@@ -39,6 +39,14 @@ struct OverlapStat {
   int contact = -1;
 };
 
+/// What the balls load a wall object with: the force (N) and the touching contacts, side by side so that a servo
+/// reads both in one copy.
+struct WallLoad {
+  Real force[3] = {0, 0, 0};
+  int touching = 0;
+};
+using WallLoadView = Kokkos::View<WallLoad*, MemSpace>;
+
 /// A step's statistics, kept on the device, a row per step of a ring of steps (host/engine/step_rows.hpp): the
 /// reductions' roots as Reals, and the largest overlaps of the ball-ball and ball-wall contacts.
 using StepRowsView = Kokkos::View<Real**, Kokkos::LayoutRight, MemSpace>;
