@@ -217,10 +217,12 @@ void CellBatch::plan() {
 }
 
 void CellBatch::step(const std::vector<char>& measure) {
+  bool measured = false;  // some specimen's step is
   for (std::size_t s = 0; s < spec_.size(); ++s) {
     const bool m = measure.empty() || measure[s];
     dirty_ = dirty_ || spec_[s].prm.integ.measure != m;
     spec_[s].prm.integ.measure = m;
+    measured = measured || m;
   }
   upload();
   // A specimen's lists expire as its Simulation's would (lists_expired, read every step). A rebuild changes no bit
@@ -232,8 +234,7 @@ void CellBatch::step(const std::vector<char>& measure) {
   if (any) rebuild();
   compute_ball_forces(p_, balls_, params_, dev_spec_, items_, OverlapResultView(worst_.data()));
   integrate_batch_to(p_, dev_spec_, particle_tree_, make_gather(balls_, own_, adj_balls_, walls_, adj_walls_), integ_,
-                     rows_.data(), Leapfrog::kValues,
-                     measure.empty() || std::any_of(measure.begin(), measure.end(), [](char m) { return m != 0; }));
+                     rows_.data(), Leapfrog::kValues, measured);
   // The cells' stretch, on the device and on the host alike (Simulation::move_boundaries).
   auto& hon = host_stretching_;
   bool stretch = false;

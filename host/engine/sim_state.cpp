@@ -188,8 +188,9 @@ SimState Simulation::state() const {
   s.x = vec3_out(p_.x, n);
   s.v = vec3_out(p_.v, n);
   s.w = vec3_out(p_.w, n);
-  s.f = vec3_out(particles_with_forces().f, n);
-  s.m = vec3_out(p_.m, n);
+  const Particles& forces = particles_with_forces();
+  s.f = vec3_out(forces.f, n);
+  s.m = vec3_out(forces.m, n);
   s.x_ref = vec3_out(p_.x_ref, n);
   s.radius = scalar_out<double>(p_.radius, n);
   s.mass = scalar_out<double>(p_.mass, n);
