@@ -114,7 +114,8 @@ TEST(HotPath, AStepAllocatesNothingAndReadsItsStatisticsEveryKSteps) {
 // Every stage of the tiny membrane test (specimen layers, consolidation, shear) and of the tiny periodic cell, with
 // the statistics read every step and every 16 steps: the same steps bit for bit (the rebuilds decided between reads
 // as a read at every step decides them), and the steps' own waits down to the reads. What remains per step is the
-// stages' control (servo readings, platen speeds: docs/performance.md).
+// membrane test's control (the platen servo's readings and speeds: docs/performance.md); the periodic cell's servo
+// runs on the device.
 TEST(HotPath, StatisticsReadEvery16StepsGiveTheSameStepsWithFewerWaits) {
   const MembraneRun every1 = membrane_run(1), every16 = membrane_run(16);
   ASSERT_EQ(every1.stages.size(), every16.stages.size());
@@ -156,8 +157,14 @@ TEST(HotPath, StatisticsReadEvery16StepsGiveTheSameStepsWithFewerWaits) {
     print_stage(p1.stages[k]);
     print_stage(p16.stages[k]);
     EXPECT_EQ(p1.stages[k].steps, p16.stages[k].steps);
+    EXPECT_EQ(p1.stages[k].parts.rebuilds, p16.stages[k].parts.rebuilds);
     EXPECT_EQ(p16.stages[k].parts.late_rebuilds, 0);
     EXPECT_LT(step_waits(p16.stages[k]), 0.25);
+    // The cell's servo runs on the device (Simulation::set_cell_servo): its control waits for nothing, and its kernels
+    // allocate nothing. On the host it read the stress every step and the stiffness every tenth: 1.1 copies a step.
+    const SyncCounts control = part_of(p16.stages[k], SyncPart::kControl);
+    EXPECT_EQ(control.syncs(), 0) << p16.stages[k].name;
+    EXPECT_EQ(control.allocations + part_of(p16.stages[k], SyncPart::kStep).allocations, 0) << p16.stages[k].name;
   }
   ASSERT_EQ(p1.series.size(), p16.series.size());
   for (std::size_t k = 0; k < p1.series.size(); ++k) {
@@ -219,8 +226,9 @@ TEST(HotPath, AStateTakenBetweenReadsResumesBitForBit) {
 
 namespace {
 
-/// A batch step's waits: `cells` periodic lattices of 125 balls, steps 20-35 (no rebuild), counted per step.
-SyncCounts batch_step_waits(int cells) {
+/// A batch step's waits: `cells` periodic lattices of 125 balls, steps 22-37 (no rebuild), counted per step; with
+/// `servoed`, each cell's three axes servoed on the device from step 21 (a slow one: the lattice barely moves).
+SyncCounts batch_step_waits(int cells, bool servoed = false) {
   std::vector<std::unique_ptr<Simulation>> made;
   std::vector<const Simulation*> sims;
   for (int s = 0; s < cells; ++s) {
@@ -231,6 +239,16 @@ SyncCounts batch_step_waits(int cells) {
   }
   CellBatch batch(sims);
   for (int k = 0; k < 20; ++k) batch.step();
+  if (servoed) {
+    CellServoSpec spec;
+    for (bool& on : spec.servo) on = true;
+    spec.sigma3 = 1e3;
+    spec.alpha = 0.5;
+    spec.max_rate = 1e-3;
+    spec.stiffness_every = 10;
+    for (int s = 0; s < cells; ++s) batch.set_cell_servo(s, spec);
+  }
+  batch.step();  // the cells start stretching: the device learns which
   const long rebuilds = batch.rebuild_steps();
   const SyncTally before = sync_tally();
   {
@@ -257,6 +275,15 @@ TEST(HotPath, ABatchStepWaitsAsOftenForSixCellsAsForTwo) {
   EXPECT_EQ(six.host_results, two.host_results);
   EXPECT_EQ(six.allocations, 0);
   EXPECT_LE(six.copies + six.host_results, 2 * 16) << "the statistics, and the count of overlaps past their limits";
+  // Servoed on the device, the cells add launches (the stress's and, on one step in ten, the stiffness's reductions,
+  // the rates, the stretch) and no wait: on the host their servo read the stresses and sent the rates, two copies a
+  // step.
+  const SyncCounts servoed = batch_step_waits(6, true);
+  std::printf("a servoed batch step: %.2f launches, %.2f copies, %.2f results, %.2f allocations (6 cells)\n",
+              servoed.launches / 16.0, servoed.copies / 16.0, servoed.host_results / 16.0, servoed.allocations / 16.0);
+  EXPECT_EQ(servoed.copies + servoed.host_results, six.copies + six.host_results);
+  EXPECT_EQ(servoed.allocations, 0);
+  EXPECT_GT(servoed.launches, six.launches);
 }
 
 namespace {

@@ -11,6 +11,7 @@
 #include <random>
 
 #include "host/engine/packing.hpp"
+#include "host/triax/periodic_stages.hpp"
 #include "host/triax/periodic_triaxial.hpp"
 #include "test_util.hpp"
 
@@ -64,7 +65,78 @@ PeriodicTriaxialResult shear(const Specimen& s, Real mu_s, const PeriodicTriaxia
   return run_periodic_triaxial(*sim, p);
 }
 
+/// A Simulation's cell that keeps its servo on the host: each step the host reads the stress and sets the rates.
+class HostServoed final : public CellControl {
+ public:
+  explicit HostServoed(Simulation& sim) : c_(cell_of(sim)) {}
+  std::array<Real, 3> lengths() const override { return c_->lengths(); }
+  Real volume() const override { return c_->volume(); }
+  std::array<Real, 3> stress() override { return c_->stress(); }
+  std::array<Real, 3> stiffness() override { return c_->stiffness(); }
+  void set_rates(const Vec3& rate) override { c_->set_rates(rate); }
+  Vec3 rates() const override { return c_->rates(); }
+  Real dt() const override { return c_->dt(); }
+  long step_count() const override { return c_->step_count(); }
+  Real time() const override { return c_->time(); }
+  long touching() override { return c_->touching(); }
+  Real unbalanced_ratio() override { return c_->unbalanced_ratio(); }
+  Real kinetic() override { return c_->kinetic(); }
+  int balls() const override { return c_->balls(); }
+
+ private:
+  std::unique_ptr<CellControl> c_;
+};
+
+/// run_periodic_triaxial's stages on `cell`.
+PeriodicTriaxialResult run_stages(Simulation& sim, CellControl& cell, const PeriodicTriaxialParams& prm) {
+  GrainScales g;
+  PeriodicTriaxialResult res = start_result(sim, prm, g);
+  Consolidation consolidation(cell, res.params);
+  StageEnd end = run_stage(sim, consolidation.steps(), nullptr);
+  EXPECT_EQ(consolidation.end(end), "");
+  res.consolidation_steps = end.step;
+  Shear shear(cell, res, g, nullptr, nullptr);
+  shear.end(run_stage(sim, shear.steps(), nullptr).timing, 0);
+  return res;
+}
+
 }  // namespace
+
+// The servo on the device (Simulation::set_cell_servo) does the host's arithmetic: a test whose servo reads the
+// stress on the host before every step gives the same bits, record by record, with the membrane's share of the
+// lateral targets (which moves with the lateral lengths the host does not know between records) and its stiffness
+// summed on one step in ten. Read every 16 steps, as a GPU build does, so that the rebuilds are decided between
+// reads too.
+TEST(PeriodicTriaxial, ServoOnTheDeviceGivesTheHostServosBits) {
+  const Specimen s = dense_specimen(kBalls, 4);
+  PeriodicTriaxialParams p = quiet(0.01);
+  p.membrane_stiffness = 1e6;
+  SolverConfig solver = test::cell_solver();
+  solver.stats_every = 16;
+  PeriodicTriaxialResult r[2];
+  for (int host = 0; host < 2; ++host) {
+    auto sim = make_periodic_simulation(s.balls, s.cell, test::law(1e8, 1.5, 0.3, 0), solver);
+    if (host == 1) {
+      HostServoed cell(*sim);
+      r[host] = run_stages(*sim, cell, p);
+    } else {
+      r[host] = run_stages(*sim, *cell_of(*sim), p);
+    }
+  }
+  EXPECT_EQ(r[0].consolidation_steps, r[1].consolidation_steps);
+  ASSERT_EQ(r[0].series.size(), r[1].series.size());
+  ASSERT_GT(r[0].series.size(), 5u);
+  for (std::size_t k = 0; k < r[0].series.size(); ++k) {
+    const PeriodicTriaxialRecord &a = r[0].series[k], &b = r[1].series[k];
+    EXPECT_EQ(a.step, b.step) << "record " << k;
+    EXPECT_EQ(a.q, b.q) << "record " << k;
+    EXPECT_EQ(a.eps_v, b.eps_v) << "record " << k;
+    EXPECT_EQ(a.rate_x, b.rate_x) << "record " << k;
+    EXPECT_EQ(a.rate_y, b.rate_y) << "record " << k;
+    EXPECT_EQ(a.membrane, b.membrane) << "record " << k;
+  }
+  EXPECT_GT(r[0].series.back().membrane, 0.0);  // the membrane's share was in play
+}
 
 TEST(PeriodicTriaxial, LateralStressesHeldAtSigma3ThroughShear) {
   const Specimen s = dense_specimen(kBalls, 1);

@@ -58,20 +58,9 @@ IndexView contact_starts(const ContactList& c, const SpecimenParamsView& spec, i
   return first;
 }
 
-/// The periodic cell's affine step of every specimen marked in `on` (Simulation's, CellStretch), on the device.
-void stretch_specimens(const Particles& p, const SpecimenParamsView& spec, const Kokkos::View<const char*, MemSpace>& on) {
-  auto x = p.x, xr = p.x_ref;
-  auto owner = p.specimen;
-  Kokkos::parallel_for("dem::batch::affine", RangePolicy(0, p.n), KOKKOS_LAMBDA(const int i) {
-    const int s = owner(i);
-    if (!on(s)) return;
-    const CellStretch st(spec(s).dom, spec(s).integ.dt);
-    for (int d = 0; d < 3; ++d) {
-      x(i, d) = st(d, x(i, d));
-      xr(i, d) = st(d, xr(i, d));
-    }
-  });
-}
+/// A batch row: a specimen's Leapfrog values, then its cell's stretch speed (m/s) where its servo is on the device.
+constexpr int kSpeedColumn = Leapfrog::kValues;
+constexpr int kRowWidth = kSpeedColumn + 1;
 
 }  // namespace
 
@@ -120,7 +109,7 @@ CellBatch::CellBatch(const std::vector<const Simulation*>& specimens) {
   }
   dev_spec_ = SpecimenParamsView("dem::batch::specimens", spec_.size());
   host_spec_ = Kokkos::create_mirror_view(dev_spec_);
-  rows_ = StepRowsView("dem::batch::rows", spec_.size(), Leapfrog::kValues);
+  rows_ = StepRowsView("dem::batch::rows", spec_.size(), kRowWidth);
   host_rows_ = Kokkos::create_mirror_view(rows_);
   worst_ = Kokkos::View<OverlapStat, MemSpace>("dem::batch::worst");
   items_.exceeded_count = Kokkos::View<int, MemSpace>("dem::batch::exceeded_count");
@@ -128,6 +117,9 @@ CellBatch::CellBatch(const std::vector<const Simulation*>& specimens) {
   sums_ = Kokkos::View<Real**, Kokkos::LayoutRight, MemSpace>("dem::batch::sums", spec_.size(), 3);
   host_sums_ = Kokkos::create_mirror_view(sums_);
   host_stretching_ = Kokkos::create_mirror_view(stretching_);
+  servo_slots_ = CellServoSlotView("dem::batch::servo_slots", spec_.size());
+  host_slots_ = Kokkos::create_mirror_view(servo_slots_);
+  servo_sums_ = CellServoSumRowsView("dem::batch::servo_sums", spec_.size());
   walls_ = ContactList(0);
   adj_walls_ = build_adjacency(p_.n, walls_, walls_.i);
 }
@@ -138,8 +130,86 @@ int CellBatch::running_count() const {
   return n;
 }
 
+const Domain& CellBatch::domain(int s) const {
+  const Specimen& sp = spec_.at(static_cast<std::size_t>(s));
+  if (sp.stale) read_cells();
+  return sp.prm.domain;
+}
+
+Real CellBatch::axis_length(int s, int d) const {
+  const Specimen& sp = spec_.at(static_cast<std::size_t>(s));
+  if (sp.stale && sp.servo.on && sp.servo.spec.servo[d]) read_cells();
+  return sp.prm.domain.length(d);
+}
+
+void CellBatch::read_cells() const {
+  bool any = false;
+  for (const Specimen& sp : spec_) any = any || sp.stale;
+  if (!any) return;
+  Kokkos::deep_copy(host_spec_, dev_spec_);
+  for (std::size_t s = 0; s < spec_.size(); ++s) {
+    Specimen& sp = spec_[s];
+    if (!sp.stale) continue;
+    sp.prm.domain = host_spec_(s).dom;
+    sp.stale = false;
+  }
+}
+
+void CellBatch::upload_slots() {
+  for (std::size_t s = 0; s < spec_.size(); ++s) host_slots_(s) = spec_[s].servo;
+  Kokkos::deep_copy(servo_slots_, host_slots_);
+}
+
+void CellBatch::set_cell_servo(int s, const CellServoSpec& spec) {
+  Specimen& sp = spec_.at(static_cast<std::size_t>(s));
+  if (!sp.running) return;
+  read_cells();
+  sp.servo.spec = spec;
+  sp.servo.reach = 2 * sp.rmax + sp.prm.skin;
+  sp.servo.calls = 0;
+  sp.servo.on = 1;
+  // The rates the kernel sets the fixed axes to, which the host's copy moves them by.
+  for (int d = 0; d < 3; ++d)
+    if (!spec.servo[d]) sp.prm.domain.strain_rate[d] = spec.fixed[d];
+  upload_slots();
+}
+
+void CellBatch::servo_step() {
+  bool any = false, fresh = false;
+  for (Specimen& sp : spec_) {
+    if (!sp.running || !sp.servo.on) continue;
+    any = true;
+    if (sp.servo.calls++ % sp.servo.spec.stiffness_every == 0) fresh = true;  // every one's calls counted
+    sp.stale = true;
+  }
+  if (!any) return;
+  const SpecimenImages images{p_.specimen, dev_spec_};
+  Real* sums = servo_sums_.data();  // device memory: the host passes it on, never reads it
+  const int stride = CellServoSums::kCount;
+  if (fresh_) {
+    Kokkos::deep_copy(servo_sums_, Real(0));  // no contacts yet: no sums (per_volume's zeros)
+  } else {
+    if (fresh) {
+      const StiffnessTerms<SpecimenImages> terms{p_.x, p_.radius, images};
+      segmented_reduce_lanes_to<3, 0, 1>("dem::batch::servo_stiffness", owner_tree_,
+                                         OwnerSums<3, StiffnessTerms<SpecimenImages>>{owners(), terms},
+                                         sums + CellServoSums::kStiffnessSums, stride);
+    }
+    segmented_reduce_lanes_to<3, 0, 1>("dem::batch::servo_stress", owner_tree_,
+                                       OwnerSums<3, LoveWeberTerms<3, SpecimenImages>>{owners(), {p_.x, images}},
+                                       sums + CellServoSums::kStressSums, stride);
+  }
+  cell_servo_rates(dev_spec_, servo_slots_, servo_sums_);
+}
+
 void CellBatch::set_strain_rate(int s, const Vec3& rate) {
-  Domain& dom = spec_.at(static_cast<std::size_t>(s)).prm.domain;
+  Specimen& sp = spec_.at(static_cast<std::size_t>(s));
+  read_cells();
+  if (sp.servo.on) {
+    sp.servo.on = 0;
+    upload_slots();
+  }
+  Domain& dom = sp.prm.domain;
   dirty_ = dirty_ || dom.strain_rate[0] != rate.x || dom.strain_rate[1] != rate.y || dom.strain_rate[2] != rate.z;
   dom.strain_rate[0] = rate.x;
   dom.strain_rate[1] = rate.y;
@@ -150,12 +220,17 @@ void CellBatch::stop(int s) {
   Specimen& sp = spec_.at(static_cast<std::size_t>(s));
   if (!sp.running) return;
   sp.running = false;
+  if (sp.servo.on) {
+    sp.servo.on = 0;
+    upload_slots();
+  }
   if (!fresh_) plan();
 }
 
 void CellBatch::upload() const {
   if (!dirty_) return;
   dirty_ = false;
+  read_cells();  // the cells the device's servos changed are the device's
   for (std::size_t s = 0; s < spec_.size(); ++s) {
     const Specimen& sp = spec_[s];
     SpecimenParams& h = host_spec_(s);
@@ -170,6 +245,7 @@ void CellBatch::upload() const {
 }
 
 void CellBatch::rebuild() {
+  read_cells();
   std::vector<SpecimenBin> bins;
   for (const Specimen& sp : spec_)
     bins.push_back({sp.first, sp.count, sp.prm.domain, 2 * sp.rmax + sp.prm.skin, sp.prm.skin, sp.running});
@@ -225,6 +301,7 @@ void CellBatch::step(const std::vector<char>& measure) {
     measured = measured || m;
   }
   upload();
+  servo_step();
   // A specimen's lists expire as its Simulation's would (lists_expired, read every step). A rebuild changes no bit
   // of a run (contact_sums.hpp, step_wrap), so every running specimen is rebuilt when one is due: their lists then
   // expire together, at the pace of the fastest, where each on its own would have the batch rebuild at most steps.
@@ -234,27 +311,37 @@ void CellBatch::step(const std::vector<char>& measure) {
   if (any) rebuild();
   compute_ball_forces(p_, balls_, params_, dev_spec_, items_, OverlapResultView(worst_.data()));
   integrate_batch_to(p_, dev_spec_, particle_tree_, make_gather(balls_, own_, adj_balls_, walls_, adj_walls_), integ_,
-                     rows_.data(), Leapfrog::kValues, measured);
-  // The cells' stretch, on the device and on the host alike (Simulation::move_boundaries).
+                     rows_.data(), kRowWidth, measured);
+  // The cells' stretch, on the device and on the host alike (Simulation::move_boundaries): the host's copy of a
+  // servoed cell moves along the axes whose rate it knows, and the speed of its stretch comes with its row.
   auto& hon = host_stretching_;
-  bool stretch = false;
+  bool stretch = false, changed = !stretching_sent_;
   std::vector<Real>& speed = speed_;
   speed.assign(spec_.size(), 0);
   for (std::size_t s = 0; s < spec_.size(); ++s) {
     Specimen& sp = spec_[s];
-    hon(s) = sp.running && stretching(sp.prm.domain);
-    if (!hon(s)) continue;
+    const bool servoed = sp.running && sp.servo.on;
+    const char on = sp.running && (servoed || stretching(sp.prm.domain));
+    changed = changed || hon(s) != on;
+    hon(s) = on;
+    if (!on) continue;
     stretch = true;
-    CellStretch(sp.prm.domain, sp.prm.integ.dt).apply(sp.prm.domain);
-    dirty_ = true;
-    speed[s] = stretch_speed(sp.prm.domain, 2 * sp.rmax + sp.prm.skin);
+    Domain& dom = sp.prm.domain;
+    const CellStretch st(dom, sp.prm.integ.dt);
+    for (int d = 0; d < 3; ++d)
+      if (!servoed || !sp.servo.spec.servo[d]) dom.hi[d] = st(d, dom.hi[d]);
+    if (servoed) sp.stale = true;  // a rebuild may have read it within this step
+    else speed[s] = stretch_speed(dom, 2 * sp.rmax + sp.prm.skin);
   }
-  if (stretch) {
-    Kokkos::deep_copy(stretching_, hon);
-    stretch_specimens(p_, dev_spec_, stretching_);
+  if (changed) {
+    Kokkos::deep_copy(stretching_, hon);  // only when a cell starts or stops stretching
+    stretching_sent_ = true;
   }
+  if (stretch) stretch_cells(p_, dev_spec_, stretching_, servo_slots_, rows_.data() + kSpeedColumn, kRowWidth);
   ++batch_steps_;
   Kokkos::deep_copy(host_rows_, rows_);
+  for (std::size_t s = 0; s < spec_.size(); ++s)
+    if (spec_[s].running && spec_[s].servo.on) speed[s] = host_rows_(s, kSpeedColumn);
   // Each specimen's largest overlap past its limit: the contacts the force kernel listed (rarely any), each to its
   // specimen, the larger kept and ties to the later contact (MaxOverlap's rule).
   std::vector<OverlapStat>& worst = worst_of_;
@@ -327,7 +414,7 @@ const std::vector<std::array<Real, 3>>& CellBatch::per_volume(const char* label,
   cache.assign(spec_.size(), {});
   at = batch_steps_;
   if (fresh_) return cache;
-  upload();  // the cells as they are now: a step stretched them after its upload
+  read_cells();  // the volumes of the cells as they are now
   cache = contact_sums<3>(label, f);
   for (std::size_t s = 0; s < spec_.size(); ++s) {
     const Real V = spec_[s].prm.domain.volume();

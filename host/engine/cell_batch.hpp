@@ -41,9 +41,15 @@ class CellBatch {
   /// Why specimen s stopped with a blow-up (the message its own Simulation's BlowUp gives), or "".
   const std::string& blowup(int s) const { return spec_.at(static_cast<std::size_t>(s)).blowup; }
 
-  const Domain& domain(int s) const { return spec_.at(static_cast<std::size_t>(s)).prm.domain; }
-  /// As Simulation::set_strain_rate, for specimen s.
+  /// Specimen s's cell now: read from the device where its servo on the device changed it since the last read.
+  const Domain& domain(int s) const;
+  /// Its length along axis d (m): an axis its servo on the device does not steer is known without a read.
+  Real axis_length(int s, int d) const;
+  /// As Simulation::set_strain_rate, for specimen s (its servo on the device ends).
   void set_strain_rate(int s, const Vec3& rate);
+  /// As Simulation::set_cell_servo, for specimen s: before each of its steps a kernel sets its rates, the batch's
+  /// servos in one launch after two reductions for all of them, with no wait of the host.
+  void set_cell_servo(int s, const CellServoSpec& spec);
   /// Steps specimen s has taken, and its time (s).
   long step_count(int s) const { return spec_.at(static_cast<std::size_t>(s)).steps; }
   Real time(int s) const { return spec_.at(static_cast<std::size_t>(s)).time; }
@@ -79,11 +85,14 @@ class CellBatch {
     Real wall_disp = 0;  ///< the cell's travel since the specimen's last rebuild (m), as Simulation's
     bool running = true;
     std::string blowup;
+    CellServoSlot servo;  ///< its servo on the device, as the host knows it (calls counted alike)
+    bool stale = false;   ///< the device's cell has changed since the host last read it (its servo's axes)
   };
   Particles p_;
   ParamTableView params_;
   int nmat_ = 0;
-  std::vector<Specimen> spec_;
+  // The host's copies of the cells are read from the device when asked for (read_cells): mutable.
+  mutable std::vector<Specimen> spec_;
   SpecimenParamsView dev_spec_;
   mutable decltype(Kokkos::create_mirror_view(SpecimenParamsView())) host_spec_;
   CellList cells_;
@@ -98,7 +107,7 @@ class CellBatch {
   /// gids (a stopped specimen's stress is that of its state).
   SegmentedTree particle_tree_, owner_tree_;
   ContactOwners owners() const { return {balls_, walls_, own_, IndexView(), IndexView(), integ_.gid2local}; }
-  StepRowsView rows_;  ///< a row of Leapfrog values per specimen
+  StepRowsView rows_;  ///< a row per specimen: its Leapfrog values, its cell's stretch speed where a servo set it
   decltype(Kokkos::create_mirror_view(StepRowsView())) host_rows_;
   Kokkos::View<OverlapStat, MemSpace> worst_;  ///< the force kernel's largest overlap of all, not read: see exceeded
   Kokkos::View<OverlapStat*, MemSpace> exceeded_buf_;  ///< room for ContactItems::exceeded
@@ -125,14 +134,25 @@ class CellBatch {
   mutable long stress_at_ = -1, stiffness_at_ = -1, force_sums_at_ = -1;
   Kokkos::View<char*, MemSpace> stretching_;  ///< which specimens' cells stretch this step
   decltype(Kokkos::create_mirror_view(Kokkos::View<char*, MemSpace>())) host_stretching_;
+  bool stretching_sent_ = false;  ///< the device has the host's stretching flags
+  CellServoSlotView servo_slots_;
+  decltype(Kokkos::create_mirror_view(CellServoSlotView())) host_slots_;
+  CellServoSumRowsView servo_sums_;
   bool fresh_ = true;
+
+  /// The servos on the device before a step: their specimens' sums and rates.
+  void servo_step();
+  /// The slots of the servos to the device (when one starts or ends).
+  void upload_slots();
+  /// The cells the device has changed to the host's copies (one copy), where any has.
+  void read_cells() const;
 
   /// Rebuilds the running specimens' lists, keeping the stopped ones'.
   void rebuild();
   /// The work items and trees of the running specimens' particles and contacts.
   void plan();
   /// Specimen s's statistics after a step: its blow-up checks (it stops on one; `worst`: its largest overlap past
-  /// its limit, if any), and its cell's travel.
+  /// its limit, if any).
   void take_row(int s, const OverlapStat& worst);
   /// The host's specimen table to the device, where it changed (a cache of the host's: so const).
   void upload() const;

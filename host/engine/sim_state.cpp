@@ -183,7 +183,7 @@ SimState Simulation::state() const {
   s.step = step_;
   s.time = time_;
   s.dt = prm_.integ.dt;
-  s.domain = prm_.domain;
+  s.domain = domain();
   const int n = p_.n;
   s.x = vec3_out(p_.x, n);
   s.v = vec3_out(p_.v, n);
@@ -227,6 +227,9 @@ void Simulation::restore(const SimState& s) {
   time_ = s.time;
   prm_.integ.dt = s.dt;
   prm_.domain = s.domain;
+  servo_on_ = false;
+  cell_stale_ = false;
+  upload_cell();
   vec3_in(p_.x, s.x, p_.n);
   vec3_in(p_.v, s.v, p_.n);
   vec3_in(p_.w, s.w, p_.n);

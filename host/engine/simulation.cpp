@@ -34,17 +34,6 @@ void move_walls(const WallSet& walls, Real dt) {
   });
 }
 
-/// The periodic cell's affine step: positions, and the positions of the last rebuild, stretched by `st`.
-void stretch_particles(const Particles& p, const CellStretch& st) {
-  auto x = p.x, xr = p.x_ref;
-  Kokkos::parallel_for("dem::sim::affine", RangePolicy(0, p.n), KOKKOS_LAMBDA(const int i) {
-    for (int d = 0; d < 3; ++d) {
-      x(i, d) = st(d, x(i, d));
-      xr(i, d) = st(d, xr(i, d));
-    }
-  });
-}
-
 /// Moves the facet mesh's nodes by dt node_v; the largest node speed (m/s) goes to `speed`, in device memory.
 void move_nodes(const FacetMesh& mesh, Real dt, Real* speed) {
   auto nx = mesh.node_x, nv = mesh.node_v;
@@ -72,6 +61,9 @@ Simulation::Simulation(Particles particles, WallSet walls, FacetMesh mesh, const
   Kokkos::deep_copy(hwall_point_, walls_.point);
   Kokkos::deep_copy(hwall_vel_, walls_.velocity);
   rmax_ = max_radius(p_);
+  cell_ = CellView("dem::sim::cell");
+  servo_sums_ = CellServoSumsView("dem::sim::servo_sums");
+  upload_cell();
   count_syncs();
   if (prm_.skin <= 0) throw std::invalid_argument("Verlet skin must be > 0");
   if (prm_.stats_every < 1 || prm_.stats_every > StepRows::kSlots)
@@ -111,6 +103,7 @@ Real Simulation::critical_dt() const {
 
 void Simulation::rebuild() {
   const SyncScope part(SyncPart::kRebuild);
+  read_cell();
   // Balls move less than the skin between rebuilds, so an escape is caught within a rebuild of happening.
   const int out = ball_outside(p_, prm_.domain, 2);
   if (out >= 0) {
@@ -189,9 +182,16 @@ class PartClock {
 
 void Simulation::step(bool measure) {
   PartClock clock(step_ % kTimedEvery == 0 ? kTimedEvery : 0);
+  // The servo reads the state the last step left, as a servo on the host does before the step.
+  if (servo_on_) {
+    servo_step();
+    clock.lap(times_.boundaries);
+  }
   if (rebuild_due()) clock.always(times_.rebuild, [this] { rebuild(); });
   const Real dt = prm_.integ.dt;
-  compute_ball_forces(p_, balls_, params_, prm_.domain, dt, rows_.overlap(step_, StepRows::kBalls));
+  prm_.integ.measure = measure;
+  const SpecimenTable one = specimen();
+  compute_ball_forces(p_, balls_, params_, one, rows_.overlap(step_, StepRows::kBalls));
   clock.lap(times_.forces);
   compute_wall_forces(p_, wall_c_, adj_walls_, walls_, mesh_, params_, dt, rows_.overlap(step_, StepRows::kWalls));
   clock.lap(times_.walls);
@@ -202,8 +202,7 @@ void Simulation::step(bool measure) {
     membrane_integrate_to(membrane_, membrane_f_, membrane_prm_, rows_.at(step_, StepRows::kMembrane));
     clock.lap(times_.membrane);
   }
-  prm_.integ.measure = measure;
-  integrate_to(p_, prm_.domain, prm_.integ, gather(), integ_, rows_.at(step_, StepRows::kLeapfrog));
+  integrate_to(p_, one, gather(), integ_, rows_.at(step_, StepRows::kLeapfrog));
   forces_current_ = false;
   clock.lap(times_.integrate);
   move_boundaries();
@@ -233,16 +232,75 @@ void Simulation::move_boundaries() {
   // The device moves its copy of the walls by the same arithmetic (no contraction, CMakeLists.txt): the host's
   // stays equal to it bit for bit, with no copy between them.
   if (vmax > 0) move_walls(walls_, dt);
-  if (stretching(prm_.domain)) {
+  // Neighbours within the cut-off drift apart (or together) by at most |rate| dt times the cut-off.
+  const Real reach = 2 * rmax_ + prm_.skin;
+  Real cell_bound = -1;
+  if (!servo_on_) read_cell();  // a servo on the device that ended left the rates it set
+  if (servo_on_ || stretching(prm_.domain)) {
+    // The device stretches its cell by the same arithmetic as the host its copy (no contraction, CMakeLists.txt).
+    stretch_cell(p_, cell_, dt, reach, rows_.at(step_, StepRows::kCellSpeed));
     const CellStretch st(prm_.domain, dt);
-    stretch_particles(p_, st);
-    st.apply(prm_.domain);
-    // Neighbours within the cut-off drift apart (or together) by at most |rate| dt times the cut-off.
-    vmax = std::max(vmax, stretch_speed(prm_.domain, 2 * rmax_ + prm_.skin));
+    if (servo_on_) {
+      // The host knows the rates of the axes the servo does not steer; the others' speed is read with the row.
+      for (int d = 0; d < 3; ++d)
+        if (!servo_.servo[d]) prm_.domain.hi[d] = st(d, prm_.domain.hi[d]);
+      cell_stale_ = true;
+      cell_bound = servo_speed_bound(servo_, reach);
+    } else {
+      st.apply(prm_.domain);
+      vmax = std::max(vmax, stretch_speed(prm_.domain, reach));
+    }
   }
   // The membrane nodes' speed joins vmax when the row is read (read_rows).
   if (mesh_.ntri > 0) move_nodes(mesh_, dt, rows_.at(step_, StepRows::kNodeSpeed));
-  boundary_step(vmax, dt);
+  boundary_step(vmax, dt, cell_bound);
+}
+
+SpecimenTable Simulation::specimen() const {
+  SpecimenTable one;
+  one.one.integ = prm_.integ;
+  one.cell = cell_;
+  return one;
+}
+
+void Simulation::upload_cell() {
+  Kokkos::deep_copy(cell_, Kokkos::View<Domain, HostSpace, Kokkos::MemoryUnmanaged>(&prm_.domain));
+}
+
+void Simulation::read_cell() const {
+  if (!cell_stale_) return;
+  Kokkos::deep_copy(Kokkos::View<Domain, HostSpace, Kokkos::MemoryUnmanaged>(&prm_.domain), cell_);
+  cell_stale_ = false;
+}
+
+Real Simulation::axis_length(int d) const {
+  if (servo_on_ && servo_.servo[d]) read_cell();
+  return prm_.domain.length(d);
+}
+
+void Simulation::set_cell_servo(const CellServoSpec& spec) {
+  const Domain& dom = domain();
+  if (!(dom.periodic[0] && dom.periodic[1] && dom.periodic[2]))
+    throw std::invalid_argument("set_cell_servo: the cell must be periodic along x, y and z");
+  servo_ = spec;
+  servo_on_ = true;
+  servo_calls_ = 0;
+  // The rates the kernel sets the fixed axes to, which the host's copy moves them by.
+  for (int d = 0; d < 3; ++d)
+    if (!spec.servo[d]) prm_.domain.strain_rate[d] = spec.fixed[d];
+}
+
+void Simulation::servo_step() {
+  const bool fresh = servo_calls_++ % servo_.stiffness_every == 0;
+  const CellImage image{cell_};
+  Real* sums = servo_sums_.data();  // device memory: the host passes it on, never reads it
+  if (fresh)
+    owner_sums_to<3>("dem::sim::servo_stiffness", StiffnessTerms<CellImage>{p_.x, p_.radius, image},
+                     sums + CellServoSums::kStiffnessSums);
+  owner_sums_to<3>("dem::sim::servo_stress", LoveWeberTerms<3, CellImage>{p_.x, image},
+                   sums + CellServoSums::kStressSums);
+  cell_servo_rates(cell_, servo_, servo_sums_, fresh, prm_.integ.dt);
+  cell_stale_ = true;
 }
 
 void Simulation::set_membrane(const Membrane& m, const MembraneIntegrateParams& prm) {
@@ -255,9 +313,14 @@ void Simulation::set_membrane(const Membrane& m, const MembraneIntegrateParams& 
 }
 
 void Simulation::set_strain_rate(const Vec3& rate) {
-  prm_.domain.strain_rate[0] = rate.x;
-  prm_.domain.strain_rate[1] = rate.y;
-  prm_.domain.strain_rate[2] = rate.z;
+  read_cell();
+  servo_on_ = false;
+  Domain& dom = prm_.domain;
+  if (dom.strain_rate[0] == rate.x && dom.strain_rate[1] == rate.y && dom.strain_rate[2] == rate.z) return;
+  dom.strain_rate[0] = rate.x;
+  dom.strain_rate[1] = rate.y;
+  dom.strain_rate[2] = rate.z;
+  upload_cell();  // a constant rate: no copy
 }
 
 namespace {

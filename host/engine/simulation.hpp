@@ -12,6 +12,7 @@
 #include "kernels/neighbor/binning.hpp"
 #include "kernels/neighbor/contact_detect.hpp"
 #include "kernels/contact/contact_force.hpp"
+#include "kernels/motion/cell_servo.hpp"
 #include "kernels/motion/integrate.hpp"
 #include "kernels/motion/membrane.hpp"
 #include "host/engine/sim_state.hpp"
@@ -103,6 +104,12 @@ class Simulation {
     const int gids = static_cast<int>(integ_.gid2local.extent(0));
     deterministic_reduce_lanes<N, 0, 1>(label, gids, OwnerSums<N, Terms>{contact_owners(), terms}, out);
   }
+  /// The same, left in device memory at `root` (a servo on the device reads them there).
+  template <int N, class Terms>
+  void owner_sums_to(const char* label, const Terms& terms, Real* root) const {
+    const int gids = static_cast<int>(integ_.gid2local.extent(0));
+    deterministic_reduce_lanes_to<N, 0, 1>(label, gids, OwnerSums<N, Terms>{contact_owners(), terms}, root);
+  }
   const ContactList& wall_contacts() const { return wall_c_; }
   /// The last step's statistics (read from the device where they wait).
   const StepStats& stats() const {
@@ -112,6 +119,7 @@ class Simulation {
   const StageTimes& times() const { return times_; }
   /// The stage times of the run segments before a resume, so that reports cover the whole run.
   void set_times(const StageTimes& t) { times_ = t; }
+  /// The parameters; their domain is the cell as the host last knew it: domain() is the cell now.
   const SimParams& params() const { return prm_; }
   /// The material-pair table of the contact laws, on the device (nmat x nmat).
   const ParamTableView& contact_table() const { return params_; }
@@ -147,9 +155,25 @@ class Simulation {
   }
 
   /// Homogeneous deformation of a periodic cell: each step the cell and the particle positions are
-  /// stretched about domain.lo by (1 + rate dt) along each axis (1/s, extension positive).
+  /// stretched about domain.lo by (1 + rate dt) along each axis (1/s, extension positive). Ends a servo on the
+  /// device (set_cell_servo).
   void set_strain_rate(const Vec3& rate);
-  const Domain& domain() const { return prm_.domain; }
+  /// The cell's rates set before each step by the strain-rate servo `spec` on the device, from the next step until
+  /// set_strain_rate (kernels/motion/cell_servo.hpp): a kernel sums the contact stress (and the stiffness on one
+  /// step in spec.stiffness_every, from the first) and sets the rates, with the host's arithmetic (host/triax's
+  /// CellServo) and its bits, and the host waits for none of it. The host reads the cell when asked for it (domain(),
+  /// axis_length of a servoed axis, a rebuild). Throws std::invalid_argument unless the cell is periodic along x, y
+  /// and z.
+  void set_cell_servo(const CellServoSpec& spec);
+  /// Stops the servo on the device where one runs, leaving the rates it set last (no copy: a stage that stops early).
+  void end_cell_servo() { servo_on_ = false; }
+  /// The cell now: read from the device where the servo on the device has changed it since the last read.
+  const Domain& domain() const {
+    read_cell();
+    return prm_.domain;
+  }
+  /// The cell's length along axis d (m): an axis the servo on the device does not steer the host knows without a read.
+  Real axis_length(int d) const;
   /// Love-Weber stress of the ball-ball contacts over `volume` (m^3), compression positive, row-major
   /// 3 x 3 (Pa): sigma = -(1/V) sum fc (x) (x2 - x1). Boundary (wall, facet) contacts are not included.
   std::array<Real, 9> contact_stress(Real volume) const;
@@ -191,11 +215,20 @@ class Simulation {
 
  private:
   Particles p_;
+  // The cell in device memory, which the kernels read (SpecimenTable::cell); the host's copy is prm_.domain. The host
+  // moves its copy as the device moves its own, so that they stay equal bit for bit, except for the axes a servo on the
+  // device steers: the host reads those when it needs them (read_cell), hence the mutable copy.
+  CellView cell_;
+  CellServoSumsView servo_sums_;
+  CellServoSpec servo_;
+  bool servo_on_ = false;
+  long servo_calls_ = 0;
+  mutable bool cell_stale_ = false;
   WallSet walls_;
   decltype(Kokkos::create_mirror(WallSet().point)) hwall_point_, hwall_vel_;
   FacetMesh mesh_;
   ParamTableView params_;
-  SimParams prm_;
+  mutable SimParams prm_;
   CellList cells_;
   ContactList balls_, wall_c_;
   ListBuffers ball_bufs_, wall_bufs_;
@@ -225,6 +258,7 @@ class Simulation {
   /// The host-known part of each step's boundary speed (walls, the cell's stretch; m/s) and its dt, by ring slot.
   struct BoundaryStep {
     Real speed = 0, dt = 0;
+    bool cell = false;  ///< the cell's speed is on the step's row (StepRows::kCellSpeed): a servo on the device set it
   };
   std::array<BoundaryStep, StepRows::kSlots> boundary_steps_{};
   mutable StageTimes times_;
@@ -236,8 +270,9 @@ class Simulation {
 
   Gather gather() const { return make_gather(balls_, own_, adj_balls_, wall_c_, adj_walls_); }
   bool rebuild_due();
-  /// Records the step's host-known boundary speed (m/s) and dt, and adds to the bound on the unread steps' travel.
-  void boundary_step(Real speed, Real dt);
+  /// Records the step's host-known boundary speed (m/s) and dt, and adds to the bound on the unread steps' travel
+  /// (`cell_bound`, m/s, where the cell's speed is on the row: its bound).
+  void boundary_step(Real speed, Real dt, Real cell_bound);
   /// Reads the rows of the steps not yet read: their blow-up checks, displacements and statistics.
   void read_rows() const;
   /// Whether the neighbour lists must be rebuilt after a step with largest displacement^2 `disp2` since the last
@@ -246,6 +281,13 @@ class Simulation {
   void rebuild();
   void index_contacts();  ///< owner ranges, adjacency and object offsets of the contact lists
   void move_boundaries();
+  /// The kernels' one specimen: the cell in device memory, the time integration.
+  SpecimenTable specimen() const;
+  /// The servo on the device's sums and rates, before a step.
+  void servo_step();
+  /// The host's copy of the cell to the device / the device's to the host where it is stale.
+  void upload_cell();
+  void read_cell() const;
   /// Sets the host's copy of wall w's velocity; false where it was v already.
   bool store_wall_velocity(int w, const Vec3& v);
   /// Throws BlowUp where step `step`'s statistics and overlaps show one.

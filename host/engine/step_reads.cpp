@@ -11,6 +11,7 @@
 // steps are bit for bit those of stats_every = 1, unless a ball speeds up more than kSpeedGrowth times within a read's
 // steps: the read then finds the lists expired at an earlier step (a late rebuild, counted in StageTimes and reported
 // once on stderr), and the run differs from there.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -47,9 +48,9 @@ bool Simulation::rebuild_due() {
   return lists_expired(stats_.max_disp2, wall_disp_);
 }
 
-void Simulation::boundary_step(Real speed, Real dt) {
-  boundary_steps_[static_cast<std::size_t>(StepRows::slot(step_))] = {speed, dt};
-  unread_travel_ += std::max(speed, mesh_.ntri > 0 ? kSpeedGrowth * node_bound_ : Real(0)) * dt;
+void Simulation::boundary_step(Real speed, Real dt, Real cell_bound) {
+  boundary_steps_[static_cast<std::size_t>(StepRows::slot(step_))] = {speed, dt, cell_bound >= 0};
+  unread_travel_ += std::max({speed, cell_bound, mesh_.ntri > 0 ? kSpeedGrowth * node_bound_ : Real(0)}) * dt;
 }
 
 void Simulation::read_rows() const {
@@ -64,6 +65,7 @@ void Simulation::read_rows() const {
     check_blowup(s, st, rows_.host_overlap(s, StepRows::kBalls), rows_.host_overlap(s, StepRows::kWalls));
     const BoundaryStep& b = boundary_steps_[static_cast<std::size_t>(StepRows::slot(s))];
     Real speed = b.speed;
+    if (b.cell) speed = std::max(speed, row[StepRows::kCellSpeed]);
     if (mesh_.ntri > 0) {
       speed = std::max(speed, row[StepRows::kNodeSpeed]);
       node_max = std::max(node_max, row[StepRows::kNodeSpeed]);

@@ -27,7 +27,8 @@ struct WallStiffnessTerms {
 
 }  // namespace
 
-bool walled(const Simulation& sim) { return sim.num_walls() == 6 && !sim.domain().periodic[0]; }
+// Which axes are periodic never changes: the host's copy of the cell knows it without a read.
+bool walled(const Simulation& sim) { return sim.num_walls() == 6 && !sim.params().domain.periodic[0]; }
 
 std::vector<WallSpec> cell_walls(const std::array<Real, 3>& cell) {
   Config box;

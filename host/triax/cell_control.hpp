@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "kernels/core/vec3.hpp"
+#include "kernels/motion/cell_servo.hpp"
 
 namespace dem {
 
@@ -16,10 +17,15 @@ class CellControl {
  public:
   virtual ~CellControl() = default;
   virtual std::array<Real, 3> lengths() const = 0;  ///< L_d (m)
+  /// L_d (m) of axis d alone: a cell steered on the device knows an axis its servo does not steer without a read.
+  virtual Real length(int d) const { return lengths()[static_cast<std::size_t>(d)]; }
   virtual Real volume() const = 0;                   ///< m^3
   virtual std::array<Real, 3> stress() = 0;          ///< sigma_dd (Pa, compression positive)
   virtual std::array<Real, 3> stiffness() = 0;       ///< the servo's K_dd (Pa)
   virtual void set_rates(const Vec3& rate) = 0;      ///< strain rates of the next steps (1/s, extension positive)
+  /// Hands the servo `spec` to the device for the steps until set_rates, where the cell can take it (a periodic cell:
+  /// Simulation::set_cell_servo, CellBatch::set_cell_servo); false where the host servos it before each step (walls).
+  virtual bool servo_on_device(const CellServoSpec&) { return false; }
   virtual Vec3 rates() const = 0;
   virtual Real dt() const = 0;                        ///< s
   virtual long step_count() const = 0;

@@ -15,12 +15,35 @@ namespace {
 
 constexpr Real kPi = 3.14159265358979323846;
 
+/// The servo of stage (a): every axis to sigma3, its rates clamped to consolidation_rate.
+CellServoSpec consolidation_servo(const PeriodicTriaxialParams& prm) {
+  CellServoSpec s;
+  for (bool& on : s.servo) on = true;
+  s.sigma3 = prm.sigma3;
+  s.alpha = prm.servo_alpha;
+  s.max_rate = prm.consolidation_rate;
+  s.stiffness_every = prm.stiffness_every;
+  return s;
+}
+
+/// The servo of stage (b): the lateral axes to sigma3 plus the membrane's confinement from their strains since L0,
+/// clamped to max_lateral_rate; the axial axis shortened at axial_rate.
+CellServoSpec shear_servo(const PeriodicTriaxialParams& prm, const std::array<Real, 3>& L0) {
+  CellServoSpec s = consolidation_servo(prm);
+  s.servo[2] = false;
+  s.fixed[2] = -prm.axial_rate;
+  s.membrane_stiffness = prm.membrane_stiffness;
+  for (int d = 0; d < 3; ++d) s.L0[d] = L0[static_cast<std::size_t>(d)];
+  s.max_rate = prm.max_lateral_rate;
+  return s;
+}
+
 /// Lateral confinement per axis: sigma3 plus the membrane's, from the cell's lateral strains since L0.
 std::array<Real, 3> lateral_targets(const std::array<Real, 3>& lengths, const PeriodicTriaxialParams& prm,
                                     const std::array<Real, 3>& L0) {
+  const CellServoSpec s = shear_servo(prm, L0);
   std::array<Real, 3> t{};
-  for (int d = 0; d < 3; ++d)
-    t[d] = prm.sigma3 + membrane_confinement(prm.membrane_stiffness, lengths[d] / L0[d] - 1);
+  for (int d = 0; d < 3; ++d) t[static_cast<std::size_t>(d)] = servo_target(s, d, lengths[static_cast<std::size_t>(d)]);
   return t;
 }
 
@@ -141,34 +164,33 @@ PeriodicTriaxialResult start_result(Simulation& sim, const PeriodicTriaxialParam
   return res;
 }
 
-void CellServo::update(CellControl& cell, const bool servo[3], const Real fixed[3], const Real target[3]) {
-  if (calls_++ % prm_.stiffness_every == 0) k_ = cell.stiffness();
-  stress_ = cell.stress();
-  const Real dt = cell.dt();
+void CellServo::update(CellControl& cell) {
+  if (on_device_) return;
+  if (calls_ == 0 && cell.servo_on_device(spec_)) {
+    on_device_ = true;
+    return;
+  }
+  if (calls_++ % spec_.stiffness_every == 0) k_ = cell.stiffness();
+  const std::array<Real, 3> stress = cell.stress();
+  const std::array<Real, 3> lengths = cell.lengths();
   Real rate[3];
-  for (int d = 0; d < 3; ++d) {
-    if (!servo[d]) { rate[d] = fixed[d]; continue; }
-    const Real err = stress_[d] - target[d];
-    // gain = alpha sigma3 / (K dt); with no contacts (K = 0) the clamp decides.
-    const Real r = k_[d] > 0 ? prm_.servo_alpha * err / (k_[d] * dt)
-                             : (err > 0 ? max_rate_ : (err < 0 ? -max_rate_ : Real(0)));
-    rate[d] = std::clamp(r, -max_rate_, max_rate_);
+  for (std::size_t d = 0; d < 3; ++d) {
+    const int a = static_cast<int>(d);
+    rate[d] = spec_.servo[d] ? servo_rate(spec_, stress[d] - servo_target(spec_, a, lengths[d]), k_[d], cell.dt())
+                             : spec_.fixed[d];
   }
   cell.set_rates(Vec3(rate[0], rate[1], rate[2]));
 }
 
 Consolidation::Consolidation(CellControl& cell, const PeriodicTriaxialParams& prm)
-    : cell_(cell), prm_(prm), servo_(prm, prm.consolidation_rate),
+    : cell_(cell), prm_(prm), servo_(consolidation_servo(prm)),
       progress_(prm.name + " consolidation (ETA to the step cap)", prm.max_consolidation_steps) {}
 
 StageSteps Consolidation::steps() {
   StageSteps stage;
   stage.last = prm_.max_consolidation_steps;
   stage.before = [this](long n) {
-    const bool all[3] = {true, true, true};
-    const Real none[3] = {0, 0, 0};
-    const Real target[3] = {prm_.sigma3, prm_.sigma3, prm_.sigma3};
-    servo_.update(cell_, all, none, target);
+    servo_.update(cell_);
     return StepPlan{false, n % prm_.check_every == 0};
   };
   stage.after = [this](long n, bool measured) {
@@ -223,7 +245,7 @@ void SnapshotSchedule::at(Real eps) {
 
 Shear::Shear(CellControl& cell, PeriodicTriaxialResult& res, const GrainScales& g, io::Output* out, Simulation* sim)
     : cell_(cell), res_(res), prm_(res.params), g_(g), out_(out), snapshots_(prm_, sim, out),
-      servo_(prm_, prm_.max_lateral_rate),
+      servo_(shear_servo(prm_, cell.lengths())),
       total_(static_cast<long>(std::ceil(-std::log(1 - prm_.target_strain) / (prm_.axial_rate * cell.dt())))),
       progress_(prm_.name + " shear", total_), next_record_(prm_.record_strain) {
   L0_ = cell_.lengths();
@@ -239,12 +261,8 @@ StageSteps Shear::steps() {
   StageSteps stage;
   stage.last = std::numeric_limits<long>::max();  // until the target strain
   stage.before = [this](long) {
-    const bool lateral[3] = {true, true, false};
-    const Real axial[3] = {0, 0, -prm_.axial_rate};
-    const std::array<Real, 3> lengths = cell_.lengths();
-    const std::array<Real, 3> target = lateral_targets(lengths, prm_, L0_);
-    servo_.update(cell_, lateral, axial, target.data());
-    const Real h = lengths[2];
+    servo_.update(cell_);
+    const Real h = cell_.length(2);
     const Real eps_next = (res_.h0 - h * (1 - prm_.axial_rate * cell_.dt())) / res_.h0;
     last_ = eps_next >= prm_.target_strain;
     return StepPlan{false, last_ || eps_next >= next_record_ - 1e-12};  // a recorded step measures
@@ -262,7 +280,7 @@ StageSteps Shear::steps() {
       }
       if (out_ && res_.series.size() % 50 == 0) out_->flush_series();
     }
-    snapshots_.at((res_.h0 - cell_.lengths()[2]) / res_.h0);
+    snapshots_.at((res_.h0 - cell_.length(2)) / res_.h0);
     return last_;
   };
   return stage;

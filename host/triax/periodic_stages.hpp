@@ -23,20 +23,20 @@ GrainScales grain_scales(Simulation& sim);
 /// The result's parameters and grain figures before the test (`g` receives these), and its first line when verbose.
 PeriodicTriaxialResult start_result(Simulation& sim, const PeriodicTriaxialParams& prm, GrainScales& g);
 
-/// The strain-rate servo of the cell: each call measures the contact stress and sets the next step's rates.
+/// The strain-rate servo of the cell (kernels/motion/cell_servo.hpp), called before each step of a stage: on the
+/// device where the cell takes it (from the first call on), else on the host, each call measuring the contact stress
+/// and setting the next step's rates, with the same arithmetic.
 class CellServo {
  public:
-  CellServo(const PeriodicTriaxialParams& prm, Real max_rate) : prm_(prm), max_rate_(max_rate) {}
+  explicit CellServo(const CellServoSpec& spec) : spec_(spec) {}
 
-  /// servo[d]: axis d is servoed to target[d] (Pa); otherwise its rate is fixed[d] (1/s, extension positive).
-  void update(CellControl& cell, const bool servo[3], const Real fixed[3], const Real target[3]);
+  void update(CellControl& cell);
 
  private:
-  PeriodicTriaxialParams prm_;
-  Real max_rate_;
+  CellServoSpec spec_;
+  bool on_device_ = false;
   long calls_ = 0;
   std::array<Real, 3> k_{};
-  std::array<Real, 3> stress_{};
 };
 
 /// Stage (a), isotropic consolidation, on a cell: its servo, its progress line, and the state it reached.

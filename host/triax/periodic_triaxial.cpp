@@ -83,6 +83,4 @@ PeriodicTriaxialResult run_periodic_triaxial(Simulation& sim, const PeriodicTria
   return res;
 }
 
-Real membrane_confinement(Real stiffness, Real eps) { return stiffness * std::max(eps, Real(0)); }
-
 }  // namespace dem

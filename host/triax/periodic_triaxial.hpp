@@ -110,13 +110,6 @@ std::vector<BatchedTest> run_periodic_batch(const std::vector<Simulation*>& sims
                                             const std::vector<PeriodicTriaxialParams>& prms,
                                             bool consolidate_only = false, std::array<long, 2>* steps = nullptr);
 
-/// Membrane extension: the extra lateral confinement (Pa) of a membrane of stiffness E_m t / R0 (Pa, its
-/// modulus times thickness over the specimen's radius) at lateral strain eps (extension positive): the hoop
-/// tension E_m t eps of a thin cylinder acting on the radius R0. None in contraction: latex buckles rather
-/// than push. In the periodic cell each lateral axis is servoed to sigma3 plus this, and q is reported
-/// against sigma3, the cell pressure, as a lab does.
-Real membrane_confinement(Real stiffness, Real eps);
-
 /// K_ii = (1/V) sum_c (Fn/overlap) l_i^2 over touching ball-ball contacts (Pa): the servo's stiffness.
 std::array<Real, 3> cell_stiffness(Simulation& sim);
 

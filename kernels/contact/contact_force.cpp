@@ -44,7 +44,8 @@ struct BallForce : MaxOverlap {
     }
     const int lanes = end - s0 < W ? end - s0 : W;
     const SpecimenParams& specimen = spec(sp);
-    const MinImage image(specimen.dom);
+    const Domain& dom = spec.dom(sp);
+    const MinImage image(dom);
     const Real dt = specimen.integ.dt;
     const int row = specimen.material_row;
     // Lanes past the end repeat the last contact; their results are not stored.
@@ -85,7 +86,7 @@ struct BallForce : MaxOverlap {
     // Branch vectors from the centres to the contact point: r1 = a n, r2 = -b n (both along n),
     // which folds the two spin terms of the relative velocity into one cross product.
     const T a = ri - Real(0.5) * overlap, b = rj - Real(0.5) * overlap;
-    kin.vrel = vj - vi - cross(a * wi + b * wj, kin.n) + specimen.dom.affine_velocity(d);
+    kin.vrel = vj - vi - cross(a * wi + b * wj, kin.n) + dom.affine_velocity(d);
     kin.dtheta = dt * (wj - wi);
     kin.dt = dt;
     kin.kn = RRLinear::stiffness(prm, ri, rj);
@@ -238,9 +239,17 @@ OverlapStat read_back(const Launch& launch) {
 
 void compute_ball_forces(const Particles& p, ContactList& c, const ParamTableView& params, const Domain& dom, Real dt,
                          const OverlapResultView& worst) {
+  SpecimenTable one;
+  one.one.dom = dom;
+  one.one.integ.dt = dt;
+  compute_ball_forces(p, c, params, one, worst);
+}
+
+void compute_ball_forces(const Particles& p, ContactList& c, const ParamTableView& params, const SpecimenTable& one,
+                         const OverlapResultView& worst) {
   BallForce k;
   bind_particles(k, p);
-  k.c = c; k.params = params; k.spec.one.dom = dom; k.spec.one.integ.dt = dt;
+  k.c = c; k.params = params; k.spec = one;
   const int items = (c.n + BallForce::W - 1) / BallForce::W;
   Kokkos::parallel_reduce("dem::force::balls" TRIAXDEM_DEVICE_RESULT, RangePolicy(0, items), k, worst);
 }

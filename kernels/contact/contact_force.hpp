@@ -14,6 +14,9 @@ namespace dem {
 /// `worst`, in device memory: the host does not wait.
 void compute_ball_forces(const Particles& p, ContactList& c, const ParamTableView& params, const Domain& dom, Real dt,
                          const OverlapResultView& worst);
+/// The same for the one specimen of `one` (SpecimenTable: its cell by value or in device memory, its time step).
+void compute_ball_forces(const Particles& p, ContactList& c, const ParamTableView& params, const SpecimenTable& one,
+                         const OverlapResultView& worst);
 
 /// A batch's ball-ball contacts cut into work items of kContactLanes that stay within one specimen: specimen s's
 /// contacts [contact_first(s), contact_first(s + 1)) are items [item_first(s), item_first(s + 1)) (S + 1 entries

@@ -50,6 +50,12 @@ struct OneImage {
   KOKKOS_INLINE_FUNCTION MinImage operator()(int) const { return image; }
 };
 
+/// The minimum image of a Simulation's one cell where it lies in device memory (a cell steered on the device).
+struct CellImage {
+  ConstCellView cell;
+  KOKKOS_INLINE_FUNCTION MinImage operator()(int) const { return MinImage(cell()); }
+};
+
 /// The minimum image of particle i's specimen's cell, in a batch.
 struct SpecimenImages {
   ConstIndexView owner;

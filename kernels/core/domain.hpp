@@ -81,7 +81,7 @@ struct CellStretch {
   /// Coordinate x along axis d after the step.
   KOKKOS_INLINE_FUNCTION Real operator()(int d, Real x) const { return lo[d] + (x - lo[d]) * f[d]; }
   /// The cell's bounds after the step.
-  void apply(Domain& dom) const {
+  KOKKOS_INLINE_FUNCTION void apply(Domain& dom) const {
     for (int d = 0; d < 3; ++d) dom.hi[d] = (*this)(d, dom.hi[d]);
   }
 };
@@ -93,7 +93,7 @@ inline bool stretching(const Domain& dom) {
 
 /// How fast the cell's stretch moves two balls within `reach` (m) of each other apart or together (m/s): the cell's
 /// share of the neighbour lists' travel (the largest rate times the reach).
-inline Real stretch_speed(const Domain& dom, Real reach) {
+KOKKOS_INLINE_FUNCTION Real stretch_speed(const Domain& dom, Real reach) {
   Real rate = 0;
   for (int d = 0; d < 3; ++d) rate = kc::fabs(dom.strain_rate[d]) > rate ? kc::fabs(dom.strain_rate[d]) : rate;
   return rate * reach;

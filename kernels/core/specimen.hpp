@@ -30,13 +30,22 @@ struct SpecimenParams {
   Real overlap_limit = 0;    ///< overlap / radius past which a contact is a blow-up (listed by a batch's force kernel)
 };
 using SpecimenParamsView = Kokkos::View<SpecimenParams*, MemSpace>;
+/// A Simulation's cell in device memory, where the kernels of a cell steered on the device change it
+/// (kernels/motion/cell_servo.hpp).
+using CellView = Kokkos::View<Domain, MemSpace>;
+using ConstCellView = Kokkos::View<const Domain, MemSpace>;
 
-/// The specimens of a kernel: `one` where `many` is empty (a simulation of one specimen), else many(s).
+/// The specimens of a kernel: `one` where `many` is empty (a simulation of one specimen), else many(s). One
+/// specimen's cell is `cell`, in device memory, where it is set, else one.dom: kernels take a cell by dom(s).
 struct SpecimenTable {
   SpecimenParams one;
   Kokkos::View<const SpecimenParams*, MemSpace> many;
+  ConstCellView cell;
   KOKKOS_INLINE_FUNCTION bool batched() const { return many.extent(0) > 0; }
   KOKKOS_INLINE_FUNCTION const SpecimenParams& operator()(const int s) const { return batched() ? many(s) : one; }
+  KOKKOS_INLINE_FUNCTION const Domain& dom(const int s) const {
+    return batched() ? many(s).dom : (cell.data() != nullptr ? cell() : one.dom);
+  }
 };
 
 }  // namespace dem

@@ -40,6 +40,12 @@ void integrate_to(Particles& p, const Domain& dom, const IntegrateParams& prm, c
   SpecimenTable one;
   one.one.dom = dom;
   one.one.integ = prm;
+  integrate_to(p, one, gather, scratch, values);
+}
+
+void integrate_to(Particles& p, const SpecimenTable& one, const Gather& gather, const IntegrateScratch& scratch,
+                  Real* values) {
+  const IntegrateParams& prm = one.one.integ;
   deterministic_reduce_lanes_to<Leapfrog::kSums, Leapfrog::kMaxima, Leapfrog::W>(
       "dem::integrate::leapfrog", p.n, leapfrog(p, one, gather, scratch), values);
   if (!prm.measure) return;

@@ -68,7 +68,8 @@ struct Leapfrog {
   KOKKOS_INLINE_FUNCTION void operator()(const int i0, const int count, Real (*vals)[kValues]) const {
     using T = ContactPack;
     // A group of W particles lies in one specimen: the blocks of a batch's reduction start at its specimens' first.
-    const SpecimenParams& sp = spec(spec.batched() ? owner(i0) : 0);
+    const int own = spec.batched() ? owner(i0) : 0;
+    const SpecimenParams& sp = spec(own);
     const IntegrateParams& prm = sp.integ;
     // Lanes past count repeat the last particle; their results are not stored.
     int id[W];
@@ -91,7 +92,7 @@ struct Leapfrog {
     vi = vi + a * damped(force, damped_velocity(prm, vi, x0), prm.alpha);
     wi = wi + b * damped(moment, wi, prm.alpha);
     Vec3T<T> xi = x0 + T(prm.dt) * vi;
-    const Vec3T<T> shift = step_wrap(sp.dom, xi);
+    const Vec3T<T> shift = step_wrap(spec.dom(own), xi);
     const auto put_all = [&](auto at) {
       put(v, at, vi);
       put(w, at, wi);
@@ -149,6 +150,9 @@ StepStats integrate(Particles& p, const Domain& dom, const IntegrateParams& prm,
 /// The same, with the step's Leapfrog::kValues values left in device memory at `values` (step_stats reads them).
 void integrate_to(Particles& p, const Domain& dom, const IntegrateParams& prm, const Gather& gather,
                   const IntegrateScratch& scratch, Real* values);
+/// The same for the one specimen of `one` (SpecimenTable: its cell by value or in device memory, one.one.integ).
+void integrate_to(Particles& p, const SpecimenTable& one, const Gather& gather, const IntegrateScratch& scratch,
+                  Real* values);
 /// The same for the specimens of a batch at once (specimens(s) holding specimen s's particles and time integration,
 /// `tree` segmented by their particles, which are its gids too): specimen s's values go to values[s * stride + q],
 /// bit for bit those of integrate_to on the specimen alone. `measured`: some specimen's step is measured.

@@ -1,0 +1,108 @@
+#pragma once
+/// The periodic cell steered on the device: the strain-rate servo of the cell test's stages
+/// (host/triax/periodic_stages.hpp) and the cell's affine step. A Simulation whose cell the servo steers keeps the
+/// cell in device memory (CellView), where these kernels change it and the force and integration kernels read it, so
+/// that a step waits for nothing on the host (host/engine/simulation.hpp: set_cell_servo). The servo's arithmetic is
+/// here once: the host's servo (a walled cell, a batch) calls the same functions.
+#include "kernels/core/particles.hpp"
+#include "kernels/core/specimen.hpp"
+
+namespace dem {
+
+/// What the servo does with each axis of the cell before a step.
+struct CellServoSpec {
+  bool servo[3] = {false, false, false};  ///< axis d servoed to its target stress; else its rate is fixed[d]
+  Real fixed[3] = {0, 0, 0};              ///< 1/s, extension positive
+  Real sigma3 = 0;                        ///< Pa, the target's confining part (compression positive)
+  Real membrane_stiffness = 0;            ///< Pa, the target's membrane part (membrane_confinement); 0: none
+  Real L0[3] = {1, 1, 1};                 ///< m, the lengths the membrane's strain counts from
+  Real alpha = 0;                         ///< the servo's gain as a fraction of the stiffness (0, 1]
+  Real max_rate = 0;                      ///< 1/s, the servoed rates' clamp
+  int stiffness_every = 1;                ///< the stiffness is summed on one call in this many, from the first
+};
+
+/// Membrane extension: the extra lateral confinement (Pa) of a membrane of stiffness E_m t / R0 (Pa, its modulus times
+/// thickness over the specimen's radius) at lateral strain eps (extension positive): the hoop tension E_m t eps of a
+/// thin cylinder acting on the radius R0. None in contraction: latex buckles rather than push. In the periodic cell
+/// each lateral axis is servoed to sigma3 plus this, and q is reported against sigma3, the cell pressure, as a lab
+/// does.
+KOKKOS_INLINE_FUNCTION Real membrane_confinement(Real stiffness, Real eps) { return stiffness * (eps < 0 ? Real(0) : eps); }
+
+/// The target stress (Pa) of axis d at length L (m): sigma3 plus the membrane's.
+KOKKOS_INLINE_FUNCTION Real servo_target(const CellServoSpec& s, int d, Real L) {
+  return s.sigma3 + membrane_confinement(s.membrane_stiffness, L / s.L0[d] - 1);
+}
+
+/// The servoed rate (1/s) for stress error err = sigma - target (Pa) at stiffness k (Pa) over a step of dt (s):
+/// alpha err / (k dt), so that the step corrects the fraction alpha of the error, clamped to +-max_rate; with no
+/// contacts (k = 0) the clamp decides.
+KOKKOS_INLINE_FUNCTION Real servo_rate(const CellServoSpec& s, Real err, Real k, Real dt) {
+  const Real r = k > 0 ? s.alpha * err / (k * dt) : (err > 0 ? s.max_rate : (err < 0 ? -s.max_rate : Real(0)));
+  return r < -s.max_rate ? -s.max_rate : (s.max_rate < r ? s.max_rate : r);
+}
+
+/// The fastest the servo can move two balls within `reach` (m) of each other apart or together (m/s): the host's bound
+/// on the cell's share of the neighbour lists' travel over the steps it has not read (stretch_speed's, at the clamp).
+inline Real servo_speed_bound(const CellServoSpec& s, Real reach) {
+  Real rate = 0;
+  for (int d = 0; d < 3; ++d) {
+    const Real r = s.servo[d] ? s.max_rate : kc::fabs(s.fixed[d]);
+    rate = r > rate ? r : rate;
+  }
+  return rate * reach;
+}
+
+/// Where the servo keeps its sums between kernels, in device memory: the stiffness's sums (K_dd V) and the contact
+/// stress's (sigma_dd V) of this call, the stiffness of the call that last summed it (Pa).
+struct CellServoSums {
+  enum : int { kStiffnessSums = 0, kStressSums = 3, kStiffness = 6, kCount = 9 };
+};
+using CellServoSumsView = Kokkos::View<Real[CellServoSums::kCount], MemSpace>;
+/// A batch's: a row per specimen.
+using CellServoSumRowsView = Kokkos::View<Real* [CellServoSums::kCount], Kokkos::LayoutRight, MemSpace>;
+
+/// One cell's servo: the rates of `dom` for the next step from its sums (CellServoSums; the stiffness's where
+/// `fresh_stiffness`), as the host's CellServo sets them.
+KOKKOS_INLINE_FUNCTION void servo_cell(Domain& dom, const CellServoSpec& spec, Real* sums, bool fresh_stiffness,
+                                       Real dt) {
+  // The same divisions as the host's cell_stiffness and contact_stress_diagonal: the same bits.
+  const Real V = dom.volume();
+  for (int d = 0; d < 3; ++d) {
+    if (fresh_stiffness) sums[CellServoSums::kStiffness + d] = sums[CellServoSums::kStiffnessSums + d] / V;
+    if (!spec.servo[d]) {
+      dom.strain_rate[d] = spec.fixed[d];
+      continue;
+    }
+    const Real err = sums[CellServoSums::kStressSums + d] / V - servo_target(spec, d, dom.length(d));
+    dom.strain_rate[d] = servo_rate(spec, err, sums[CellServoSums::kStiffness + d], dt);
+  }
+}
+
+/// Sets the cell's rates for the next step from the sums in `sums`: one work item.
+void cell_servo_rates(const CellView& cell, const CellServoSpec& spec, const CellServoSumsView& sums,
+                      bool fresh_stiffness, Real dt);
+
+/// A batch specimen's servo on the device: its spec, while `on`; the calls it has had (the stiffness is summed on the
+/// first and one in spec.stiffness_every after); the reach of its neighbour lists (m: stretch_speed's).
+struct CellServoSlot {
+  CellServoSpec spec;
+  Real reach = 0;
+  long calls = 0;
+  int on = 0;
+};
+using CellServoSlotView = Kokkos::View<CellServoSlot*, MemSpace>;
+
+/// The batch's servos: the rates of each specimen whose slot is on, from its row of `sums`, one work item each.
+void cell_servo_rates(const SpecimenParamsView& spec, const CellServoSlotView& slots, const CellServoSumRowsView& sums);
+
+/// The periodic cell's affine step over dt at the rates the cell holds: positions and the positions of the last
+/// rebuild stretched about lo (CellStretch), the cell's upper bounds likewise, and stretch_speed(reach) of the step
+/// to `speed`, in device memory.
+void stretch_cell(const Particles& p, const CellView& cell, Real dt, Real reach, Real* speed);
+
+/// The same for each specimen s of a batch marked in `on`, at its cell's rates and time step; where its servo's slot
+/// is on, its stretch_speed goes to speeds[s * stride].
+void stretch_cells(const Particles& p, const SpecimenParamsView& spec, const Kokkos::View<const char*, MemSpace>& on,
+                   const CellServoSlotView& slots, Real* speeds, int stride);
+
+}  // namespace dem
