@@ -521,3 +521,55 @@ TEST(Dynamics, LocalDampingAboutAMeanFlow) {
     EXPECT_NEAR(v, expected, 1e-12 * std::fabs(expected)) << (about ? "about the flow" : "absolute");
   }
 }
+
+// The platen servo on the device (kernels/motion/wall_servo.hpp): the wall's velocity is the gain
+// relax A / (kn N_c dt) times the stress error, along its axis into the specimen, within +-v_max; at v_max with no
+// contacts; its tied nodes get the same velocity and the others keep theirs. Values: A = 1e-3 m^2, kn = 1e5 N/m,
+// N_c = 4, dt = 1e-6 s, relax 0.1: gain 2.5e-4 m/(s Pa), so 5e4 Pa of error is 12.5 m/s. The tolerance is a few
+// roundings of the six operations.
+TEST(WallServo, SpeedIsTheGainOnTheErrorWithinTheClampAndTiedNodesFollow) {
+  WallServoSpec spec;
+  spec.servo.target = 1e5;
+  spec.servo.area = 1e-3;
+  spec.servo.relax = 0.1;
+  spec.servo.v_max = 100;
+  spec.wall = 1;
+  spec.axis = 2;
+  spec.sign = -1;
+  spec.kn = 1e5;
+  IndexView tied("tied", 2);
+  auto ht = Kokkos::create_mirror_view(tied);
+  ht(0) = 1;
+  ht(1) = 3;
+  Kokkos::deep_copy(tied, ht);
+  spec.tied = tied;
+  const auto run = [&](Real fz, int touching, bool none, Real v_max) {
+    spec.servo.v_max = v_max;
+    WallLoadView loads("loads", 2);
+    auto hl = Kokkos::create_mirror_view(loads);
+    hl(1).force[2] = fz;
+    hl(1).touching = touching;
+    Kokkos::deep_copy(loads, hl);
+    Vec3View wall_v("wall_v", 2), node_v("node_v", 5);
+    Kokkos::View<Real, MemSpace> speed("speed");
+    wall_servo_velocity(spec, loads, none, wall_v, node_v, 1e-6, speed.data());
+    auto hw = Kokkos::create_mirror_view_and_copy(HostSpace(), wall_v);
+    auto hn = Kokkos::create_mirror_view_and_copy(HostSpace(), node_v);
+    Real hs = 0;
+    Kokkos::deep_copy(hs, speed);
+    for (int d = 0; d < 3; ++d) {
+      EXPECT_EQ(hw(0, d), 0.0) << "another wall";
+      for (int k : {1, 3}) EXPECT_EQ(hn(k, d), hw(1, d)) << "tied node " << k;
+      for (int k : {0, 2, 4}) EXPECT_EQ(hn(k, d), 0.0) << "free node " << k;
+    }
+    EXPECT_EQ(hw(1, 0), 0.0);
+    EXPECT_EQ(hw(1, 1), 0.0);
+    EXPECT_EQ(hs, std::fabs(hw(1, 2)));
+    return hw(1, 2);
+  };
+  EXPECT_NEAR(run(50, 4, false, 100), -12.5, 1e-12 * 12.5);  // 5e4 Pa short of the target: down into the specimen
+  EXPECT_NEAR(run(150, 4, false, 100), 12.5, 1e-12 * 12.5);  // 5e4 Pa over: back up
+  EXPECT_EQ(run(50, 4, false, 1), -1.0);                     // clamped
+  EXPECT_EQ(run(50, 0, false, 1), -1.0);                     // no contact: the approach at v_max
+  EXPECT_EQ(run(150, 4, true, 1), -1.0);                     // before the first detection: no load yet
+}

@@ -114,8 +114,8 @@ TEST(HotPath, AStepAllocatesNothingAndReadsItsStatisticsEveryKSteps) {
 // Every stage of the tiny membrane test (specimen layers, consolidation, shear) and of the tiny periodic cell, with
 // the statistics read every step and every 16 steps: the same steps bit for bit (the rebuilds decided between reads
 // as a read at every step decides them), and the steps' own waits down to the reads. What remains per step is the
-// membrane test's control (the platen servo's readings and speeds: docs/performance.md); the periodic cell's servo
-// runs on the device.
+// membrane specimen's layers' control (the platen's compaction: docs/performance.md); the servos of the membrane's
+// consolidation and of the periodic cell run on the device.
 TEST(HotPath, StatisticsReadEvery16StepsGiveTheSameStepsWithFewerWaits) {
   const MembraneRun every1 = membrane_run(1), every16 = membrane_run(16);
   ASSERT_EQ(every1.stages.size(), every16.stages.size());
@@ -136,10 +136,12 @@ TEST(HotPath, StatisticsReadEvery16StepsGiveTheSameStepsWithFewerWaits) {
     // Read every step: two copies a step. Every 16: two copies in 16 steps, and the reads the rebuilds ask for.
     EXPECT_NEAR(step_waits(a), 2.0, 0.01) << a.name;
     EXPECT_LT(step_waits(b), 0.25) << a.name;
-    // The platen servo's control: its walls' forces and contact counts in one copy, the platen's speed in another.
+    // The platen servo runs on the device (Simulation::set_wall_servo): the stage's control reads the platens only
+    // before a measured step (one in 200) for its check. On the host the servo read them and sent the platen's speed,
+    // two copies a step.
     if (a.name == "consolidation") {
       const SyncCounts control = part_of(b, SyncPart::kControl);
-      EXPECT_LE(double(control.copies + control.host_results) / double(b.steps), 2.0) << a.name;
+      EXPECT_LE(double(control.copies + control.host_results) / double(b.steps), 1.0 / 200 + 1e-9) << a.name;
     }
   }
   const std::vector<TriaxialRecord>&r1 = every1.result.records, &r16 = every16.result.records;

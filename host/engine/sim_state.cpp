@@ -200,6 +200,7 @@ SimState Simulation::state() const {
   s.material = scalar_out<int>(p_.material, n);
   s.balls = history_out(balls_);
   s.walls = history_out(wall_c_);
+  read_walls();
   s.wall_point = vec3_out(hwall_point_, walls_.n);
   s.wall_velocity = vec3_out(hwall_vel_, walls_.n);
   s.node_x = vec3_out(mesh_.node_x, mesh_.nnode);
@@ -245,6 +246,8 @@ void Simulation::restore(const SimState& s) {
   scalar_in(p_.material, s.material, p_.n);
   balls_ = history_in(s.balls, "ball-ball");
   wall_c_ = history_in(s.walls, "ball-wall");
+  wall_servo_on_ = false;
+  walls_stale_ = false;
   vec3_in(hwall_point_, s.wall_point, walls_.n);
   vec3_in(hwall_vel_, s.wall_velocity, walls_.n);
   Kokkos::deep_copy(walls_.point, hwall_point_);

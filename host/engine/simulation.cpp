@@ -187,6 +187,13 @@ void Simulation::step(bool measure) {
     servo_step();
     clock.lap(times_.boundaries);
   }
+  if (wall_servo_on_) {
+    if (!fresh_) wall_loads_into(wall_c_, obj_offsets_, walls_.n, wall_load_);
+    wall_servo_velocity(wall_servo_, wall_load_, fresh_, walls_.velocity, mesh_.node_v, prm_.integ.dt,
+                        rows_.at(step_, StepRows::kWallSpeed));
+    walls_stale_ = true;
+    clock.lap(times_.boundaries);
+  }
   if (rebuild_due()) clock.always(times_.rebuild, [this] { rebuild(); });
   const Real dt = prm_.integ.dt;
   prm_.integ.measure = measure;
@@ -223,7 +230,10 @@ const Particles& Simulation::particles_with_forces() const {
 void Simulation::move_boundaries() {
   const Real dt = prm_.integ.dt;
   Real vmax = 0;
+  if (!wall_servo_on_) read_walls();  // a servo on the device that ended left the velocity it set
   for (int w = 0; w < walls_.n; ++w) {
+    // The host does not know the velocity of the wall a servo on the device steers: its speed is read with the row.
+    if (wall_servo_on_ && w == wall_servo_.wall) continue;
     const Vec3 v = load(hwall_vel_, w);
     if (norm2(v) == 0) continue;
     store(hwall_point_, w, load(hwall_point_, w) + dt * v);
@@ -231,7 +241,8 @@ void Simulation::move_boundaries() {
   }
   // The device moves its copy of the walls by the same arithmetic (no contraction, CMakeLists.txt): the host's
   // stays equal to it bit for bit, with no copy between them.
-  if (vmax > 0) move_walls(walls_, dt);
+  if (vmax > 0 || wall_servo_on_) move_walls(walls_, dt);
+  const Real wall_bound = wall_servo_on_ ? wall_servo_.servo.v_max : Real(-1);
   // Neighbours within the cut-off drift apart (or together) by at most |rate| dt times the cut-off.
   const Real reach = 2 * rmax_ + prm_.skin;
   Real cell_bound = -1;
@@ -253,7 +264,7 @@ void Simulation::move_boundaries() {
   }
   // The membrane nodes' speed joins vmax when the row is read (read_rows).
   if (mesh_.ntri > 0) move_nodes(mesh_, dt, rows_.at(step_, StepRows::kNodeSpeed));
-  boundary_step(vmax, dt, cell_bound);
+  boundary_step(vmax, dt, cell_bound, wall_bound);
 }
 
 SpecimenTable Simulation::specimen() const {
@@ -352,7 +363,26 @@ bool Simulation::store_wall_velocity(int w, const Vec3& v) {
   return true;
 }
 
+void Simulation::read_walls() const {
+  if (!walls_stale_) return;
+  Kokkos::deep_copy(hwall_point_, walls_.point);
+  Kokkos::deep_copy(hwall_vel_, walls_.velocity);
+  walls_stale_ = false;
+}
+
+void Simulation::set_wall_servo(const WallServoSpec& spec) {
+  if (spec.wall < 0 || spec.wall >= walls_.n || spec.axis < 0 || spec.axis > 2)
+    throw std::invalid_argument("set_wall_servo: wall " + std::to_string(spec.wall) + " or axis " +
+                                std::to_string(spec.axis) + " out of range");
+  if (static_cast<int>(wall_load_.extent(0)) < walls_.n)
+    wall_load_ = WallLoadView("dem::sim::wall_loads", walls_.n);  // here, not in a step
+  wall_servo_ = spec;
+  wall_servo_on_ = true;
+}
+
 void Simulation::set_wall_velocity(int w, const Vec3& v) {
+  read_walls();
+  if (w == wall_servo_.wall) wall_servo_on_ = false;
   if (store_wall_velocity(w, v)) Kokkos::deep_copy(walls_.velocity, hwall_vel_);  // a constant speed: no copy
 }
 
@@ -360,16 +390,25 @@ void Simulation::set_wall_velocities(const std::vector<Vec3>& v) {
   if (static_cast<int>(v.size()) != walls_.n)
     throw std::invalid_argument("set_wall_velocities: " + std::to_string(v.size()) + " velocities for " +
                                 std::to_string(walls_.n) + " walls");
+  read_walls();
+  wall_servo_on_ = false;
   bool changed = false;
   for (int w = 0; w < walls_.n; ++w) changed = store_wall_velocity(w, v[static_cast<std::size_t>(w)]) || changed;
   if (changed) Kokkos::deep_copy(walls_.velocity, hwall_vel_);
 }
 
-Vec3 Simulation::wall_velocity(int w) const { return load(hwall_vel_, w); }
+Vec3 Simulation::wall_velocity(int w) const {
+  read_walls();
+  return load(hwall_vel_, w);
+}
 
-Vec3 Simulation::wall_point(int w) const { return load(hwall_point_, w); }
+Vec3 Simulation::wall_point(int w) const {
+  read_walls();
+  return load(hwall_point_, w);
+}
 
 void Simulation::set_wall_point(int w, const Vec3& p) {
+  read_walls();
   read_rows();  // the steps before add to wall_disp_ first, as they happened first
   const Real moved = norm(p - load(hwall_point_, w));
   store(hwall_point_, w, p);

@@ -15,6 +15,7 @@
 #include "kernels/motion/cell_servo.hpp"
 #include "kernels/motion/integrate.hpp"
 #include "kernels/motion/membrane.hpp"
+#include "kernels/motion/wall_servo.hpp"
 #include "host/engine/sim_state.hpp"
 #include "host/engine/step_rows.hpp"
 
@@ -180,8 +181,15 @@ class Simulation {
   /// Its diagonal (xx, yy, zz) alone, bit for bit the same values, at a third of the sums: a servo's every step.
   std::array<Real, 3> contact_stress_diagonal(Real volume) const;
 
-  /// Rigid wall velocity (m/s) and position (m) control.
+  /// Rigid wall velocity (m/s) and position (m) control. Setting a velocity ends a servo on the device.
   void set_wall_velocity(int w, const Vec3& v);
+  /// Wall spec.wall's velocity (and its tied nodes') set before each step by the stress servo `spec` on the device,
+  /// from the next step until end_wall_servo or a velocity set (kernels/motion/wall_servo.hpp): a kernel reads the
+  /// wall's load and sets the velocity, with the host's arithmetic and its bits, and the host waits for none of it. The
+  /// host reads the walls when asked for them (wall_point, wall_velocity, a state).
+  void set_wall_servo(const WallServoSpec& spec);
+  /// Ends it, leaving the velocity it set last.
+  void end_wall_servo() { wall_servo_on_ = false; }
   /// Every analytic wall's velocity at once (one per wall), in one copy to the device: a servo's every step.
   void set_wall_velocities(const std::vector<Vec3>& v);
   Vec3 wall_velocity(int w) const;
@@ -224,6 +232,10 @@ class Simulation {
   bool servo_on_ = false;
   long servo_calls_ = 0;
   mutable bool cell_stale_ = false;
+  // A servo on the device steering a wall: the host's copies of the walls (hwall_*) are read when asked for.
+  WallServoSpec wall_servo_;
+  bool wall_servo_on_ = false;
+  mutable bool walls_stale_ = false;
   WallSet walls_;
   decltype(Kokkos::create_mirror(WallSet().point)) hwall_point_, hwall_vel_;
   FacetMesh mesh_;
@@ -259,6 +271,7 @@ class Simulation {
   struct BoundaryStep {
     Real speed = 0, dt = 0;
     bool cell = false;  ///< the cell's speed is on the step's row (StepRows::kCellSpeed): a servo on the device set it
+    bool wall = false;  ///< a wall's likewise (StepRows::kWallSpeed)
   };
   std::array<BoundaryStep, StepRows::kSlots> boundary_steps_{};
   mutable StageTimes times_;
@@ -271,8 +284,8 @@ class Simulation {
   Gather gather() const { return make_gather(balls_, own_, adj_balls_, wall_c_, adj_walls_); }
   bool rebuild_due();
   /// Records the step's host-known boundary speed (m/s) and dt, and adds to the bound on the unread steps' travel
-  /// (`cell_bound`, m/s, where the cell's speed is on the row: its bound).
-  void boundary_step(Real speed, Real dt, Real cell_bound);
+  /// (`cell_bound`, `wall_bound`, m/s, where the cell's or a wall's speed is on the row: its bound; else negative).
+  void boundary_step(Real speed, Real dt, Real cell_bound, Real wall_bound);
   /// Reads the rows of the steps not yet read: their blow-up checks, displacements and statistics.
   void read_rows() const;
   /// Whether the neighbour lists must be rebuilt after a step with largest displacement^2 `disp2` since the last
@@ -288,6 +301,8 @@ class Simulation {
   /// The host's copy of the cell to the device / the device's to the host where it is stale.
   void upload_cell();
   void read_cell() const;
+  /// The walls' points and velocities from the device, where a servo on the device has moved one since the last read.
+  void read_walls() const;
   /// Sets the host's copy of wall w's velocity; false where it was v already.
   bool store_wall_velocity(int w, const Vec3& v);
   /// Throws BlowUp where step `step`'s statistics and overlaps show one.

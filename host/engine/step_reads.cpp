@@ -48,9 +48,10 @@ bool Simulation::rebuild_due() {
   return lists_expired(stats_.max_disp2, wall_disp_);
 }
 
-void Simulation::boundary_step(Real speed, Real dt, Real cell_bound) {
-  boundary_steps_[static_cast<std::size_t>(StepRows::slot(step_))] = {speed, dt, cell_bound >= 0};
-  unread_travel_ += std::max({speed, cell_bound, mesh_.ntri > 0 ? kSpeedGrowth * node_bound_ : Real(0)}) * dt;
+void Simulation::boundary_step(Real speed, Real dt, Real cell_bound, Real wall_bound) {
+  boundary_steps_[static_cast<std::size_t>(StepRows::slot(step_))] = {speed, dt, cell_bound >= 0, wall_bound >= 0};
+  unread_travel_ +=
+      std::max({speed, cell_bound, wall_bound, mesh_.ntri > 0 ? kSpeedGrowth * node_bound_ : Real(0)}) * dt;
 }
 
 void Simulation::read_rows() const {
@@ -66,6 +67,7 @@ void Simulation::read_rows() const {
     const BoundaryStep& b = boundary_steps_[static_cast<std::size_t>(StepRows::slot(s))];
     Real speed = b.speed;
     if (b.cell) speed = std::max(speed, row[StepRows::kCellSpeed]);
+    if (b.wall) speed = std::max(speed, row[StepRows::kWallSpeed]);
     if (mesh_.ntri > 0) {
       speed = std::max(speed, row[StepRows::kNodeSpeed]);
       node_max = std::max(node_max, row[StepRows::kNodeSpeed]);

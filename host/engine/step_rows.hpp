@@ -14,13 +14,14 @@ struct StepRows {
   /// Steps the ring holds: the most that SimParams::stats_every may ask for.
   static constexpr int kSlots = static_cast<int>(kMaxStatsEvery);
   /// A row's columns: the leapfrog's values (Leapfrog), the membrane's (membrane_integrate_to), the fastest
-  /// membrane node (m/s), the periodic cell's stretch_speed (m/s).
+  /// membrane node (m/s), the periodic cell's stretch_speed (m/s), the speed of a wall a servo on the device steers (m/s).
   enum Column : int {
     kLeapfrog = 0,
     kMembrane = kLeapfrog + Leapfrog::kValues,
     kNodeSpeed = kMembrane + kMembraneValues,
     kCellSpeed = kNodeSpeed + 1,
-    kColumns = kCellSpeed + 1
+    kWallSpeed = kCellSpeed + 1,
+    kColumns = kWallSpeed + 1
   };
   /// The overlaps of a row: ball-ball and ball-wall.
   enum Overlap : int { kBalls = 0, kWalls = 1 };

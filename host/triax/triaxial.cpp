@@ -15,7 +15,7 @@
 #include "host/data/measured.hpp"
 #include "host/triax/micro_report.hpp"
 #include "host/util/progress.hpp"
-#include "host/engine/servo.hpp"
+#include "kernels/motion/wall_servo.hpp"
 #include "host/triax/summary.hpp"
 #include "host/triax/triaxial_cell.hpp"
 #include "host/triax/triaxial_measure.hpp"
@@ -83,12 +83,22 @@ StageTiming consolidate(const Config& cfg, const Specimen& sp, Cell& cell, Stage
   Real top = 0, bottom = 0;  // the platens' stresses before the step
   stage.first = st.step + 1;
   stage.last = tc.max_consolidation_steps;
+  // The servo steers the top platen and its ring of membrane nodes on the device, before each step.
+  WallServoSpec on_top;
+  on_top.servo = servo;
+  on_top.wall = kTopPlaten;
+  on_top.axis = 2;
+  on_top.sign = -1;  // down, into the specimen
+  on_top.kn = cell.kn_wall;
+  on_top.tied = cell.membrane.ring_top;
+  bool servoing = false;
   stage.before = [&](long n) {
-    const Simulation::WallLoads platens = sim.wall_loads(false);  // the membrane's facets are not the servo's
-    std::tie(top, bottom) = platen_stresses(cell, platens.force);
-    const int touching = platens.touching[kTopPlaten];
-    set_top_velocity(cell, -servo.speed(top, touching * cell.kn_wall, dt));
-    return StepPlan{false, n % 200 == 0};
+    if (!servoing) sim.set_wall_servo(on_top);
+    servoing = true;
+    const bool measured = n % 200 == 0;
+    // What the servo reads before a measured step, for the stage's check after it.
+    if (measured) std::tie(top, bottom) = platen_stresses(cell, sim.wall_loads(false).force);
+    return StepPlan{false, measured};
   };
   stage.after = [&](long n, bool measured) {
     if (measured) {
@@ -108,6 +118,7 @@ StageTiming consolidate(const Config& cfg, const Specimen& sp, Cell& cell, Stage
     return false;
   };
   const StageEnd end = run_stage(sim, stage, plan);
+  sim.end_wall_servo();
   if (!end.done)
     throw ConfigError(cfg.path + ": [triaxial] max_consolidation_steps: consolidation to " +
                       std::to_string(tc.sigma3 / 1e3) + " kPa did not settle within " +
