@@ -130,78 +130,6 @@ int CellBatch::running_count() const {
   return n;
 }
 
-const Domain& CellBatch::domain(int s) const {
-  const Specimen& sp = spec_.at(static_cast<std::size_t>(s));
-  if (sp.stale) read_cells();
-  return sp.prm.domain;
-}
-
-Real CellBatch::axis_length(int s, int d) const {
-  const Specimen& sp = spec_.at(static_cast<std::size_t>(s));
-  if (sp.stale && sp.servo.on && sp.servo.spec.servo[d]) read_cells();
-  return sp.prm.domain.length(d);
-}
-
-void CellBatch::read_cells() const {
-  bool any = false;
-  for (const Specimen& sp : spec_) any = any || sp.stale;
-  if (!any) return;
-  Kokkos::deep_copy(host_spec_, dev_spec_);
-  for (std::size_t s = 0; s < spec_.size(); ++s) {
-    Specimen& sp = spec_[s];
-    if (!sp.stale) continue;
-    sp.prm.domain = host_spec_(s).dom;
-    sp.stale = false;
-  }
-}
-
-void CellBatch::upload_slots() {
-  for (std::size_t s = 0; s < spec_.size(); ++s) host_slots_(s) = spec_[s].servo;
-  Kokkos::deep_copy(servo_slots_, host_slots_);
-}
-
-void CellBatch::set_cell_servo(int s, const CellServoSpec& spec) {
-  Specimen& sp = spec_.at(static_cast<std::size_t>(s));
-  if (!sp.running) return;
-  read_cells();
-  sp.servo.spec = spec;
-  sp.servo.reach = 2 * sp.rmax + sp.prm.skin;
-  sp.servo.calls = 0;
-  sp.servo.on = 1;
-  // The rates the kernel sets the fixed axes to, which the host's copy moves them by.
-  for (int d = 0; d < 3; ++d)
-    if (!spec.servo[d]) sp.prm.domain.strain_rate[d] = spec.fixed[d];
-  upload_slots();
-}
-
-void CellBatch::servo_step() {
-  bool any = false, fresh = false;
-  for (Specimen& sp : spec_) {
-    if (!sp.running || !sp.servo.on) continue;
-    any = true;
-    if (sp.servo.calls++ % sp.servo.spec.stiffness_every == 0) fresh = true;  // every one's calls counted
-    sp.stale = true;
-  }
-  if (!any) return;
-  const SpecimenImages images{p_.specimen, dev_spec_};
-  Real* sums = servo_sums_.data();  // device memory: the host passes it on, never reads it
-  const int stride = CellServoSums::kCount;
-  if (fresh_) {
-    Kokkos::deep_copy(servo_sums_, Real(0));  // no contacts yet: no sums (per_volume's zeros)
-  } else {
-    if (fresh) {
-      const StiffnessTerms<SpecimenImages> terms{p_.x, p_.radius, images};
-      segmented_reduce_lanes_to<3, 0, 1>("dem::batch::servo_stiffness", owner_tree_,
-                                         OwnerSums<3, StiffnessTerms<SpecimenImages>>{owners(), terms},
-                                         sums + CellServoSums::kStiffnessSums, stride);
-    }
-    segmented_reduce_lanes_to<3, 0, 1>("dem::batch::servo_stress", owner_tree_,
-                                       OwnerSums<3, LoveWeberTerms<3, SpecimenImages>>{owners(), {p_.x, images}},
-                                       sums + CellServoSums::kStressSums, stride);
-  }
-  cell_servo_rates(dev_spec_, servo_slots_, servo_sums_);
-}
-
 void CellBatch::set_strain_rate(int s, const Vec3& rate) {
   Specimen& sp = spec_.at(static_cast<std::size_t>(s));
   read_cells();
@@ -326,12 +254,9 @@ void CellBatch::step(const std::vector<char>& measure) {
     hon(s) = on;
     if (!on) continue;
     stretch = true;
-    Domain& dom = sp.prm.domain;
-    const CellStretch st(dom, sp.prm.integ.dt);
-    for (int d = 0; d < 3; ++d)
-      if (!servoed || !sp.servo.spec.servo[d]) dom.hi[d] = st(d, dom.hi[d]);
+    stretch_known_axes(sp.prm.domain, servoed ? &sp.servo.spec : nullptr, sp.prm.integ.dt);
     if (servoed) sp.stale = true;  // a rebuild may have read it within this step
-    else speed[s] = stretch_speed(dom, 2 * sp.rmax + sp.prm.skin);
+    else speed[s] = stretch_speed(sp.prm.domain, 2 * sp.rmax + sp.prm.skin);
   }
   if (changed) {
     Kokkos::deep_copy(stretching_, hon);  // only when a cell starts or stops stretching

@@ -250,68 +250,18 @@ void Simulation::move_boundaries() {
   if (servo_on_ || stretching(prm_.domain)) {
     // The device stretches its cell by the same arithmetic as the host its copy (no contraction, CMakeLists.txt).
     stretch_cell(p_, cell_, dt, reach, rows_.at(step_, StepRows::kCellSpeed));
-    const CellStretch st(prm_.domain, dt);
+    stretch_known_axes(prm_.domain, servo_on_ ? &servo_ : nullptr, dt);
     if (servo_on_) {
-      // The host knows the rates of the axes the servo does not steer; the others' speed is read with the row.
-      for (int d = 0; d < 3; ++d)
-        if (!servo_.servo[d]) prm_.domain.hi[d] = st(d, prm_.domain.hi[d]);
+      // The servoed axes' speed is read with the row.
       cell_stale_ = true;
       cell_bound = servo_speed_bound(servo_, reach);
     } else {
-      st.apply(prm_.domain);
       vmax = std::max(vmax, stretch_speed(prm_.domain, reach));
     }
   }
   // The membrane nodes' speed joins vmax when the row is read (read_rows).
   if (mesh_.ntri > 0) move_nodes(mesh_, dt, rows_.at(step_, StepRows::kNodeSpeed));
   boundary_step(vmax, dt, cell_bound, wall_bound);
-}
-
-SpecimenTable Simulation::specimen() const {
-  SpecimenTable one;
-  one.one.integ = prm_.integ;
-  one.cell = cell_;
-  return one;
-}
-
-void Simulation::upload_cell() {
-  Kokkos::deep_copy(cell_, Kokkos::View<Domain, HostSpace, Kokkos::MemoryUnmanaged>(&prm_.domain));
-}
-
-void Simulation::read_cell() const {
-  if (!cell_stale_) return;
-  Kokkos::deep_copy(Kokkos::View<Domain, HostSpace, Kokkos::MemoryUnmanaged>(&prm_.domain), cell_);
-  cell_stale_ = false;
-}
-
-Real Simulation::axis_length(int d) const {
-  if (servo_on_ && servo_.servo[d]) read_cell();
-  return prm_.domain.length(d);
-}
-
-void Simulation::set_cell_servo(const CellServoSpec& spec) {
-  const Domain& dom = domain();
-  if (!(dom.periodic[0] && dom.periodic[1] && dom.periodic[2]))
-    throw std::invalid_argument("set_cell_servo: the cell must be periodic along x, y and z");
-  servo_ = spec;
-  servo_on_ = true;
-  servo_calls_ = 0;
-  // The rates the kernel sets the fixed axes to, which the host's copy moves them by.
-  for (int d = 0; d < 3; ++d)
-    if (!spec.servo[d]) prm_.domain.strain_rate[d] = spec.fixed[d];
-}
-
-void Simulation::servo_step() {
-  const bool fresh = servo_calls_++ % servo_.stiffness_every == 0;
-  const CellImage image{cell_};
-  Real* sums = servo_sums_.data();  // device memory: the host passes it on, never reads it
-  if (fresh)
-    owner_sums_to<3>("dem::sim::servo_stiffness", StiffnessTerms<CellImage>{p_.x, p_.radius, image},
-                     sums + CellServoSums::kStiffnessSums);
-  owner_sums_to<3>("dem::sim::servo_stress", LoveWeberTerms<3, CellImage>{p_.x, image},
-                   sums + CellServoSums::kStressSums);
-  cell_servo_rates(cell_, servo_, servo_sums_, fresh, prm_.integ.dt);
-  cell_stale_ = true;
 }
 
 void Simulation::set_membrane(const Membrane& m, const MembraneIntegrateParams& prm) {
@@ -321,17 +271,6 @@ void Simulation::set_membrane(const Membrane& m, const MembraneIntegrateParams& 
   membrane_prm_ = prm;
   membrane_f_ = Vec3View("dem::sim::membrane_force", m.nnode);  // here, not in a step
   membrane_prm_.move_nodes = false;  // move_boundaries moves every facet node by dt node_v
-}
-
-void Simulation::set_strain_rate(const Vec3& rate) {
-  read_cell();
-  servo_on_ = false;
-  Domain& dom = prm_.domain;
-  if (dom.strain_rate[0] == rate.x && dom.strain_rate[1] == rate.y && dom.strain_rate[2] == rate.z) return;
-  dom.strain_rate[0] = rate.x;
-  dom.strain_rate[1] = rate.y;
-  dom.strain_rate[2] = rate.z;
-  upload_cell();  // a constant rate: no copy
 }
 
 namespace {
@@ -354,66 +293,6 @@ std::array<Real, 9> Simulation::contact_stress(Real volume) const {
 
 std::array<Real, 3> Simulation::contact_stress_diagonal(Real volume) const {
   return love_weber_stress<3>("dem::sim::contact_stress_diagonal", *this, volume);
-}
-
-bool Simulation::store_wall_velocity(int w, const Vec3& v) {
-  const Vec3 now = load(hwall_vel_, w);
-  if (v.x == now.x && v.y == now.y && v.z == now.z) return false;
-  store(hwall_vel_, w, v);
-  return true;
-}
-
-void Simulation::read_walls() const {
-  if (!walls_stale_) return;
-  Kokkos::deep_copy(hwall_point_, walls_.point);
-  Kokkos::deep_copy(hwall_vel_, walls_.velocity);
-  walls_stale_ = false;
-}
-
-void Simulation::set_wall_servo(const WallServoSpec& spec) {
-  if (spec.wall < 0 || spec.wall >= walls_.n || spec.axis < 0 || spec.axis > 2)
-    throw std::invalid_argument("set_wall_servo: wall " + std::to_string(spec.wall) + " or axis " +
-                                std::to_string(spec.axis) + " out of range");
-  if (static_cast<int>(wall_load_.extent(0)) < walls_.n)
-    wall_load_ = WallLoadView("dem::sim::wall_loads", walls_.n);  // here, not in a step
-  wall_servo_ = spec;
-  wall_servo_on_ = true;
-}
-
-void Simulation::set_wall_velocity(int w, const Vec3& v) {
-  read_walls();
-  if (w == wall_servo_.wall) wall_servo_on_ = false;
-  if (store_wall_velocity(w, v)) Kokkos::deep_copy(walls_.velocity, hwall_vel_);  // a constant speed: no copy
-}
-
-void Simulation::set_wall_velocities(const std::vector<Vec3>& v) {
-  if (static_cast<int>(v.size()) != walls_.n)
-    throw std::invalid_argument("set_wall_velocities: " + std::to_string(v.size()) + " velocities for " +
-                                std::to_string(walls_.n) + " walls");
-  read_walls();
-  wall_servo_on_ = false;
-  bool changed = false;
-  for (int w = 0; w < walls_.n; ++w) changed = store_wall_velocity(w, v[static_cast<std::size_t>(w)]) || changed;
-  if (changed) Kokkos::deep_copy(walls_.velocity, hwall_vel_);
-}
-
-Vec3 Simulation::wall_velocity(int w) const {
-  read_walls();
-  return load(hwall_vel_, w);
-}
-
-Vec3 Simulation::wall_point(int w) const {
-  read_walls();
-  return load(hwall_point_, w);
-}
-
-void Simulation::set_wall_point(int w, const Vec3& p) {
-  read_walls();
-  read_rows();  // the steps before add to wall_disp_ first, as they happened first
-  const Real moved = norm(p - load(hwall_point_, w));
-  store(hwall_point_, w, p);
-  Kokkos::deep_copy(walls_.point, hwall_point_);
-  wall_disp_ += moved;
 }
 
 Simulation::WallLoads Simulation::wall_loads(bool facets) const {

@@ -2,6 +2,16 @@
 
 namespace dem {
 
+namespace {
+/// Particle i's position, and its position at the last rebuild, stretched by `st`.
+KOKKOS_INLINE_FUNCTION void stretch_particle(const Vec3View& x, const Vec3View& xr, int i, const CellStretch& st) {
+  for (int d = 0; d < 3; ++d) {
+    x(i, d) = st(d, x(i, d));
+    xr(i, d) = st(d, xr(i, d));
+  }
+}
+}  // namespace
+
 void cell_servo_rates(const CellView& cell, const CellServoSpec& spec, const CellServoSumsView& sums,
                       bool fresh_stiffness, Real dt) {
   Kokkos::parallel_for("dem::cell_servo::rates", RangePolicy(0, 1), KOKKOS_LAMBDA(const int) {
@@ -26,12 +36,7 @@ void stretch_cell(const Particles& p, const CellView& cell, Real dt, Real reach,
     // Every item reads the cell's lo and rates, which no item writes; the first alone moves its upper bounds,
     // which no item reads.
     const CellStretch st(cell(), dt);
-    if (i < n) {
-      for (int d = 0; d < 3; ++d) {
-        x(i, d) = st(d, x(i, d));
-        xr(i, d) = st(d, xr(i, d));
-      }
-    }
+    if (i < n) stretch_particle(x, xr, i, st);
     if (i == 0) {
       st.apply(cell());
       *speed = stretch_speed(cell(), reach);
@@ -46,11 +51,7 @@ void stretch_cells(const Particles& p, const SpecimenParamsView& spec, const Kok
   Kokkos::parallel_for("dem::cell_servo::stretch_batch", RangePolicy(0, p.n), KOKKOS_LAMBDA(const int i) {
     const int s = owner(i);
     if (!on(s)) return;
-    const CellStretch st(spec(s).dom, spec(s).integ.dt);
-    for (int d = 0; d < 3; ++d) {
-      x(i, d) = st(d, x(i, d));
-      xr(i, d) = st(d, xr(i, d));
-    }
+    stretch_particle(x, xr, i, CellStretch(spec(s).dom, spec(s).integ.dt));
   });
   // The cells after their particles, in a launch of their own: no item writes a cell that another reads.
   Kokkos::parallel_for("dem::cell_servo::stretch_batch_cells", RangePolicy(0, static_cast<int>(spec.extent(0))),

@@ -52,6 +52,20 @@ inline Real servo_speed_bound(const CellServoSpec& s, Real reach) {
   return rate * reach;
 }
 
+/// The host's copy of a cell the servo steers: it takes the rates the kernel gives the fixed axes.
+inline void take_fixed_rates(Domain& dom, const CellServoSpec& s) {
+  for (int d = 0; d < 3; ++d)
+    if (!s.servo[d]) dom.strain_rate[d] = s.fixed[d];
+}
+
+/// The host's copy of a cell over a step of dt: stretched along the axes whose rate the host knows, every axis
+/// where no servo steers it (`servo` null), else the axes it does not servo; the device stretches its own alike.
+inline void stretch_known_axes(Domain& dom, const CellServoSpec* servo, Real dt) {
+  const CellStretch st(dom, dt);
+  for (int d = 0; d < 3; ++d)
+    if (!servo || !servo->servo[d]) dom.hi[d] = st(d, dom.hi[d]);
+}
+
 /// Where the servo keeps its sums between kernels, in device memory: the stiffness's sums (K_dd V) and the contact
 /// stress's (sigma_dd V) of this call, the stiffness of the call that last summed it (Pa).
 struct CellServoSums {
