@@ -257,6 +257,74 @@ TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
   for (int k = 0; k < kPressures; ++k) EXPECT_EQ(each[k].q, one[k][k % 2].q) << "sigma3 " << like[k].sigma3;
 }
 
+// A calibration packed its specimens anew in every stage and every job (57% of a walled calibration's time, the state
+// match's last packing twice): the packing store keeps each specimen under a hash of what decides it, a later lab
+// reads it with its bits, and a damaged file (a byte changed, cut short) is packed again rather than used.
+TEST(PackingStore, ALaterLabReadsTheStoredSpecimensAndADamagedOneIsPackedAgain) {
+  namespace fs = std::filesystem;
+  Config cfg = test::tiny_cell_config();
+  cfg.fingerprint = "packing-store-test";  // a config from a file; one built in code is never stored
+  const fs::path dir = test::scratch_dir("packing_store");
+  cfg.packing_store = (dir / "cells").string();
+  Config bare = cfg;
+  bare.packing_store.clear();
+  const PeriodicLab unstored(bare, false, 2, 1);
+  const PeriodicLab first(cfg, false, 2, 1);
+  Config second = cfg;  // member 1's packing
+  second.run.seed = 2;
+  const std::string path = packing_path(second);
+  ASSERT_FALSE(path.empty());
+  PackedCell s;
+  ASSERT_TRUE(read_packing(second, s)) << path;
+  EXPECT_EQ(s.balls.size(), 100u);
+  EXPECT_EQ(s.void_ratio, first.prepared_void_ratio(1));
+  for (int j = 0; j < 2; ++j) EXPECT_EQ(first.prepared_void_ratio(j), unstored.prepared_void_ratio(j)) << j;
+  // Read, not packed: a stored file marked with another void ratio is what the next lab gets.
+  PackedCell marked = s;
+  marked.void_ratio = 42;
+  write_packing(second, marked);
+  EXPECT_EQ(PeriodicLab(cfg, false, 2, 1).prepared_void_ratio(1), 42);
+  // Damaged: one byte of a ball changed, then the file cut short; each time packed again, and kept whole.
+  {
+    std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekg(300);
+    char c = 0;
+    f.get(c);
+    f.seekp(300);
+    f.put(static_cast<char>(c ^ 0x10));
+  }
+  EXPECT_EQ(PeriodicLab(cfg, false, 2, 1).prepared_void_ratio(1), unstored.prepared_void_ratio(1));
+  ASSERT_TRUE(read_packing(second, s));
+  EXPECT_EQ(s.void_ratio, unstored.prepared_void_ratio(1));
+  fs::resize_file(path, fs::file_size(path) / 2);
+  EXPECT_FALSE(read_packing(second, s));
+  EXPECT_EQ(PeriodicLab(cfg, false, 2, 1).prepared_void_ratio(1), unstored.prepared_void_ratio(1));
+  // Specimens packed side by side are kept with the same bits.
+  Config batched = cfg;
+  batched.calibrate.batch = 8;
+  batched.packing_store = (dir / "batched").string();
+  const PeriodicLab together(batched, false, 2, 1);
+  batched.run.seed = 2;
+  ASSERT_TRUE(read_packing(batched, s));
+  EXPECT_EQ(s.void_ratio, unstored.prepared_void_ratio(1));
+  // What decides a packing names another file: the preparation friction, the seed, the cell, the ball law.
+  for (auto change : std::vector<void (*)(Config&)>{[](Config& c) { c.periodic.prep_mu_s = 0.1; },
+                                                    [](Config& c) { c.run.seed = 3; },
+                                                    [](Config& c) { c.particles.count = 200; },
+                                                    [](Config& c) { c.box.size[2] *= 1.1; },
+                                                    [](Config& c) { c.periodic.boundary = CellBoundary::walls; },
+                                                    [](Config& c) { c.ball.emod *= 2; }}) {
+    Config other = second;
+    change(other);
+    EXPECT_NE(packing_path(other), path);
+  }
+  bare.run.seed = 2;
+  EXPECT_EQ(packing_path(bare), "");
+  Config in_code = second;
+  in_code.fingerprint.clear();
+  EXPECT_EQ(packing_path(in_code), "") << "a config built in code has settings the hash does not see";
+}
+
 // A run stopped by a blow-up gives no test (every quantity missing) and is counted with its pressure, so that the
 // calibration can say why data went missing (a walled diagnosis once lost most of its 300 kPa runs to the default
 // overlap guard, silently). Contacts 10^5 times softer than the specimen was packed with overlap by far more than

@@ -39,6 +39,14 @@ std::string resumed_parent(const std::string& folder) {
   return parent.empty() ? "." : parent.string();
 }
 
+/// The reference test's cell, its packings kept in (and read from) the output folder's .specimens/cells, where a
+/// later job on the same base finds them.
+Config stored_cell(const Config& base, const CalibrationOptions& o) {
+  Config c = reference_cell(base, o.reference_test);
+  c.packing_store = (o.resume.empty() ? o.output : resumed_parent(o.resume)) + "/.specimens/cells";
+  return c;
+}
+
 /// The free parameters: from the command line, else from the config's [calibrate] free.
 std::vector<FreeParam> free_params(const Config& cfg, const std::vector<std::string>& cli) {
   std::vector<FreeParam> out;
@@ -95,7 +103,7 @@ Session::Session(const Config& base, const CalibrationOptions& o, const std::str
       free(free_params(base, o.free)), noise(noise_options(o.noise)), predict_template(prediction_template(base, o.predict)),
       walls_prediction(walls_prediction_wanted(base, o)), workers(o.workers),
       two_fidelity(two_fidelity_wanted(base, o.reference_test, predict_template.has_value())),
-      lab(matched(reference_cell(base, o.reference_test), o.workers), true, o.workers),
+      lab(matched(stored_cell(base, o), o.workers), true, o.workers),
       folder(o.resume.empty() ? new_dated_folder(o.output, kind) : resumed_folder(o.resume, kind)),
       output(o.resume.empty() ? o.output : resumed_parent(o.resume)) {
   ranks::check_shared_folder(folder);  // every rank reads the run store there
@@ -227,7 +235,8 @@ std::string Session::predict_boundary(const Config& base, const std::map<std::st
   std::optional<Config> walls;
   if (walls_prediction) {
     StateMatch walls_state;  // the walled cell's own preparation to the data's state
-    const Config cell = reference_cell(base, kPredictWalls);
+    Config cell = reference_cell(base, kPredictWalls);
+    cell.packing_store = lab.config().packing_store;
     walls = matched_state(cell, data.tests, walls_state, true, match_plan(cell, workers));
   }
   const std::string test = walls ? walled_cell_text(*walls) : membrane_test_text(*predict_template);

@@ -41,7 +41,8 @@ int synth_job(const Config& base, const SynthOptions& o) {
                                                  : base.run.seed + kForeignSeedOffset;
   comment += ", a specimen per test (packing seeds from " + std::to_string(specimen) + ", " +
              std::to_string(kGeneratorCellFactor) + " times the config's balls)";
-  PeriodicLab lab(larger_cell(base, kGeneratorCellFactor), false, static_cast<int>(o.sigma3.size()), specimen);
+  PeriodicLab lab(larger_cell(base, kGeneratorCellFactor), true, static_cast<int>(o.sigma3.size()), specimen);
+  lab.set_progress("synth: the tests");
   const std::vector<TriaxialTest> tests = synthetic_tests(lab, truth, o.sigma3, o.material, o.seed);
   write_measured_curves(o.output, tests, comment);
   std::printf("synth: %s -> %s\n", comment.c_str(), o.output.c_str());

@@ -205,6 +205,9 @@ struct Config {
   PeriodicConfig periodic;
   bool has_periodic = false;  ///< the file has a [periodic] table
   CalibrateConfig calibrate;
+  /// Where packed cell specimens are kept and read back (host/lab/packing_store.hpp): a job sets it (calibrate,
+  /// diagnose and synth: the output folder's .specimens/cells); never a key, so not in the fingerprint. "" keeps none.
+  std::string packing_store;
 };
 
 /// The smallest time step a run takes, as a fraction of the critical step: quasi-static DEM runs at 0.1-0.3 of it,

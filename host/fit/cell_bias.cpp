@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "host/util/text_format.hpp"
 
@@ -31,9 +32,18 @@ CellBias measure_cell_bias(PeriodicLab& lab, const Model& base, const std::vecto
   // The lab's cell was matched to the same data: the larger one's friction lies near its own.
   plan.around = std::sqrt(lab.config().periodic.prep_mu_s);
   plan.store = lab.run_store();
-  const Config cfg = matched_state(larger_cell(lab.config(), kCellCheckFactor), measured, state, false, plan);
-  PeriodicLab check(cfg, false, kCellCheckSpecimens, plan.first_seed, kCellCheckSpecimens, lab.workers());
+  const Config bigger = larger_cell(lab.config(), kCellCheckFactor);
+  if (lab.verbose())
+    std::printf("triaxdem: the cell's bias check: %d cells of %ld balls at the base model, %zu tests each%s\n",
+                kCellCheckSpecimens, bigger.particles.count, measured.size(),
+                std::any_of(measured.begin(), measured.end(),
+                            [](const TriaxialTest& t) { return std::isfinite(t.void_ratio); })
+                    ? ", prepared to the data's void ratio"
+                    : "");
+  const Config cfg = matched_state(bigger, measured, state, lab.verbose(), plan);
+  PeriodicLab check(cfg, lab.verbose(), kCellCheckSpecimens, plan.first_seed, kCellCheckSpecimens, lab.workers());
   check.set_run_store(lab.run_store());  // its own specimens: their runs have their own names there
+  if (lab.verbose()) check.set_progress("triaxdem: the cell's bias check");
   const Ensemble larger = check.run_ensemble(base, measured, true);
   const Real n = static_cast<Real>(lab.balls()), factor = static_cast<Real>(check.balls()) / n;
   std::vector<std::vector<Real>> sd(measured.size());

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
-#include <type_traits>
+#include <optional>
 
 #include "host/triax/periodic_triaxial.hpp"
 #include "host/util/forked_runs.hpp"
@@ -44,7 +44,7 @@ Config larger_cell(const Config& base, int factor) {
 }
 
 PeriodicLab::PeriodicLab(const Config& base, bool verbose, int members, unsigned first_seed, int specimens, int workers)
-    : cfg_(base), members_(std::max(members, 1)), first_seed_(first_seed) {
+    : cfg_(base), members_(std::max(members, 1)), first_seed_(first_seed), verbose_(verbose) {
   set_workers(workers);
   set_batch(base.calibrate.batch);
   pack(std::max(members_, specimens), verbose);
@@ -69,59 +69,68 @@ void PeriodicLab::pack(int count, bool verbose) {
     ~Clock() { time_so_far.packing += seconds_since(t0); }
   } clock{t0};
   specimens_.assign(static_cast<std::size_t>(count), PackedCell{});
-  if (batch_ > 1 && count > 1) {
-    if (verbose)
-      std::printf("triaxdem: preparation: %d specimens of %ld balls, side by side in batches of up to %d\n", count,
-                  cfg_.particles.count, batch_);
-    for (int first = 0; first < count; first += batch_) {
-      std::vector<Config> cfgs;
-      for (int k = first; k < std::min(count, first + batch_); ++k) {
-        cfgs.push_back(cfg_);
-        cfgs.back().run.seed = first_seed_ + static_cast<unsigned>(k);
-      }
-      const std::vector<PreparedCell> made = prepare_periodic_specimens(cfgs);
-      for (std::size_t j = 0; j < made.size(); ++j) {
-        PackedCell& s = specimens_[static_cast<std::size_t>(first) + j];
-        s.balls = made[j].balls;
-        s.cell = made[j].cell;
-        s.void_ratio = void_ratio_of(s.balls, s.cell);
+  std::vector<Config> cfgs(specimens_.size(), cfg_);
+  std::vector<std::size_t> todo;  // the specimens the store does not hold
+  for (std::size_t k = 0; k < cfgs.size(); ++k) {
+    cfgs[k].run.seed = first_seed_ + static_cast<unsigned>(k);
+    if (!read_packing(cfgs[k], specimens_[k])) todo.push_back(k);
+  }
+  const std::size_t read = specimens_.size() - todo.size();
+  if (verbose && read > 0)
+    std::printf("triaxdem: %zu of %d specimens of %ld balls read from the packing store %s\n", read, count,
+                cfg_.particles.count, cfg_.packing_store.c_str());
+  if (todo.empty()) return;
+  const bool one_by_one = (batch_ <= 1 || todo.size() <= 1) && (workers_ <= 1 || todo.size() <= 1);
+  std::optional<Progress> progress;
+  if (verbose && todo.size() > 1) {
+    const int at_once = one_by_one ? 1 : std::min(static_cast<int>(todo.size()), batch_ > 1 ? batch_ : workers_);
+    progress.emplace("triaxdem: packing " + std::to_string(todo.size()) + " specimens of " +
+                         std::to_string(cfg_.particles.count) + " balls, " + std::to_string(at_once) + " at once",
+                     static_cast<long>(todo.size()));
+    progress->update(0, "specimens");
+  }
+  long packed = 0;
+  auto made = [&](std::size_t k) {
+    PackedCell& s = specimens_[k];
+    s.void_ratio = void_ratio_of(s.balls, s.cell);
+    write_packing(cfgs[k], s);
+    if (progress) progress->update(++packed, "specimens");
+  };
+  if (batch_ > 1 && todo.size() > 1) {
+    for (std::size_t first = 0; first < todo.size(); first += static_cast<std::size_t>(batch_)) {
+      const std::size_t last = std::min(todo.size(), first + static_cast<std::size_t>(batch_));
+      std::vector<Config> chunk;
+      for (std::size_t j = first; j < last; ++j) chunk.push_back(cfgs[todo[j]]);
+      const std::vector<PreparedCell> prepared = prepare_periodic_specimens(chunk);
+      for (std::size_t j = first; j < last; ++j) {
+        specimens_[todo[j]].balls = prepared[j - first].balls;
+        specimens_[todo[j]].cell = prepared[j - first].cell;
+        made(todo[j]);
       }
     }
-    return;
+  } else if (one_by_one) {
+    for (const std::size_t k : todo) {
+      prepare_periodic_specimen(cfgs[k], specimens_[k].balls, specimens_[k].cell, verbose && k == todo.front());
+      made(k);
+    }
+  } else {  // each specimen in a child, sent back as packed_bytes
+    forked_runs(
+        todo.size(), workers_,
+        [&](std::size_t j, int fd) {
+          PackedCell& s = specimens_[todo[j]];
+          prepare_periodic_specimen(cfgs[todo[j]], s.balls, s.cell, false);
+          s.void_ratio = void_ratio_of(s.balls, s.cell);
+          const std::string bytes = packed_bytes(s);
+          put_bytes(fd, bytes.data(), bytes.size());
+        },
+        [&](std::size_t j, int fd) {
+          if (!get_packed(fd, specimens_[todo[j]], static_cast<std::size_t>(cfg_.particles.count))) return false;
+          made(todo[j]);
+          return true;
+        },
+        "specimen preparation");
   }
-  auto prepare = [&](std::size_t k) {
-    Config c = cfg_;
-    c.run.seed = first_seed_ + static_cast<unsigned>(k);
-    PackedCell& s = specimens_[k];
-    prepare_periodic_specimen(c, s.balls, s.cell, verbose && k == 0);
-    s.void_ratio = void_ratio_of(s.balls, s.cell);
-  };
-  if (workers_ <= 1 || count <= 1) {
-    for (std::size_t k = 0; k < specimens_.size(); ++k) prepare(k);
-    return;
-  }
-  // Each specimen in a child, sent back as its ball count, balls (plain data), cell and void ratio.
-  static_assert(std::is_trivially_copyable<BallSpec>::value, "BallSpec goes through a pipe as bytes");
-  forked_runs(
-      specimens_.size(), workers_,
-      [&](std::size_t k, int fd) {
-        prepare(k);
-        const PackedCell& s = specimens_[k];
-        const std::size_t n = s.balls.size();
-        put_bytes(fd, &n, sizeof n);
-        put_bytes(fd, s.balls.data(), n * sizeof(BallSpec));
-        put_bytes(fd, s.cell.data(), sizeof s.cell);
-        put_bytes(fd, &s.void_ratio, sizeof s.void_ratio);
-      },
-      [&](std::size_t k, int fd) {
-        PackedCell& s = specimens_[k];
-        std::size_t n = 0;
-        if (!get_bytes(fd, &n, sizeof n)) return false;
-        s.balls.resize(n);
-        return get_bytes(fd, s.balls.data(), n * sizeof(BallSpec)) && get_bytes(fd, s.cell.data(), sizeof s.cell) &&
-               get_bytes(fd, &s.void_ratio, sizeof s.void_ratio);
-      },
-      "specimen preparation");
+  if (progress) progress->finish("");
 }
 
 StateMatch PeriodicLab::grow_cell(int factor, const StateMatch& state) {
@@ -130,14 +139,17 @@ StateMatch PeriodicLab::grow_cell(int factor, const StateMatch& state) {
   cell_factor_ *= factor;
   // The friction that packs the data's void ratio in a small cell packs a larger one to another.
   StateMatch grown = state;
+  if (verbose_)
+    std::printf("triaxdem: the cell grows to %ld balls (%d x the config's): its specimens are packed again%s\n",
+                cfg_.particles.count, cell_factor_, state.tests > 0 ? ", to the data's void ratio" : "");
   if (state.tests > 0) {
     MatchPlan plan;
     plan.first_seed = first_seed_;
     plan.specimens = state.specimens;
     plan.workers = workers_;
-    cfg_.periodic.prep_mu_s = grown.prep_mu_s = prep_friction_for(cfg_, state.target, grown.reached, false, plan);
+    cfg_.periodic.prep_mu_s = grown.prep_mu_s = prep_friction_for(cfg_, state.target, grown.reached, verbose_, plan);
   }
-  pack(specimens(), false);
+  pack(specimens(), verbose_);
   return grown;
 }
 

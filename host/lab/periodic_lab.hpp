@@ -14,6 +14,7 @@
 #include "host/config/config.hpp"
 #include "host/engine/builder.hpp"
 #include "host/data/measured.hpp"
+#include "host/lab/packing_store.hpp"
 #include "host/lab/state_match.hpp"
 
 namespace dem {
@@ -72,6 +73,8 @@ class PeriodicLab {
   StateMatch grow_cell(int factor, const StateMatch& state);
   /// The cell's balls as a multiple of the config's.
   int cell_factor() const { return cell_factor_; }
+  /// Whether the lab reports its own work (packings, the state match of a grown cell) as it goes.
+  bool verbose() const { return verbose_; }
   int specimens() const { return static_cast<int>(specimens_.size()); }
   const Config& config() const { return cfg_; }
   /// Keeps every run's curves in `folder` (one file each, named by a hash of the model, the pressure, the
@@ -95,12 +98,6 @@ class PeriodicLab {
   Real prepared_void_ratio(int k) const { return specimens_[static_cast<std::size_t>(k)].void_ratio; }
 
  private:
-  /// A member's specimen: its balls packed in their periodic cell.
-  struct PackedCell {
-    std::vector<BallSpec> balls;
-    std::array<Real, 3> cell{};
-    Real void_ratio = 0;
-  };
   Config cfg_;
   std::vector<PackedCell> specimens_;
   long runs_ = 0;
@@ -115,6 +112,10 @@ class PeriodicLab {
   int members_ = 1;
   int cell_factor_ = 1;
   unsigned first_seed_ = 0;
+  bool verbose_ = false;
+  /// Packs `count` specimens (seeds first_seed_ on), reading those the packing store holds (Config::packing_store)
+  /// and keeping those it packs; `verbose`: a progress line with ETA, and the first one's preparation where the
+  /// specimens are packed one at a time.
   void pack(int count, bool verbose);
   /// One run to make: a test's material and pressure on one member's specimen.
   struct Case {

@@ -50,10 +50,11 @@ void Progress::update(long done, const std::string& extra) {
     return;
   }
   const long run = done - first_;  // done by this run, at the elapsed time's rate
-  const double eta = run > 0 ? elapsed * static_cast<double>(total_ - done) / run : 0;
+  // Nothing done yet gives no rate: the line says when an ETA will come, not a false 0m00s.
+  const std::string eta = run > 0 ? format_duration(elapsed * static_cast<double>(total_ - done) / run)
+                                  : std::string("after the first");
   std::printf("%s%s %ld/%ld (%3.0f%%) elapsed %s ETA %s %s%s", tty_ ? "\r" : "", what_.c_str(), done, total_,
-              100 * frac, format_duration(elapsed).c_str(), format_duration(eta).c_str(), extra.c_str(),
-              tty_ ? "   " : "\n");
+              100 * frac, format_duration(elapsed).c_str(), eta.c_str(), extra.c_str(), tty_ ? "   " : "\n");
   std::fflush(stdout);
 }
 
