@@ -16,6 +16,8 @@
 #include "host/fit/diagnose.hpp"
 #include "host/data/measured.hpp"
 #include "host/fit/misfit.hpp"
+#include "host/lab/run_cost.hpp"
+#include "host/triax/periodic_triaxial.hpp"
 #include "test_util.hpp"
 
 using namespace dem;
@@ -323,6 +325,32 @@ TEST(PackingStore, ALaterLabReadsTheStoredSpecimensAndADamagedOneIsPackedAgain) 
   Config in_code = second;
   in_code.fingerprint.clear();
   EXPECT_EQ(packing_path(in_code), "") << "a config built in code has settings the hash does not see";
+}
+
+// A job's plan counts a run's shear steps before it runs: the estimate is the stage's own count (the end strain at
+// the rate set from the inertial number at sigma3, with the time step of the cell's balls), at two pressures; the
+// probe measures a finite speed. A shear counted by engineering strain (0.01 / (rate dt)) is 0.5% short and fails.
+TEST(RunCost, TheShearsStepsAreCountedAsTheStageCountsThem) {
+  Config cfg = test::tiny_cell_config();
+  const CellCost c = measure_cell_cost(cfg, 0.01);
+  EXPECT_GT(c.ns_per_particle_step, 0);
+  EXPECT_TRUE(std::isfinite(c.ns_per_particle_step));
+  EXPECT_GT(c.packing_steps, 0);
+  std::vector<BallSpec> balls;
+  std::array<Real, 3> cell{};
+  prepare_periodic_specimen(cfg, balls, cell, false);
+  for (const Real sigma3 : {100e3, 400e3}) {
+    auto sim = make_periodic_simulation(balls, cell, cfg.ball, cfg.solver, CellBoundary::periodic);
+    // The same balls' masses and stiffness, summed in another order: equal to rounding.
+    EXPECT_NEAR(sim->params().integ.dt, c.dt, 1e-12 * c.dt) << "the probe's time step is the runs'";
+    PeriodicTriaxialParams p = cfg.periodic.triax;
+    p.sigma3 = sigma3;
+    p.verbose = false;
+    const PeriodicTriaxialResult r = run_periodic_triaxial(*sim, p);
+    ASSERT_EQ(r.stages.size(), 2u);
+    EXPECT_EQ(c.shear_steps(sigma3), r.stages[1].steps) << "sigma3 " << sigma3;
+    EXPECT_GT(c.run_steps(sigma3), c.shear_steps(sigma3));
+  }
 }
 
 // A run stopped by a blow-up gives no test (every quantity missing) and is counted with its pressure, so that the

@@ -345,6 +345,54 @@ TEST(CliEdges, ARefusedCalibrationLeavesNoFolder) {
   EXPECT_TRUE(fs::is_empty(dir / "out")) << "a refused calibration left its dated folder";
 }
 
+// A walled calibration at the data's size ran for over an hour, silent for minutes at a time, and nothing said so
+// before it began: calibrate and diagnose print their plan (each stage's work, particle-steps and time on this
+// machine) before any packing; --plan prints it and stops, making no folder and packing nothing.
+TEST(CliEdges, APlanIsPrintedBeforeAnyPackingAndPlanStopsThere) {
+  const fs::path dir = dem::test::scratch_dir("cli_plan");
+  write_four_point_curve(dir / "d.csv");
+  for (const char* kind : {"calibrate", "diagnose"}) {
+    const Outcome o = triaxdem(std::string(kind) + " " + (dir / "d.csv").string() + " --config tests/data/hidden_effects.toml "
+                               "--predict none -j 1 --plan -o " + (dir / "out").string(), dir);
+    EXPECT_EQ(o.code, 0) << o.output;
+    for (const std::string line : {std::string(kind) + ": plan (before any packing):", std::string("scatter runs: "),
+                                   std::string("cell's bias check, runs: "), std::string(kind) + ": in all ",
+                                   std::string("ns a particle-step")})
+      EXPECT_NE(o.output.find(line), std::string::npos) << line << "\n" << o.output;
+    EXPECT_EQ(o.output.find("triaxdem: packing"), std::string::npos) << o.output;
+    EXPECT_EQ(o.output.find("matching the void ratio"), std::string::npos) << o.output;
+    EXPECT_FALSE(fs::exists(dir / "out") && !fs::is_empty(dir / "out")) << "--plan made a result folder";
+  }
+}
+
+// A plan beyond the bound (four hours here) is refused before any packing unless --yes is given, naming its costliest
+// stage and the setting that sizes it; 64 scatter specimens of 8,000 balls with an "auto" ensemble are such a job.
+TEST(CliEdges, AJobBeyondItsBoundAsksForYes) {
+  const fs::path dir = dem::test::scratch_dir("cli_plan_bound");
+  write_four_point_curve(dir / "d.csv");
+  {
+    std::ifstream in(std::string(TRIAXDEM_SOURCE_DIR) + "/tests/data/hidden_effects.toml");
+    std::ofstream out(dir / "big.toml");
+    std::string line;
+    while (std::getline(in, line)) {
+      if (line.rfind("count = ", 0) == 0) line = "count = 8000";
+      if (line.rfind("size_mm = ", 0) == 0) line = "size_mm = [58.0, 58.0, 58.0]";
+      if (line.rfind("ensemble = ", 0) == 0) line = "ensemble = \"auto\"";
+      if (line.rfind("scatter_specimens = ", 0) == 0) line = "scatter_specimens = 64";
+      out << line << "\n";
+    }
+  }
+  const Outcome o = triaxdem("calibrate " + (dir / "d.csv").string() + " --config " + (dir / "big.toml").string() +
+                             " --predict none -j 1 -o " + (dir / "out").string(), dir);
+  EXPECT_EQ(o.code, 1) << o.output;
+  EXPECT_NE(o.output.find("run it with --yes, or make it smaller; its costliest stage is A: search"),
+            std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("sized by [calibrate] ensemble (auto)"), std::string::npos) << o.output;
+  EXPECT_EQ(o.output.find("triaxdem: packing"), std::string::npos) << o.output;
+  EXPECT_EQ(o.output.find("matching the void ratio"), std::string::npos) << o.output;
+  EXPECT_FALSE(fs::exists(dir / "out") && !fs::is_empty(dir / "out"));
+}
+
 // A prediction of the walled cell beside a walled reference would compare the cell with itself: refused before any
 // run or folder, naming the option and what to give instead.
 TEST(CliEdges, AWalledPredictionOfAWalledCalibrationIsRefused) {

@@ -121,6 +121,7 @@ std::string reference_table(const Session& ss, const std::string& material, cons
 }  // namespace
 
 int calibrate_job(const Config& base, const CalibrationOptions& o) {
+  if (o.plan_only) return JobInputs(base, o).announce_plan(base, o, "calibrate"), 0;
   Session ss(base, o, "calibrate");
   std::ostringstream table;
   table << "material,parameter,value,low95,high95,reference,chi2,data,runs\n";
@@ -196,10 +197,12 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
   const std::string prediction = ss.predict_boundary(base, models);
   if (!prediction.empty()) io::write_text_atomic(ss.folder + "/prediction.md", prediction);
   ss.write_pools();
+  std::printf("calibrate: %s\n", ss.plan_text().c_str());
   return 0;
 }
 
 int diagnose_job(const Config& base, const CalibrationOptions& o) {
+  if (o.plan_only) return JobInputs(base, o).announce_plan(base, o, "diagnose"), 0;
   Session ss(base, o, "diagnose");
   if (ss.two_fidelity)
     std::printf("diagnose: note: the diagnosis fits the periodic cell; two fidelities apply to calibrate (the "
@@ -265,6 +268,7 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
   const std::string prediction = ss.predict_boundary(base, models);
   if (!prediction.empty()) io::write_text_atomic(ss.folder + "/diagnosis.md", md.str() + "\n" + prediction);
   ss.write_pools();
+  std::printf("diagnose: %s\n", ss.plan_text().c_str());
   return 0;
 }
 

@@ -25,6 +25,8 @@ struct CalibrationOptions {
   /// A result folder of an earlier calibrate or diagnose of the same data to continue in: its stored runs
   /// (PeriodicLab::set_run_store) are read instead of run again. "": a new dated folder.
   std::string resume;
+  bool plan_only = false;  ///< --plan: print the plan (what runs, about how long) and stop before any packing
+  bool yes = false;        ///< --yes: run a plan longer than kPlanBoundSeconds
 };
 
 /// Calibrates each material of the data; writes calibrate_<date>/ under options.output. Returns 0.

@@ -96,13 +96,45 @@ std::map<std::string, std::vector<TriaxialTest>> by_material(const MeasuredData&
   return out;
 }
 
-Session::Session(const Config& base, const CalibrationOptions& o, const std::string& kind)
+JobInputs::JobInputs(const Config& base, const CalibrationOptions& o)
     : data(load_measured(o.data)),
       ref(o.reference.empty() ? ReferenceValues{}
                               : load_reference(o.reference, [](const std::string& n) { free_param(n); })),
       free(free_params(base, o.free)), noise(noise_options(o.noise)), predict_template(prediction_template(base, o.predict)),
       walls_prediction(walls_prediction_wanted(base, o)), workers(o.workers),
-      two_fidelity(two_fidelity_wanted(base, o.reference_test, predict_template.has_value())),
+      two_fidelity(two_fidelity_wanted(base, o.reference_test, predict_template.has_value())) {}
+
+JobPlan JobInputs::announce_plan(const Config& base, const CalibrationOptions& o, const std::string& kind) const {
+  PlanInput in;
+  in.cell = reference_cell(base, o.reference_test);
+  in.materials = by_material(data, o.material);
+  in.free = static_cast<int>(free.size());
+  in.diagnose = kind == "diagnose";
+  in.two_fidelity = two_fidelity;
+  in.membrane = predict_template ? &*predict_template : nullptr;
+  in.walls = walls_prediction;
+  in.at_once = runs_at_once(o.workers);
+  JobPlan plan = plan_job(in);
+  std::printf("%s", plan.text(kind).c_str());
+  if (plan.high() > kPlanBoundSeconds && !o.yes && !o.plan_only) {
+    const PlanStage& top = plan.costliest();
+    throw ConfigError(kind + ": the plan takes up to " + format_duration(plan.high()) + " on this machine, above the " +
+                      format_duration(kPlanBoundSeconds) + " a job runs without asking: run it with --yes, or make it "
+                      "smaller; its costliest stage is " + top.name + " (up to " + format_duration(top.high) +
+                      "), sized by " + top.setting + " (docs/calibration.md, What a job costs)");
+  }
+  return plan;
+}
+
+std::string Session::plan_text() const {
+  return "the plan said about " +
+         (plan.high() - plan.low() < 0.5 ? format_duration(plan.high())
+                                         : format_duration(plan.low()) + " to " + format_duration(plan.high())) +
+         "; the job took " + format_duration(seconds_since(started));
+}
+
+Session::Session(const Config& base, const CalibrationOptions& o, const std::string& kind)
+    : JobInputs(base, o), plan(announce_plan(base, o, kind)),
       lab(matched(stored_cell(base, o), o.workers), true, o.workers),
       folder(o.resume.empty() ? new_dated_folder(o.output, kind) : resumed_folder(o.resume, kind)),
       output(o.resume.empty() ? o.output : resumed_parent(o.resume)) {

@@ -11,6 +11,7 @@
 
 #include "host/cli/calibration_jobs.hpp"
 #include "host/fit/calibrate.hpp"
+#include "host/fit/job_plan.hpp"
 #include "host/fit/misfit.hpp"
 #include "host/fit/prediction.hpp"
 #include "host/lab/periodic_lab.hpp"
@@ -39,23 +40,35 @@ struct EmptyFolderRemover {
   }
 };
 
-/// What calibrate and diagnose share: the data, the free parameters, the simulator and a new result folder.
-struct Session {
+/// What a calibrate or diagnose job is asked to do, read and checked before any work: the data, the free
+/// parameters, the noise, the prediction; and the plan of the work (--plan stops after it).
+struct JobInputs {
   MeasuredData data;
   ReferenceValues ref;
   std::vector<FreeParam> free;
-  std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();
   NoiseOptions noise;
-  StateMatch state;  ///< the data's void ratio and the preparation that packs it, on the lab's present cell
   std::optional<Config> predict_template;
   bool walls_prediction = false;  ///< the prediction is the reference cell between six walls (kPredictWalls)
   int workers = 1;
   bool two_fidelity = false;  ///< the reference test: the periodic cell corrected by the membrane test
+  JobInputs(const Config& base, const CalibrationOptions& o);
+  /// The job's plan (host/fit/job_plan.hpp), printed. A plan above kPlanBoundSeconds without --yes is refused
+  /// (ConfigError naming its costliest stage and the setting that sizes it).
+  JobPlan announce_plan(const Config& base, const CalibrationOptions& o, const std::string& kind) const;
+};
+
+/// What calibrate and diagnose share: the job's inputs, the simulator and a new result folder.
+struct Session : JobInputs {
+  std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();
+  JobPlan plan;
+  StateMatch state;  ///< the data's void ratio and the preparation that packs it, on the lab's present cell
   std::string discrepancy;    ///< what the two fidelities measured, for the report
   PeriodicLab lab;
   std::string folder, output;
   EmptyFolderRemover remover{folder};
   Session(const Config& base, const CalibrationOptions& o, const std::string& kind);
+  /// The plan's estimate beside the job's time so far, for the job's last lines.
+  std::string plan_text() const;
   /// The reference test's cell, for the report.
   std::string cell_text() const;
   /// "N runs", how many of them a resumed session read from its store, and how many a blow-up stopped: their data

@@ -200,6 +200,10 @@ void add_calibration_commands(CLI::App& app, Args& a, Commands& c) {
                   "(the cell between six servo-controlled walls, measured at the walls) or two_fidelity (the cell "
                   "corrected by the --predict membrane test); default: [calibrate] reference_test")
         ->check(CLI::IsMember({"periodic", "walls", "two_fidelity"}));
+    cmd->add_flag("--plan", a.cal.plan_only, "print the plan (each stage's runs, their balls and particle-steps, about "
+                  "how long on this machine) and stop before any packing");
+    cmd->add_flag("--yes", a.cal.yes, "run a plan longer than 4 hours (without it such a job is refused, naming the "
+                  "setting that costs most)");
   };
   c.calibrate = app.add_subcommand("calibrate", "fit the free parameters to measured triaxial data");
   add_calibration(c.calibrate);

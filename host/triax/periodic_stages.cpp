@@ -246,7 +246,7 @@ void SnapshotSchedule::at(Real eps) {
 Shear::Shear(CellControl& cell, PeriodicTriaxialResult& res, const GrainScales& g, io::Output* out, Simulation* sim)
     : cell_(cell), res_(res), prm_(res.params), g_(g), out_(out), snapshots_(prm_, sim, out),
       servo_(shear_servo(prm_, cell.lengths())),
-      total_(static_cast<long>(std::ceil(-std::log(1 - prm_.target_strain) / (prm_.axial_rate * cell.dt())))),
+      total_(shear_step_count(prm_.target_strain, prm_.axial_rate, cell.dt())),
       progress_(prm_.name + " shear", total_), next_record_(prm_.record_strain) {
   L0_ = cell_.lengths();
   res_.h0 = L0_[2];

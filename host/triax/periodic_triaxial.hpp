@@ -30,6 +30,7 @@
 /// is stable and monotone, and the non-affine relaxation of the particles only lowers the real stiffness.
 /// A positive rate extends the cell (stress too high -> extend).
 #include <array>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -74,6 +75,12 @@ struct PeriodicTriaxialResult {
   double wall_seconds = 0;
   std::vector<StageTiming> stages;   ///< consolidation and shear
 };
+
+/// Steps of a shear to the engineering axial strain `target_strain` at the constant true strain `axial_rate` (1/s)
+/// with time step dt (s): the stage's plan, and a job's estimate of its cost (host/lab/run_cost.hpp).
+inline long shear_step_count(Real target_strain, Real axial_rate, Real dt) {
+  return static_cast<long>(std::ceil(-std::log(1 - target_strain) / (axial_rate * dt)));
+}
 
 /// Fills in the automatic rates and checks the parameters against the simulation: fully periodic, no
 /// walls, zero gravity, I within bounds. Throws std::invalid_argument with the reason.

@@ -1,0 +1,218 @@
+#include "host/fit/job_plan.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include "host/fit/calibrate.hpp"
+#include "host/fit/cell_bias.hpp"
+#include "host/fit/diagnose.hpp"
+#include "host/lab/periodic_lab.hpp"
+#include "host/lab/run_cost.hpp"
+#include "host/lab/state_match.hpp"
+#include "host/triax/specimen.hpp"
+#include "host/util/progress.hpp"
+#include "host/util/text_format.hpp"
+
+namespace dem {
+
+/// A membrane specimen's build (layers compacted and settled) over one membrane test's steps: the README's small S-1
+/// case builds its specimen in 3.5 minutes and runs the test in 2 min 45 s on 2 cores. A specimen is built once per
+/// seed and cached (.specimens), then tested at every pressure.
+constexpr Real kMembraneSpecimenOverTest = 1.3;
+
+double JobPlan::low() const {
+  double s = 0;
+  for (const PlanStage& p : stages) s += p.low;
+  return s;
+}
+
+double JobPlan::high() const {
+  double s = 0;
+  for (const PlanStage& p : stages) s += p.high;
+  return s;
+}
+
+double JobPlan::particle_steps() const {
+  double s = 0;
+  for (const PlanStage& p : stages) s += p.particle_steps;
+  return s;
+}
+
+const PlanStage& JobPlan::costliest() const {
+  return *std::max_element(stages.begin(), stages.end(),
+                           [](const PlanStage& a, const PlanStage& b) { return a.high < b.high; });
+}
+
+namespace {
+
+std::string span(double low, double high) {
+  return std::fabs(high - low) < 0.5 ? format_duration(high) : format_duration(low) + " to " + format_duration(high);
+}
+
+/// Wall seconds of `n` pieces of `each` seconds, `at_once` of them side by side.
+double wall(double n, double each, int at_once) { return std::ceil(n / std::max(at_once, 1) - 1e-9) * each; }
+
+/// Mean of a cost over the tests' pressures.
+template <class F>
+double mean_over(const std::vector<TriaxialTest>& tests, F f) {
+  double s = 0;
+  for (const TriaxialTest& t : tests) s += f(t.sigma3);
+  return tests.empty() ? 0 : s / static_cast<double>(tests.size());
+}
+
+/// The builder of a plan's stages.
+struct Stages {
+  JobPlan& plan;
+  int at_once;
+  /// `n` packings of `cost`'s cell, up to `side` of them at once, `low_n` at the lower end.
+  void packings(const std::string& name, const std::string& setting, const CellCost& c, double low_n, double n,
+                int side, const std::string& what) {
+    if (n <= 0 || c.packing_steps <= 0) return;
+    const int k = std::min(at_once, side);
+    plan.stages.push_back({name, what + " of " + std::to_string(c.balls) + " balls", setting,
+                           n * static_cast<double>(c.packing_steps) * static_cast<double>(c.balls),
+                           wall(low_n, c.packing_seconds(), k), wall(n, c.packing_seconds(), k)});
+  }
+  /// Runs of `tests` on `low_k` to `k` specimens per point, `points` points one after another.
+  void runs(const std::string& name, const std::string& setting, const CellCost& c,
+            const std::vector<TriaxialTest>& tests, double points, int low_k, int k, const std::string& what) {
+    const double each = mean_over(tests, [&](Real s) { return c.run_seconds(s); });
+    const double steps = mean_over(tests, [&](Real s) { return static_cast<double>(c.run_steps(s)); });
+    const double per_point_low = static_cast<double>(tests.size()) * low_k, per_point = static_cast<double>(tests.size()) * k;
+    plan.stages.push_back({name, what, setting, points * per_point * steps * static_cast<double>(c.balls),
+                           points * wall(per_point_low, each, at_once), points * wall(per_point, each, at_once)});
+  }
+};
+
+/// The membrane test's cost: its specimen's balls, its time step and speed, its shear at its own rate.
+CellCost membrane_cost(const Config& membrane) {
+  Config m = membrane;
+  m.particles.count = specimen_ball_count(membrane);
+  m.periodic.triax.axial_rate = 0;
+  m.periodic.triax.target_inertial = membrane.triaxial.inertial_number;
+  m.periodic.triax.target_strain = membrane.triaxial.axial_strain_end;
+  return measure_cell_cost(m);
+}
+
+}  // namespace
+
+JobPlan plan_job(const PlanInput& in) {
+  JobPlan plan;
+  Stages add{plan, in.at_once};
+  const CalibrateConfig& cc = in.cell.calibrate;
+  const int factor = static_cast<int>(std::max(cc.cell_factor, 1L));
+  Config cell = larger_cell(in.cell, factor);
+  bool void_ratio = false;
+  for (const auto& m : in.materials)
+    for (const TriaxialTest& t : m.second) void_ratio = void_ratio || std::isfinite(t.void_ratio);
+  // A matched state is prepared with a friction of its own: the packing then has a preparation stage.
+  if (void_ratio && cell.periodic.prep_mu_s < 0) cell.periodic.prep_mu_s = 0.5 * cell.ball.mu_s;
+  const CellCost lab = measure_cell_cost(cell);
+  const CellCost check = measure_cell_cost(larger_cell(cell, kCellCheckFactor));
+  const int S = static_cast<int>(cc.scatter_specimens);
+  const bool auto_ensemble = cc.ensemble == kAutoEnsemble;
+  const int K = auto_ensemble ? S : static_cast<int>(cc.ensemble);
+  const int K_low = auto_ensemble ? 1 : K;
+  const std::string n = std::to_string(lab.balls);
+  const int match_packings = 2 + MatchPlan{}.steps;
+  if (void_ratio)
+    add.packings("state match", "the data's void_ratio", lab, match_packings * kStateMatchSpecimens,
+                 match_packings * kStateMatchSpecimens, kStateMatchSpecimens,
+                 "up to " + std::to_string(match_packings) + " packings of " + std::to_string(kStateMatchSpecimens) +
+                     " specimens");
+  const int shared = void_ratio ? kStateMatchSpecimens : 0;  // the match's last packing is the first specimens'
+  add.packings("scatter specimens", "[calibrate] scatter_specimens", lab, S - shared, S - shared, S - shared,
+               std::to_string(S - shared) + " packings");
+  const std::vector<TriaxialTest> none;
+  for (const auto& [material, tests] : in.materials) {
+    const std::string T = std::to_string(tests.size());
+    add.runs(material + ": scatter runs", "[calibrate] scatter_specimens", lab, tests, 1, S, S,
+             std::to_string(S * static_cast<int>(tests.size())) + " runs of " + n + " balls (" + std::to_string(S) +
+                 " specimens x " + T + " tests)");
+    // The check cells' own state match starts from a bracket around the lab's friction (4 packings) and falls back
+    // to the whole range (up to 2 + kCellCheckPrepSteps more).
+    const int check_low = 4, check_high = 4 + 2 + kCellCheckPrepSteps;
+    if (void_ratio)
+      add.packings(material + ": cell's bias check, state match", "the cell's bias check (kCellCheckFactor)", check,
+                   check_low * kStateMatchSpecimens, check_high * kStateMatchSpecimens, kStateMatchSpecimens,
+                   std::to_string(check_low) + " to " + std::to_string(check_high) + " packings of " +
+                       std::to_string(kStateMatchSpecimens) + " specimens");
+    add.packings(material + ": cell's bias check, specimens", "the cell's bias check (kCellCheckFactor)", check,
+                 kCellCheckSpecimens - shared, kCellCheckSpecimens - shared, kCellCheckSpecimens,
+                 std::to_string(kCellCheckSpecimens - shared) + " packings");
+    add.runs(material + ": cell's bias check, runs", "the cell's bias check (kCellCheckFactor)", check, tests, 1,
+             kCellCheckSpecimens, kCellCheckSpecimens,
+             std::to_string(kCellCheckSpecimens * static_cast<int>(tests.size())) + " runs of " +
+                 std::to_string(check.balls) + " balls");
+    const long points = in.diagnose ? planned_points(in.free) + static_cast<long>(extensions().size()) * 6
+                                    : planned_points(in.free);
+    const std::string k = auto_ensemble ? "1 to " + std::to_string(K) : std::to_string(K);
+    const std::string search_what = std::to_string(points) + " points x " + T + " tests x " + k + " specimens of " + n +
+                                    " balls" + (in.diagnose ? " (the base model, then " +
+                                                                  std::to_string(extensions().size()) + " extensions)"
+                                                            : "");
+    add.runs(material + (in.diagnose ? ": diagnosis" : ": search"), auto_ensemble ? "[calibrate] ensemble (auto)" : "[calibrate] ensemble",
+             lab, tests, static_cast<double>(points), K_low, K, search_what);
+    if (in.membrane) {
+      const CellCost mem = membrane_cost(*in.membrane);
+      const int P = static_cast<int>(cc.predict_specimens);
+      const double build = kMembraneSpecimenOverTest * mean_over(tests, [&](Real s) { return mem.run_seconds(s); });
+      const double tests_s = mean_over(tests, [&](Real s) { return mem.run_seconds(s); }) * P *
+                             static_cast<double>(tests.size());
+      const double steps = mean_over(tests, [&](Real s) { return static_cast<double>(mem.run_steps(s)); }) *
+                           static_cast<double>(mem.balls) * P * (static_cast<double>(tests.size()) + kMembraneSpecimenOverTest);
+      const std::string what = std::to_string(P * static_cast<int>(tests.size())) + " membrane tests of " +
+                               std::to_string(mem.balls) + " balls (" + std::to_string(P) + " specimens x " + T +
+                               " pressures, one at a time; a specimen in .specimens is not built again)";
+      const double each = build * P + tests_s;
+      if (in.two_fidelity && !in.diagnose) {
+        plan.stages.push_back({material + ": two fidelities, membrane tests", "[calibrate] predict_specimens", what,
+                               steps, each, each});
+        add.runs(material + ": two fidelities, periodic runs", "[calibrate] scatter_specimens", lab, tests, 1, S, S,
+                 std::to_string(S * static_cast<int>(tests.size())) + " runs of " + n + " balls");
+        add.runs(material + ": search (corrected)", "[calibrate] ensemble", lab, tests, static_cast<double>(points),
+                 K_low, K, search_what);
+      }
+      // The specimens built for two fidelities are cached: the prediction tests only.
+      const double predict = in.two_fidelity && !in.diagnose ? tests_s : each;
+      plan.stages.push_back({material + ": prediction", "[calibrate] predict_specimens", what, steps, predict, predict});
+    } else if (in.walls) {
+      const int P = static_cast<int>(cc.predict_specimens);
+      add.runs(material + ": prediction (walls)", "[calibrate] predict_specimens", lab, tests, 1, P, P,
+               std::to_string(P * static_cast<int>(tests.size())) + " runs of the walled cell of " + n + " balls");
+    }
+  }
+  plan.notes.push_back(fmt("speed measured here: %.0f ns a particle-step", lab.ns_per_particle_step) +
+                       " in the cell of " + n + " balls, " + fmt("%.0f", check.ns_per_particle_step) + " in the check's of " +
+                       std::to_string(check.balls) + "; " + std::to_string(in.at_once) +
+                       (in.at_once > 1 ? " runs at once, one thread each" : " run at a time"));
+  plan.notes.push_back(fmt("a run of %.0f steps", static_cast<double>(lab.run_steps(cell.periodic.triax.sigma3))) +
+                       fmt(" at %g kPa", 1e-3 * cell.periodic.triax.sigma3) +
+                       fmt(" (%.0f s)", lab.run_seconds(cell.periodic.triax.sigma3)) +
+                       fmt(", a packing of %.0f steps", static_cast<double>(lab.packing_steps)) +
+                       fmt(" (%.0f s)", lab.packing_seconds()) + ": estimates (host/lab/run_cost.hpp)");
+  if (auto_ensemble)
+    plan.notes.push_back("ensemble \"auto\": the scatter runs choose 1 to " + std::to_string(S) +
+                         " specimens a point (the fewest whose mean's standard error is half the data's noise): the "
+                         "searches' times are that range");
+  if (cc.cell_factor == kAutoCell && auto_ensemble)
+    plan.notes.push_back("cell \"auto\": where all " + std::to_string(S) + " scatter specimens fall short, the cell "
+                         "grows (up to " + std::to_string(kMaxCellFactor) + " x its balls) and every later stage costs "
+                         "about that factor more: the job says so when it happens");
+  plan.notes.push_back("packings kept in the packing store (.specimens/cells of the output folder) are read, not "
+                       "packed: a later job on the same base and data skips them");
+  return plan;
+}
+
+std::string JobPlan::text(const std::string& kind) const {
+  std::string s = kind + ": plan (before any packing):\n";
+  for (const PlanStage& p : stages)
+    s += "  " + p.name + ": " + p.work + fmt(", %.2g particle-steps, ", p.particle_steps) + span(p.low, p.high) + "\n";
+  s += kind + ": in all " + fmt("%.2g particle-steps, ", particle_steps()) + "about " + span(low(), high()) +
+       " on this machine\n";
+  for (const std::string& n : notes) s += "  " + n + "\n";
+  return s;
+}
+
+}  // namespace dem

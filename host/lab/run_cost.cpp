@@ -1,0 +1,87 @@
+#include "host/lab/run_cost.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "host/engine/builder.hpp"
+#include "host/triax/periodic_triaxial.hpp"
+
+namespace dem {
+
+namespace {
+/// The axial rate of a run at sigma3 (resolve_periodic_params): given, or I = rate d sqrt(rho_eff / sigma3).
+Real axial_rate(const PeriodicTriaxialParams& p, Real d, Real rho_eff, Real sigma3) {
+  return p.axial_rate > 0 ? p.axial_rate : p.target_inertial / (d * std::sqrt(rho_eff / sigma3));
+}
+}  // namespace
+
+long CellCost::shear_steps(Real sigma3) const {
+  return shear_step_count(triax.target_strain, axial_rate(triax, d, rho_eff, sigma3), dt);
+}
+
+namespace {
+
+/// Mean of d^3 over diameters uniform between the config's smallest and largest (packing.cpp's draw).
+Real mean_cube_diameter(const ParticleConfig& pc) {
+  const Real r = pc.diameter_ratio, dmin = 2 * pc.diameter / (1 + r), dmax = r * dmin;
+  if (dmax - dmin < 1e-12 * dmax) return pc.diameter * pc.diameter * pc.diameter;
+  return (std::pow(dmax, 4) - std::pow(dmin, 4)) / (4 * (dmax - dmin));
+}
+
+/// A cubic lattice of the cell's balls, each pressed into its six neighbours by 0.1% of its diameter: a probe with
+/// the contacts of a loaded packing (the gas phase of a random insertion would time a cheaper step).
+std::vector<BallSpec> probe_lattice(const Config& cell, std::array<Real, 3>& box) {
+  const ParticleConfig& pc = cell.particles;
+  const long n = static_cast<long>(std::ceil(std::cbrt(static_cast<Real>(pc.count))));
+  const Real pitch = 0.999 * pc.diameter;
+  std::vector<BallSpec> balls;
+  for (long k = 0; k < n * n * n && static_cast<long>(balls.size()) < pc.count; ++k) {
+    BallSpec b;
+    b.x = Vec3((k % n + 0.5) * pitch, ((k / n) % n + 0.5) * pitch, (k / (n * n) + 0.5) * pitch);
+    b.radius = pc.diameter / 2;
+    b.density = pc.density;
+    balls.push_back(b);
+  }
+  box = {n * pitch, n * pitch, n * pitch};
+  return balls;
+}
+
+}  // namespace
+
+CellCost measure_cell_cost(const Config& cell, double probe_seconds) {
+  CellCost c;
+  c.balls = cell.particles.count;
+  std::array<Real, 3> box{};
+  const std::vector<BallSpec> balls = probe_lattice(cell, box);
+  auto sim = make_periodic_simulation(balls, box, cell.ball.base(), cell.solver, CellBoundary::periodic);
+  c.dt = sim->params().integ.dt;
+  c.d = cell.particles.diameter;  // the mean of diameters uniform between the smallest and the largest
+  c.rho_eff = cell.particles.density * cell.solver.mass_scale;
+  c.triax = cell.periodic.triax;
+  // The probe's first steps build the lists and touch the memory: timed after them.
+  sim->run(10);
+  long steps = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  double seconds = 0;
+  while (steps < 50 || seconds < probe_seconds) {
+    sim->run(10);
+    steps += 10;
+    seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  c.ns_per_particle_step = 1e9 * seconds / (static_cast<double>(steps) * static_cast<double>(balls.size())) *
+                           kPairsOverLattice;
+  // The gas phase: the cell closes on every axis at the consolidation rate's clamp (resolve_periodic_params'
+  // defaults) from the box's solid fraction to a dense packing's.
+  const Real volume = cell.box.size[0] * cell.box.size[1] * cell.box.size[2];
+  const Real solid = static_cast<Real>(c.balls) * M_PI / 6 * mean_cube_diameter(cell.particles) / volume;
+  const Real axial = axial_rate(c.triax, c.d, c.rho_eff, c.triax.sigma3);
+  const Real rate = c.triax.consolidation_rate > 0
+                        ? c.triax.consolidation_rate
+                        : (c.triax.max_lateral_rate > 0 ? c.triax.max_lateral_rate : 5 * axial);
+  const Real gas = std::max(Real(0), std::log(kPackedSolidFraction / solid) / 3) / (rate * c.dt);
+  c.packing_steps = static_cast<long>(kPackingStepsOverGas * gas);
+  return c;
+}
+
+}  // namespace dem

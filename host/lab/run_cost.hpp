@@ -1,0 +1,46 @@
+#pragma once
+/// What a cell's runs and packings cost, estimated before any runs (a job's plan, host/fit/job_plan.hpp): steps from
+/// the config's rates and time step, and the engine's speed from a probe on this machine.
+#include <string>
+
+#include "host/config/config.hpp"
+
+namespace dem {
+
+/// Densest solid fraction a packing of the cell reaches (frictional spheres pack 0.58-0.64): where the gas phase of
+/// a packing ends.
+constexpr Real kPackedSolidFraction = 0.62;
+/// A packing's steps as a multiple of its gas phase's (the cell closing at the consolidation rate to a dense state):
+/// the settling to the preparation's unbalanced tolerance takes about as many again. Fitted on the 480-ball
+/// hidden-effect cell (26,800 steps against 13,700 in the gas phase) and the 4,000-ball walled base; an estimate,
+/// which the job's summary sets beside what it took.
+constexpr Real kPackingStepsOverGas = 2.0;
+/// A run's consolidation to its sigma3 (from the preparation's pressure and looser tolerance) as a share of its shear
+/// steps: measured 0.1-0.3 on the shipped calibration bases.
+constexpr Real kConsolidationShare = 0.25;
+/// Contact pairs a ball of a random packing has (4.5, docs/performance.md) over the probe lattice's 3: the probe's
+/// speed is scaled by it.
+constexpr Real kPairsOverLattice = 1.5;
+
+/// The cost of one cell's work on this machine: its balls, its time step, the engine's speed on it.
+struct CellCost {
+  long balls = 0;
+  Real dt = 0;                      ///< s, the runs' time step
+  Real d = 0, rho_eff = 0;          ///< m, kg/m^3: the inertial number's scales
+  double ns_per_particle_step = 0;  ///< this process's threads, as a run of the cell takes them
+  long packing_steps = 0;           ///< one specimen's packing and preparation, estimated
+  /// Steps of one run's shear at sigma3 (Pa): the config's end strain at its axial rate (given, or from its
+  /// inertial number at p = sigma3, as resolve_periodic_params sets it).
+  long shear_steps(Real sigma3) const;
+  /// Steps of one run at sigma3 (Pa): its shear and its consolidation.
+  long run_steps(Real sigma3) const { return static_cast<long>((1 + kConsolidationShare) * shear_steps(sigma3)); }
+  double run_seconds(Real sigma3) const { return 1e-9 * ns_per_particle_step * balls * run_steps(sigma3); }
+  double packing_seconds() const { return 1e-9 * ns_per_particle_step * balls * packing_steps; }
+  PeriodicTriaxialParams triax;     ///< the cell's test parameters
+};
+
+/// The cost of `cell` (a periodic or walled cell config): its time step from a lattice of its balls pressed together
+/// (as the runs' contacts are), the speed from stepping that lattice for about `probe_seconds` (at least 50 steps).
+CellCost measure_cell_cost(const Config& cell, double probe_seconds = 0.3);
+
+}  // namespace dem
