@@ -11,6 +11,7 @@
 #include "host/fit/diagnose.hpp"
 #include "host/io/io_hdf5.hpp"
 #include "host/fit/prediction.hpp"
+#include "host/lab/periodic_lab.hpp"
 #include "host/triax/triaxial.hpp"
 #include "host/fit/two_fidelity.hpp"
 #include "test_util.hpp"
@@ -115,6 +116,45 @@ TEST(Prediction, EachPressureIsTheMembraneTestAtTheCalibratedParameters) {
                           dir.string() + " > /dev/null";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
   EXPECT_TRUE(std::filesystem::exists(dir / "prediction.png"));
+}
+
+// The membrane tests of a -j 2 calibration ran one at a time on one thread, the other core idle (7 minutes of the 27
+// of Table 6's S-1 with two fidelities, twice): with workers, each specimen is built and tested in a child, and the
+// tests are those of one at a time, bit for bit (curves, peak, void ratio, balls), labelled by specimen. It runs at
+// one thread only (tests/CMakeLists.txt): forking a multithreaded OpenMP process is unsafe, and runs_at_once says 1.
+TEST(Prediction, MembraneTestsSideBySideGiveTheTestsOneAtATime) {
+  const auto dir = test::scratch_dir("prediction_side_by_side");
+  Config t = test::tiny_triaxial_config(0.15, 0.015);
+  t.triaxial.axial_strain_end = 0.01;
+  const Model m{t.ball, 0};
+  std::vector<TriaxialTest> data(2);
+  data[0].material = data[1].material = "S-x";
+  data[0].sigma3 = 100e3;
+  data[1].sigma3 = 200e3;
+  data[0].q_peak = data[1].q_peak = 150e3;
+  const std::vector<Prediction> one =
+      predict(t, m, {"mu_s"}, data, QMeasure::kAreaCorrected, 2, (dir / "apart").string(), false, 1);
+  ASSERT_EQ(runs_at_once(2), 2) << "the tests fork only from a one-thread process (ctest runs this test so)";
+  const std::vector<Prediction> side =
+      predict(t, m, {"mu_s"}, data, QMeasure::kAreaCorrected, 2, (dir / "together").string(), false, 2);
+  ASSERT_EQ(side.size(), 2u);
+  for (std::size_t j = 0; j < 2; ++j) {
+    ASSERT_EQ(side[j].members.size(), 2u);
+    for (std::size_t k = 0; k < 2; ++k) {
+      const TriaxialTest &a = one[j].members[k], &b = side[j].members[k];
+      ASSERT_GT(a.q.size(), 2u);
+      EXPECT_EQ(b.q, a.q) << "test " << j << " specimen " << k;
+      EXPECT_EQ(b.eps_v, a.eps_v);
+      EXPECT_EQ(b.q_peak, a.q_peak);
+      EXPECT_EQ(b.void_ratio, a.void_ratio);
+      EXPECT_EQ(b.specimen_balls, a.specimen_balls);
+      EXPECT_EQ(b.sigma3, a.sigma3);
+      EXPECT_EQ(b.replicate, std::to_string(k + 1));
+      EXPECT_EQ(b.material, "S-x");
+    }
+    EXPECT_NE(one[j].members[0].q, one[j].members[1].q) << "two specimens";
+    EXPECT_EQ(side[j].q_peak_mean, one[j].q_peak_mean);
+  }
 }
 
 // A periodic calibration of data from a walled test ends with the walled cell at the calibrated parameters

@@ -190,7 +190,7 @@ std::vector<std::string> Session::free_names() const {
 
 std::vector<Prediction> Session::predict_at(const Config& base, const Model& model, const std::vector<TriaxialTest>& tests) const {
   return predict(*predict_template, model, free_names(), tests, data.q_measure,
-                 static_cast<int>(base.calibrate.predict_specimens), output + "/.specimens", true);
+                 static_cast<int>(base.calibrate.predict_specimens), output + "/.specimens", true, workers);
 }
 
 Config Session::matched(const Config& base, int workers) {

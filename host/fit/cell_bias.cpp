@@ -21,6 +21,18 @@ Real cell_bias_sd(Real diff, Real diff_var, Real extrapolation) {
 
 CellBias measure_cell_bias(PeriodicLab& lab, const Model& base, const std::vector<TriaxialTest>& measured,
                            const Ensemble& reference, const Misfit& misfit) {
+  // Data from specimens of the cell's own balls leave no size to extrapolate to: every bias the check could measure
+  // would be counted times zero (cell_bias_extrapolation), so it is not run.
+  const Real balls = static_cast<Real>(lab.balls());
+  if (std::all_of(measured.begin(), measured.end(), [&](const TriaxialTest& t) {
+        return cell_bias_extrapolation(balls, kCellCheckFactor, t.specimen_balls) == 0;
+      })) {
+    CellBias none;
+    for (std::size_t k = 0; k < measured.size(); ++k) none.sd.emplace_back(misfit.features(k).size(), Real(0));
+    none.note = fmt("the simulator's cell has the balls of the data's specimens (%.0f)", balls) +
+                ": no size to extrapolate its bias to, so the cell's check (cells of 4 times the balls) was not run";
+    return none;
+  }
   // Prepared as the simulator's specimens are: to the data's void ratio where they give one (on this cell's own
   // preparation friction), else with the same preparation.
   // The mean matched is the check cells' own (their first kStateMatchSpecimens).

@@ -11,6 +11,7 @@
 #include "host/lab/run_cost.hpp"
 #include "host/lab/state_match.hpp"
 #include "host/triax/specimen.hpp"
+#include "host/triax/triaxial.hpp"
 #include "host/util/progress.hpp"
 #include "host/util/text_format.hpp"
 
@@ -85,15 +86,23 @@ struct Stages {
   }
 };
 
-/// The membrane test's cost: its specimen's balls, its time step and speed, its shear at its own rate.
-CellCost membrane_cost(const Config& membrane) {
-  Config m = membrane;
-  m.particles.count = specimen_ball_count(membrane);
-  m.periodic.triax.axial_rate = 0;
-  m.periodic.triax.target_inertial = membrane.triaxial.inertial_number;
-  m.periodic.triax.target_strain = membrane.triaxial.axial_strain_end;
-  return measure_cell_cost(m);
-}
+/// A membrane test's cost: its specimen's balls, the time step and speed of a cell of them, and its shear's steps as
+/// the test plans them (shear_plan) at each pressure, a consolidation share more.
+struct MembraneCost {
+  Config cfg;
+  CellCost cell;
+  explicit MembraneCost(const Config& membrane) : cfg(membrane) {
+    cfg.particles.count = specimen_ball_count(membrane);
+    cell = measure_cell_cost(cfg);
+  }
+  double steps(Real sigma3) const {
+    Config c = cfg;
+    c.triaxial.sigma3 = sigma3;
+    const ShearPlan p = shear_plan(c, cell.dt);
+    return (1 + kConsolidationShare) * static_cast<double>(p.ramp + p.steps);
+  }
+  double seconds(Real sigma3) const { return 1e-9 * cell.ns_per_particle_step * cell.balls * steps(sigma3); }
+};
 
 }  // namespace
 
@@ -131,20 +140,28 @@ JobPlan plan_job(const PlanInput& in) {
              std::to_string(S * static_cast<int>(tests.size())) + " runs of " + n + " balls (" + std::to_string(S) +
                  " specimens x " + T + " tests)");
     // The check cells' own state match starts from a bracket around the lab's friction (4 packings) and falls back
-    // to the whole range (up to 2 + kCellCheckPrepSteps more).
+    // to the whole range (up to 2 + kCellCheckPrepSteps more). No check where the data's specimens have the cell's
+    // balls (measure_cell_bias).
     const int check_low = 4, check_high = 4 + 2 + kCellCheckPrepSteps;
-    if (void_ratio)
+    const bool checked = std::any_of(tests.begin(), tests.end(), [&](const TriaxialTest& t) {
+      return cell_bias_extrapolation(static_cast<Real>(lab.balls), kCellCheckFactor, t.specimen_balls) != 0;
+    });
+    if (!checked)
+      plan.notes.push_back(material + ": the data's specimens have the cell's " + n + " balls: no cell's bias check");
+    if (void_ratio && checked)
       add.packings(material + ": cell's bias check, state match", "the cell's bias check (kCellCheckFactor)", check,
                    check_low * kStateMatchSpecimens, check_high * kStateMatchSpecimens, kStateMatchSpecimens,
                    std::to_string(check_low) + " to " + std::to_string(check_high) + " packings of " +
                        std::to_string(kStateMatchSpecimens) + " specimens");
-    add.packings(material + ": cell's bias check, specimens", "the cell's bias check (kCellCheckFactor)", check,
-                 kCellCheckSpecimens - shared, kCellCheckSpecimens - shared, kCellCheckSpecimens,
-                 std::to_string(kCellCheckSpecimens - shared) + " packings");
-    add.runs(material + ": cell's bias check, runs", "the cell's bias check (kCellCheckFactor)", check, tests, 1,
-             kCellCheckSpecimens, kCellCheckSpecimens,
-             std::to_string(kCellCheckSpecimens * static_cast<int>(tests.size())) + " runs of " +
-                 std::to_string(check.balls) + " balls");
+    if (checked) {
+      add.packings(material + ": cell's bias check, specimens", "the cell's bias check (kCellCheckFactor)", check,
+                   kCellCheckSpecimens - shared, kCellCheckSpecimens - shared, kCellCheckSpecimens,
+                   std::to_string(kCellCheckSpecimens - shared) + " packings");
+      add.runs(material + ": cell's bias check, runs", "the cell's bias check (kCellCheckFactor)", check, tests, 1,
+               kCellCheckSpecimens, kCellCheckSpecimens,
+               std::to_string(kCellCheckSpecimens * static_cast<int>(tests.size())) + " runs of " +
+                   std::to_string(check.balls) + " balls");
+    }
     const long points = in.diagnose ? planned_points(in.free) + static_cast<long>(extensions().size()) * 6
                                     : planned_points(in.free);
     const std::string k = auto_ensemble ? "1 to " + std::to_string(K) : std::to_string(K);
@@ -155,19 +172,21 @@ JobPlan plan_job(const PlanInput& in) {
     add.runs(material + (in.diagnose ? ": diagnosis" : ": search"), auto_ensemble ? "[calibrate] ensemble (auto)" : "[calibrate] ensemble",
              lab, tests, static_cast<double>(points), K_low, K, search_what);
     if (in.membrane) {
-      const CellCost mem = membrane_cost(*in.membrane);
+      const MembraneCost mem(*in.membrane);
       const int P = static_cast<int>(cc.predict_specimens);
-      const double build = kMembraneSpecimenOverTest * mean_over(tests, [&](Real s) { return mem.run_seconds(s); });
-      const double tests_s = mean_over(tests, [&](Real s) { return mem.run_seconds(s); }) * P *
-                             static_cast<double>(tests.size());
-      const double steps = mean_over(tests, [&](Real s) { return static_cast<double>(mem.run_steps(s)); }) *
-                           static_cast<double>(mem.balls) * P * (static_cast<double>(tests.size()) + kMembraneSpecimenOverTest);
+      // Each specimen is built, then tested at every pressure, min(P, runs at once) specimens side by side.
+      const int side = std::min(in.at_once, P);
+      const double one = mean_over(tests, [&](Real s) { return mem.seconds(s); });
+      const double build = kMembraneSpecimenOverTest * one, tests_one = one * static_cast<double>(tests.size());
+      const double steps = mean_over(tests, [&](Real s) { return mem.steps(s); }) * static_cast<double>(mem.cell.balls) *
+                           P * (static_cast<double>(tests.size()) + kMembraneSpecimenOverTest);
       const std::string what = std::to_string(P * static_cast<int>(tests.size())) + " membrane tests of " +
-                               std::to_string(mem.balls) + " balls (" + std::to_string(P) + " specimens x " + T +
-                               " pressures, one at a time; a specimen in .specimens is not built again)";
-      const double each = build * P + tests_s;
+                               std::to_string(mem.cell.balls) + " balls (" + std::to_string(P) + " specimens x " + T +
+                               " pressures, " + std::to_string(side) +
+                               " specimens at once; a specimen in .specimens is not built again)";
+      const double each = wall(P, build + tests_one, side), tests_s = wall(P, tests_one, side);
       if (in.two_fidelity && !in.diagnose) {
-        plan.stages.push_back({material + ": two fidelities, membrane tests", "[calibrate] predict_specimens", what,
+        plan.stages.push_back({material + ": two fidelities, membrane tests", what, "[calibrate] predict_specimens",
                                steps, each, each});
         add.runs(material + ": two fidelities, periodic runs", "[calibrate] scatter_specimens", lab, tests, 1, S, S,
                  std::to_string(S * static_cast<int>(tests.size())) + " runs of " + n + " balls");
@@ -176,12 +195,22 @@ JobPlan plan_job(const PlanInput& in) {
       }
       // The specimens built for two fidelities are cached: the prediction tests only.
       const double predict = in.two_fidelity && !in.diagnose ? tests_s : each;
-      plan.stages.push_back({material + ": prediction", "[calibrate] predict_specimens", what, steps, predict, predict});
+      plan.stages.push_back({material + ": prediction", what, "[calibrate] predict_specimens", steps, predict, predict});
     } else if (in.walls) {
       const int P = static_cast<int>(cc.predict_specimens);
       add.runs(material + ": prediction (walls)", "[calibrate] predict_specimens", lab, tests, 1, P, P,
                std::to_string(P * static_cast<int>(tests.size())) + " runs of the walled cell of " + n + " balls");
     }
+  }
+  if (in.walls) {  // the walled cell's own preparation to the data's state, once for all materials
+    const int P = static_cast<int>(cc.predict_specimens);
+    if (void_ratio)
+      add.packings("prediction (walls): state match", "the data's void_ratio", lab, match_packings * kStateMatchSpecimens,
+                   match_packings * kStateMatchSpecimens, kStateMatchSpecimens,
+                   "up to " + std::to_string(match_packings) + " packings of " + std::to_string(kStateMatchSpecimens) +
+                       " specimens");
+    add.packings("prediction (walls): specimens", "[calibrate] predict_specimens", lab, P - shared, P - shared, P,
+                 std::to_string(std::max(0, P - shared)) + " packings");
   }
   plan.notes.push_back(fmt("speed measured here: %.0f ns a particle-step", lab.ns_per_particle_step) +
                        " in the cell of " + n + " balls, " + fmt("%.0f", check.ns_per_particle_step) + " in the check's of " +

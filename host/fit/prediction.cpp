@@ -8,6 +8,8 @@
 #include <stdexcept>
 
 #include "host/fit/calibrate.hpp"
+#include "host/lab/run_store.hpp"
+#include "host/util/forked_runs.hpp"
 #include "host/util/progress.hpp"
 #include "host/triax/specimen.hpp"
 #include "host/util/text_format.hpp"
@@ -65,29 +67,60 @@ Config prediction_config(const Config& membrane, const Model& calibrated, const 
 
 std::vector<Prediction> predict(const Config& membrane, const Model& calibrated, const std::vector<std::string>& free,
                                 const std::vector<TriaxialTest>& tests, QMeasure measure, int specimens,
-                                const std::string& cache, bool verbose) {
-  Ensemble runs(tests.size());
-  Progress progress("prediction: membrane tests", static_cast<long>(tests.size() * specimens));
+                                const std::string& cache, bool verbose, int workers) {
+  const int at_once = std::min(runs_at_once(workers), specimens);
+  Ensemble runs(tests.size(), std::vector<TriaxialTest>(static_cast<std::size_t>(specimens)));
+  Progress progress("prediction: membrane tests" + (at_once > 1 ? ", " + std::to_string(at_once) + " specimens at once" : std::string()),
+                    static_cast<long>(tests.size() * specimens));
   long done = 0;
-  for (int k = 0; k < specimens; ++k) {
-    // Friction and pressure do not change the specimen: one packing per member serves every test.
-    if (verbose) std::printf("prediction: specimen %d of %d (packed once, then cached in %s)\n", k + 1, specimens,
-                             cache.c_str());
+  auto ran = [&](int k, std::size_t j) {
+    TriaxialTest& t = runs[j][static_cast<std::size_t>(k)];
+    t.material = tests[j].material;
+    t.replicate = std::to_string(k + 1);
+    if (verbose)
+      progress.update(++done, t.material + " at " + fmt("%g kPa", 1e-3 * t.sigma3) + ", specimen " + t.replicate +
+                                  ": q_peak " + fmt("%.1f kPa", 1e-3 * t.q_peak));
+  };
+  // Specimen k's tests (friction and pressure do not change the specimen: one packing per member serves them all).
+  auto run_specimen = [&](int k, bool say) {
+    if (say) std::printf("prediction: specimen %d of %d (packed once, then cached in %s)\n", k + 1, specimens,
+                         cache.c_str());
     const Specimen sp = cached_specimen(prediction_config(membrane, calibrated, free, membrane.triaxial.sigma3, k),
-                                        cache, verbose);
+                                        cache, say);
     for (std::size_t j = 0; j < tests.size(); ++j) {
       const Config c = prediction_config(membrane, calibrated, free, tests[j].sigma3, k);
       const TriaxialResult r = run_triaxial(c, sp, nullptr, false);
-      TriaxialTest t = curves_of(r, q_field(measure), c.triaxial.sigma3);
-      t.material = tests[j].material;
-      t.replicate = std::to_string(k + 1);
+      TriaxialTest& t = runs[j][static_cast<std::size_t>(k)];
+      t = curves_of(r, q_field(measure), c.triaxial.sigma3);
       t.void_ratio = r.void_ratio_consolidated;
       t.specimen_balls = static_cast<Real>(sp.balls.size());
-      runs[j].push_back(t);
-      if (verbose)
-        progress.update(++done, t.material + " at " + fmt("%g kPa", 1e-3 * t.sigma3) + ", specimen " + t.replicate +
-                                    ": q_peak " + fmt("%.1f kPa", 1e-3 * t.q_peak));
+      if (at_once <= 1) ran(k, j);
     }
+  };
+  if (at_once <= 1) {
+    for (int k = 0; k < specimens; ++k) run_specimen(k, verbose);
+  } else {
+    // Each specimen's build and tests in a child; its tests come back as curves (summarised again as curves_of
+    // summarised them) with the specimen's balls.
+    forked_runs(
+        static_cast<std::size_t>(specimens), at_once,
+        [&](std::size_t k, int fd) {
+          run_specimen(static_cast<int>(k), false);
+          for (std::size_t j = 0; j < tests.size(); ++j) {
+            send_curves(fd, runs[j][k]);
+            put_bytes(fd, &runs[j][k].specimen_balls, sizeof(Real));
+          }
+        },
+        [&](std::size_t k, int fd) {
+          for (std::size_t j = 0; j < tests.size(); ++j) {
+            TriaxialTest& t = runs[j][k];
+            t.sigma3 = tests[j].sigma3;
+            if (!receive_curves(fd, t) || !get_bytes(fd, &t.specimen_balls, sizeof(Real))) return false;
+            ran(static_cast<int>(k), j);
+          }
+          return true;
+        },
+        "membrane test");
   }
   if (verbose) progress.finish("");
   return predictions_of(tests, std::move(runs));

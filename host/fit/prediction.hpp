@@ -58,10 +58,12 @@ struct Prediction {
 std::vector<Prediction> predictions_of(const std::vector<TriaxialTest>& tests, Ensemble runs);
 
 /// Runs the template at `calibrated` for every test of `tests` on `specimens` specimens (packed once each, cached in
-/// `cache`), q summarised in `measure`. Prints a progress line when `verbose`.
+/// `cache`), q summarised in `measure`. Prints a progress line when `verbose`. `workers` > 1: the specimens side by
+/// side, each with its tests in a child process, where that is safe (runs_at_once), with the same results, bit for
+/// bit, as one at a time.
 std::vector<Prediction> predict(const Config& membrane, const Model& calibrated, const std::vector<std::string>& free,
                                 const std::vector<TriaxialTest>& tests, QMeasure measure, int specimens,
-                                const std::string& cache, bool verbose);
+                                const std::string& cache, bool verbose, int workers = 1);
 
 /// The cell between six walls of `walls` (a walled config: reference_cell(base, "walls"), its preparation matched)
 /// at `calibrated` for every test of `tests`, on its first `specimens` specimens (packing seeds from [run] seed),

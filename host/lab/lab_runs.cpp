@@ -91,6 +91,8 @@ void put_curves(const TriaxialTest& t, Put put) {
     if (n > 0) put(v->data(), sizeof(Real) * v->size());
 }
 
+}  // namespace
+
 void send_curves(int fd, const TriaxialTest& t) {
   put_curves(t, [fd](const void* p, std::size_t n) { put_bytes(fd, p, n); });
 }
@@ -109,8 +111,6 @@ bool receive_curves(int fd, TriaxialTest& t) {
   summarise(t);
   return true;
 }
-
-}  // namespace
 
 void PeriodicLab::set_run_store(std::string folder) { store_ = std::move(folder); }
 

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "host/config/config.hpp"
+#include "host/data/measured.hpp"
 
 namespace dem {
 
@@ -19,5 +20,11 @@ bool read_stored(const std::string& path, const std::function<bool(int fd)>& rea
 /// Writes `bytes` to `path` atomically (io::write_text_atomic), making its folder at the first file: a killed
 /// calibration leaves whole files only. Throws std::runtime_error naming the path.
 void write_stored(const std::string& path, const std::string& bytes);
+
+/// A run's curves through a child's pipe: its row count, void ratio, eps_a, q and eps_v (a run that blew up: every
+/// quantity missing). The receiver summarises them as the sender's test was summarised (set its sigma3 first);
+/// false where the bytes are cut short.
+void send_curves(int fd, const TriaxialTest& t);
+bool receive_curves(int fd, TriaxialTest& t);
 
 }  // namespace dem
