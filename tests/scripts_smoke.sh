@@ -66,6 +66,11 @@ if [ "$part" != diagnoses ]; then
     { cat "$work/sweep_table.py.log"; echo "scripts_smoke: sweep_table miscounted the shipped lab-like sweep" >&2; exit 1; }
 
   check perf/scaling.sh env BUILD="$build" WORK="$work/scaling" K=4 STEPS=20 bash "$root/perf/scaling.sh"
+  # The tiny calibration above, again from its packing store: the plan, a first and a second job, one row each.
+  check perf/time_to_answer.sh env BUILD="$build" WORK="$work/answer" CASES=tiny JOBS=1 STORE="$work/cal" \
+    bash "$root/perf/time_to_answer.sh"
+  [ "$(grep -c '^| tiny (' "$work/time_to_answer.sh.log")" = 2 ] ||
+    { cat "$work/time_to_answer.sh.log"; echo "scripts_smoke: time_to_answer gave no row per pass" >&2; exit 1; }
   check perf/specimen_settling.sh env BUILD="$build" WORK="$work/settling" CONFIG="$root/tests/data/tiny_triaxial.toml" \
     SEEDS=1 NP=1 bash "$root/perf/specimen_settling.sh"
   grep -q "^q_peak kPa " "$work/specimen_settling.sh.log" ||

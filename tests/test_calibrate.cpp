@@ -16,6 +16,7 @@
 #include "host/fit/diagnose.hpp"
 #include "host/data/measured.hpp"
 #include "host/fit/misfit.hpp"
+#include "host/fit/job_plan.hpp"
 #include "host/lab/run_cost.hpp"
 #include "host/triax/periodic_triaxial.hpp"
 #include "test_util.hpp"
@@ -325,6 +326,46 @@ TEST(PackingStore, ALaterLabReadsTheStoredSpecimensAndADamagedOneIsPackedAgain) 
   Config in_code = second;
   in_code.fingerprint.clear();
   EXPECT_EQ(packing_path(in_code), "") << "a config built in code has settings the hash does not see";
+}
+
+// A second job on the same base packed nothing, and its plan still counted every packing: the plan replays the state
+// match on the packing store alone and counts only the specimens still to pack (here: none, after the match and the
+// lab a job makes; before them, the match's packings and the scatter specimens beyond the match's two).
+TEST(JobPlan, PackingsInTheStoreAreNotCounted) {
+  Config cfg = test::tiny_cell_config();
+  cfg.fingerprint = "job-plan-test";
+  cfg.packing_store = (test::scratch_dir("job_plan") / "cells").string();
+  cfg.calibrate.scatter_specimens = 3;
+  cfg.calibrate.ensemble = 2;
+  const auto [lo, hi] = preparation_reach(cfg, match_plan(cfg, 1));
+  TriaxialTest t;
+  t.material = "A";
+  t.sigma3 = 100e3;
+  t.void_ratio = 0.5 * (lo + hi);
+  t.specimen_balls = 100;  // the cell's own: no check cells to plan
+  PlanInput in;
+  in.cell = cfg;
+  in.materials["A"] = {t};
+  in.state_tests = {t};
+  in.free = 2;
+  auto stage = [](const JobPlan& p, const std::string& name) {
+    for (const PlanStage& s : p.stages)
+      if (s.name == name) return s.work;
+    return std::string();
+  };
+  const JobPlan before = plan_job(in);
+  EXPECT_EQ(stage(before, "state match"), "up to 10 packings of 2 specimens of 100 balls");
+  EXPECT_EQ(stage(before, "scatter specimens"), "1 packings of 100 balls");
+  StateMatch m;
+  const Config matched = matched_state(cfg, {t}, m, false, match_plan(cfg, 1));
+  const PeriodicLab lab(matched, false, 2, cfg.run.seed, 3);
+  const JobPlan after = plan_job(in);
+  EXPECT_EQ(stage(after, "state match"), "");
+  EXPECT_EQ(stage(after, "scatter specimens"), "");
+  bool said = false;
+  for (const std::string& n : after.notes) said = said || n.find("state match: its packings are in the packing store") == 0;
+  EXPECT_TRUE(said);
+  EXPECT_LT(after.high(), before.high());
 }
 
 // A job's plan counts a run's shear steps before it runs: the estimate is the stage's own count (the end strain at

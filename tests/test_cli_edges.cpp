@@ -341,8 +341,9 @@ TEST(CliEdges, ARefusedCalibrationLeavesNoFolder) {
                              "--predict none --material nosuch -j 1 -o " + (dir / "out").string(), dir);
   EXPECT_EQ(o.code, 1) << o.output;
   EXPECT_NE(o.output.find("no tests of material 'nosuch'"), std::string::npos) << o.output;
-  ASSERT_TRUE(fs::is_directory(dir / "out")) << o.output;  // the parent a user named stays
-  EXPECT_TRUE(fs::is_empty(dir / "out")) << "a refused calibration left its dated folder";
+  // Refused with the plan's checks, before anything is made: no dated folder, and no parent either.
+  EXPECT_FALSE(fs::exists(dir / "out") && !fs::is_empty(dir / "out")) << "a refused calibration left its dated folder";
+  EXPECT_EQ(o.output.find("plan (before any packing)"), std::string::npos) << o.output;
 }
 
 // A walled calibration at the data's size ran for over an hour, silent for minutes at a time, and nothing said so
@@ -362,6 +363,28 @@ TEST(CliEdges, APlanIsPrintedBeforeAnyPackingAndPlanStopsThere) {
     EXPECT_EQ(o.output.find("triaxdem: packing"), std::string::npos) << o.output;
     EXPECT_EQ(o.output.find("matching the void ratio"), std::string::npos) << o.output;
     EXPECT_FALSE(fs::exists(dir / "out") && !fs::is_empty(dir / "out")) << "--plan made a result folder";
+  }
+}
+
+// Refusals after the work: -o naming a file, and a diagnose resumed in a calibrate folder, were refused after the
+// packings (12 s and 1 min 38 s). They are refused with the plan's other checks, before any packing or plan.
+TEST(CliEdges, AFolderThatCannotBeWrittenIsRefusedBeforeAnyWork) {
+  const fs::path dir = dem::test::scratch_dir("cli_plan_folders");
+  write_four_point_curve(dir / "d.csv");
+  std::ofstream(dir / "a_file") << "x\n";
+  fs::create_directories(dir / "calibrate_20260101-000000");
+  const std::string job = " " + (dir / "d.csv").string() + " --config tests/data/hidden_effects.toml --predict none -j 1 ";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"calibrate" + job + "-o " + (dir / "a_file").string(), "a_file is a file, not a folder"},
+      {"calibrate" + job + "-o " + (dir / "a_file" / "below").string(), "a_file is a file, not a folder"},
+      {"diagnose" + job + "--resume " + (dir / "calibrate_20260101-000000").string(),
+       "not a diagnose_<date> folder of an earlier diagnose"}};
+  for (const auto& [args, said] : cases) {
+    const Outcome o = triaxdem(args, dir);
+    EXPECT_EQ(o.code, 1) << args << "\n" << o.output;
+    EXPECT_NE(o.output.find(said), std::string::npos) << args << "\n" << o.output;
+    EXPECT_EQ(o.output.find("plan (before any packing)"), std::string::npos) << o.output;
+    EXPECT_EQ(o.output.find("triaxdem: packing"), std::string::npos) << o.output;
   }
 }
 

@@ -1,5 +1,7 @@
 #include "host/cli/calibration_session.hpp"
 
+#include <unistd.h>
+
 #include <cstdio>
 
 #include "host/fit/calibration_report.hpp"
@@ -37,6 +39,24 @@ std::string resumed_folder(const std::string& folder, const std::string& kind) {
 std::string resumed_parent(const std::string& folder) {
   const fs::path parent = folder_path(folder).parent_path();
   return parent.empty() ? "." : parent.string();
+}
+
+/// The folders a job writes checked before any work (a refusal after the packings wasted them): the resumed folder
+/// is one of this kind's, or -o names a folder (or none yet) whose nearest existing parent can be written.
+void check_folders(const CalibrationOptions& o, const std::string& kind) {
+  if (!o.resume.empty()) {
+    resumed_folder(o.resume, kind);
+    return;
+  }
+  if (o.output.empty()) throw std::invalid_argument("-o: an empty folder name (allowed: a folder to write in)");
+  std::error_code ec;
+  fs::path p = fs::absolute(o.output, ec);
+  while (!p.empty() && !fs::exists(p, ec) && p != p.parent_path()) p = p.parent_path();
+  if (!fs::is_directory(p, ec))
+    throw std::invalid_argument("-o " + o.output + ": " + p.string() + " is a file, not a folder (allowed: a folder "
+                                "to write in)");
+  if (::access(p.c_str(), W_OK) != 0)
+    throw std::invalid_argument("-o " + o.output + ": " + p.string() + " cannot be written (allowed: a folder to write in)");
 }
 
 /// The reference test's cell, its packings kept in (and read from) the output folder's .specimens/cells, where a
@@ -105,9 +125,11 @@ JobInputs::JobInputs(const Config& base, const CalibrationOptions& o)
       two_fidelity(two_fidelity_wanted(base, o.reference_test, predict_template.has_value())) {}
 
 JobPlan JobInputs::announce_plan(const Config& base, const CalibrationOptions& o, const std::string& kind) const {
+  check_folders(o, kind);
   PlanInput in;
-  in.cell = reference_cell(base, o.reference_test);
+  in.cell = stored_cell(base, o);
   in.materials = by_material(data, o.material);
+  in.state_tests = data.tests;
   in.free = static_cast<int>(free.size());
   in.diagnose = kind == "diagnose";
   in.two_fidelity = two_fidelity;

@@ -86,6 +86,36 @@ struct Stages {
   }
 };
 
+/// Replays a state match on the packing store's packings alone (MatchPlan::stored_only): true, with `matched` its
+/// config, where the store holds every packing it needs.
+bool stored_match(const Config& base, const std::vector<TriaxialTest>& tests, MatchPlan plan, Config& matched) {
+  plan.stored_only = true;
+  plan.store.clear();
+  try {
+    StateMatch m;
+    matched = matched_state(base, tests, m, false, plan);
+    return true;
+  } catch (const NotPacked&) {
+    return false;
+  }
+}
+
+/// How many of the specimens of seeds first .. first + count - 1 of `cell` the packing store holds.
+int stored_specimens(Config cell, unsigned first, int count) {
+  int n = 0;
+  PackedCell s;
+  for (int k = 0; k < count; ++k) {
+    cell.run.seed = first + static_cast<unsigned>(k);
+    n += read_packing(cell, s) ? 1 : 0;
+  }
+  return n;
+}
+
+/// A membrane test's particle-step over a periodic cell's of the same balls: the membrane's facets, its nodes and the
+/// platens. The small S-1 case at one thread (28 November): 83,450 steps of 3,662 balls in 1 min 48 s, 350 ns a
+/// particle-step, against the cell probe's 150.
+constexpr Real kMembraneStepOverCell = 2.3;
+
 /// A membrane test's cost: its specimen's balls, the time step and speed of a cell of them, and its shear's steps as
 /// the test plans them (shear_plan) at each pressure, a consolidation share more.
 struct MembraneCost {
@@ -101,7 +131,9 @@ struct MembraneCost {
     const ShearPlan p = shear_plan(c, cell.dt);
     return (1 + kConsolidationShare) * static_cast<double>(p.ramp + p.steps);
   }
-  double seconds(Real sigma3) const { return 1e-9 * cell.ns_per_particle_step * cell.balls * steps(sigma3); }
+  double seconds(Real sigma3) const {
+    return 1e-9 * kMembraneStepOverCell * cell.ns_per_particle_step * cell.balls * steps(sigma3);
+  }
 };
 
 }  // namespace
@@ -125,15 +157,24 @@ JobPlan plan_job(const PlanInput& in) {
   const int K_low = auto_ensemble ? 1 : K;
   const std::string n = std::to_string(lab.balls);
   const int match_packings = 2 + MatchPlan{}.steps;
-  if (void_ratio)
+  // What the packing store holds already: the match replayed on its packings, then the specimens at its friction.
+  Config matched = in.cell;
+  const bool match_stored = stored_match(in.cell, in.state_tests, match_plan(in.cell, in.at_once), matched);
+  const Config lab_cell = larger_cell(matched, factor);
+  const unsigned seed = in.cell.run.seed;
+  if (match_stored && void_ratio)
+    plan.notes.push_back("state match: its packings are in the packing store (preparation friction " +
+                         fmt("%.4g", matched.periodic.prep_mu_s) + ")");
+  if (void_ratio && !match_stored)
     add.packings("state match", "the data's void_ratio", lab, match_packings * kStateMatchSpecimens,
                  match_packings * kStateMatchSpecimens, kStateMatchSpecimens,
                  "up to " + std::to_string(match_packings) + " packings of " + std::to_string(kStateMatchSpecimens) +
                      " specimens");
-  const int shared = void_ratio ? kStateMatchSpecimens : 0;  // the match's last packing is the first specimens'
-  add.packings("scatter specimens", "[calibrate] scatter_specimens", lab, S - shared, S - shared, S - shared,
-               std::to_string(S - shared) + " packings");
-  const std::vector<TriaxialTest> none;
+  // The match's last packing is the first specimens'; with the match known, the store says which are left.
+  const int shared = void_ratio ? kStateMatchSpecimens : 0;
+  const int to_pack = match_stored ? S - stored_specimens(lab_cell, seed, S) : S - shared;
+  add.packings("scatter specimens", "[calibrate] scatter_specimens", lab, to_pack, to_pack, to_pack,
+               std::to_string(to_pack) + " packings");
   for (const auto& [material, tests] : in.materials) {
     const std::string T = std::to_string(tests.size());
     add.runs(material + ": scatter runs", "[calibrate] scatter_specimens", lab, tests, 1, S, S,
@@ -148,15 +189,26 @@ JobPlan plan_job(const PlanInput& in) {
     });
     if (!checked)
       plan.notes.push_back(material + ": the data's specimens have the cell's " + n + " balls: no cell's bias check");
-    if (void_ratio && checked)
+    // The check's own match (measure_cell_bias' plan), replayed on the store where the lab's match is known.
+    MatchPlan check_plan;
+    check_plan.first_seed = seed + kCellCheckSeedOffset;
+    check_plan.steps = kCellCheckPrepSteps;
+    check_plan.workers = in.at_once;
+    check_plan.around = std::sqrt(lab_cell.periodic.prep_mu_s);
+    Config check_cell = larger_cell(lab_cell, kCellCheckFactor);
+    const bool check_stored =
+        match_stored && stored_match(larger_cell(lab_cell, kCellCheckFactor), tests, check_plan, check_cell);
+    const int check_to_pack = check_stored ? kCellCheckSpecimens - stored_specimens(check_cell, check_plan.first_seed,
+                                                                                    kCellCheckSpecimens)
+                                           : kCellCheckSpecimens - shared;
+    if (void_ratio && checked && !check_stored)
       add.packings(material + ": cell's bias check, state match", "the cell's bias check (kCellCheckFactor)", check,
                    check_low * kStateMatchSpecimens, check_high * kStateMatchSpecimens, kStateMatchSpecimens,
                    std::to_string(check_low) + " to " + std::to_string(check_high) + " packings of " +
                        std::to_string(kStateMatchSpecimens) + " specimens");
     if (checked) {
       add.packings(material + ": cell's bias check, specimens", "the cell's bias check (kCellCheckFactor)", check,
-                   kCellCheckSpecimens - shared, kCellCheckSpecimens - shared, kCellCheckSpecimens,
-                   std::to_string(kCellCheckSpecimens - shared) + " packings");
+                   check_to_pack, check_to_pack, kCellCheckSpecimens, std::to_string(check_to_pack) + " packings");
       add.runs(material + ": cell's bias check, runs", "the cell's bias check (kCellCheckFactor)", check, tests, 1,
                kCellCheckSpecimens, kCellCheckSpecimens,
                std::to_string(kCellCheckSpecimens * static_cast<int>(tests.size())) + " runs of " +
@@ -229,8 +281,8 @@ JobPlan plan_job(const PlanInput& in) {
     plan.notes.push_back("cell \"auto\": where all " + std::to_string(S) + " scatter specimens fall short, the cell "
                          "grows (up to " + std::to_string(kMaxCellFactor) + " x its balls) and every later stage costs "
                          "about that factor more: the job says so when it happens");
-  plan.notes.push_back("packings kept in the packing store (.specimens/cells of the output folder) are read, not "
-                       "packed: a later job on the same base and data skips them");
+  plan.notes.push_back("packings in the packing store (" + in.cell.packing_store + ") are read, not packed, and not "
+                       "counted above");
   return plan;
 }
 

@@ -21,8 +21,18 @@ namespace {
 /// its specimens, so that the mean matched is the mean of a lab's first specimens, bit for bit.
 Real prepared_void_ratio(const Config& cfg, const MatchPlan& plan) {
   const int n = std::max(plan.specimens, 1);
-  const PeriodicLab lab(larger_cell(cfg, plan.cell_factor), false, n, plan.first_seed, n, plan.workers);
   Real sum = 0;
+  if (plan.stored_only) {  // the same void ratios a lab would read from the store, summed in the same order
+    Config c = larger_cell(cfg, plan.cell_factor);
+    for (int k = 0; k < n; ++k) {
+      c.run.seed = plan.first_seed + static_cast<unsigned>(k);
+      PackedCell s;
+      if (!read_packing(c, s)) throw NotPacked("no stored packing for seed " + std::to_string(c.run.seed));
+      sum += s.void_ratio;
+    }
+    return sum / static_cast<Real>(n);
+  }
+  const PeriodicLab lab(larger_cell(cfg, plan.cell_factor), false, n, plan.first_seed, n, plan.workers);
   for (int k = 0; k < n; ++k) sum += lab.prepared_void_ratio(k);
   return sum / static_cast<Real>(n);
 }

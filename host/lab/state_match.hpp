@@ -2,6 +2,7 @@
 /// The measured specimens' state matched: the preparation friction with which the simulator's specimens pack to the
 /// data's void ratio (host/lab/state_match.cpp), for the lab's cell, a grown cell or the cell-bias check's cells.
 #include <limits>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -31,6 +32,14 @@ struct MatchPlan {
   Real around = -1;
   /// A run store (PeriodicLab::set_run_store) that keeps each packing's mean void ratio; "" keeps nothing.
   std::string store;
+  /// Packs nothing: reads the packings from the packing store (Config::packing_store) and throws NotPacked at one it
+  /// lacks. A job's plan replays its matches so, to count only the packings still to make.
+  bool stored_only = false;
+};
+
+/// A MatchPlan::stored_only match met a packing the packing store does not hold.
+struct NotPacked : std::runtime_error {
+  using std::runtime_error::runtime_error;
 };
 /// Half the width of a MatchPlan's bracket in sqrt(prep_mu_s): a cell of four times the balls packs within about
 /// 0.005 in void ratio of the smaller one at one friction, 0.02-0.05 in sqrt(prep_mu_s) on the shipped configs.
