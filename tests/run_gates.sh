@@ -21,7 +21,7 @@ cmake --build "$build" -j"$(nproc)" --target triaxdem triaxdem_tests $targets
 export ASAN_OPTIONS="detect_leaks=0:abort_on_error=1:${ASAN_OPTIONS:-}"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:${UBSAN_OPTIONS:-}"
 export OMP_WAIT_POLICY=passive
-fast='^(Config|Measured|Misfit|Calibrate|CellBias|BlowUp|ContactLaw|Detection|Dynamics|WallServo|SimdLanes|Reduce|IoHdf5|Membrane[A-Za-z]*|PeriodicCell|Stress|Micro|Untrusted)\.|^Reference\.ContactLaws'
+fast='^(Config|Measured|Misfit|Calibrate|PackingStore|CellBias|BlowUp|ContactLaw|Detection|Dynamics|WallServo|SimdLanes|Reduce|IoHdf5|Membrane[A-Za-z]*|PeriodicCell|Stress|Micro|Untrusted)\.|^Reference\.ContactLaws'
 # Not the tests that pack and shear whole cells through the lab (the cell choice, the cell's bias, the state match
 # and its bracket: 1-4 minutes each under the sanitizers): Calibrate.ParallelRunsEqualSequentialRuns runs that lab
 # code here, and CellBias.* the bias's arithmetic.

@@ -1,8 +1,6 @@
 #pragma once
 /// What a cell's runs and packings cost, estimated before any runs (a job's plan, host/fit/job_plan.hpp): steps from
 /// the config's rates and time step, and the engine's speed from a probe on this machine.
-#include <string>
-
 #include "host/config/config.hpp"
 
 namespace dem {
@@ -11,12 +9,14 @@ namespace dem {
 /// a packing ends.
 constexpr Real kPackedSolidFraction = 0.62;
 /// A packing's steps as a multiple of its gas phase's (the cell closing at the consolidation rate to a dense state):
-/// the settling to the preparation's unbalanced tolerance takes about as many again. Fitted on the 480-ball
-/// hidden-effect cell (26,800 steps against 13,700 in the gas phase) and the 4,000-ball walled base; an estimate,
-/// which the job's summary sets beside what it took.
+/// the settling to the preparation's unbalanced tolerance takes about as many again. The 480-ball hidden-effect cell
+/// took 26,800 steps against 27,900 estimated, the 1,000-ball walled cross-code base 12,800 against 19,150; an
+/// estimate, which the job's last line sets beside what it took.
 constexpr Real kPackingStepsOverGas = 2.0;
-/// A run's consolidation to its sigma3 (from the preparation's pressure and looser tolerance) as a share of its shear
-/// steps: measured 0.1-0.3 on the shipped calibration bases.
+/// A run's steps beyond its shear, as a share of them: its consolidation to sigma3 (measured 0.04 of the shear on
+/// the walled cross-code base, 0.09 in the small S-1 membrane test) and its set-up and records, which the probe does
+/// not time. With 0.25 the walled case's 24 scatter and 12 check runs came within 20% of the plan (26 s and 1m10s
+/// against 31 s and 1m06s).
 constexpr Real kConsolidationShare = 0.25;
 /// Contact pairs a ball of a random packing has (4.5, docs/performance.md) over the probe lattice's 3: the probe's
 /// speed is scaled by it.
