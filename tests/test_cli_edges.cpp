@@ -487,7 +487,8 @@ TEST(CliEdges, ACalibrationResumesFromItsStoredRuns) {
   o = triaxdem(calibrate + "-o " + (dir / "out").string(), dir);
   ASSERT_EQ(o.code, 0) << o.output;
   fs::path folder;
-  for (const auto& e : fs::directory_iterator(dir / "out")) folder = e.path();
+  for (const auto& e : fs::directory_iterator(dir / "out"))  // beside it, the packing store's .specimens
+    if (e.path().filename().string().rfind("calibrate_", 0) == 0) folder = e.path();
   std::vector<fs::path> runs;
   for (const auto& e : fs::directory_iterator(folder / "runs")) runs.push_back(e.path());
   ASSERT_GT(runs.size(), 20u) << "each run stored as it ended";
