@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <random>
 #include <string>
 
 #include "host/fit/calibrate.hpp"
@@ -667,7 +668,7 @@ TEST(Calibrate, SearchFindsAValleyTheSurfacesMiss) {
     return bowl * (1 - 0.55 * std::exp(-std::pow((x - 0.892) / 0.05, 2)));
   };
   long runs = 0;
-  const Simulator simulate = [&](const Model& m) {
+  const Simulator simulate = [&](const Model& m, Real) {
     ++runs;
     SimulatedPoint s;
     s.r.assign(kData, std::sqrt(chi2_at(m.law.mu_s, m.law.mu_r) / kData));
@@ -694,7 +695,7 @@ TEST(Calibrate, ABetterBaseRunFoundLaterCarriesItsOwnIntervals) {
   const std::vector<FreeParam> free{free_param("mu_s", base), free_param("mu_r", base)};
   constexpr int kData = 6;
   // A smooth bowl in the unit coordinates: residuals linear in (x, y), chi2 minimal at (0.3, 0.4).
-  const Simulator simulate = [&](const Model& m) {
+  const Simulator simulate = [&](const Model& m, Real) {
     const Real x = free[0].unit(m.law.mu_s), y = free[1].unit(m.law.mu_r);
     SimulatedPoint s;
     for (int i = 0; i < kData; ++i)
@@ -710,7 +711,7 @@ TEST(Calibrate, ABetterBaseRunFoundLaterCarriesItsOwnIntervals) {
   Model at = base;
   set_param(at, "mu_s", free[0].value(0.6));
   set_param(at, "mu_r", free[1].value(0.7));
-  better.r = simulate(at).r;
+  better.r = simulate(at, 0).r;
   better.chi2 = 0;
   for (Real& v : better.r) v *= 0.01, better.chi2 += v * v;
   ASSERT_LT(better.chi2, r.best.chi2);
@@ -726,5 +727,100 @@ TEST(Calibrate, ABetterBaseRunFoundLaterCarriesItsOwnIntervals) {
     EXPECT_GE(r.interval[k].second, r.values[k]) << free[k].name;
     EXPECT_FALSE(old_interval[k].first <= r.values[k] && r.values[k] <= old_interval[k].second)
         << free[k].name << ": the old interval held the new value, so this test could not tell them apart";
+  }
+}
+
+// Screening's rule (clearly_above): a member's residuals r = r_mean + e, e of expected square norm `spread`. A point
+// whose mean lies just inside the bound is screened out by chance only: at most 1.2% of draws for one datum (|e| above
+// 2.5 sd), less for more data (the bound's 2.5 roots of the spread; 20,000 draws give the rate to +-0.2%). A point
+// whose mean lies twice the rule's margin beyond the bound's root is screened in at least 98% of draws (one datum:
+// |e| below -2.5 sd has 0.6%), and one whose member happens to read below the bound never.
+TEST(Calibrate, ScreeningDropsAPointInsideTheBoundRarely) {
+  std::mt19937 rng(5);
+  std::normal_distribution<Real> z(0, 1);
+  const Real bound = 10, spread_per_datum = 1.5;
+  for (int n : {1, 3, 12}) {
+    int dropped = 0, kept_far = 0;
+    constexpr int kDraws = 20000;
+    const Real margin = kScreenSigmas * std::sqrt(n * spread_per_datum), far_norm = std::sqrt(bound) + 2 * margin;
+    for (int i = 0; i < kDraws; ++i) {
+      std::vector<Real> inside(n), far(n);
+      for (int j = 0; j < n; ++j) {
+        const Real e = std::sqrt(spread_per_datum) * z(rng);
+        inside[j] = std::sqrt(0.99 * bound / n) + e;
+        far[j] = far_norm / std::sqrt(Real(n)) + e;
+      }
+      dropped += clearly_above(inside, n * spread_per_datum, bound);
+      kept_far += !clearly_above(far, n * spread_per_datum, bound);
+    }
+    const Real rate = static_cast<Real>(dropped) / kDraws, kept = static_cast<Real>(kept_far) / kDraws;
+    std::printf("screening, %d data: %.4f of points just inside the bound dropped, %.4f of those far above kept\n", n,
+                rate, kept);
+    EXPECT_LT(rate, 0.014) << n << " data";
+    EXPECT_LT(kept, 0.02) << n << " data";
+  }
+  EXPECT_FALSE(clearly_above({2.0}, 1.0, 9.0)) << "a member below the bound's root";
+}
+
+// A search that screens finds what a search without screening finds, with fewer runs. The simulator: a bowl in the
+// unit coordinates (6 residuals, linear in them, least chi2 at (0.3, 0.4)) seen by 4 members, each with its own
+// fixed departure (common random numbers) of sd 0.5 a residual; a point costs 1 run a member. The bowl is as steep
+// as Table 6's S-1 (its design's corners 68-678 in chi2, the compass's quarter steps 83-142, against a best of 1.8).
+// Screened, most corners of the design and the compass's far steps cost 1 run instead of 4; the best point and the
+// intervals are those of the unscreened search (the surfaces weigh a screened point little: it lies far above).
+TEST(Calibrate, ScreeningFindsTheSameOptimumWithFewerRuns) {
+  Model base;
+  base.law.mu_s = 0.3;
+  base.law.mu_r = 0.02;
+  const std::vector<FreeParam> free{free_param("mu_s", base), free_param("mu_r", base)};
+  constexpr int kData = 6, kMembers = 4;
+  std::mt19937 rng(3);
+  std::normal_distribution<Real> z(0, 0.5);
+  std::vector<std::vector<Real>> departure(kMembers, std::vector<Real>(kData));
+  for (auto& d : departure)
+    for (Real& v : d) v = z(rng);
+  const Real spread = (1 - 1.0 / kMembers) * kData * 0.25;
+  auto run_search = [&](bool screen, long& runs) {
+    runs = 0;
+    const Simulator simulate = [&](const Model& m, Real bound) {
+      const Real x = free[0].unit(m.law.mu_s), y = free[1].unit(m.law.mu_r);
+      auto member = [&](int j) {
+        std::vector<Real> r;
+        for (int i = 0; i < kData; ++i)
+          r.push_back(0.5 + 16 * (x - 0.3) * (i % 2 ? 1 : 0.5) + 12 * (y - 0.4) * (i % 3 ? 1 : -1) + departure[j][i]);
+        return r;
+      };
+      SimulatedPoint s;
+      s.r = member(0);
+      ++runs;
+      if (screen && std::isfinite(bound) && clearly_above(s.r, spread, bound)) {
+        s.screened = true;
+        return s;
+      }
+      for (int j = 1; j < kMembers; ++j) {
+        const std::vector<Real> r = member(j);
+        for (int i = 0; i < kData; ++i) s.r[i] += r[i];
+        ++runs;
+      }
+      for (Real& v : s.r) v /= kMembers;
+      return s;
+    };
+    return calibrate(simulate, base, free, kData);
+  };
+  long full_runs = 0, screened_runs = 0;
+  const CalibrationResult full = run_search(false, full_runs), screened = run_search(true, screened_runs);
+  std::printf("screening: %ld runs against %ld; mu_s %.4g and %.4g, mu_r %.4g and %.4g\n", screened_runs, full_runs,
+              screened.values[0], full.values[0], screened.values[1], full.values[1]);
+  long dropped = 0;
+  for (const Evaluation& e : screened.design) dropped += e.screened;
+  EXPECT_GT(dropped, 0);
+  EXPECT_LT(screened_runs, 0.8 * full_runs);
+  EXPECT_FALSE(screened.best.screened);
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_GE(screened.values[k], full.interval[k].first) << free[k].name;
+    EXPECT_LE(screened.values[k], full.interval[k].second) << free[k].name;
+    const Real w = full.interval[k].second - full.interval[k].first,
+               ws = screened.interval[k].second - screened.interval[k].first;
+    EXPECT_NEAR(ws, w, 0.2 * w) << free[k].name << ": the interval's width within 20% of the unscreened search's";
   }
 }

@@ -99,11 +99,37 @@ bool recentre(FreeParam& f, Real v) {
 
 namespace {
 
+/// The 95% quantile of chi2 with d degrees of freedom: the table's for d = 1..4, where Wilson-Hilferty is up to 3%
+/// low, chi2_quantile beyond.
+Real chi2_95(int d) {
+  static const Real q[] = {3.841, 5.991, 7.815, 9.488};
+  if (d >= 1 && d <= 4) return q[d - 1];
+  return chi2_quantile(d, 1.645);
+}
+
+/// The joint 95% region's rise at a best chi2, as add_uncertainty counts it.
+Real region_rise_at(Real best_chi2, int data, int d) {
+  return chi2_95(std::max(d, 1)) * std::max(Real(1), best_chi2 / std::max(1, data - d));
+}
+
+}  // namespace
+
+Real significant_gain(Real best_chi2, int data, int d) { return 0.05 * region_rise_at(best_chi2, data, d); }
+
+Real screen_bound(Real best_chi2, int data, int d) { return best_chi2 + region_rise_at(best_chi2, data, d); }
+
+bool clearly_above(const std::vector<Real>& r, Real spread, Real bound) {
+  return std::sqrt(sum_sq(r)) - kScreenSigmas * std::sqrt(std::max(Real(0), spread)) > std::sqrt(bound);
+}
+
+namespace {
+
 /// One search over fixed ranges: every point run is kept in `res.design`, the best in `res.best`.
 class Search {
  public:
-  Search(const Simulator& simulate, const Model& base, const std::vector<FreeParam>& free, int data)
-      : simulate_(simulate), base_(base), free_(free), d_(static_cast<int>(free.size())) {
+  /// `known_best`: the best chi2 of an earlier search (a widened one's), the screening's bound until one is run here.
+  Search(const Simulator& simulate, const Model& base, const std::vector<FreeParam>& free, int data, Real known_best)
+      : simulate_(simulate), base_(base), free_(free), d_(static_cast<int>(free.size())), known_best_(known_best) {
     res.free = free;
     res.data = data;
   }
@@ -112,11 +138,14 @@ class Search {
     for (int k = 0; k < d_; ++k) set_param(m, free_[k].name, free_[k].value(u[k]));
     return m;
   }
-  /// The 3^d design: each parameter at the ends and the middle of its range.
+  /// The 3^d design: each parameter at the ends and the middle of its range, the centre first (its chi2 bounds the
+  /// screening of the corners).
   void design() {
     long points = 1;
     for (int k = 0; k < d_; ++k) points *= 3;
-    for (long p = 0; p < points; ++p) {
+    const long centre = (points - 1) / 2;  // every digit 1 in base 3
+    for (long i = 0; i < points; ++i) {
+      const long p = i == 0 ? centre : i <= centre ? i - 1 : i;
       std::vector<Real> u(d_);
       long c = p;
       for (int k = 0; k < d_; ++k, c /= 3) u[k] = 0.5 * static_cast<Real>(c % 3);
@@ -133,19 +162,24 @@ class Search {
   }
   /// A compass search around the best point in steps of 1/4, then 1/8, of each range (a valley the quadratic
   /// surfaces miss), and a last surrogate step where it moved.
+  /// It moves on a significant gain only (significant_gain).
   void compass() {
     if (d_ == 0) return;
     bool moved = false;
+    std::vector<Real> from = res.best.u;
+    Real at = res.best.chi2;
     for (Real step : {0.25, 0.125}) {
       for (bool better = true; better;) {
         better = false;
-        const std::vector<Real> from = res.best.u;
         for (int k = 0; k < d_ && !better; ++k)
           for (Real sign : {-1.0, 1.0}) {
             std::vector<Real> u = from;
             u[k] += sign * step;
             if (u[k] < -1e-9 || u[k] > 1 + 1e-9 || run_before(u)) continue;
-            if (evaluate(u)) {
+            const Real chi2 = evaluate(u);
+            if (chi2 < at - significant_gain(at, res.data, d_)) {
+              from = u;
+              at = chi2;
               better = moved = true;
               break;
             }
@@ -165,18 +199,20 @@ class Search {
     }
     return false;
   }
-  /// Runs u; true where it beats the best so far.
-  bool evaluate(const std::vector<Real>& u) {
+  /// Runs u (screened against the best so far); its chi2.
+  Real evaluate(const std::vector<Real>& u) {
+    const Real best = res.design.empty() ? known_best_ : std::min(known_best_, res.best.chi2);
     Evaluation e;
     e.u = u;
-    SimulatedPoint s = simulate_(model_at(u));
+    SimulatedPoint s = simulate_(model_at(u), std::isfinite(best) ? screen_bound(best, res.data, d_)
+                                                                  : std::numeric_limits<Real>::infinity());
     e.sim = std::move(s.sim);
     e.r = std::move(s.r);
     e.chi2 = sum_sq(e.r);
+    e.screened = s.screened;
     res.design.push_back(e);
-    const bool better = res.design.size() == 1 || e.chi2 < res.best.chi2;
-    if (better) res.best = e;
-    return better;
+    if (res.design.size() == 1 || (!e.screened && (res.best.screened || e.chi2 < res.best.chi2))) res.best = e;
+    return e.chi2;
   }
   /// Runs the surrogate's optimum, the surfaces centred on the best run; false when that point was run before.
   bool surrogate_step() {
@@ -194,12 +230,21 @@ class Search {
   const Model& base_;
   const std::vector<FreeParam>& free_;
   int d_;
+  Real known_best_;
 };
 
+/// The least chi2 of the design's points whose coordinate k lies inside its range (not on an edge).
+Real best_inside(const CalibrationResult& r, std::size_t k) {
+  Real best = std::numeric_limits<Real>::infinity();
+  for (const Evaluation& e : r.design)
+    if (!e.screened && e.u[k] >= 0.01 && e.u[k] <= 0.99) best = std::min(best, e.chi2);
+  return best;
+}
+
 CalibrationResult search(const Simulator& simulate, const Model& base, const std::vector<FreeParam>& free, int data,
-                         int rounds, int widen) {
+                         int rounds, int widen, Real known_best = std::numeric_limits<Real>::infinity()) {
   const int d = static_cast<int>(free.size());
-  Search sr(simulate, base, free, data);
+  Search sr(simulate, base, free, data, known_best);
   sr.design();
   sr.surrogate_rounds(rounds);
   sr.compass();
@@ -212,6 +257,15 @@ CalibrationResult search(const Simulator& simulate, const Model& base, const std
   std::vector<std::string> notes;
   for (int k = 0; k < d; ++k) {
     if (res.best.u[k] >= 0.01 && res.best.u[k] <= 0.99) continue;
+    const Real inside = best_inside(res, static_cast<std::size_t>(k));
+    if (res.best.chi2 > inside - significant_gain(inside, data, d)) {
+      char line[200];
+      std::snprintf(line, sizeof line, "%s: best %.4g on the edge of [%.4g, %.4g], chi2 %.2f against %.2f inside: "
+                    "no significant gain, the range kept", free[k].name.c_str(), free[k].shown * res.values[k],
+                    free[k].shown * free[k].lo, free[k].shown * free[k].hi, res.best.chi2, inside);
+      notes.push_back(line);
+      continue;
+    }
     if (!recentre(moved[k], res.values[k])) continue;
     char line[160];
     std::snprintf(line, sizeof line, "%s: best %.4g on the edge of [%.4g, %.4g]; searched again over [%.4g, %.4g]",
@@ -219,8 +273,13 @@ CalibrationResult search(const Simulator& simulate, const Model& base, const std
                   free[k].shown * free[k].hi, moved[k].shown * moved[k].lo, moved[k].shown * moved[k].hi);
     notes.push_back(line);
   }
-  if (notes.empty()) return res;
-  CalibrationResult again = search(simulate, base, moved, data, rounds, widen - 1);
+  bool any_moved = false;
+  for (int k = 0; k < d; ++k) any_moved = any_moved || moved[k].lo != free[k].lo || moved[k].hi != free[k].hi;
+  if (!any_moved) {
+    res.widened.insert(res.widened.begin(), notes.begin(), notes.end());
+    return res;
+  }
+  CalibrationResult again = search(simulate, base, moved, data, rounds, widen - 1, res.best.chi2);
   if (again.best.chi2 >= res.best.chi2) {
     notes.push_back("the wider search found no better point");
     for (int k = 0; k < d; ++k)
@@ -229,14 +288,6 @@ CalibrationResult search(const Simulator& simulate, const Model& base, const std
   CalibrationResult& out = again.best.chi2 < res.best.chi2 ? again : res;
   out.widened.insert(out.widened.begin(), notes.begin(), notes.end());
   return out;
-}
-
-/// The 95% quantile of chi2 with d degrees of freedom: the table's for d = 1..4, where Wilson-Hilferty is up to 3%
-/// low, chi2_quantile beyond.
-Real chi2_95(int d) {
-  static const Real q[] = {3.841, 5.991, 7.815, 9.488};
-  if (d >= 1 && d <= 4) return q[d - 1];
-  return chi2_quantile(d, 1.645);
 }
 
 void add_uncertainty(CalibrationResult& r) {
@@ -363,12 +414,31 @@ CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vect
   const long planned = planned_points(static_cast<int>(free.size()), rounds) * static_cast<long>(measured.size()) *
                        lab.members();
   Real best = std::numeric_limits<Real>::infinity();
-  auto simulate = [&](const Model& m) {
+  const Real spread = misfit.member_spread();
+  auto simulate = [&](const Model& m, Real screen_above) {
     SimulatedPoint s;
-    const Ensemble ens = lab.run_ensemble(m, measured);
-    for (const auto& members : ens) s.sim.push_back(mean_curve(members));
+    const std::size_t K = static_cast<std::size_t>(lab.members()), T = measured.size(),
+                      W = static_cast<std::size_t>(std::max(1, lab.workers()));
+    // The first member's tests, and as many of the next member's as fill the workers' last round: a point that is
+    // not screened then takes the rounds of the whole ensemble at once.
+    const std::size_t first = std::min(T * K, (T + W - 1) / W * W);
+    const bool screen = K > 1 && first < T * K && std::isfinite(screen_above);
+    Ensemble ens = lab.run_part(m, measured, K, 0, screen ? first : T * K);
+    if (screen) {
+      Ensemble one(T);
+      for (std::size_t k = 0; k < T; ++k) one[k].push_back(ens[k].front());
+      s.r = misfit.residuals(one);
+      s.screened = clearly_above(s.r, spread, screen_above);
+      if (s.screened) {
+        ens = one;
+      } else {
+        const Ensemble rest = lab.run_part(m, measured, K, first, T * K);
+        for (std::size_t k = 0; k < T; ++k) ens[k].insert(ens[k].end(), rest[k].begin(), rest[k].end());
+      }
+    }
+    for (const auto& one : ens) s.sim.push_back(mean_curve(one));
     s.r = misfit.residuals(ens);
-    best = std::min(best, sum_sq(s.r));
+    if (!s.screened) best = std::min(best, sum_sq(s.r));
     if (progress) progress(lab.runs(), planned, best);
     return s;
   };

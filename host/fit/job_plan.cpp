@@ -273,8 +273,9 @@ JobPlan plan_job(const PlanInput& in) {
                        fmt(" (%.0f s)", lab.run_seconds(cell.periodic.triax.sigma3)) +
                        fmt(", a packing of %.0f steps", static_cast<double>(lab.packing_steps)) +
                        fmt(" (%.0f s)", lab.packing_seconds()) + ": estimates (host/lab/run_cost.hpp)");
-  plan.notes.push_back("a search counts its planned points: one whose optimum lies on the edge of a range searches "
-                       "again beyond it, and runs more (Table 6's S-1: 636 runs where 264 were planned)");
+  plan.notes.push_back("a search counts its planned points on the whole ensemble: one whose optimum lies on the edge "
+                       "of a range searches again beyond it and runs more, and points far above the best run one "
+                       "specimen only (Table 6's S-1: 330 runs where 264 were planned)");
   if (auto_ensemble)
     plan.notes.push_back("ensemble \"auto\": the scatter runs choose 1 to " + std::to_string(S) +
                          " specimens a point (the fewest whose mean's standard error is half the data's noise): the "

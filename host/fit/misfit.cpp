@@ -186,6 +186,9 @@ void Misfit::build_summary_noise(const std::vector<TriaxialTest>& measured, cons
       cov(i, i) += fs[i].ensemble_sd * fs[i].ensemble_sd / members_;
     }
     cov_.emplace_back(cov.data(), cov.data() + n * n);
+    std::vector<Real> member(static_cast<std::size_t>(n) * n, 0);
+    for (int i = 0; i < n; ++i) member[static_cast<std::size_t>(i) * n + i] = fs[i].ensemble_sd * fs[i].ensemble_sd;
+    member_cov_.push_back(member);
   }
 }
 
@@ -267,6 +270,17 @@ std::vector<Real> Misfit::test_residuals(std::size_t k, const std::vector<Triaxi
   for (int i = 0; i < n; ++i) diff[i] = s[i] - features_[k][i].measured;
   const Eigen::Map<const Eigen::MatrixXd> cov(cov_[k].data(), n, n);
   return whiten(cov, diff);
+}
+
+Real Misfit::member_spread() const {
+  Real spread = 0;
+  for (std::size_t k = 0; k < cov_.size(); ++k) {
+    const int n = static_cast<int>(features_[k].size());
+    const Eigen::Map<const Eigen::MatrixXd> cov(cov_[k].data(), n, n), member(member_cov_[k].data(), n, n);
+    spread += cov.llt().solve(member).trace();
+  }
+  // One member less the mean of K that include it: its deviation's variance is (1 - 1/K) of one member's.
+  return (1 - 1 / static_cast<Real>(members_)) * spread;
 }
 
 std::vector<Real> Misfit::residuals(const Ensemble& sim) const {

@@ -139,6 +139,11 @@ class Misfit {
   Real sd(std::size_t k, std::size_t i) const {
     return std::sqrt(cov_[k][i * features_[k].size() + i]);
   }
+  /// The expected square norm of the change in the whitened residuals (all tests) when one member stands for the
+  /// mean of the ensemble: (1 - 1/K) sum over tests of tr(Sigma^-1 Sigma_member), Sigma_member one member's
+  /// scatter as Sigma counts it (correlated along strain where it is). A search that runs a point on one member
+  /// first (calibrate.hpp, screening) reads that member's residuals with this spread.
+  Real member_spread() const;
   /// The members' mean feature values of test k (NaN where no member has one).
   std::vector<Real> mean_values(std::size_t k, const std::vector<TriaxialTest>& members) const;
   /// What noise was used, per test and in words, for the report.
@@ -174,6 +179,7 @@ class Misfit {
   void add_correlated(const std::vector<std::vector<Real>>& sd, Real Feature::*field, const std::string& what);
   std::vector<std::vector<Feature>> features_;
   std::vector<std::vector<Real>> cov_;   ///< per test, Sigma (n x n, row-major)
+  std::vector<std::vector<Real>> member_cov_;  ///< per test, one member's scatter (n x n): Sigma holds it / K
   std::vector<std::string> notes_;
   std::string source_;
   Real length_ = 1;

@@ -218,8 +218,10 @@ void Misfit::build_curve_noise(const std::vector<TriaxialTest>& measured, const 
       }
       f.data_sd = std::sqrt(data_var[i]);
     }
+    std::vector<Real> member(static_cast<std::size_t>(n) * n);
     for_each_pair(fs, use_lab ? noise.lab.length : length_, true, [&](int i, int j, Real rho) {
       const Feature &a = fs[i], &b = fs[j];
+      member[static_cast<std::size_t>(i) * n + j] = rho * a.ensemble_sd * b.ensemble_sd;
       Real c = rho * (a.specimen_sd * b.specimen_sd + a.ensemble_sd * b.ensemble_sd / members_);
       if (use_lab && a.quantity == 0 && b.quantity == 0) {
         // The lab's specimen factor moves the whole q curve together: rank one, beside the correlated rest.
@@ -238,6 +240,7 @@ void Misfit::build_curve_noise(const std::vector<TriaxialTest>& measured, const 
       cov(i, i) += floor * floor;
     }
     cov_.emplace_back(cov.data(), cov.data() + n * n);
+    member_cov_.push_back(member);
   }
   if (lab)
     notes_.push_back("noise: " + noise.lab_name + fmt(" (q %.3g%%", 100 * noise.lab.q_rel) +

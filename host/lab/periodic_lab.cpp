@@ -195,12 +195,20 @@ void PeriodicLab::count_runs(std::size_t n, std::chrono::steady_clock::time_poin
 
 Ensemble PeriodicLab::run_ensemble(const Model& m, const std::vector<TriaxialTest>& like, bool all) {
   const std::size_t M = all ? specimens_.size() : static_cast<std::size_t>(members_);
-  std::vector<Case> cases;  // case j: test j / M on member j % M
-  for (std::size_t j = 0; j < like.size() * M; ++j)
-    cases.push_back({like[j / M].material, like[j / M].sigma3, static_cast<int>(j % M)});
+  return run_part(m, like, M, 0, like.size() * M);
+}
+
+Ensemble PeriodicLab::run_part(const Model& m, const std::vector<TriaxialTest>& like, std::size_t members,
+                               std::size_t from, std::size_t to) {
+  const std::size_t T = like.size();
+  if (members > specimens_.size() || from > to || to > T * members)
+    throw std::logic_error("periodic lab: cases beyond its specimens");
+  std::vector<Case> cases;
+  for (std::size_t c = from; c < to; ++c)
+    cases.push_back({like[c % T].material, like[c % T].sigma3, static_cast<int>(c / T)});
   const std::vector<TriaxialTest> done = run_cases(m, cases);
-  Ensemble out(like.size());
-  for (std::size_t j = 0; j < done.size(); ++j) out[j / M].push_back(done[j]);
+  Ensemble out(T);
+  for (std::size_t j = 0; j < done.size(); ++j) out[(from + j) % T].push_back(done[j]);
   return out;
 }
 

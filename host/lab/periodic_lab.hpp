@@ -52,6 +52,11 @@ class PeriodicLab {
   /// Every test of `like` (its materials and pressures) on every member (on every specimen with `all`); up to
   /// workers() runs at once.
   Ensemble run_ensemble(const Model& m, const std::vector<TriaxialTest>& like, bool all = false);
+  /// Part of the ensemble of `members` members: its cases [from, to) in member-major order (case c: test c % T of
+  /// `like` on member c / T), each test's runs in member order (a search's screening runs the first member's tests,
+  /// and as many more as fill the workers, before the rest).
+  Ensemble run_part(const Model& m, const std::vector<TriaxialTest>& like, std::size_t members, std::size_t from,
+                    std::size_t to);
   /// Test j of `like` (its material and pressure) on member j % members(): data made on a specimen per test.
   std::vector<TriaxialTest> run_each(const Model& m, const std::vector<TriaxialTest>& like);
   /// Runs at once: each in a child process (fork) with the same specimens; the results are the same as one at a
