@@ -55,9 +55,9 @@ TEST_P(CrossCode, DiagnosisOfAnotherCodesCurves) {
   EXPECT_EQ(dg.verdict, c.verdict) << dg.explanation;
   if (c.verdict == "none") {
     // The generating friction must lie inside the reported joint 95% region. On the CI's cell it
-    // does only narrowly, 0.94 of the region's chi2 rise (mu_s 0.293 [0.233, 0.378], mu_r 0.064
-    // [0.029, 0.080], chi2 100 on 60 data; 0.94 again with the cell's bias counted, chi2 36.1), so there it is
-    // printed, not asserted: it would turn on the rounding of the next kernel change. The fits lean to less
+    // does not reliably: 0.94 of the region's chi2 rise once (mu_s 0.293 [0.233, 0.378], mu_r 0.064
+    // [0.029, 0.080]), 1.60 on 28 November (mu_s 0.258 [0.218, 0.350]) and 1.68 with the search's screening
+    // (0.263 [0.218, 0.342]), so there it is printed, not asserted: it turns on the search's path. The fits lean to less
     // sliding and more rolling friction than YADE's, and without the cell's bias the simulator misses these data
     // by more than their noise. Not because it shears three times faster than the
     // data (at the data's I = 1e-3, `triaxdem calibrate` gives mu_s 0.30 [0.23, 0.37], mu_r 0.08 on its range's
