@@ -14,6 +14,7 @@
 
 #include "host/fit/calibrate.hpp"
 #include "host/cli/calibration_jobs.hpp"
+#include "host/cli/calibration_session.hpp"
 #include "host/fit/diagnose.hpp"
 #include "host/data/measured.hpp"
 #include "host/fit/misfit.hpp"
@@ -822,5 +823,37 @@ TEST(Calibrate, ScreeningFindsTheSameOptimumWithFewerRuns) {
     const Real w = full.interval[k].second - full.interval[k].first,
                ws = screened.interval[k].second - screened.interval[k].first;
     EXPECT_NEAR(ws, w, 0.2 * w) << free[k].name << ": the interval's width within 20% of the unscreened search's";
+  }
+}
+
+// A cell sheared past the data's last strain ran steps that nothing compared (item 3 of issue 61): curve data to 0.5%
+// shear the cell to 0.55% where the config asks for 1%, and the shortened shear's records are the longer one's, bit
+// for bit, but for its last, the end's own record (the shear's rate and records do not depend on where it stops).
+// Summary data (a peak) and data beyond the config's strain keep the config's.
+TEST(Calibrate, TheCellShearsNoFurtherThanTheCurveDataNeed) {
+  const Config cfg = test::tiny_cell_config();  // to 1%, records every 0.1%
+  MeasuredData data;
+  data.curves = true;
+  TriaxialTest t;
+  t.eps_a = {0, 0.002, 0.005};
+  data.tests = {t};
+  const Config cut = sheared_for(cfg, data);
+  EXPECT_NEAR(cut.periodic.triax.target_strain, kStrainBeyondData * 0.005, 1e-15);
+  data.tests[0].eps_a.back() = 0.05;
+  EXPECT_EQ(sheared_for(cfg, data).periodic.triax.target_strain, cfg.periodic.triax.target_strain);
+  data.curves = false;
+  EXPECT_EQ(sheared_for(cut, data).periodic.triax.target_strain, cut.periodic.triax.target_strain) << "summary data";
+  Model m;
+  m.law = cfg.ball;
+  PeriodicLab whole(cfg, false, 1, 1), part(cut, false, 1, 1);
+  const TriaxialTest a = whole.run(m, 100e3), b = part.run(m, 100e3);
+  ASSERT_GT(b.eps_a.size(), 3u);
+  ASSERT_GT(a.eps_a.size(), b.eps_a.size()) << "the shorter shear records fewer rows";
+  // The end's record lies within a shear step of the end (at 100 kPa a step strains the tiny cell by about 1e-6).
+  EXPECT_NEAR(b.eps_a.back(), cut.periodic.triax.target_strain, 1e-5);
+  for (std::size_t i = 0; i + 1 < b.eps_a.size(); ++i) {
+    EXPECT_EQ(b.eps_a[i], a.eps_a[i]) << "row " << i;
+    EXPECT_EQ(b.q[i], a.q[i]) << "row " << i;
+    EXPECT_EQ(b.eps_v[i], a.eps_v[i]) << "row " << i;
   }
 }

@@ -59,10 +59,10 @@ void check_folders(const CalibrationOptions& o, const std::string& kind) {
     throw std::invalid_argument("-o " + o.output + ": " + p.string() + " cannot be written (allowed: a folder to write in)");
 }
 
-/// The reference test's cell, its packings kept in (and read from) the output folder's .specimens/cells, where a
-/// later job on the same base finds them.
-Config stored_cell(const Config& base, const CalibrationOptions& o) {
-  Config c = reference_cell(base, o.reference_test);
+/// The reference test's cell, sheared as far as the data need, its packings kept in (and read from) the output
+/// folder's .specimens/cells, where a later job on the same base finds them.
+Config stored_cell(const Config& base, const CalibrationOptions& o, const MeasuredData& data) {
+  Config c = sheared_for(reference_cell(base, o.reference_test), data);
   c.packing_store = (o.resume.empty() ? o.output : resumed_parent(o.resume)) + "/.specimens/cells";
   return c;
 }
@@ -107,6 +107,15 @@ bool walls_prediction_wanted(const Config& base, const CalibrationOptions& o) {
 
 }  // namespace
 
+Config sheared_for(Config cell, const MeasuredData& data) {
+  if (!data.curves) return cell;
+  Real last = 0;
+  for (const TriaxialTest& t : data.tests)
+    if (!t.eps_a.empty()) last = std::max(last, t.eps_a.back());
+  if (last > 0) cell.periodic.triax.target_strain = std::min(cell.periodic.triax.target_strain, kStrainBeyondData * last);
+  return cell;
+}
+
 /// The tests of the data by material (sorted by name), filtered by `only` when it is set.
 std::map<std::string, std::vector<TriaxialTest>> by_material(const MeasuredData& d, const std::string& only) {
   std::map<std::string, std::vector<TriaxialTest>> out;
@@ -127,7 +136,7 @@ JobInputs::JobInputs(const Config& base, const CalibrationOptions& o)
 JobPlan JobInputs::announce_plan(const Config& base, const CalibrationOptions& o, const std::string& kind) const {
   check_folders(o, kind);
   PlanInput in;
-  in.cell = stored_cell(base, o);
+  in.cell = stored_cell(base, o, data);
   in.materials = by_material(data, o.material);
   in.state_tests = data.tests;
   in.free = static_cast<int>(free.size());
@@ -157,7 +166,7 @@ std::string Session::plan_text() const {
 
 Session::Session(const Config& base, const CalibrationOptions& o, const std::string& kind)
     : JobInputs(base, o), plan(announce_plan(base, o, kind)),
-      lab(matched(stored_cell(base, o), o.workers), true, o.workers),
+      lab(matched(stored_cell(base, o, data), o.workers), true, o.workers),
       folder(o.resume.empty() ? new_dated_folder(o.output, kind) : resumed_folder(o.resume, kind)),
       output(o.resume.empty() ? o.output : resumed_parent(o.resume)) {
   ranks::check_shared_folder(folder);  // every rank reads the run store there
@@ -165,6 +174,10 @@ Session::Session(const Config& base, const CalibrationOptions& o, const std::str
   if (!o.resume.empty())
     std::printf("%s: resuming in %s: the runs stored there are read, not run again\n", kind.c_str(), folder.c_str());
   for (const std::string& n : data.notes) std::printf("%s: note: %s\n", kind.c_str(), n.c_str());
+  if (const Real end = lab.config().periodic.triax.target_strain; end < base.periodic.triax.target_strain)
+    std::printf("%s: note: the cell shears to %.3g%% axial strain, a tenth beyond the data's last, not to the "
+                "config's %.3g%% ([periodic] target_axial_strain_pct): the data compare nothing beyond\n", kind.c_str(),
+                100 * end, 100 * base.periodic.triax.target_strain);
 }
 
 std::string Session::cell_text() const {

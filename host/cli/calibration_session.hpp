@@ -21,6 +21,14 @@ namespace dem {
 /// The data's tests by material: all of them, or those of `only` (DataError naming the file where it has none).
 std::map<std::string, std::vector<TriaxialTest>> by_material(const MeasuredData& d, const std::string& only);
 
+/// How far beyond the data's last strain the cell shears (a tenth: the misfit's last feature lies inside the cell's
+/// curve, with records on both sides for its window).
+constexpr Real kStrainBeyondData = 1.1;
+/// `cell` sheared no further than curve data need: to kStrainBeyondData times their last axial strain where the config
+/// asks for more (the shear's records up to there are the same bit for bit, and the misfit compares no strain beyond
+/// the data's). Summary data (a peak, an end value) keep the config's strain.
+Config sheared_for(Config cell, const MeasuredData& data);
+
 /// A material's calibration as the prediction needs it: its tests, the model, and the periodic cell's tests at it.
 struct Calibrated {
   std::vector<TriaxialTest> tests;
