@@ -97,29 +97,10 @@ bool recentre(FreeParam& f, Real v) {
   return true;
 }
 
-namespace {
-
-/// The 95% quantile of chi2 with d degrees of freedom: the table's for d = 1..4, where Wilson-Hilferty is up to 3%
-/// low, chi2_quantile beyond.
 Real chi2_95(int d) {
   static const Real q[] = {3.841, 5.991, 7.815, 9.488};
   if (d >= 1 && d <= 4) return q[d - 1];
   return chi2_quantile(d, 1.645);
-}
-
-/// The joint 95% region's rise at a best chi2, as add_uncertainty counts it.
-Real region_rise_at(Real best_chi2, int data, int d) {
-  return chi2_95(std::max(d, 1)) * std::max(Real(1), best_chi2 / std::max(1, data - d));
-}
-
-}  // namespace
-
-Real significant_gain(Real best_chi2, int data, int d) { return 0.05 * region_rise_at(best_chi2, data, d); }
-
-Real screen_bound(Real best_chi2, int data, int d) { return best_chi2 + region_rise_at(best_chi2, data, d); }
-
-bool clearly_above(const std::vector<Real>& r, Real spread, Real bound) {
-  return std::sqrt(sum_sq(r)) - kScreenSigmas * std::sqrt(std::max(Real(0), spread)) > std::sqrt(bound);
 }
 
 namespace {
@@ -255,6 +236,7 @@ CalibrationResult search(const Simulator& simulate, const Model& base, const std
   // A best value on an edge of its range: the range moved to centre it, and searched again.
   std::vector<FreeParam> moved = free;
   std::vector<std::string> notes;
+  bool any_moved = false;
   for (int k = 0; k < d; ++k) {
     if (res.best.u[k] >= 0.01 && res.best.u[k] <= 0.99) continue;
     const Real inside = best_inside(res, static_cast<std::size_t>(k));
@@ -267,14 +249,13 @@ CalibrationResult search(const Simulator& simulate, const Model& base, const std
       continue;
     }
     if (!recentre(moved[k], res.values[k])) continue;
+    any_moved = true;
     char line[160];
     std::snprintf(line, sizeof line, "%s: best %.4g on the edge of [%.4g, %.4g]; searched again over [%.4g, %.4g]",
                   free[k].name.c_str(), free[k].shown * res.values[k], free[k].shown * free[k].lo,
                   free[k].shown * free[k].hi, moved[k].shown * moved[k].lo, moved[k].shown * moved[k].hi);
     notes.push_back(line);
   }
-  bool any_moved = false;
-  for (int k = 0; k < d; ++k) any_moved = any_moved || moved[k].lo != free[k].lo || moved[k].hi != free[k].hi;
   if (!any_moved) {
     res.widened.insert(res.widened.begin(), notes.begin(), notes.end());
     return res;
@@ -406,43 +387,6 @@ CalibrationResult calibrate(const Simulator& simulate, const Model& base, const 
   CalibrationResult r = search(simulate, base, free, data, rounds, widen);
   add_uncertainty(r);
   return r;
-}
-
-CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,
-                            const std::vector<TriaxialTest>& measured, const Misfit& misfit, int rounds,
-                            const CalibrationProgress& progress, int widen) {
-  const long planned = planned_points(static_cast<int>(free.size()), rounds) * static_cast<long>(measured.size()) *
-                       lab.members();
-  Real best = std::numeric_limits<Real>::infinity();
-  const Real spread = misfit.member_spread();
-  auto simulate = [&](const Model& m, Real screen_above) {
-    SimulatedPoint s;
-    const std::size_t K = static_cast<std::size_t>(lab.members()), T = measured.size(),
-                      W = static_cast<std::size_t>(std::max(1, lab.workers()));
-    // The first member's tests, and as many of the next member's as fill the workers' last round: a point that is
-    // not screened then takes the rounds of the whole ensemble at once.
-    const std::size_t first = std::min(T * K, (T + W - 1) / W * W);
-    const bool screen = K > 1 && first < T * K && std::isfinite(screen_above);
-    Ensemble ens = lab.run_part(m, measured, K, 0, screen ? first : T * K);
-    if (screen) {
-      Ensemble one(T);
-      for (std::size_t k = 0; k < T; ++k) one[k].push_back(ens[k].front());
-      s.r = misfit.residuals(one);
-      s.screened = clearly_above(s.r, spread, screen_above);
-      if (s.screened) {
-        ens = one;
-      } else {
-        const Ensemble rest = lab.run_part(m, measured, K, first, T * K);
-        for (std::size_t k = 0; k < T; ++k) ens[k].insert(ens[k].end(), rest[k].begin(), rest[k].end());
-      }
-    }
-    for (const auto& one : ens) s.sim.push_back(mean_curve(one));
-    s.r = misfit.residuals(ens);
-    if (!s.screened) best = std::min(best, sum_sq(s.r));
-    if (progress) progress(lab.runs(), planned, best);
-    return s;
-  };
-  return calibrate(simulate, base, free, misfit.data(), rounds, widen);
 }
 
 }  // namespace dem

@@ -160,6 +160,9 @@ struct SimulatedPoint {
 /// that lies clearly above (infinity: run it whole).
 using Simulator = std::function<SimulatedPoint(const Model& m, Real screen_above)>;
 
+/// The 95% quantile of chi2 with d degrees of freedom: the table's for d = 1..4, where Wilson-Hilferty is up to 3%
+/// low, chi2_quantile beyond.
+Real chi2_95(int d);
 /// The least fall of the chi2 that a search counts as a better point: a twentieth of the joint 95% region's rise
 /// (chi2_95(d) x scale, scale = max(1, chi2 / (data - d)), as the intervals count it). Such a gain moves the
 /// optimum by about a fifth (the root of 1/20) of the region's radius, within the region's own uncertainty.
