@@ -287,6 +287,49 @@ TEST(PeriodicTriaxial, RefusesFastRatesAndReportsUnconvergedConsolidation) {
   }
 }
 
+// The gas phase: with no contacts the clamp decides the servo's rate, gas_rate while the cell's volume is above the
+// balls' volume over gas_solid_fraction and consolidation_rate after, so the cell's edge follows L' = L (1 - r dt)
+// with r switching on the first step that starts at or below that volume. Two balls that never touch (half the cell's
+// diagonal apart), on the device and with the host's servo alike. Tolerance 1e-12 relative: the recurrence's rounding
+// over 2,000 steps (a step rounds the edge once or twice); a switch one step early or late moves it by 2e-4.
+TEST(PeriodicTriaxial, AGasClosesAtItsOwnRateUntilItsSolidFraction) {
+  const Real L0 = 20e-3, R = 1e-3;
+  std::vector<BallSpec> balls(2);
+  balls[0].x = Vec3(5e-3, 5e-3, 5e-3);
+  balls[1].x = Vec3(15e-3, 15e-3, 15e-3);
+  for (BallSpec& b : balls) {
+    b.radius = R;
+    b.density = 2500;
+  }
+  PeriodicTriaxialParams p = quiet(0.05);
+  p.consolidation_rate = 40;
+  p.gas_rate = 400;
+  const Real v_solid = 2 * 4.0 / 3.0 * test::kPi * R * R * R;
+  p.gas_solid_fraction = 2 * v_solid / (L0 * L0 * L0);  // the gas phase ends where the volume has halved
+  p.max_consolidation_steps = 2000;
+  for (int host = 0; host < 2; ++host) {
+    auto sim = make_periodic_simulation(balls, {L0, L0, L0}, test::law(1e8, 1.5, 0.3, 0), test::cell_solver());
+    const PeriodicTriaxialParams prm = resolve_periodic_params(*sim, p);
+    EXPECT_NEAR(prm.gas_volume / (0.5 * L0 * L0 * L0), 1, 1e-12);
+    std::unique_ptr<CellControl> cell = host ? std::make_unique<HostServoed>(*sim) : cell_of(*sim);
+    Consolidation stage(*cell, prm);
+    StageEnd end = run_stage(*sim, stage.steps(), nullptr);
+    EXPECT_NE(stage.end(end), "") << "a gas cannot reach sigma3";
+    const Real dt = sim->params().integ.dt;
+    Real L = L0;
+    long fast = 0;
+    for (long n = 0; n < sim->step_count(); ++n) {
+      const bool gas = L * L * L > prm.gas_volume;
+      fast += gas;
+      L *= 1 - (gas ? p.gas_rate : p.consolidation_rate) * dt;
+    }
+    ASSERT_GT(fast, 100) << "the gas phase was in play";
+    ASSERT_LT(fast, sim->step_count() - 100) << "and so was the consolidation rate after it";
+    for (int d = 0; d < 3; ++d) EXPECT_NEAR(cell->length(d) / L, 1, 1e-12) << (host ? "host" : "device") << " axis " << d;
+    EXPECT_EQ(sim->touching()[0], 0) << "the balls never touched";
+  }
+}
+
 // A periodic cell must keep 3 contact cut-offs on every side through consolidation and shear. 64 balls of
 // 2 mm at solid fraction 0.64 make a cube of 7.48 mm, 7.40 mm axially after 1% strain, under 1.05 x 3 x 2.4 mm
 // = 7.56 mm: refused with the key and the smallest count that fits (64 x (7.56 / 7.40)^3 = 69). 100 balls

@@ -225,6 +225,8 @@ void read_periodic(const Tables& read, Config& c) {
   pr.number("servo_alpha", t.servo_alpha, 0, 1, 1, true);
   pr.number("max_lateral_rate_per_s", t.max_lateral_rate, 0, 1e6);
   pr.number("consolidation_rate_per_s", t.consolidation_rate, 0, 1e6);
+  pr.number("gas_rate_per_s", t.gas_rate, 0, 1e6);
+  pr.number("gas_solid_fraction", t.gas_solid_fraction, 0, kGasSolidFractionMax, 1, true);
   pr.number("stress_tolerance", t.stress_tolerance, 0, 1, 1, true);
   pr.number("unbalanced_tolerance", t.unbalanced_tolerance, 0, 1, 1, true);
   pr.integer("max_consolidation_steps", t.max_consolidation_steps, 1, 1000000000L);

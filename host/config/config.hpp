@@ -111,6 +111,11 @@ struct MicroConfig {
   int rose_bins = 18;      ///< angle bins of the directional distributions over 0-180 deg
 };
 
+/// The gas phase's clamp over the consolidation's where [periodic] gas_rate_per_s is automatic (see gas_rate).
+inline constexpr Real kGasRateFactor = 4;
+/// The highest solid fraction a gas phase may close to: below random loose packing (0.53-0.55, frictional spheres).
+inline constexpr Real kGasSolidFractionMax = 0.53;
+
 /// Periodic-cell triaxial test parameters (SI); see host/triax/periodic_triaxial.hpp for the method.
 struct PeriodicTriaxialParams {
   std::string name = "periodic";     ///< label of the progress line
@@ -123,6 +128,13 @@ struct PeriodicTriaxialParams {
   Real servo_alpha = 0.5;            ///< fraction of the stress error one step of affine response corrects, (0, 1]
   Real max_lateral_rate = 0;         ///< 1/s, clamp of the servoed rates in shear; 0: 5 x axial_rate
   Real consolidation_rate = 0;       ///< 1/s, clamp of the servoed rates in consolidation; 0: max_lateral_rate
+  /// 1/s, the clamp in consolidation while the balls' solid fraction is below gas_solid_fraction; 0: kGasRateFactor x
+  /// consolidation_rate in a periodic cell, consolidation_rate between walls. Far from jamming the balls meet rarely
+  /// and gently: at 4x the packings' state and curves stay within their seeds' scatter, at 10x the gas heats and
+  /// packs otherwise (docs/performance.md, The gas phase).
+  Real gas_rate = 0;
+  Real gas_solid_fraction = 0.40;    ///< where the gas phase ends; at most kGasSolidFractionMax
+  Real gas_volume = 0;               ///< m^3, the cell's volume at gas_solid_fraction (resolve_periodic_params)
   Real stress_tolerance = 0.005;     ///< consolidation: |sigma_ii - sigma3| / sigma3 on every axis
   Real unbalanced_tolerance = 1e-3;  ///< consolidation: unbalanced-force ratio
   long max_consolidation_steps = 2000000;

@@ -71,15 +71,19 @@ CellCost measure_cell_cost(const Config& cell, double probe_seconds) {
   }
   c.ns_per_particle_step = 1e9 * seconds / (static_cast<double>(steps) * static_cast<double>(balls.size())) *
                            kPairsOverLattice;
-  // The gas phase: the cell closes on every axis at the consolidation rate's clamp (resolve_periodic_params'
-  // defaults) from the box's solid fraction to a dense packing's.
+  // The gas phase: the cell closes on every axis from the box's solid fraction to a dense packing's, at the gas
+  // phase's clamp to gas_solid_fraction and at the consolidation rate's after (resolve_periodic_params' defaults).
   const Real volume = cell.box.size[0] * cell.box.size[1] * cell.box.size[2];
   const Real solid = static_cast<Real>(c.balls) * M_PI / 6 * mean_cube_diameter(cell.particles) / volume;
   const Real axial = axial_rate(c.triax, c.d, c.rho_eff, c.triax.sigma3);
   const Real rate = c.triax.consolidation_rate > 0
                         ? c.triax.consolidation_rate
                         : (c.triax.max_lateral_rate > 0 ? c.triax.max_lateral_rate : 5 * axial);
-  const Real gas = std::max(Real(0), std::log(kPackedSolidFraction / solid) / 3) / (rate * c.dt);
+  const Real gas_rate = std::max(rate, c.triax.gas_rate > 0 ? c.triax.gas_rate
+                                       : (cell.periodic.boundary == CellBoundary::walls ? 1 : kGasRateFactor) * rate);
+  const Real gas_end = std::max(solid, std::min(c.triax.gas_solid_fraction, kPackedSolidFraction));
+  auto closing = [&](Real from, Real to, Real r) { return std::max(Real(0), std::log(to / from) / 3) / (r * c.dt); };
+  const Real gas = closing(solid, gas_end, gas_rate) + closing(gas_end, kPackedSolidFraction, rate);
   c.packing_steps = static_cast<long>(kPackingStepsOverGas * gas);
   return c;
 }

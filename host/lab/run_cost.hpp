@@ -8,10 +8,11 @@ namespace dem {
 /// Densest solid fraction a packing of the cell reaches (frictional spheres pack 0.58-0.64): where the gas phase of
 /// a packing ends.
 constexpr Real kPackedSolidFraction = 0.62;
-/// A packing's steps as a multiple of its gas phase's (the cell closing at the consolidation rate to a dense state):
-/// the settling to the preparation's unbalanced tolerance takes about as many again. The 480-ball hidden-effect cell
-/// took 26,800 steps against 27,900 estimated, the 1,000-ball walled cross-code base 12,800 against 19,150; an
-/// estimate, which the job's last line sets beside what it took.
+/// A packing's steps as a multiple of its gas phase's (the cell closing at the gas phase's and then the
+/// consolidation's rate to a dense state): the settling to the preparation's unbalanced tolerance takes about as many
+/// again. Measured (means of 8 seeds): the 120-ball hidden-effect cell 13,640 steps against 13,910 estimated, the
+/// 200-ball calibration base 17,230 against 13,260; the 1,000-ball walled cross-code base 12,800 against 19,150 (one
+/// seed); an estimate, which the job's last line sets beside what it took.
 constexpr Real kPackingStepsOverGas = 2.0;
 /// A run's steps beyond its shear, as a share of them: its consolidation to sigma3 (measured 0.04 of the shear on
 /// the walled cross-code base, 0.09 in the small S-1 membrane test) and its set-up and records, which the probe does

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "host/data/measured.hpp"
+#include "host/engine/micro.hpp"
 #include "host/engine/setup.hpp"
 
 namespace dem {
@@ -15,13 +16,16 @@ namespace {
 
 constexpr Real kPi = 3.14159265358979323846;
 
-/// The servo of stage (a): every axis to sigma3, its rates clamped to consolidation_rate.
+/// The servo of stage (a): every axis to sigma3, its rates clamped to consolidation_rate, or to gas_rate while the
+/// cell holds a gas.
 CellServoSpec consolidation_servo(const PeriodicTriaxialParams& prm) {
   CellServoSpec s;
   for (bool& on : s.servo) on = true;
   s.sigma3 = prm.sigma3;
   s.alpha = prm.servo_alpha;
   s.max_rate = prm.consolidation_rate;
+  s.gas_rate = prm.gas_rate;
+  s.gas_volume = prm.gas_volume;
   s.stiffness_every = prm.stiffness_every;
   return s;
 }
@@ -35,6 +39,7 @@ CellServoSpec shear_servo(const PeriodicTriaxialParams& prm, const std::array<Re
   s.membrane_stiffness = prm.membrane_stiffness;
   for (int d = 0; d < 3; ++d) s.L0[d] = L0[static_cast<std::size_t>(d)];
   s.max_rate = prm.max_lateral_rate;
+  s.gas_rate = 0;  // a sheared packing is no gas, however it dilates
   return s;
 }
 
@@ -173,11 +178,13 @@ void CellServo::update(CellControl& cell) {
   if (calls_++ % spec_.stiffness_every == 0) k_ = cell.stiffness();
   const std::array<Real, 3> stress = cell.stress();
   const std::array<Real, 3> lengths = cell.lengths();
+  const Real volume = cell.volume();
   Real rate[3];
   for (std::size_t d = 0; d < 3; ++d) {
     const int a = static_cast<int>(d);
-    rate[d] = spec_.servo[d] ? servo_rate(spec_, stress[d] - servo_target(spec_, a, lengths[d]), k_[d], cell.dt())
-                             : spec_.fixed[d];
+    rate[d] = spec_.servo[d]
+                  ? servo_rate(spec_, stress[d] - servo_target(spec_, a, lengths[d]), k_[d], cell.dt(), volume)
+                  : spec_.fixed[d];
   }
   cell.set_rates(Vec3(rate[0], rate[1], rate[2]));
 }
@@ -239,7 +246,9 @@ void SnapshotSchedule::at(Real eps) {
   while (next_ < strains_.size() && eps >= strains_[next_] - 1e-9) nominal = strains_[next_++];
   if (nominal >= 0 && out_ && sim_) {
     out_->flush_series();
-    out_->write_snapshot(take_snapshot(*sim_, pct_label(nominal)));
+    // With its contacts, for `triaxdem micro` (the fabric of the packing at each snapshot).
+    const io::ContactTable contacts = contact_table(contact_set(*sim_));
+    out_->write_snapshot(take_snapshot(*sim_, pct_label(nominal)), nullptr, &contacts);
   }
 }
 

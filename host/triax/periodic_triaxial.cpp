@@ -36,7 +36,10 @@ PeriodicTriaxialParams resolve_periodic_params(Simulation& sim, PeriodicTriaxial
   if (!(prm.servo_alpha > 0 && prm.servo_alpha <= 1)) bad("servo alpha must be in (0, 1]");
   if (!(prm.stress_tolerance > 0 && prm.unbalanced_tolerance > 0)) bad("tolerances must be > 0");
   if (!(prm.record_strain > 0)) bad("record strain interval must be > 0");
-  if (prm.axial_rate < 0 || prm.max_lateral_rate < 0 || prm.consolidation_rate < 0) bad("rates must be >= 0");
+  if (prm.axial_rate < 0 || prm.max_lateral_rate < 0 || prm.consolidation_rate < 0 || prm.gas_rate < 0)
+    bad("rates must be >= 0");
+  if (!(prm.gas_solid_fraction > 0 && prm.gas_solid_fraction <= kGasSolidFractionMax))
+    bad("the gas phase's solid fraction must be in (0, " + std::to_string(kGasSolidFractionMax) + "]");
   if (prm.check_every < 1 || prm.stiffness_every < 1 || prm.max_consolidation_steps < 1)
     bad("check_every, stiffness_every and max_consolidation_steps must be >= 1");
   const GrainScales g = grain_scales(sim);
@@ -56,6 +59,10 @@ PeriodicTriaxialParams resolve_periodic_params(Simulation& sim, PeriodicTriaxial
   }
   if (prm.max_lateral_rate == 0) prm.max_lateral_rate = 5 * prm.axial_rate;
   if (prm.consolidation_rate == 0) prm.consolidation_rate = prm.max_lateral_rate;
+  // Between walls the gas is struck by the walls, which move at the rate times half the cell: no faster gas phase
+  // unless asked for (at 4x the walled cell's Z moved by 1.3 seeds' SDs, docs/performance.md).
+  if (prm.gas_rate == 0) prm.gas_rate = walled(sim) ? prm.consolidation_rate : kGasRateFactor * prm.consolidation_rate;
+  prm.gas_volume = g.v_solid / prm.gas_solid_fraction;
   return prm;
 }
 

@@ -18,6 +18,10 @@ struct CellServoSpec {
   Real L0[3] = {1, 1, 1};                 ///< m, the lengths the membrane's strain counts from
   Real alpha = 0;                         ///< the servo's gain as a fraction of the stiffness (0, 1]
   Real max_rate = 0;                      ///< 1/s, the servoed rates' clamp
+  /// 1/s, the clamp instead while the cell's volume is above gas_volume (m^3): a cell that holds a gas, far from
+  /// jamming, may close faster than a packing may form; 0 (or below max_rate): max_rate throughout.
+  Real gas_rate = 0;
+  Real gas_volume = 0;
   int stiffness_every = 1;                ///< the stiffness is summed on one call in this many, from the first
 };
 
@@ -33,12 +37,18 @@ KOKKOS_INLINE_FUNCTION Real servo_target(const CellServoSpec& s, int d, Real L) 
   return s.sigma3 + membrane_confinement(s.membrane_stiffness, L / s.L0[d] - 1);
 }
 
-/// The servoed rate (1/s) for stress error err = sigma - target (Pa) at stiffness k (Pa) over a step of dt (s):
-/// alpha err / (k dt), so that the step corrects the fraction alpha of the error, clamped to +-max_rate; with no
-/// contacts (k = 0) the clamp decides.
-KOKKOS_INLINE_FUNCTION Real servo_rate(const CellServoSpec& s, Real err, Real k, Real dt) {
-  const Real r = k > 0 ? s.alpha * err / (k * dt) : (err > 0 ? s.max_rate : (err < 0 ? -s.max_rate : Real(0)));
-  return r < -s.max_rate ? -s.max_rate : (s.max_rate < r ? s.max_rate : r);
+/// The servoed rates' clamp (1/s) of a cell of volume V (m^3): the gas phase's above gas_volume, else max_rate.
+KOKKOS_INLINE_FUNCTION Real servo_clamp(const CellServoSpec& s, Real V) {
+  return s.gas_rate > s.max_rate && V > s.gas_volume ? s.gas_rate : s.max_rate;
+}
+
+/// The servoed rate (1/s) for stress error err = sigma - target (Pa) at stiffness k (Pa) over a step of dt (s) in a
+/// cell of volume V (m^3): alpha err / (k dt), so that the step corrects the fraction alpha of the error, clamped to
+/// +-servo_clamp; with no contacts (k = 0) the clamp decides.
+KOKKOS_INLINE_FUNCTION Real servo_rate(const CellServoSpec& s, Real err, Real k, Real dt, Real V) {
+  const Real clamp = servo_clamp(s, V);
+  const Real r = k > 0 ? s.alpha * err / (k * dt) : (err > 0 ? clamp : (err < 0 ? -clamp : Real(0)));
+  return r < -clamp ? -clamp : (clamp < r ? clamp : r);
 }
 
 /// The fastest the servo can move two balls within `reach` (m) of each other apart or together (m/s): the host's bound
@@ -46,7 +56,7 @@ KOKKOS_INLINE_FUNCTION Real servo_rate(const CellServoSpec& s, Real err, Real k,
 inline Real servo_speed_bound(const CellServoSpec& s, Real reach) {
   Real rate = 0;
   for (int d = 0; d < 3; ++d) {
-    const Real r = s.servo[d] ? s.max_rate : kc::fabs(s.fixed[d]);
+    const Real r = s.servo[d] ? (s.gas_rate > s.max_rate ? s.gas_rate : s.max_rate) : kc::fabs(s.fixed[d]);
     rate = r > rate ? r : rate;
   }
   return rate * reach;
@@ -88,7 +98,7 @@ KOKKOS_INLINE_FUNCTION void servo_cell(Domain& dom, const CellServoSpec& spec, R
       continue;
     }
     const Real err = sums[CellServoSums::kStressSums + d] / V - servo_target(spec, d, dom.length(d));
-    dom.strain_rate[d] = servo_rate(spec, err, sums[CellServoSums::kStiffness + d], dt);
+    dom.strain_rate[d] = servo_rate(spec, err, sums[CellServoSums::kStiffness + d], dt, V);
   }
 }
 
