@@ -388,6 +388,27 @@ TEST(CliEdges, AFolderThatCannotBeWrittenIsRefusedBeforeAnyWork) {
   }
 }
 
+// The walled cell compares the q the data name (fixed_area or area_corrected, both of which its walls measure); data
+// that name a q it cannot give (parabolic, a membrane test's bulge correction) are refused with the measures it can,
+// before the plan, with the file and the column; the periodic cell takes such data (its two fidelities correct q).
+TEST(CliEdges, AQTheWalledCellCannotGiveIsRefusedBeforeAnyWork) {
+  const fs::path dir = dem::test::scratch_dir("cli_q_measure");
+  std::ofstream(dir / "d.csv") << "material,sigma3_kPa,eps_a_pct,q_kPa,eps_v_pct,q_measure\n"
+                                  "A,100,0,0,0,parabolic\nA,100,1,60,0.1,parabolic\nA,100,2,70,-0.1,parabolic\n"
+                                  "A,100,3,65,-0.3,parabolic\n";
+  const std::string job = "calibrate " + (dir / "d.csv").string() +
+                          " --config tests/data/crosscode/walled_base.toml --predict none -j 1 --plan -o " +
+                          (dir / "out").string();
+  const Outcome walls = triaxdem(job, dir);
+  EXPECT_EQ(walls.code, 1) << walls.output;
+  for (const std::string said : {std::string("d.csv:q_measure: 'parabolic' is not a q the cell between walls"),
+                                 std::string("fixed_area"), std::string("area_corrected")})
+    EXPECT_NE(walls.output.find(said), std::string::npos) << said << "\n" << walls.output;
+  EXPECT_EQ(walls.output.find("plan (before any packing)"), std::string::npos) << walls.output;
+  const Outcome periodic = triaxdem(job + " --reference-test periodic", dir);
+  EXPECT_EQ(periodic.code, 0) << periodic.output;
+}
+
 // A plan beyond the bound (four hours here) is refused before any packing unless --yes is given, naming its costliest
 // stage and the setting that sizes it; 64 scatter specimens of 8,000 balls with an "auto" ensemble are such a job.
 TEST(CliEdges, AJobBeyondItsBoundAsksForYes) {

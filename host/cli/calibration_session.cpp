@@ -105,6 +105,19 @@ bool walls_prediction_wanted(const Config& base, const CalibrationOptions& o) {
   return true;
 }
 
+/// The q the reference cell's tests carry: the walled cell's walls measure the deviator force over the cross-section
+/// at the start of shear and over the current one, and give the one the data name; the periodic cell gives its
+/// contacts' stress (area_corrected), whatever the data name (two fidelities take the measure up in the membrane test).
+QMeasure reference_q_measure(const Config& base, const CalibrationOptions& o, const MeasuredData& data) {
+  if (reference_cell(base, o.reference_test).periodic.boundary != CellBoundary::walls) return QMeasure::kAreaCorrected;
+  if (data.q_measure != QMeasure::kFixedArea && data.q_measure != QMeasure::kAreaCorrected)
+    throw DataError(data.path, "q_measure",
+                    std::string("'") + name_of(data.q_measure) + "' is not a q the cell between walls measures "
+                    "(allowed with the walled cell: fixed_area, the deviator force over the cross-section at the start "
+                    "of shear, or area_corrected, over the current cross-section)");
+  return data.q_measure;
+}
+
 }  // namespace
 
 Config sheared_for(Config cell, const MeasuredData& data) {
@@ -131,7 +144,8 @@ JobInputs::JobInputs(const Config& base, const CalibrationOptions& o)
                               : load_reference(o.reference, [](const std::string& n) { free_param(n); })),
       free(free_params(base, o.free)), noise(noise_options(o.noise)), predict_template(prediction_template(base, o.predict)),
       walls_prediction(walls_prediction_wanted(base, o)), workers(o.workers),
-      two_fidelity(two_fidelity_wanted(base, o.reference_test, predict_template.has_value())) {}
+      two_fidelity(two_fidelity_wanted(base, o.reference_test, predict_template.has_value())),
+      cell_q(reference_q_measure(base, o, data)) {}
 
 JobPlan JobInputs::announce_plan(const Config& base, const CalibrationOptions& o, const std::string& kind) const {
   check_folders(o, kind);
@@ -171,9 +185,16 @@ Session::Session(const Config& base, const CalibrationOptions& o, const std::str
       output(o.resume.empty() ? o.output : resumed_parent(o.resume)) {
   ranks::check_shared_folder(folder);  // every rank reads the run store there
   lab.set_run_store(folder + "/runs");
+  lab.set_q_measure(cell_q);
   if (!o.resume.empty())
     std::printf("%s: resuming in %s: the runs stored there are read, not run again\n", kind.c_str(), folder.c_str());
   for (const std::string& n : data.notes) std::printf("%s: note: %s\n", kind.c_str(), n.c_str());
+  if (lab.config().periodic.boundary == CellBoundary::walls)
+    std::printf("%s: note: the walled cell compares its q over the %s cross-section (%s%s); its walls also give q "
+                "over the %s one (%s)\n", kind.c_str(), cell_q == QMeasure::kFixedArea ? "initial" : "current",
+                name_of(cell_q), data.q_measure_given ? ", the data's q_measure" : ", taken where the data say no "
+                "q_measure: name yours in a q_measure column", cell_q == QMeasure::kFixedArea ? "current" : "initial",
+                cell_q == QMeasure::kFixedArea ? "area_corrected" : "fixed_area");
   if (const Real end = lab.config().periodic.triax.target_strain; end < base.periodic.triax.target_strain)
     std::printf("%s: note: the cell shears to %.3g%% axial strain, a tenth beyond the data's last, not to the "
                 "config's %.3g%% ([periodic] target_axial_strain_pct): the data compare nothing beyond\n", kind.c_str(),

@@ -59,6 +59,7 @@ struct JobInputs {
   bool walls_prediction = false;  ///< the prediction is the reference cell between six walls (kPredictWalls)
   int workers = 1;
   bool two_fidelity = false;  ///< the reference test: the periodic cell corrected by the membrane test
+  QMeasure cell_q = QMeasure::kAreaCorrected;  ///< the q the reference cell's tests carry (reference_q_measure)
   JobInputs(const Config& base, const CalibrationOptions& o);
   /// The job's plan (host/fit/job_plan.hpp), printed. A plan above kPlanBoundSeconds without --yes is refused
   /// (ConfigError naming its costliest stage and the setting that sizes it).

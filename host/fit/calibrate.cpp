@@ -119,19 +119,32 @@ class Search {
     for (int k = 0; k < d_; ++k) set_param(m, free_[k].name, free_[k].value(u[k]));
     return m;
   }
-  /// The 3^d design: each parameter at the ends and the middle of its range, the centre first (its chi2 bounds the
-  /// screening of the corners).
+  /// The 3^d design: each parameter at the ends and the middle of its range, the centre first. Every point is
+  /// probed on the simulator's first part (kProbe) before any is run whole: the best probe bounds the screening of
+  /// all, where the centre alone, often far from the optimum, bounded little.
   void design() {
     long points = 1;
     for (int k = 0; k < d_; ++k) points *= 3;
     const long centre = (points - 1) / 2;  // every digit 1 in base 3
+    std::vector<std::vector<Real>> us;
     for (long i = 0; i < points; ++i) {
       const long p = i == 0 ? centre : i <= centre ? i - 1 : i;
       std::vector<Real> u(d_);
       long c = p;
       for (int k = 0; k < d_; ++k, c /= 3) u[k] = 0.5 * static_cast<Real>(c % 3);
-      evaluate(u);
+      us.push_back(u);
     }
+    std::vector<char> whole(us.size(), 0);
+    for (std::size_t i = 0; i < us.size(); ++i) {
+      SimulatedPoint s = simulate_(model_at(us[i]), kProbe);
+      probe_best_ = std::min(probe_best_, sum_sq(s.r));
+      if (!s.screened) {  // a simulator without parts ran it whole
+        record(us[i], std::move(s));
+        whole[i] = 1;
+      }
+    }
+    for (std::size_t i = 0; i < us.size(); ++i)
+      if (!whole[i]) evaluate(us[i]);
   }
   /// Up to `rounds` surrogate steps, until one points at a point already run or stops improving by 2%.
   void surrogate_rounds(int rounds) {
@@ -180,13 +193,16 @@ class Search {
     }
     return false;
   }
-  /// Runs u (screened against the best so far); its chi2.
+  /// Runs u (screened against the best so far, the probes' included); its chi2.
   Real evaluate(const std::vector<Real>& u) {
-    const Real best = res.design.empty() ? known_best_ : std::min(known_best_, res.best.chi2);
+    const Real best = std::min(probe_best_, res.design.empty() ? known_best_ : std::min(known_best_, res.best.chi2));
+    return record(u, simulate_(model_at(u), std::isfinite(best) ? screen_bound(best, res.data, d_)
+                                                                : std::numeric_limits<Real>::infinity()));
+  }
+  /// Keeps the point u simulated as s in the design, and as the best where it is; its chi2.
+  Real record(const std::vector<Real>& u, SimulatedPoint s) {
     Evaluation e;
     e.u = u;
-    SimulatedPoint s = simulate_(model_at(u), std::isfinite(best) ? screen_bound(best, res.data, d_)
-                                                                  : std::numeric_limits<Real>::infinity());
     e.sim = std::move(s.sim);
     e.r = std::move(s.r);
     e.chi2 = sum_sq(e.r);
@@ -212,6 +228,9 @@ class Search {
   const std::vector<FreeParam>& free_;
   int d_;
   Real known_best_;
+  /// The least chi2 of the design's probes: one member's, above the ensemble mean's by the members' spread on
+  /// average.
+  Real probe_best_ = std::numeric_limits<Real>::infinity();
 };
 
 /// The least chi2 of the design's points whose coordinate k lies inside its range (not on an edge).

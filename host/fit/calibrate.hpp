@@ -48,6 +48,7 @@
 /// A widened search takes the best chi2 of the search before as its bound.
 #include <array>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -157,8 +158,10 @@ struct SimulatedPoint {
 };
 /// The simulator at a model, given a chi2 bound (`screen_above`) above which the point matters to the search only as
 /// worse than its best: the simulator may then run it on part of its ensemble and return that part's estimate, where
-/// that lies clearly above (infinity: run it whole).
+/// that lies clearly above (infinity: run it whole). kProbe asks for the part alone, screened, as a probe: a later
+/// call at the same model goes on from it (a simulator without parts returns the whole point, not screened).
 using Simulator = std::function<SimulatedPoint(const Model& m, Real screen_above)>;
+inline constexpr Real kProbe = -std::numeric_limits<Real>::infinity();
 
 /// The 95% quantile of chi2 with d degrees of freedom: the table's for d = 1..4, where Wilson-Hilferty is up to 3%
 /// low, chi2_quantile beyond.

@@ -55,6 +55,7 @@ CellBias measure_cell_bias(PeriodicLab& lab, const Model& base, const std::vecto
   const Config cfg = matched_state(bigger, measured, state, lab.verbose(), plan);
   PeriodicLab check(cfg, lab.verbose(), kCellCheckSpecimens, plan.first_seed, kCellCheckSpecimens, lab.workers());
   check.set_run_store(lab.run_store());  // its own specimens: their runs have their own names there
+  check.set_q_measure(lab.q_measure());
   if (lab.verbose()) check.set_progress("triaxdem: the cell's bias check");
   const Ensemble larger = check.run_ensemble(base, measured, true);
   const Real n = static_cast<Real>(lab.balls()), factor = static_cast<Real>(check.balls()) / n;

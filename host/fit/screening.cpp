@@ -33,6 +33,8 @@ CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vect
                        lab.members();
   Real best = std::numeric_limits<Real>::infinity();
   const Real spread = misfit.member_spread();
+  // The first parts that probes ran, each taken up by its point's next call.
+  std::vector<std::pair<Model, Ensemble>> probed;
   auto simulate = [&](const Model& m, Real screen_above) {
     SimulatedPoint s;
     const std::size_t K = static_cast<std::size_t>(lab.members()), T = measured.size(),
@@ -40,14 +42,22 @@ CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vect
     // The first member's tests, and as many of the next member's as fill the workers' last round: a point that is
     // not screened then takes the rounds of the whole ensemble at once.
     const std::size_t first = std::min(T * K, (T + W - 1) / W * W);
-    const bool screen = K > 1 && first < T * K && std::isfinite(screen_above);
-    Ensemble ens = lab.run_part(m, measured, K, 0, screen ? first : T * K);
-    if (screen) {
+    const bool parts = K > 1 && first < T * K && (screen_above == kProbe || std::isfinite(screen_above));
+    const auto was = std::find_if(probed.begin(), probed.end(), [&](const auto& p) { return same_model(p.first, m); });
+    Ensemble ens;
+    if (was != probed.end()) {
+      ens = std::move(was->second);
+      probed.erase(was);
+    } else {
+      ens = lab.run_part(m, measured, K, 0, parts ? first : T * K);
+    }
+    if (ens.back().size() < K) {  // the first part: the last test has its first member only
       Ensemble one(T);
       for (std::size_t k = 0; k < T; ++k) one[k].push_back(ens[k].front());
       s.r = misfit.residuals(one);
-      s.screened = clearly_above(s.r, spread, screen_above);
+      s.screened = screen_above == kProbe || clearly_above(s.r, spread, screen_above);
       if (s.screened) {
+        if (screen_above == kProbe) probed.emplace_back(m, ens);
         ens = one;
       } else {
         const Ensemble rest = lab.run_part(m, measured, K, first, T * K);

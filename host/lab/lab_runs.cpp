@@ -2,6 +2,7 @@
 /// batch (CellBatch), or read back from the run store; and what a run gives the lab.
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -30,11 +31,15 @@ void mark_failed(TriaxialTest& t) {
       std::numeric_limits<Real>::quiet_NaN();
 }
 
-/// A run's test as the lab reports it: its curves summarised, or, for a run that blew up (null), a missing test.
-TriaxialTest lab_test(const PeriodicTriaxialResult* r, Real sigma3, const std::string& material) {
+/// A run's test as the lab reports it: its curves summarised, q as `measure` (PeriodicLab::set_q_measure), or, for a
+/// run that blew up (null), a missing test.
+TriaxialTest lab_test(const PeriodicTriaxialResult* r, Real sigma3, const std::string& material, QMeasure measure) {
   TriaxialTest t;
   if (r) {
-    t = summarised(r->series, sigma3);
+    std::vector<PeriodicTriaxialRecord> rows = r->series;
+    if (measure == QMeasure::kFixedArea)
+      for (PeriodicTriaxialRecord& row : rows) row.q = row.q_fixed_area;
+    t = summarised(rows, sigma3);
     t.void_ratio = r->void_ratio0;
   } else {
     t.sigma3 = sigma3;
@@ -53,9 +58,9 @@ TriaxialTest PeriodicLab::run(const Model& m, Real sigma3, const std::string& ma
   try {
     auto sim = make_periodic_simulation(sp.balls, sp.cell, m.law, cfg_.solver, cfg_.periodic.boundary);
     const PeriodicTriaxialResult r = run_periodic_triaxial(*sim, test_params(m, sigma3));
-    t = lab_test(&r, sigma3, material);
+    t = lab_test(&r, sigma3, material, q_measure_);
   } catch (const BlowUp&) {
-    t = lab_test(nullptr, sigma3, material);
+    t = lab_test(nullptr, sigma3, material, q_measure_);
   }
   count_runs(1, t0);
   return t;
@@ -112,7 +117,18 @@ bool receive_curves(int fd, TriaxialTest& t) {
   return true;
 }
 
+bool same_model(const Model& a, const Model& b) {
+  return std::memcmp(&a.law, &b.law, sizeof a.law) == 0 && std::memcmp(&a.membrane, &b.membrane, sizeof a.membrane) == 0;
+}
+
 void PeriodicLab::set_run_store(std::string folder) { store_ = std::move(folder); }
+
+void PeriodicLab::set_q_measure(QMeasure m) {
+  if (m != QMeasure::kAreaCorrected && m != QMeasure::kFixedArea)
+    throw std::invalid_argument(std::string("PeriodicLab: a cell gives q as area_corrected or fixed_area, not ") +
+                                name_of(m));
+  q_measure_ = m;
+}
 
 std::string PeriodicLab::stored_path(const Model& m, const Case& c) const {
   if (store_.empty()) return "";
@@ -120,6 +136,7 @@ std::string PeriodicLab::stored_path(const Model& m, const Case& c) const {
   h = fnv1a(&m.law, sizeof m.law, h);  // Reals only: no padding
   h = fnv1a(&m.membrane, sizeof m.membrane, h);
   h = fnv1a(&c.sigma3, sizeof c.sigma3, h);
+  if (q_measure_ != QMeasure::kAreaCorrected) h = fnv1a(&q_measure_, sizeof q_measure_, h);  // earlier runs' names kept
   const PackedCell& sp = specimens_.at(static_cast<std::size_t>(c.member));
   for (const BallSpec& b : sp.balls) {
     const Real v[] = {b.x.x, b.x.y, b.x.z, b.v.x, b.v.y, b.v.z, b.w.x, b.w.y, b.w.z, b.radius, b.density};
@@ -231,7 +248,8 @@ std::vector<TriaxialTest> PeriodicLab::run_batch(const Model& m, const std::vect
   for (std::size_t j = 0; j < cases.size(); ++j) {
     // As run() meets them: a consolidation that does not converge is the job's error, a blow-up a missing test.
     if (!runs[j].failure.empty()) throw std::runtime_error(runs[j].failure);
-    out[j] = lab_test(runs[j].blowup.empty() ? &runs[j].result : nullptr, cases[j].sigma3, cases[j].material);
+    out[j] = lab_test(runs[j].blowup.empty() ? &runs[j].result : nullptr, cases[j].sigma3, cases[j].material,
+                      q_measure_);
   }
   return out;
 }

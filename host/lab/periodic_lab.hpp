@@ -27,6 +27,8 @@ struct Model {
 
 /// The model of a config: its ball law and the periodic cell's membrane.
 Model model_of(const Config& cfg);
+/// Whether two models are the same, bit for bit (their Reals: the run store names a run by the same bytes).
+bool same_model(const Model& a, const Model& b);
 
 /// Simulated tests of an ensemble: [test][member], each summarised like measured curves.
 using Ensemble = std::vector<std::vector<TriaxialTest>>;
@@ -88,6 +90,10 @@ class PeriodicLab {
   /// search from the stored runs, bit for bit. "" keeps nothing.
   void set_run_store(std::string folder);
   const std::string& run_store() const { return store_; }
+  /// Which deviator the lab's tests carry as q: the cell's own (area_corrected: over the current cross-section, the
+  /// default) or over the cross-section at the start of shear (fixed_area), as the data name theirs.
+  void set_q_measure(QMeasure m);
+  QMeasure q_measure() const { return q_measure_; }
   /// Of runs(), those read from the store instead of run.
   long stored_runs_read() const { return stored_read_; }
   /// Names the runs that follow in a progress line with ETA (each batch of runs counts them); "" for none: a
@@ -111,6 +117,7 @@ class PeriodicLab {
   double seconds_ = 0;
   std::string progress_label_;
   std::string store_;
+  QMeasure q_measure_ = QMeasure::kAreaCorrected;
   long stored_read_ = 0;
   int workers_ = 1;
   int batch_ = 1;

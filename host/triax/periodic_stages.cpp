@@ -69,6 +69,7 @@ PeriodicTriaxialRecord measure_row(CellControl& cell, const PeriodicTriaxialPara
   const std::array<Real, 3> target = lateral_targets(lengths, prm, L0);
   r.membrane = 0.5 * (target[0] + target[1]) - prm.sigma3;
   r.q = r.sigma1 - (lateral - r.membrane);
+  r.q_fixed_area = r.q * (lengths[0] * lengths[1]) / (L0[0] * L0[1]);
   r.p = (r.sigma1 + r.sigma2 + r.sigma3) / 3;
   const Real sum = r.sigma1 + lateral;
   r.phi_mob_deg = sum > 0 ? std::asin(std::clamp(r.q / sum, Real(-1), Real(1))) * 180 / kPi : 0;

@@ -52,6 +52,9 @@ struct PeriodicTriaxialRecord {
   Real eps_a = 0, eps_v = 0;
   Real sigma1 = 0, sigma2 = 0, sigma3 = 0;  ///< zz, xx, yy from the contacts
   Real q = 0, p = 0, phi_mob_deg = 0;
+  /// Pa, q over the cross-section at the start of shear (L_x L_y there): the deviator force over a fixed area, as a
+  /// lab that does not correct its area reports it (q_measure fixed_area); q is over the current cross-section.
+  Real q_fixed_area = 0;
   Real void_ratio = 0;               ///< V / V_solid - 1
   Real coordination = 0;             ///< 2 x touching ball-ball contacts / balls (rattlers included)
   Real unbalanced = 0, kinetic = 0;  ///< unbalanced-force ratio, fluctuating kinetic energy (J)
