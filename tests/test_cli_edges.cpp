@@ -409,6 +409,26 @@ TEST(CliEdges, AQTheWalledCellCannotGiveIsRefusedBeforeAnyWork) {
   EXPECT_EQ(periodic.code, 0) << periodic.output;
 }
 
+// Between walls the specimen's size is part of the test: data without specimen_balls are taken to be of the walled
+// cell's balls, so the plan has no cell's bias check (it extrapolated the walled cell to an infinite specimen, 4 cells
+// of 4,000 balls for the 1,000-ball base); given a larger specimen, the check runs toward it.
+TEST(CliEdges, AWalledCellTakesItsBallsAsTheDatasSpecimen) {
+  const fs::path dir = dem::test::scratch_dir("cli_walled_size");
+  std::ofstream(dir / "d.csv") << "material,sigma3_kPa,eps_a_pct,q_kPa,eps_v_pct,q_measure\n"
+                                  "A,100,0,0,0,area_corrected\nA,100,1,60,0.1,area_corrected\n"
+                                  "A,100,2,70,-0.1,area_corrected\nA,100,3,65,-0.3,area_corrected\n";
+  std::ofstream(dir / "big.csv") << "material,sigma3_kPa,eps_a_pct,q_kPa,eps_v_pct,q_measure,specimen_balls\n"
+                                    "A,100,0,0,0,area_corrected,4000\nA,100,1,60,0.1,area_corrected,4000\n"
+                                    "A,100,2,70,-0.1,area_corrected,4000\nA,100,3,65,-0.3,area_corrected,4000\n";
+  for (const char* file : {"d.csv", "big.csv"}) {
+    const Outcome o = triaxdem("calibrate " + (dir / file).string() + " --config tests/data/crosscode/walled_base.toml "
+                               "--predict none -j 1 --plan -o " + (dir / "out").string(), dir);
+    EXPECT_EQ(o.code, 0) << o.output;
+    const bool check = o.output.find("cell's bias check, runs: ") != std::string::npos;
+    EXPECT_EQ(check, std::string(file) == "big.csv") << file << "\n" << o.output;
+  }
+}
+
 // A plan beyond the bound (four hours here) is refused before any packing unless --yes is given, naming its costliest
 // stage and the setting that sizes it; 64 scatter specimens of 8,000 balls with an "auto" ensemble are such a job.
 TEST(CliEdges, AJobBeyondItsBoundAsksForYes) {

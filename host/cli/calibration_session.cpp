@@ -118,6 +118,26 @@ QMeasure reference_q_measure(const Config& base, const CalibrationOptions& o, co
   return data.q_measure;
 }
 
+/// Between walls the specimen's size is part of the test (the walls' looser layer falls as N^-1/3): tests that give
+/// no specimen_balls are taken to be of the walled cell's balls, with a note, where the cell's bias check would have
+/// extrapolated the cell to an infinite specimen and counted the walls' share as the simulator's bias.
+void take_walled_size(const Config& base, const CalibrationOptions& o, MeasuredData& data) {
+  const Config cell = reference_cell(base, o.reference_test);
+  if (cell.periodic.boundary != CellBoundary::walls) return;
+  const Real balls = static_cast<Real>(cell.particles.count * std::max(cell.calibrate.cell_factor, 1L));
+  bool took = false;
+  for (TriaxialTest& t : data.tests)
+    if (!std::isfinite(t.specimen_balls)) {
+      t.specimen_balls = balls;
+      took = true;
+    }
+  if (took)
+    data.notes.push_back("no specimen_balls: the walled cell takes its " + fmt("%.0f", balls) +
+                         " balls as the data's specimen (between walls the size is part of the test, and the cell's "
+                         "bias is not extrapolated to an infinite one); give specimen_balls where the data's specimen "
+                         "differs");
+}
+
 }  // namespace
 
 Config sheared_for(Config cell, const MeasuredData& data) {
@@ -145,7 +165,9 @@ JobInputs::JobInputs(const Config& base, const CalibrationOptions& o)
       free(free_params(base, o.free)), noise(noise_options(o.noise)), predict_template(prediction_template(base, o.predict)),
       walls_prediction(walls_prediction_wanted(base, o)), workers(o.workers),
       two_fidelity(two_fidelity_wanted(base, o.reference_test, predict_template.has_value())),
-      cell_q(reference_q_measure(base, o, data)) {}
+      cell_q(reference_q_measure(base, o, data)) {
+  take_walled_size(base, o, data);
+}
 
 JobPlan JobInputs::announce_plan(const Config& base, const CalibrationOptions& o, const std::string& kind) const {
   check_folders(o, kind);
