@@ -356,7 +356,7 @@ TEST(CliEdges, APlanIsPrintedBeforeAnyPackingAndPlanStopsThere) {
     const Outcome o = triaxdem(std::string(kind) + " " + (dir / "d.csv").string() + " --config tests/data/hidden_effects.toml "
                                "--predict none -j 1 --plan -o " + (dir / "out").string(), dir);
     EXPECT_EQ(o.code, 0) << o.output;
-    for (const std::string line : {std::string(kind) + ": plan (before any packing):", std::string("scatter runs: "),
+    for (const std::string& line : {std::string(kind) + ": plan (before any packing):", std::string("scatter runs: "),
                                    std::string("cell's bias check, runs: "), std::string(kind) + ": in all ",
                                    std::string("ns a particle-step")})
       EXPECT_NE(o.output.find(line), std::string::npos) << line << "\n" << o.output;
@@ -401,7 +401,7 @@ TEST(CliEdges, AQTheWalledCellCannotGiveIsRefusedBeforeAnyWork) {
                           (dir / "out").string();
   const Outcome walls = triaxdem(job, dir);
   EXPECT_EQ(walls.code, 1) << walls.output;
-  for (const std::string said : {std::string("d.csv:q_measure: 'parabolic' is not a q the cell between walls"),
+  for (const std::string& said : {std::string("d.csv:q_measure: 'parabolic' is not a q the cell between walls"),
                                  std::string("fixed_area"), std::string("area_corrected")})
     EXPECT_NE(walls.output.find(said), std::string::npos) << said << "\n" << walls.output;
   EXPECT_EQ(walls.output.find("plan (before any packing)"), std::string::npos) << walls.output;
