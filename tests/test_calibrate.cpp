@@ -819,6 +819,25 @@ struct Bowl {
   }
 };
 
+/// The base model the bowls are searched from.
+Model bowl_base() {
+  Model base;
+  base.law.mu_s = 0.3;
+  base.law.mu_r = 0.02;
+  return base;
+}
+
+/// A bowl with `data` residuals and 4 members, least chi2 at (x0, y0): searched without screening (first) and with it
+/// (second), each on its own copy, whose runs are counted.
+struct BowlSearches {
+  Bowl full, screened;
+  CalibrationResult unscreened, with_screening;
+  BowlSearches(int data, Real x0, Real y0, unsigned seed)
+      : full(bowl_base(), data, 4, x0, y0, seed), screened(bowl_base(), data, 4, x0, y0, seed),
+        unscreened(calibrate(full.simulator(false), bowl_base(), full.free, data)),
+        with_screening(calibrate(screened.simulator(true), bowl_base(), screened.free, data)) {}
+};
+
 /// Expects the screened search's optimum inside the unscreened one's intervals and its intervals' widths within 20%.
 void expect_same_answer(const CalibrationResult& screened, const CalibrationResult& full) {
   EXPECT_FALSE(screened.best.screened);
@@ -840,12 +859,9 @@ void expect_same_answer(const CalibrationResult& screened, const CalibrationResu
 // 1 run instead of 4; the best point and the intervals are those of the unscreened search (the surfaces weigh a
 // screened point little: it lies far above).
 TEST(Calibrate, ScreeningFindsTheSameOptimumWithFewerRuns) {
-  Model base;
-  base.law.mu_s = 0.3;
-  base.law.mu_r = 0.02;
-  Bowl full_bowl(base, 6, 4, 0.3, 0.4, 3), screened_bowl(base, 6, 4, 0.3, 0.4, 3);
-  const CalibrationResult full = calibrate(full_bowl.simulator(false), base, full_bowl.free, 6),
-                          screened = calibrate(screened_bowl.simulator(true), base, screened_bowl.free, 6);
+  const BowlSearches b(6, 0.3, 0.4, 3);
+  const Bowl &full_bowl = b.full, &screened_bowl = b.screened;
+  const CalibrationResult &full = b.unscreened, &screened = b.with_screening;
   std::printf("screening: %ld runs against %ld; mu_s %.4g and %.4g, mu_r %.4g and %.4g\n", screened_bowl.runs,
               full_bowl.runs, screened.values[0], full.values[0], screened.values[1], full.values[1]);
   long dropped = 0;
@@ -862,12 +878,9 @@ TEST(Calibrate, ScreeningFindsTheSameOptimumWithFewerRuns) {
 // (a probe's member is taken up by its point's run), the design's far corners cost one run instead of four, and the
 // answer is the unscreened search's.
 TEST(Calibrate, ProbingTheDesignFirstScreensItsFarCorners) {
-  Model base;
-  base.law.mu_s = 0.3;
-  base.law.mu_r = 0.02;
-  Bowl full_bowl(base, 3, 4, 0.1, 0.15, 11), screened_bowl(base, 3, 4, 0.1, 0.15, 11);
-  const CalibrationResult full = calibrate(full_bowl.simulator(false), base, full_bowl.free, 3),
-                          screened = calibrate(screened_bowl.simulator(true), base, screened_bowl.free, 3);
+  const BowlSearches b(3, 0.1, 0.15, 11);
+  const Bowl &full_bowl = b.full, &screened_bowl = b.screened;
+  const CalibrationResult &full = b.unscreened, &screened = b.with_screening;
   long dropped = 0, whole = 0, design_dropped = 0;
   for (std::size_t i = 0; i < screened.design.size(); ++i) {
     const Evaluation& e = screened.design[i];
