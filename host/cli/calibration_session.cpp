@@ -211,12 +211,14 @@ Session::Session(const Config& base, const CalibrationOptions& o, const std::str
   if (!o.resume.empty())
     std::printf("%s: resuming in %s: the runs stored there are read, not run again\n", kind.c_str(), folder.c_str());
   for (const std::string& n : data.notes) std::printf("%s: note: %s\n", kind.c_str(), n.c_str());
-  if (lab.config().periodic.boundary == CellBoundary::walls)
+  if (lab.config().periodic.boundary == CellBoundary::walls) {
+    const bool fixed = cell_q == QMeasure::kFixedArea;
     std::printf("%s: note: the walled cell compares its q over the %s cross-section (%s%s); its walls also give q "
-                "over the %s one (%s)\n", kind.c_str(), cell_q == QMeasure::kFixedArea ? "initial" : "current",
-                name_of(cell_q), data.q_measure_given ? ", the data's q_measure" : ", taken where the data say no "
-                "q_measure: name yours in a q_measure column", cell_q == QMeasure::kFixedArea ? "current" : "initial",
-                cell_q == QMeasure::kFixedArea ? "area_corrected" : "fixed_area");
+                "over the %s one (%s)\n", kind.c_str(), fixed ? "initial" : "current", name_of(cell_q),
+                data.q_measure_given ? ", the data's q_measure"
+                                     : ", taken where the data say no q_measure: name yours in a q_measure column",
+                fixed ? "current" : "initial", name_of(fixed ? QMeasure::kAreaCorrected : QMeasure::kFixedArea));
+  }
   if (const Real end = lab.config().periodic.triax.target_strain; end < base.periodic.triax.target_strain)
     std::printf("%s: note: the cell shears to %.3g%% axial strain, a tenth beyond the data's last, not to the "
                 "config's %.3g%% ([periodic] target_axial_strain_pct): the data compare nothing beyond\n", kind.c_str(),

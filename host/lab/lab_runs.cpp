@@ -36,10 +36,13 @@ void mark_failed(TriaxialTest& t) {
 TriaxialTest lab_test(const PeriodicTriaxialResult* r, Real sigma3, const std::string& material, QMeasure measure) {
   TriaxialTest t;
   if (r) {
-    std::vector<PeriodicTriaxialRecord> rows = r->series;
-    if (measure == QMeasure::kFixedArea)
+    if (measure == QMeasure::kFixedArea) {
+      std::vector<PeriodicTriaxialRecord> rows = r->series;
       for (PeriodicTriaxialRecord& row : rows) row.q = row.q_fixed_area;
-    t = summarised(rows, sigma3);
+      t = summarised(rows, sigma3);
+    } else {
+      t = summarised(r->series, sigma3);
+    }
     t.void_ratio = r->void_ratio0;
   } else {
     t.sigma3 = sigma3;
