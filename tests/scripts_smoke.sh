@@ -114,6 +114,11 @@ if [ "$part" != tools ]; then
   check perf/hidden_sweep "$build/perf/hidden_sweep" --config "$base" --seeds 1 --hidden none -j 1 --data-cell-factor 1 \
     -o "$work/sweep.csv"
   exists "$work/sweep.csv"
+  # Table 6 by the loop: each case's plan (a case runs 30-60 minutes), then the table, whose rows say "not run".
+  check perf/table6_loop.sh env BUILD="$build" WORK="$work/table6" MATERIALS=S-1 CASES="all 300" JOBS=1 PLAN=1 \
+    bash "$root/perf/table6_loop.sh"
+  [ "$(grep -c '^| S-1 | .* | not run |' "$work/table6_loop.sh.log")" = 2 ] ||
+    { cat "$work/table6_loop.sh.log"; echo "scripts_smoke: table6_loop gave no row per case" >&2; exit 1; }
   check perf/inertial_scan "$build/perf/inertial_scan" --config "$base" --specimens 2 --pressures 100 \
     --inertial 1e-3,4e-3 -j 1 -o "$work/inertial.csv"
   exists "$work/inertial.csv"

@@ -426,7 +426,43 @@ TEST(CliEdges, AWalledCellTakesItsBallsAsTheDatasSpecimen) {
     EXPECT_EQ(o.code, 0) << o.output;
     const bool check = o.output.find("cell's bias check, runs: ") != std::string::npos;
     EXPECT_EQ(check, std::string(file) == "big.csv") << file << "\n" << o.output;
+    // A walled cell smaller than the data's specimen is said before any work, with what it does to the interior.
+    const bool smaller = o.output.find("note: the walled cell of 1000 balls is smaller than the data's specimen of 4000: "
+                                       "its walls' looser layer") != std::string::npos;
+    EXPECT_EQ(smaller, std::string(file) == "big.csv") << file << "\n" << o.output;
   }
+}
+
+// --hold-out leaves a pressure out of the fit and predicts it: the plan fits the other two tests and predicts all three;
+// a pressure the data lack, or one that would leave a material nothing to fit, is refused before any work, naming
+// the file, the option and the data's pressures.
+TEST(CliEdges, AHeldOutPressureIsLeftOutOfTheFitAndPredicted) {
+  const fs::path dir = dem::test::scratch_dir("cli_hold_out");
+  {
+    std::ofstream d(dir / "d.csv");
+    d << "material,sigma3_kPa,eps_a_pct,q_kPa,eps_v_pct\n";
+    for (int s3 : {100, 200, 300})
+      d << "A," << s3 << ",0,0,0\nA," << s3 << ",1," << 0.6 * s3 << ",0.1\nA," << s3 << ",2," << 0.7 * s3
+        << ",-0.1\nA," << s3 << ",3," << 0.65 * s3 << ",-0.3\n";
+    d << "B,300,0,0,0\nB,300,1,180,0.1\nB,300,2,210,-0.1\nB,300,3,195,-0.3\n";
+  }
+  const std::string job = "calibrate " + (dir / "d.csv").string() +
+                          " --config configs/calibration/base.toml --predict configs/small/S1_100kPa.toml -j 1 --plan -o " +
+                          (dir / "out").string();
+  const Outcome held = triaxdem(job + " --material A --hold-out 300", dir);
+  EXPECT_EQ(held.code, 0) << held.output;
+  for (const std::string& said : {std::string("A: search: 22 points x 2 tests"), std::string("1 held out")})
+    EXPECT_NE(held.output.find(said), std::string::npos) << said << "\n" << held.output;
+  const Outcome missing = triaxdem(job + " --material A --hold-out 250", dir);
+  EXPECT_EQ(missing.code, 1) << missing.output;
+  EXPECT_NE(missing.output.find("d.csv: --hold-out 250 kPa: no test at that pressure (the data's, kPa: 100, 200, 300)"),
+            std::string::npos) << missing.output;
+  const Outcome alone = triaxdem(job + " --hold-out 300", dir);
+  EXPECT_EQ(alone.code, 1) << alone.output;
+  EXPECT_NE(alone.output.find("--hold-out 300 kPa: material B has no other test to fit"), std::string::npos)
+      << alone.output;
+  for (const Outcome* o : {&missing, &alone})
+    EXPECT_EQ(o->output.find("plan (before any packing)"), std::string::npos) << o->output;
 }
 
 // A plan beyond the bound (four hours here) is refused before any packing unless --yes is given, naming its costliest

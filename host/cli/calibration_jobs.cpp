@@ -150,19 +150,22 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
     };
     CalibrationResult r = fit(misfit, "calibrate");
     if (ss.two_fidelity) {
-      // The boundary's discrepancy at the periodic optimum, then the cell calibrated to the data less it.
-      std::printf("calibrate: %s: two fidelities: the membrane test and every periodic specimen at the periodic "
-                  "optimum\n", material.c_str());
-      const std::vector<Prediction> mem = ss.predict_at(base, r.model, tests);
-      const Discrepancy d = measure_discrepancy(misfit, mem, ss.lab.run_ensemble(r.model, tests, true));
-      const std::string text = discrepancy_text(misfit, d, tests);
-      std::printf("%s", text.c_str());
-      ss.discrepancy += text;
-      Misfit corrected = misfit;
-      corrected.add_discrepancy(d.delta, d.sd, "two fidelities: the data less the membrane test's excess over the "
-                                               "periodic cell at the periodic optimum (" + ss.predict_template->path +
-                                               "), with its standard error");
-      r = fit(corrected, "calibrate (corrected)");
+      // The boundary's discrepancy at each optimum, and the cell calibrated to the data less it, to a fixed point.
+      int round = 0;
+      const FidelityRounds rounds = two_fidelity_rounds(r, misfit, tests, [&](const Model& at) {
+        std::printf("calibrate: %s: two fidelities, round %d: the membrane test and every periodic specimen at the "
+                    "last optimum\n", material.c_str(), ++round);
+        const Discrepancy d = measure_discrepancy(misfit, ss.predict_at(base, at, tests),
+                                                  ss.lab.run_ensemble(at, tests, true));
+        std::printf("%s", discrepancy_text(misfit, d, tests).c_str());
+        return d;
+      }, [&](const Misfit& corrected) {
+        return fit(corrected, "calibrate (corrected, round " + std::to_string(round) + ")");
+      }, ss.predict_template->path);
+      const std::string text = rounds.text();
+      std::printf("calibrate: %s: two fidelities:\n%s", material.c_str(), text.c_str());
+      ss.discrepancy += "### " + material + "\n\n" + text + "\n";
+      r = rounds.last();
     }
     for (std::size_t k = 0; k < ss.free.size(); ++k) {
       const FreeParam& f = ss.free[k];
@@ -182,7 +185,10 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
                 ss.lab.runs() - runs0);
     all_meas.insert(all_meas.end(), tests.begin(), tests.end());
     all_sim.insert(all_sim.end(), r.best.sim.begin(), r.best.sim.end());
-    models[material] = Calibrated{tests, r.model, r.best.sim};
+    std::vector<TriaxialTest> held;
+    for (const TriaxialTest& t : ss.held_out)
+      if (t.material == material) held.push_back(t);
+    models[material] = Calibrated{tests, r.model, r.best.sim, held};
   }
   if (ss.two_fidelity)
     std::printf("calibrate: two fidelities: the table sets the periodic cell against the data as measured; it was "
@@ -227,7 +233,9 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
     for (const std::string& name : dg.base.at_edge()) edge += (edge.empty() ? "" : ", ") + name;
     if (!edge.empty())
       std::printf("diagnose: %s: WARNING: %s at the edge of the search range\n", material.c_str(), edge.c_str());
-    md << "## " << material << "\n\n**Verdict: " << dg.verdict << ".** " << dg.explanation << "\n\n"
+    md << "## " << material << "\n\n"
+       << (misfit.cell_bias_finding().empty() ? "" : "**Finding: the cell's bias.** " + misfit.cell_bias_finding() + "\n\n")
+       << "**Verdict: " << dg.verdict << ".** " << dg.explanation << "\n\n"
        << noise_table(misfit, tests)
        << (widened.empty() ? "" : "Search ranges: " + widened + ".\n\n")
        << (edge.empty() ? "" : "**Warning:** the base model's " + edge + " lies at the edge of its search range: the "
@@ -252,7 +260,7 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
     md << "\n";
     all_meas.insert(all_meas.end(), tests.begin(), tests.end());
     all_sim.insert(all_sim.end(), dg.base.best.sim.begin(), dg.base.best.sim.end());
-    models[material] = Calibrated{tests, dg.base.model, dg.base.best.sim};
+    models[material] = Calibrated{tests, dg.base.model, dg.base.best.sim, {}};
   }
   if (ss.lab.failed_runs() > 0) md << "**Warning:** " << ss.failed_text() << ".\n\n";
   md << "![measured and simulated: the base model in full lines, the extended one dashed](calibration.png)\n";

@@ -27,6 +27,9 @@ struct CalibrationOptions {
   std::string resume;
   bool plan_only = false;  ///< --plan: print the plan (what runs, about how long) and stop before any packing
   bool yes = false;        ///< --yes: run a plan longer than kPlanBoundSeconds
+  /// --hold-out: the confining pressure (kPa) whose tests the calibration leaves out and the prediction predicts
+  /// (NaN: none), a test of the transfer to a pressure the fit never saw.
+  Real hold_out_kPa = std::numeric_limits<Real>::quiet_NaN();
 };
 
 /// Calibrates each material of the data; writes calibrate_<date>/ under options.output. Returns 0.

@@ -2,6 +2,8 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "host/fit/calibration_report.hpp"
@@ -131,11 +133,45 @@ void take_walled_size(const Config& base, const CalibrationOptions& o, MeasuredD
       t.specimen_balls = balls;
       took = true;
     }
+  Real largest = 0;
+  for (const TriaxialTest& t : data.tests) largest = std::max(largest, t.specimen_balls);
+  if (largest > balls * 1.01)
+    data.notes.push_back("the walled cell of " + fmt("%.0f", balls) + " balls is smaller than the data's specimen of " +
+                         fmt("%.0f", largest) + ": its walls' looser layer is a larger share of it (the share falls as "
+                         "N^-1/3), so matched to the data's void ratio its interior packs denser; the cell's bias check "
+                         "measures the difference, with both preparation frictions, and a walled cell of the data's "
+                         "balls ([particles] count) avoids it");
   if (took)
     data.notes.push_back("no specimen_balls: the walled cell takes its " + fmt("%.0f", balls) +
                          " balls as the data's specimen (between walls the size is part of the test, and the cell's "
                          "bias is not extrapolated to an infinite one); give specimen_balls where the data's specimen "
                          "differs");
+}
+
+/// Takes the tests at --hold-out's pressure out of `data` and returns them. Refused (DataError naming the file, the
+/// option and the data's pressures) where no test has that pressure or a material the job calibrates (--material)
+/// would keep none.
+std::vector<TriaxialTest> hold_out(const CalibrationOptions& o, MeasuredData& data) {
+  if (!std::isfinite(o.hold_out_kPa)) return {};
+  std::vector<TriaxialTest> kept, held;
+  std::string pressures;
+  for (const TriaxialTest& t : data.tests) {
+    const bool at = std::fabs(1e-3 * t.sigma3 - o.hold_out_kPa) < 0.5;  // within the half kPa the files are given in
+    (at ? held : kept).push_back(t);
+    if (pressures.find(fmt(" %g,", 1e-3 * t.sigma3)) == std::string::npos) pressures += fmt(" %g,", 1e-3 * t.sigma3);
+  }
+  if (!pressures.empty()) pressures.pop_back();
+  const std::string held_kPa = fmt("%g kPa", o.hold_out_kPa);
+  if (held.empty())
+    throw DataError(data.path + ": --hold-out " + held_kPa + ": no test at that pressure (the data's, kPa:" + pressures +
+                    ")");
+  for (const TriaxialTest& h : held)
+    if ((o.material.empty() || h.material == o.material) && std::none_of(kept.begin(), kept.end(), [&](const TriaxialTest& t) { return t.material == h.material; }))
+      throw DataError(data.path + ": --hold-out " + held_kPa + ": material " + h.material +
+                      " has no other test to fit (the data's pressures, kPa:" + pressures + ")");
+  data.tests = kept;
+  data.notes.push_back("held out: the tests at " + held_kPa + " are left out of the fit and predicted at the end");
+  return held;
 }
 
 }  // namespace
@@ -167,6 +203,7 @@ JobInputs::JobInputs(const Config& base, const CalibrationOptions& o)
       two_fidelity(two_fidelity_wanted(base, o.reference_test, predict_template.has_value())),
       cell_q(reference_q_measure(base, o, data)) {
   take_walled_size(base, o, data);
+  held_out = hold_out(o, data);
 }
 
 JobPlan JobInputs::announce_plan(const Config& base, const CalibrationOptions& o, const std::string& kind) const {
@@ -181,7 +218,9 @@ JobPlan JobInputs::announce_plan(const Config& base, const CalibrationOptions& o
   in.membrane = predict_template ? &*predict_template : nullptr;
   in.walls = walls_prediction;
   in.at_once = runs_at_once(o.workers);
+  in.held_out = held_out;
   JobPlan plan = plan_job(in);
+  for (const std::string& n : data.notes) std::printf("%s: note: %s\n", kind.c_str(), n.c_str());
   std::printf("%s", plan.text(kind).c_str());
   if (plan.high() > kPlanBoundSeconds && !o.yes && !o.plan_only) {
     const PlanStage& top = plan.costliest();
@@ -210,7 +249,6 @@ Session::Session(const Config& base, const CalibrationOptions& o, const std::str
   lab.set_q_measure(cell_q);
   if (!o.resume.empty())
     std::printf("%s: resuming in %s: the runs stored there are read, not run again\n", kind.c_str(), folder.c_str());
-  for (const std::string& n : data.notes) std::printf("%s: note: %s\n", kind.c_str(), n.c_str());
   if (lab.config().periodic.boundary == CellBoundary::walls) {
     const bool fixed = cell_q == QMeasure::kFixedArea;
     std::printf("%s: note: the walled cell compares its q over the %s cross-section (%s%s); its walls also give q "
@@ -302,6 +340,8 @@ Misfit Session::misfit_of(const Config& base, const std::string& material, const
   lab.set_progress("");
   state = budget.state;  // a grown cell was matched again: the next material's budget starts from it
   const Misfit m(tests, noise, budget);
+  if (!m.cell_bias_finding().empty())
+    std::printf("%s: %s: FINDING: %s\n", folder.c_str(), material.c_str(), m.cell_bias_finding().c_str());
   for (const std::string& n : m.notes()) std::printf("  noise: %s\n", n.c_str());
   const Real ratio = m.ensemble_ratio();
   const bool chosen = base.calibrate.ensemble == kAutoEnsemble;
@@ -356,13 +396,15 @@ std::string Session::predict_boundary(const Config& base, const std::map<std::st
   std::vector<Prediction> all;
   std::vector<TriaxialTest> curves;
   for (const auto& [material, cal] : models) {
-    const std::vector<TriaxialTest>& tests = cal.tests;
+    std::vector<TriaxialTest> tests = cal.tests;
+    tests.insert(tests.end(), cal.held_out.begin(), cal.held_out.end());
     std::printf("%s: %s: predicting %s at the calibrated parameters: %zu pressures x %d specimens\n",
                 folder.c_str(), material.c_str(), walls ? "the walled cell" : predict_template->path.c_str(),
                 tests.size(), specimens);
     std::vector<Prediction> p = walls ? predict_walls(*walls, cal.model, tests, specimens, workers)
                                       : predict_at(base, cal.model, tests);
     for (std::size_t k = 0; k < p.size() && k < cal.sim.size(); ++k) p[k].periodic_q_peak = cal.sim[k].q_peak;
+    for (std::size_t k = cal.tests.size(); k < p.size(); ++k) p[k].held_out = true;
     for (Prediction& x : p) {
       curves.insert(curves.end(), x.members.begin(), x.members.end());
       all.push_back(std::move(x));

@@ -34,6 +34,7 @@ struct Calibrated {
   std::vector<TriaxialTest> tests;
   Model model;
   std::vector<TriaxialTest> sim;  ///< in the order of tests
+  std::vector<TriaxialTest> held_out;  ///< tests left out of the fit (--hold-out), predicted after the fitted ones
 };
 
 /// Removes a result folder that is still empty when the job ends: a refusal after the folder was made.
@@ -60,6 +61,7 @@ struct JobInputs {
   int workers = 1;
   bool two_fidelity = false;  ///< the reference test: the periodic cell corrected by the membrane test
   QMeasure cell_q = QMeasure::kAreaCorrected;  ///< the q the reference cell's tests carry (reference_q_measure)
+  std::vector<TriaxialTest> held_out;  ///< the tests --hold-out took out of `data` (the fit never sees them)
   JobInputs(const Config& base, const CalibrationOptions& o);
   /// The job's plan (host/fit/job_plan.hpp), printed. A plan above kPlanBoundSeconds without --yes is refused
   /// (ConfigError naming its costliest stage and the setting that sizes it).

@@ -207,6 +207,8 @@ void add_calibration_commands(CLI::App& app, Args& a, Commands& c) {
   };
   c.calibrate = app.add_subcommand("calibrate", "fit the free parameters to measured triaxial data");
   add_calibration(c.calibrate);
+  c.calibrate->add_option("--hold-out", a.cal.hold_out_kPa, "a confining pressure (kPa) of the data whose tests the "
+                          "fit leaves out and the prediction predicts: the transfer to a pressure it never saw");
   c.diagnose = app.add_subcommand("diagnose", "calibrate, then find which model extension explains the misfit");
   add_calibration(c.diagnose);
   c.synth = app.add_subcommand("synth", "synthetic measured curves with a hidden model extension");

@@ -11,24 +11,6 @@
 
 namespace dem {
 
-namespace {
-
-/// A quantity in the unit of the tables: MPa for the stiffness, kPa for stresses, % for the strain.
-std::pair<double, const char*> in_table_unit(int q, Real v) {
-  if (q == kInitialStiffness) return {1e-6 * v, "MPa"};
-  if (q == kStrainAtPeak) return {100 * v, "pct"};
-  if (q == kDilatancy) return {v, "-"};
-  return {1e-3 * v, "kPa"};
-}
-
-/// A feature's value and unit in the tables: q in kPa, eps_v in %, summary quantities in_table_unit.
-std::pair<double, const char*> feature_unit(const Feature& f, Real v) {
-  if (f.strain == 0) return in_table_unit(f.quantity, v);
-  return f.quantity == 0 ? std::make_pair(1e-3 * v, "kPa") : std::make_pair(100 * v, "pct");
-}
-
-}  // namespace
-
 /// The errors table (like the paper's Table 6): measured, simulated and error per test and quantity.
 namespace {
 
@@ -102,7 +84,7 @@ std::string noise_table(const Misfit& mf, const std::vector<TriaxialTest>& tests
   for (std::size_t k = 0; k < mf.tests(); ++k) {
     std::map<std::string, std::vector<std::array<Real, 4>>> by;
     for (const Feature& f : mf.features(k)) {
-      const std::string q = f.strain > 0 ? (f.quantity == 0 ? "q (kPa)" : "eps_v (%)") : f.name;
+      const std::string q = f.strain > 0 ? quantity_group(f) + (f.quantity == 0 ? " (kPa)" : " (%)") : f.name;
       const Real u = feature_unit(f, 1).first;
       by[q].push_back({u * f.data_sd, u * f.specimen_sd, u * f.ensemble_sd / std::sqrt(Real(mf.members())), u * f.cell_sd});
     }

@@ -48,4 +48,11 @@ Real cell_bias_sd(Real diff, Real diff_var, Real extrapolation);
 CellBias measure_cell_bias(PeriodicLab& lab, const Model& base, const std::vector<TriaxialTest>& measured,
                            const Ensemble& reference, const Misfit& misfit);
 
+/// The bias from the two ensembles at the base model: `reference` on the simulator's cell of `n` balls, `larger` on
+/// cells of `factor` times them (walled cells where `walls`), each test's difference beyond their scatter
+/// extrapolated to the test's specimen_balls; the note says by how much, the finding where it exceeds the data's
+/// noise. measure_cell_bias runs the larger cells and calls it.
+CellBias cell_bias_between(const Misfit& misfit, const std::vector<TriaxialTest>& measured, const Ensemble& reference,
+                           const Ensemble& larger, Real n, Real factor, bool walls);
+
 }  // namespace dem

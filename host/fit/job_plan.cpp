@@ -7,6 +7,7 @@
 #include "host/fit/calibrate.hpp"
 #include "host/fit/cell_bias.hpp"
 #include "host/fit/diagnose.hpp"
+#include "host/fit/two_fidelity.hpp"
 #include "host/lab/periodic_lab.hpp"
 #include "host/lab/run_cost.hpp"
 #include "host/lab/state_match.hpp"
@@ -85,6 +86,12 @@ struct Stages {
                            points * wall(per_point_low, each, at_once), points * wall(per_point, each, at_once)});
   }
 };
+
+/// A stage repeated 1 to kFidelityRounds times: its time at the lower end once, its work and upper end every round.
+void upto_rounds(PlanStage& p) {
+  p.particle_steps *= kFidelityRounds;
+  p.high *= kFidelityRounds;
+}
 
 /// Replays a state match on the packing store's packings alone (MatchPlan::stored_only): true, with `matched` its
 /// config, where the store holds every packing it needs.
@@ -230,24 +237,36 @@ JobPlan plan_job(const PlanInput& in) {
       const int side = std::min(in.at_once, P);
       const double one = mean_over(tests, [&](Real s) { return mem.seconds(s); });
       const double build = kMembraneSpecimenOverTest * one, tests_one = one * static_cast<double>(tests.size());
-      const double steps = mean_over(tests, [&](Real s) { return mem.steps(s); }) * static_cast<double>(mem.cell.balls) *
-                           P * (static_cast<double>(tests.size()) + kMembraneSpecimenOverTest);
+      const double test_steps = mean_over(tests, [&](Real s) { return mem.steps(s); }) *
+                                static_cast<double>(mem.cell.balls) * P;  // one pressure's, on every specimen
+      const double T_n = static_cast<double>(tests.size());
       const std::string what = std::to_string(P * static_cast<int>(tests.size())) + " membrane tests of " +
                                std::to_string(mem.cell.balls) + " balls (" + std::to_string(P) + " specimens x " + T +
                                " pressures, " + std::to_string(side) +
                                " specimens at once; a specimen in .specimens is not built again)";
       const double each = wall(P, build + tests_one, side), tests_s = wall(P, tests_one, side);
       if (in.two_fidelity && !in.diagnose) {
-        plan.stages.push_back({material + ": two fidelities, membrane tests", what, "[calibrate] predict_specimens",
-                               steps, each, each});
+        // 1 to kFidelityRounds rounds (two_fidelity_rounds), the specimens built in the first.
+        const double R = kFidelityRounds;
+        const std::string rounds = ", 1 to " + std::to_string(kFidelityRounds) + " rounds";
+        plan.stages.push_back({material + ": two fidelities, membrane tests", what + rounds,
+                               "[calibrate] predict_specimens", test_steps * (R * T_n + kMembraneSpecimenOverTest),
+                               each, each + (R - 1) * tests_s});
         add.runs(material + ": two fidelities, periodic runs", "[calibrate] scatter_specimens", lab, tests, 1, S, S,
-                 std::to_string(S * static_cast<int>(tests.size())) + " runs of " + n + " balls");
+                 std::to_string(S * static_cast<int>(tests.size())) + " runs of " + n + " balls" + rounds);
+        upto_rounds(plan.stages.back());
         add.runs(material + ": search (corrected)", "[calibrate] ensemble", lab, tests, static_cast<double>(points),
-                 K_low, K, search_what);
+                 K_low, K, search_what + rounds);
+        upto_rounds(plan.stages.back());
       }
-      // The specimens built for two fidelities are cached: the prediction tests only.
-      const double predict = in.two_fidelity && !in.diagnose ? tests_s : each;
-      plan.stages.push_back({material + ": prediction", what, "[calibrate] predict_specimens", steps, predict, predict});
+      // The specimens built for two fidelities are cached: the prediction tests only, the held-out pressures too.
+      double held = 0;
+      for (const TriaxialTest& t : in.held_out) held += t.material == material ? 1 : 0;
+      const double with_held = tests_one * (T_n + held) / T_n;
+      const double predict = wall(P, in.two_fidelity && !in.diagnose ? with_held : build + with_held, side);
+      plan.stages.push_back({material + ": prediction", what + (held > 0 ? fmt(", %.0f held out", held) : ""),
+                             "[calibrate] predict_specimens", test_steps * (T_n + held + kMembraneSpecimenOverTest),
+                             predict, predict});
     } else if (in.walls) {
       const int P = static_cast<int>(cc.predict_specimens);
       add.runs(material + ": prediction (walls)", "[calibrate] predict_specimens", lab, tests, 1, P, P,

@@ -47,6 +47,7 @@ struct PlanInput {
   const Config* membrane = nullptr;  ///< the membrane test that predicts (and corrects two fidelities), or none
   bool walls = false;                ///< the prediction is the cell between six walls
   int at_once = 1;                   ///< simulator runs at once
+  std::vector<TriaxialTest> held_out;  ///< tests left out of the fit and predicted (--hold-out)
 };
 
 /// The plan of a job; measures the engine's speed on the cells it will run (about a second).

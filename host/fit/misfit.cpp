@@ -26,6 +26,23 @@ NoiseOptions lab_noise_options(const std::string& path) {
   return o;
 }
 
+std::pair<double, const char*> in_table_unit(int q, Real v) {
+  if (q == kInitialStiffness) return {1e-6 * v, "MPa"};
+  if (q == kStrainAtPeak) return {100 * v, "pct"};
+  if (q == kDilatancy) return {v, "-"};
+  return {1e-3 * v, "kPa"};
+}
+
+std::pair<double, const char*> feature_unit(const Feature& f, Real v) {
+  if (f.strain == 0) return in_table_unit(f.quantity, v);
+  return f.quantity == 0 ? std::make_pair(1e-3 * v, "kPa") : std::make_pair(100 * v, "pct");
+}
+
+std::string quantity_group(const Feature& f) {
+  if (f.strain > 0) return f.quantity == 0 ? "q" : "eps_v";
+  return f.name;
+}
+
 namespace {
 
 /// Lab covariance of the summary quantities `idx` of measured values m (NoiseModel).

@@ -35,6 +35,7 @@
 #include <array>
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "host/data/curve_reading.hpp"
@@ -96,11 +97,22 @@ struct Feature {
   Real data_noise() const { return std::hypot(data_sd, specimen_sd); }
 };
 
+/// A quantity in the unit of the tables: MPa for the stiffness, kPa for stresses, % for the strain.
+std::pair<double, const char*> in_table_unit(int q, Real v);
+/// A feature's value and unit in the tables: q in kPa, eps_v in %, summary quantities in_table_unit.
+std::pair<double, const char*> feature_unit(const Feature& f, Real v);
+/// The quantity a feature belongs to, as the report groups them: "q" and "eps_v" for a curve's, a summary
+/// quantity's name.
+std::string quantity_group(const Feature& f);
+
 /// The simulator's finite-cell bias as measured (host/fit/cell_bias.hpp): a standard deviation per test and
 /// feature, and how it was measured, in words.
 struct CellBias {
   std::vector<std::vector<Real>> sd;
   std::string note;
+  /// Where the bias exceeds the data's noise (a quantity's median over its data): which quantities, by how much, the
+  /// likely cause and the setting that removes it, for the report's first lines; empty otherwise.
+  std::string finding;
 };
 
 /// The noise budget of one material's data, decided once (decide_noise_budget) and then only read: the simulator's
@@ -148,6 +160,8 @@ class Misfit {
   std::vector<Real> mean_values(std::size_t k, const std::vector<TriaxialTest>& members) const;
   /// What noise was used, per test and in words, for the report.
   const std::vector<std::string>& notes() const { return notes_; }
+  /// The cell's bias where it exceeds the data's noise (CellBias::finding): a set-up error to report first.
+  const std::string& cell_bias_finding() const { return cell_finding_; }
   std::string source() const { return source_; }
   Real correlation_length() const { return length_; }
   /// The simulator's standard error over the data-side noise, median over the data: the ensemble is large
@@ -168,6 +182,7 @@ class Misfit {
 
  private:
   std::vector<Real> void_ratio_;
+  std::string cell_finding_;
   /// Sigma_cell: adds the simulator's finite-cell bias (host/fit/cell_bias.hpp), each test's correlated along
   /// strain as the ensemble's scatter is (a bias moves a curve smoothly); its note goes to notes().
   void add_cell_bias(const CellBias& bias);

@@ -264,6 +264,7 @@ void Misfit::add_correlated(const std::vector<std::vector<Real>>& sd, Real Featu
 void Misfit::add_cell_bias(const CellBias& bias) {
   add_correlated(bias.sd, &Feature::cell_sd, "cell bias");
   notes_.push_back(bias.note);
+  cell_finding_ = bias.finding;
 }
 
 void Misfit::add_discrepancy(const std::vector<std::vector<Real>>& delta, const std::vector<std::vector<Real>>& sd,

@@ -51,6 +51,7 @@ struct Prediction {
   /// Pa, the calibration's periodic cell at the same parameters and pressure (NaN: not given): the membrane
   /// test exceeds it by what its boundary (membrane, platens, bulge, walls) adds to the q the data report.
   Real periodic_q_peak = std::numeric_limits<Real>::quiet_NaN();
+  bool held_out = false;               ///< a test the calibration left out (--hold-out): predicted, never fitted
 };
 
 /// One Prediction per test of `tests` from `runs` (one list of members per test): the members' mean q_peak and
@@ -73,7 +74,8 @@ std::vector<Prediction> predict_walls(const Config& walls, const Model& calibrat
 
 /// The predictions as a Markdown table (material, sigma3, measured and predicted q_peak with the members' scatter,
 /// error; the periodic cell's q_peak and the boundary's share (predicted - periodic) / predicted where given) with
-/// the mean and largest |error| and the range of the boundary's share, and as CSV rows with a header.
+/// the mean and largest |error| over the fitted tests, each held-out test's error apart, and the range of the
+/// boundary's share, and as CSV rows with a header.
 std::string prediction_markdown(const std::vector<Prediction>& p, QMeasure measure);
 std::string prediction_csv(const std::vector<Prediction>& p, QMeasure measure);
 

@@ -1,6 +1,8 @@
 #include "host/fit/two_fidelity.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "host/util/text_format.hpp"
@@ -104,6 +106,107 @@ std::string discrepancy_text(const Misfit& misfit, const Discrepancy& d, const s
          fmt("%.3f of the membrane test's q", ratio / n) + fmt("; the data's q taken down by %.1f", 1e-3 * delta / n) +
          fmt(" +- %.1f kPa (mean over ", 1e-3 * sd / n) + std::to_string(n) + " compared q values)\n";
   }
+  return s;
+}
+
+namespace {
+
+/// The parameters of `r` in words with their intervals: "mu_s 0.105 [0.085, 0.189], mu_r 0.05 [0, 0.06]".
+std::string values_text(const CalibrationResult& r) {
+  std::string s;
+  for (std::size_t k = 0; k < r.free.size(); ++k) {
+    const Real f = r.free[k].shown;
+    s += (k ? ", " : "") + r.free[k].name + fmt(" %.4g", f * r.values[k]) + fmt(" [%.4g", f * r.interval[k].first) +
+         fmt(", %.4g]", f * r.interval[k].second);
+  }
+  return s;
+}
+
+}  // namespace
+
+namespace {
+
+/// Where round k + 1 measures: the last corrected optimum (the plain iteration), or from the third round on, per
+/// parameter, the secant root of the residual g = optimum - at through the last two rounds, where its slope says the
+/// iteration contracts (F' = 1 + slope within (-1, 1): a slope outside (-2, 0) is the runs' scatter, not the map);
+/// inside the last fit's range. `secant` says whether any parameter took the secant step.
+std::vector<Real> next_at(const std::vector<FidelityRound>& rounds, bool& secant) {
+  const FidelityRound& b = rounds.back();
+  std::vector<Real> at = b.fit.values;
+  secant = false;
+  if (rounds.size() < 2) return at;
+  const FidelityRound& a = rounds[rounds.size() - 2];
+  for (std::size_t k = 0; k < at.size(); ++k) {
+    const Real ga = a.fit.values[k] - a.at[k], gb = b.fit.values[k] - b.at[k], dx = b.at[k] - a.at[k];
+    if (dx == 0) continue;
+    const Real slope = (gb - ga) / dx;
+    if (!(slope > -2 && slope < 0)) continue;
+    at[k] = std::clamp(b.at[k] - gb / slope, b.fit.free[k].lo, b.fit.free[k].hi);
+    secant = true;
+  }
+  return at;
+}
+
+}  // namespace
+
+FidelityRounds two_fidelity_rounds(const CalibrationResult& periodic, const Misfit& misfit,
+                                   const std::vector<TriaxialTest>& tests, const DiscrepancyAt& measure,
+                                   const CalibrateTo& fit, const std::string& template_path, int max_rounds) {
+  FidelityRounds out;
+  for (int round = 1; round <= max_rounds && !out.converged; ++round) {
+    FidelityRound r;
+    Model at = periodic.model;
+    if (out.rounds.empty()) {
+      r.at = periodic.values;
+    } else {
+      r.at = next_at(out.rounds, r.secant);
+      at = out.rounds.back().fit.model;
+      for (std::size_t k = 0; k < r.at.size(); ++k) set_param(at, periodic.free[k].name, r.at[k]);
+    }
+    // Always the data as measured less this round's discrepancy: each round replaces the last one's correction.
+    const Discrepancy d = measure(at);
+    r.discrepancy = discrepancy_text(misfit, d, tests);
+    Misfit corrected = misfit;
+    corrected.add_discrepancy(d.delta, d.sd, "two fidelities, round " + std::to_string(round) +
+                                                 ": the data less the membrane test's excess over the periodic cell "
+                                                 "at the last optimum (" + template_path + "), with its standard error");
+    r.fit = fit(corrected);
+    // The fixed point's residual: how far the optimum lies from where its discrepancy was measured.
+    for (std::size_t k = 0; k < r.at.size(); ++k) {
+      const Real width = r.fit.interval[k].second - r.fit.interval[k].first;
+      const Real step = std::fabs(r.fit.values[k] - r.at[k]);
+      // A point interval (a flat direction the surfaces did not resolve) counts any move as not converged.
+      const Real moved = width > 0 ? step / width : (step > 0 ? std::numeric_limits<Real>::infinity() : 0);
+      if (k == 0 || moved > r.moved) {
+        r.moved = moved;
+        r.moved_most = r.fit.free[k].name;
+      }
+    }
+    out.converged = r.moved < kFixedPointMove;
+    out.rounds.push_back(std::move(r));
+  }
+  return out;
+}
+
+std::string FidelityRounds::text() const {
+  std::string s;
+  for (std::size_t i = 0; i < rounds.size(); ++i) {
+    const FidelityRound& r = rounds[i];
+    s += "Round " + std::to_string(i + 1) + ": the discrepancy measured at";
+    for (std::size_t k = 0; k < r.at.size(); ++k)
+      s += (k ? ", " : " ") + r.fit.free[k].name + fmt(" = %.4g", r.fit.free[k].shown * r.at[k]);
+    s += std::string(r.secant ? " (a secant step through the last two rounds)" : "") + ":\n\n" + r.discrepancy + "\nthe corrected optimum: " + values_text(r.fit) +
+         fmt(", chi2 %.1f", r.fit.best.chi2) + "; " + r.moved_most + fmt(" lies %.2f of its 95%% interval from where the discrepancy was measured", r.moved) +
+         ".\n\n";
+  }
+  if (rounds.empty()) return s;
+  const std::string n = std::to_string(rounds.size()) + (rounds.size() == 1 ? " round" : " rounds");
+  s += converged ? "The optimum reached its fixed point after " + n +
+                       fmt(" (it moved less than %.2f of its interval).\n", kFixedPointMove)
+                 : "Not converged: after " + n +
+                       fmt(" the optimum still moved %.2f of its interval; the last round's is reported, and ",
+                           rounds.back().moved) +
+                       "the membrane prediction at it shows how far it holds.\n";
   return s;
 }
 
