@@ -465,6 +465,27 @@ TEST(CliEdges, AHeldOutPressureIsLeftOutOfTheFitAndPredicted) {
     EXPECT_EQ(o->output.find("plan (before any packing)"), std::string::npos) << o->output;
 }
 
+// Two fidelities correct the cell toward the membrane template's test, so it must be the data's size: data from
+// specimens of 1,000 balls against the small S-1 template (3,662) are refused before any work, naming the key and both
+// sizes; data of the template's size plan.
+TEST(CliEdges, ATwoFidelityTemplateOfAnotherSizeIsRefusedBeforeAnyWork) {
+  const fs::path dir = dem::test::scratch_dir("cli_template_size");
+  for (const char* balls : {"1000", "3662"}) {
+    std::ofstream(dir / "d.csv") << "material,sigma3_kPa,eps_a_pct,q_kPa,eps_v_pct,specimen_balls\n"
+                                 << "A,100,0,0,0," << balls << "\nA,100,1,60,0.1," << balls << "\nA,100,2,70,-0.1,"
+                                 << balls << "\nA,100,3,65,-0.3," << balls << "\n";
+    const Outcome o = triaxdem("calibrate " + (dir / "d.csv").string() + " --config configs/calibration/base.toml "
+                               "--reference-test two_fidelity --predict configs/small/S1_100kPa.toml -j 1 --plan -o " +
+                               (dir / "out").string(), dir);
+    const bool refused = std::string(balls) == "1000";
+    EXPECT_EQ(o.code, refused ? 1 : 0) << o.output;
+    EXPECT_EQ(o.output.find("--predict: two fidelities correct the cell toward the membrane test of "
+                            "configs/small/S1_100kPa.toml, whose specimen has 3662 balls where the data's (A at 100 kPa) "
+                            "have 1000") != std::string::npos, refused) << o.output;
+    EXPECT_EQ(o.output.find("plan (before any packing)") == std::string::npos, refused) << o.output;
+  }
+}
+
 // A plan beyond the bound (four hours here) is refused before any packing unless --yes is given, naming its costliest
 // stage and the setting that sizes it; 64 scatter specimens of 8,000 balls with an "auto" ensemble are such a job.
 TEST(CliEdges, AJobBeyondItsBoundAsksForYes) {

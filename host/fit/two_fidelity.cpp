@@ -5,6 +5,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "host/triax/specimen.hpp"
 #include "host/util/text_format.hpp"
 
 namespace dem {
@@ -46,6 +47,17 @@ bool two_fidelity_wanted(const Config& base, const std::string& cli, bool membra
     throw ConfigError(base.path + ": [calibrate] predict_specimens: two_fidelity measures the discrepancy's scatter "
                       "on the membrane specimens (allowed: 2-16)");
   return true;
+}
+
+void check_template_size(const Config& membrane, const std::vector<TriaxialTest>& tests, const std::string& key) {
+  const Real balls = static_cast<Real>(specimen_ball_count(membrane));
+  for (const TriaxialTest& t : tests)
+    if (std::isfinite(t.specimen_balls) && std::fabs(balls / t.specimen_balls - 1) > kTemplateSizeTolerance)
+      throw ConfigError(key + ": two fidelities correct the cell toward the membrane test of " + membrane.path + ", " +
+                        fmt("whose specimen has %.0f balls", balls) + " where the data's (" + t.material +
+                        fmt(" at %g kPa) have ", 1e-3 * t.sigma3) + fmt("%.0f", t.specimen_balls) +
+                        fmt(": the template must be the data's size within %.0f%%", 100 * kTemplateSizeTolerance) +
+                        " (a template of the data's specimen, or --reference-test periodic with the prediction alone)");
 }
 
 bool scales_with_stress(const Feature& f) {

@@ -37,6 +37,13 @@ Config reference_cell(const Config& base, const std::string& cli);
 /// ConfigError names the key before any run.
 bool two_fidelity_wanted(const Config& base, const std::string& cli, bool membrane);
 
+/// Two fidelities correct the cell toward the membrane test of `membrane`, so that test must be the data's: where a
+/// test gives specimen_balls, the template's specimen must have them within kTemplateSizeTolerance. ConfigError
+/// names `key` (where the template came from), both sizes and the ways out, before any run.
+void check_template_size(const Config& membrane, const std::vector<TriaxialTest>& tests, const std::string& key);
+/// A quarter: the boundary's share goes as N^-1/3, so a specimen 25% larger or smaller changes it by under 8%.
+inline constexpr Real kTemplateSizeTolerance = 0.25;
+
 /// Whether a feature is a stress (q at a strain; E_ini, q_1pct, q_3pct, q_peak, q_end): the boundary scales it
 /// (the bulge's area, the walls' layer), so the discrepancy is taken as a ratio; strains (eps_v, eps_a at the peak,
 /// dilatancy) take it as a difference.
