@@ -14,15 +14,19 @@
 ///    parameters, n data; the noise is known, so chi2 is -2 log-likelihood up to a constant).
 /// 4. Verdict: each extension is accepted when it beats the base BIC by at least 6 (strong evidence: the nested
 ///    models' likelihood-ratio test) and lowers the held-out chi2 by at least 6 too (the same evidence on data
-///    the fit did not see). The accepted extension with the lowest BIC is named; accepted ones within 2 of its
-///    BIC cannot be told apart from these data and are named with it. Otherwise "none", and the report says
-///    whether the base model fits within the noise (chi2 below the 99% quantile of chi2 with n - k degrees of
-///    freedom) or misses the data in a way no extension explains. A run of an extension fit at strength 0 is
+///    the fit did not see). An accepted extension is specific when it beats the best generic discrepancy of its
+///    own size (host/fit/generic_discrepancy.hpp, lowest BIC) by the same margins on both; only a specific one is
+///    named: the specific extension with the lowest BIC, with specific ones within 2 of its BIC, which these data
+///    cannot tell apart. Accepted ones that are not specific are candidates, not causes: the verdict is "none",
+///    and the report names the generic shape that fits as well and by how much. Otherwise "none", and the report
+///    says whether the base model fits within the noise (chi2 below the 99% quantile of chi2 with n - k degrees
+///    of freedom) or misses the data in a way no extension explains. A run of an extension fit at strength 0 is
 ///    a base run: when it beats the base calibration, it becomes the base fit.
 #include <string>
 #include <vector>
 
 #include "host/fit/calibrate.hpp"
+#include "host/fit/generic_discrepancy.hpp"
 
 namespace dem {
 
@@ -50,6 +54,7 @@ struct ExtensionFit {
   Real bic = 0, heldout = 0;  ///< BIC of the fit; held-out chi2 (runs)
   long runs = 0;
   bool accepted = false;      ///< passes both tests of the verdict (BIC and held-out, each by kStrongEvidence)
+  bool specific = false;      ///< accepted, and passes both against the best generic discrepancy too
   std::string reason;         ///< why accepted or rejected, in words
 };
 
@@ -58,11 +63,16 @@ struct Diagnosis {
   Real base_bic = 0, base_heldout = 0;
   Real chi2_limit = 0;              ///< 99% quantile of chi2 with n - k degrees of freedom
   std::vector<ExtensionFit> fits;   ///< in the order of extensions()
+  std::vector<GenericFit> generic;  ///< the generic discrepancies, in the order of generic_shapes()
   std::string verdict;              ///< name of the extension found, "none", or several joined by " or "
   std::string explanation;          ///< plain words
   std::vector<std::string> notes;   ///< what the search did beyond the plan (a better base run found late)
 };
 
+
+/// The verdict (see the top of the file) from the fits in `dg` (base, extensions, generic discrepancies): sets each
+/// extension's accepted, specific and reason, and the verdict and explanation; n data, d base parameters.
+void give_verdict(Diagnosis& dg, int n, int d);
 
 /// Runs the diagnosis of `measured` (one material) from `base` with base parameters `free`.
 Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,

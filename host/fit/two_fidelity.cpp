@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <stdexcept>
 
 #include "host/triax/specimen.hpp"
@@ -183,17 +182,10 @@ FidelityRounds two_fidelity_rounds(const CalibrationResult& periodic, const Misf
                                                  ": the data less the membrane test's excess over the periodic cell "
                                                  "at the last optimum (" + template_path + "), with its standard error");
     r.fit = fit(corrected);
-    // The fixed point's residual: how far the optimum lies from where its discrepancy was measured.
-    for (std::size_t k = 0; k < r.at.size(); ++k) {
-      const Real width = r.fit.interval[k].second - r.fit.interval[k].first;
-      const Real step = std::fabs(r.fit.values[k] - r.at[k]);
-      // A point interval (a flat direction the surfaces did not resolve) counts any move as not converged.
-      const Real moved = width > 0 ? step / width : (step > 0 ? std::numeric_limits<Real>::infinity() : 0);
-      if (k == 0 || moved > r.moved) {
-        r.moved = moved;
-        r.moved_most = r.fit.free[k].name;
-      }
-    }
+    // The fixed point's residual: how far the optimum lies from where its discrepancy was measured, in the joint
+    // region's metric: a rise of the surrogate chi2 by (distance / radius)^2 of the region's, the width two radii.
+    // Along a ridge the data leave free (S-1: three peaks, two parameters) a move costs nothing and is no change.
+    r.moved = std::sqrt(std::max(Real(0), r.fit.region_rise(r.at))) / 2;
     out.converged = r.moved < kFixedPointMove;
     out.rounds.push_back(std::move(r));
   }
@@ -208,16 +200,19 @@ std::string FidelityRounds::text() const {
     for (std::size_t k = 0; k < r.at.size(); ++k)
       s += (k ? ", " : " ") + r.fit.free[k].name + fmt(" = %.4g", r.fit.free[k].shown * r.at[k]);
     s += std::string(r.secant ? " (a secant step through the last two rounds)" : "") + ":\n\n" + r.discrepancy + "\nthe corrected optimum: " + values_text(r.fit) +
-         fmt(", chi2 %.1f", r.fit.best.chi2) + "; " + r.moved_most + fmt(" lies %.2f of its 95%% interval from where the discrepancy was measured", r.moved) +
+         fmt(", chi2 %.1f", r.fit.best.chi2) +
+         fmt("; it lies %.2f", r.moved) + " of the joint 95% region's width from where the discrepancy was measured" +
          ".\n\n";
   }
   if (rounds.empty()) return s;
   const std::string n = std::to_string(rounds.size()) + (rounds.size() == 1 ? " round" : " rounds");
   s += converged ? "The optimum reached its fixed point after " + n +
-                       fmt(" (it moved less than %.2f of its interval).\n", kFixedPointMove)
+                       fmt(" (it lies less than %.2f", kFixedPointMove) +
+                       " of its region's width from where its discrepancy was measured).\n"
                  : "Not converged: after " + n +
-                       fmt(" the optimum still moved %.2f of its interval; the last round's is reported, and ",
-                           rounds.back().moved) +
+                       fmt(" the optimum still lies %.2f", rounds.back().moved) +
+                       " of its region's width from where its discrepancy was measured; the last round's is reported, "
+                       "and " +
                        "the membrane prediction at it shows how far it holds.\n";
   return s;
 }

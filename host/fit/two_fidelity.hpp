@@ -67,14 +67,14 @@ struct FidelityRound {
   bool secant = false;       ///< `at` is a secant step through the two rounds before, not the last optimum
   std::string discrepancy;   ///< discrepancy_text of the round
   CalibrationResult fit;     ///< the corrected calibration
-  /// The largest distance of a parameter from `at` to the corrected optimum, in widths of its new 95% interval:
-  /// the fixed point's residual (zero where the discrepancy was measured at the optimum it gives).
+  /// How far `at` lies from the corrected optimum, in widths of its joint 95% region (CalibrationResult::region_rise's
+  /// metric; in one parameter, of its 95% interval): the fixed point's residual, zero where the discrepancy was
+  /// measured at the optimum it gives, and small along a ridge the data leave free.
   Real moved = 0;
-  std::string moved_most;    ///< the parameter that moved most
 };
 
-/// Rounds until the corrected optimum lies within kFixedPointMove of its 95% interval of where its discrepancy was
-/// measured (a tenth: within the interval's own uncertainty, as significant_gain's fifth of a radius), at most
+/// Rounds until the corrected optimum lies within kFixedPointMove of its joint 95% region's width of where its
+/// discrepancy was measured (a tenth: within the interval's own uncertainty, as significant_gain's fifth of a radius), at most
 /// kFidelityRounds. The plain iteration (measure at the last optimum) contracts by F' = d optimum / d at a round,
 /// about -0.3 for S-1's boundary share, which against intervals a tenth of the first move needs five rounds; from the
 /// third round on, each parameter takes the secant step through the last two rounds (Steffensen's idea: a
