@@ -5,6 +5,11 @@
 
 namespace dem {
 
+namespace {
+/// The stress an offset's c is counted in: the data's lowest pressures (Table 6, the cross-code files: 50-100 kPa).
+constexpr Real kOffsetStress = 100e3;
+}  // namespace
+
 const std::vector<GenericShape>& generic_shapes() {
   // Ranges: up to half of q (or of sigma3) either way, the volumetric strain from none to twice, and a hardening
   // slope of sigma3 per 10% strain: larger than any difference between codes or set-ups seen (5-46%).
@@ -17,6 +22,12 @@ const std::vector<GenericShape>& generic_shapes() {
        [](TriaxialTest& t, Real c) {
          for (std::size_t i = 0; i < t.q.size(); ++i)
            if (t.eps_a[i] > 0) t.q[i] += c * t.sigma3;
+       }},
+      // An apparent cohesion: about the same q at every pressure, so most, relative to q, at the lowest.
+      {"q offset", "q + c 100 kPa (beyond the first row)", -0.5, 0.5,
+       [](TriaxialTest& t, Real c) {
+         for (std::size_t i = 0; i < t.q.size(); ++i)
+           if (t.eps_a[i] > 0) t.q[i] += c * kOffsetStress;
        }},
       {"eps_v scaled", "eps_v (1 + c)", -1, 1,
        [](TriaxialTest& t, Real c) {

@@ -27,7 +27,8 @@ struct GenericShape {
   void (*apply)(TriaxialTest& t, Real c) = nullptr;  ///< on the curve's rows, then summarised again
 };
 
-/// q scaled, q shifted by c sigma3, eps_v scaled, a strain-hardening term c sigma3 eps_a.
+/// q scaled, q shifted by c sigma3, q offset by c 100 kPa at every pressure (an apparent cohesion), eps_v scaled, a
+/// strain-hardening term c sigma3 eps_a.
 const std::vector<GenericShape>& generic_shapes();
 
 struct GenericFit {
