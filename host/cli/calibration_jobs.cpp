@@ -128,6 +128,29 @@ std::string reference_table(const Session& ss, const std::string& material, cons
   return md.str();
 }
 
+/// Two fidelities from the periodic optimum `r`: the membrane test's discrepancy at each optimum and the cell
+/// calibrated to the data less it (`fit(misfit, what)`), to a fixed point; the rounds in stdout and the report.
+template <class Fit>
+CalibrationResult two_fidelity_fit(Session& ss, const Config& base, const std::string& material,
+                                   const std::vector<TriaxialTest>& tests, const Misfit& misfit,
+                                   const CalibrationResult& r, const Fit& fit) {
+  int round = 0;
+  const FidelityRounds rounds = two_fidelity_rounds(r, misfit, tests, [&](const Model& at) {
+    std::printf("calibrate: %s: two fidelities, round %d: the membrane test and every periodic specimen at the "
+                "last optimum\n", material.c_str(), ++round);
+    const Discrepancy d = measure_discrepancy(misfit, ss.predict_at(base, at, tests),
+                                              ss.lab.run_ensemble(at, tests, true));
+    std::printf("%s", discrepancy_text(misfit, d, tests).c_str());
+    return d;
+  }, [&](const Misfit& corrected) {
+    return fit(corrected, "calibrate (corrected, round " + std::to_string(round) + ")");
+  }, ss.predict_template->path);
+  const std::string text = rounds.text();
+  std::printf("calibrate: %s: two fidelities:\n%s", material.c_str(), text.c_str());
+  ss.discrepancy += "### " + material + "\n\n" + text + "\n";
+  return rounds.last();
+}
+
 }  // namespace
 
 int calibrate_job(const Config& base, const CalibrationOptions& o) {
@@ -159,24 +182,7 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
       return r;
     };
     CalibrationResult r = fit(misfit, "calibrate");
-    if (ss.two_fidelity) {
-      // The boundary's discrepancy at each optimum, and the cell calibrated to the data less it, to a fixed point.
-      int round = 0;
-      const FidelityRounds rounds = two_fidelity_rounds(r, misfit, tests, [&](const Model& at) {
-        std::printf("calibrate: %s: two fidelities, round %d: the membrane test and every periodic specimen at the "
-                    "last optimum\n", material.c_str(), ++round);
-        const Discrepancy d = measure_discrepancy(misfit, ss.predict_at(base, at, tests),
-                                                  ss.lab.run_ensemble(at, tests, true));
-        std::printf("%s", discrepancy_text(misfit, d, tests).c_str());
-        return d;
-      }, [&](const Misfit& corrected) {
-        return fit(corrected, "calibrate (corrected, round " + std::to_string(round) + ")");
-      }, ss.predict_template->path);
-      const std::string text = rounds.text();
-      std::printf("calibrate: %s: two fidelities:\n%s", material.c_str(), text.c_str());
-      ss.discrepancy += "### " + material + "\n\n" + text + "\n";
-      r = rounds.last();
-    }
+    if (ss.two_fidelity) r = two_fidelity_fit(ss, base, material, tests, misfit, r, fit);
     for (std::size_t k = 0; k < ss.free.size(); ++k) {
       const FreeParam& f = ss.free[k];
       const Real ref = ss.reference(material, f.name);

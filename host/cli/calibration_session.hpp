@@ -68,6 +68,13 @@ struct JobInputs {
   JobPlan announce_plan(const Config& base, const CalibrationOptions& o, const std::string& kind) const;
 };
 
+/// What the job's data are taken to be (host/cli/data_scope.cpp). take_walled_size: between walls the specimen's size
+/// is part of the test, so tests without specimen_balls take the walled cell's balls (with a note), and a walled cell
+/// smaller than the data's specimen is said. hold_out: the tests at --hold-out's pressure out of `data`, returned;
+/// DataError where no test has it or a material the job calibrates would keep none.
+void take_walled_size(const Config& base, const CalibrationOptions& o, MeasuredData& data);
+std::vector<TriaxialTest> hold_out(const CalibrationOptions& o, MeasuredData& data);
+
 /// What calibrate and diagnose share: the job's inputs, the simulator and a new result folder.
 struct Session : JobInputs {
   std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();

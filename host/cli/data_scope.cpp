@@ -1,0 +1,65 @@
+#include "host/cli/calibration_session.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "host/fit/two_fidelity.hpp"
+#include "host/util/text_format.hpp"
+
+namespace dem {
+
+/// Between walls the specimen's size is part of the test (the walls' looser layer falls as N^-1/3): tests that give
+/// no specimen_balls are taken to be of the walled cell's balls, with a note, where the cell's bias check would have
+/// extrapolated the cell to an infinite specimen and counted the walls' share as the simulator's bias.
+void take_walled_size(const Config& base, const CalibrationOptions& o, MeasuredData& data) {
+  const Config cell = reference_cell(base, o.reference_test);
+  if (cell.periodic.boundary != CellBoundary::walls) return;
+  const Real balls = static_cast<Real>(cell.particles.count * std::max(cell.calibrate.cell_factor, 1L));
+  bool took = false;
+  for (TriaxialTest& t : data.tests)
+    if (!std::isfinite(t.specimen_balls)) {
+      t.specimen_balls = balls;
+      took = true;
+    }
+  Real largest = 0;
+  for (const TriaxialTest& t : data.tests) largest = std::max(largest, t.specimen_balls);
+  if (largest > balls * 1.01)
+    data.notes.push_back("the walled cell of " + fmt("%.0f", balls) + " balls is smaller than the data's specimen of " +
+                         fmt("%.0f", largest) + ": its walls' looser layer is a larger share of it (the share falls as "
+                         "N^-1/3), so matched to the data's void ratio its interior packs denser; the cell's bias check "
+                         "measures the difference, with both preparation frictions, and a walled cell of the data's "
+                         "balls ([particles] count) avoids it");
+  if (took)
+    data.notes.push_back("no specimen_balls: the walled cell takes its " + fmt("%.0f", balls) +
+                         " balls as the data's specimen (between walls the size is part of the test, and the cell's "
+                         "bias is not extrapolated to an infinite one); give specimen_balls where the data's specimen "
+                         "differs");
+}
+
+/// Takes the tests at --hold-out's pressure out of `data` and returns them. Refused (DataError naming the file, the
+/// option and the data's pressures) where no test has that pressure or a material the job calibrates (--material)
+/// would keep none.
+std::vector<TriaxialTest> hold_out(const CalibrationOptions& o, MeasuredData& data) {
+  if (!std::isfinite(o.hold_out_kPa)) return {};
+  std::vector<TriaxialTest> kept, held;
+  std::string pressures;
+  for (const TriaxialTest& t : data.tests) {
+    const bool at = std::fabs(1e-3 * t.sigma3 - o.hold_out_kPa) < 0.5;  // within the half kPa the files are given in
+    (at ? held : kept).push_back(t);
+    if (pressures.find(fmt(" %g,", 1e-3 * t.sigma3)) == std::string::npos) pressures += fmt(" %g,", 1e-3 * t.sigma3);
+  }
+  if (!pressures.empty()) pressures.pop_back();
+  const std::string held_kPa = fmt("%g kPa", o.hold_out_kPa);
+  if (held.empty())
+    throw DataError(data.path + ": --hold-out " + held_kPa + ": no test at that pressure (the data's, kPa:" + pressures +
+                    ")");
+  for (const TriaxialTest& h : held)
+    if ((o.material.empty() || h.material == o.material) && std::none_of(kept.begin(), kept.end(), [&](const TriaxialTest& t) { return t.material == h.material; }))
+      throw DataError(data.path + ": --hold-out " + held_kPa + ": material " + h.material +
+                      " has no other test to fit (the data's pressures, kPa:" + pressures + ")");
+  data.tests = kept;
+  data.notes.push_back("held out: the tests at " + held_kPa + " are left out of the fit and predicted at the end");
+  return held;
+}
+
+}  // namespace dem
