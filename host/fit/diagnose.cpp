@@ -175,6 +175,28 @@ ExtensionFit fit_extension(const Extension& e, const FitContext& cx, Evaluation&
   return f;
 }
 
+/// One extension on both tests, against the base model (accepted) and the generic rival where there is one
+/// (specific), with its reason in words; `testable`: enough data for an extended model (n >= d + 2).
+void weigh(ExtensionFit& f, const Diagnosis& dg, const GenericFit* rival, bool testable) {
+  char line[300];
+  const Real gain = dg.base_bic - f.bic, held = dg.base_heldout - f.heldout;
+  f.accepted = testable && gain >= kStrongEvidence && held >= kStrongEvidence;
+  std::snprintf(line, sizeof line, "BIC %s by %.1f (%s), held-out chi2 %.1f -> %.1f (%s)",
+                gain >= 0 ? "lower" : "higher", std::fabs(gain), gain >= kStrongEvidence ? "passes" : "6 needed",
+                dg.base_heldout, f.heldout, held >= kStrongEvidence ? "passes" : "a drop of 6 needed");
+  f.reason = std::string(f.accepted ? "accepted: " : "rejected: ") + line;
+  if (!rival) {
+    f.specific = f.accepted;
+    return;
+  }
+  const Real over = rival->bic - f.bic, over_held = rival->heldout - f.heldout;
+  f.specific = f.accepted && over >= kStrongEvidence && over_held >= kStrongEvidence;
+  std::snprintf(line, sizeof line, "; against the generic %s: BIC %s by %.1f, held-out chi2 %.1f -> %.1f (%s)",
+                rival->shape.name.c_str(), over >= 0 ? "lower" : "higher", std::fabs(over), rival->heldout,
+                f.heldout, f.specific ? "specific" : "not specific: a drop of 6 needed in both");
+  if (f.accepted) f.reason += line;
+}
+
 }  // namespace
 
 void give_verdict(Diagnosis& dg, int n, int d) {
@@ -190,24 +212,7 @@ void give_verdict(Diagnosis& dg, int n, int d) {
   for (const GenericFit& g : dg.generic)
     if (!rival || g.bic < rival->bic) rival = &g;
   char line[600];
-  for (ExtensionFit& f : dg.fits) {
-    const Real gain = dg.base_bic - f.bic, held = dg.base_heldout - f.heldout;
-    f.accepted = n >= d + 2 && gain >= kStrongEvidence && held >= kStrongEvidence;
-    std::snprintf(line, sizeof line, "BIC %s by %.1f (%s), held-out chi2 %.1f -> %.1f (%s)",
-                  gain >= 0 ? "lower" : "higher", std::fabs(gain), gain >= kStrongEvidence ? "passes" : "6 needed",
-                  dg.base_heldout, f.heldout, held >= kStrongEvidence ? "passes" : "a drop of 6 needed");
-    f.reason = std::string(f.accepted ? "accepted: " : "rejected: ") + line;
-    if (!rival) {
-      f.specific = f.accepted;
-      continue;
-    }
-    const Real over = rival->bic - f.bic, over_held = rival->heldout - f.heldout;
-    f.specific = f.accepted && over >= kStrongEvidence && over_held >= kStrongEvidence;
-    std::snprintf(line, sizeof line, "; against the generic %s: BIC %s by %.1f, held-out chi2 %.1f -> %.1f (%s)",
-                  rival->shape.name.c_str(), over >= 0 ? "lower" : "higher", std::fabs(over), rival->heldout,
-                  f.heldout, f.specific ? "specific" : "not specific: a drop of 6 needed in both");
-    if (f.accepted) f.reason += line;
-  }
+  for (ExtensionFit& f : dg.fits) weigh(f, dg, rival, n >= d + 2);
   const ExtensionFit* top = nullptr;
   for (const ExtensionFit& f : dg.fits)
     if (f.specific && (!top || f.bic < top->bic)) top = &f;
