@@ -4,6 +4,7 @@
 #   perf/device_check.sh prepare REF       # CPU build: the reference runs the device's are compared with
 #   perf/device_check.sh pack BUILD DIR    # a CUDA build's programs and the Debian libraries they link, for `carry`
 #   perf/device_check.sh run REF OUT       # any build: particle-steps/s, launch overhead, CPU-GPU agreement, tests
+#   perf/device_check.sh table6 LOOP OUT   # any build: Table 6 at full scale with the closed loop's parameters
 # BUILD: the build whose binaries run (default build); CPU_BUILD: the one that prepares (default build).
 # TINY=1: a few hundred balls and steps, no membrane specimen and not the suite's tests, for CI on any build.
 # PARTS: which of the suite's tests run (default "kernels other"; "kernels" when device time is short), each part
@@ -12,9 +13,13 @@
 set -uo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 mode="${1:-}"; ref="$(realpath -m "${2:-}")"
-[ "$mode" = prepare ] || [ "$mode" = pack ] || [ "$mode" = run ] && [ -n "${2:-}" ] ||
-  { echo "usage: perf/device_check.sh prepare REF | pack BUILD DIR | run REF OUT" >&2; exit 2; }
+case "$mode" in prepare|pack|run|table6) [ -n "${2:-}" ] ;; *) false ;; esac ||
+  { echo "usage: perf/device_check.sh prepare REF | pack BUILD DIR | run REF OUT | table6 LOOP OUT" >&2; exit 2; }
 tiny="${TINY:-0}"
+stage() { echo; echo "== $1 ($(date +%T))"; }
+# The first interpreter with h5py compares the checkpoints too (Debian's, or the GPU machine's own).
+py=python3
+for p in /usr/bin/python3 python3; do "$p" -c "import h5py" 2>/dev/null && { py="$p"; break; }; done
 small_cfg="$root/configs/small/S1_100kPa.toml"
 # The membrane comparison: from a checkpoint inside consolidation to a few records into the shear.
 small_start=2000; small_stop=10000
@@ -61,14 +66,96 @@ if [ "$mode" = prepare ]; then
   exit 0
 fi
 
+if [ "$mode" = table6 ]; then
+  # Table 6 at the paper's scale (issue 62, item 3): each material's parameters as perf/table6_loop.sh calibrated
+  # them (LOOP/<material>_all/calibrate_*/calibrated.csv) put into configs/paper/, its three pressures run by the
+  # membrane test, one specimen each, and set beside the lab's and the paper's own PFC3D values. BUDGET: seconds
+  # for all (660: 12 minutes of device time less the start); a test that would start with under 60 s left is not
+  # started, one cut by the budget is marked, and the table says what was reached. MATERIALS, PRESSURES: which.
+  # TINY=1: tests/data/tiny_triaxial.toml at each pressure in place of configs/paper/ (the scripts' check on a CPU).
+  loop="$ref"; out="$(realpath -m "${3:?usage: perf/device_check.sh table6 LOOP OUT}")"
+  bin="$(realpath "${BUILD:-$root/build}")/triaxdem"; budget="${BUDGET:-660}"
+  mkdir -p "$out"; : > "$out/cases.csv"
+  for m in ${MATERIALS:-S-1 S-2 S-3}; do
+    cal="$(ls "$loop/${m}_all"/calibrate_*/calibrated.csv 2>/dev/null | tail -n 1)"
+    [ -n "$cal" ] || echo "device_check: no $loop/${m}_all/calibrate_*/calibrated.csv: run perf/table6_loop.sh for $m first"
+    for p in ${PRESSURES:-100 200 300}; do
+      name="${m//-/}_${p}kPa"; cfg="$out/$name.toml"; left=$((budget - SECONDS))
+      if [ "$tiny" = 1 ]; then
+        sed -e "s/^material = .*/material = \"$m\"/" -e "s/^sigma3_kPa = .*/sigma3_kPa = $p/" \
+          "$root/tests/data/tiny_triaxial.toml" > "$cfg"
+      else cp "$root/configs/paper/$name.toml" "$cfg"; fi
+      status="not calibrated"
+      if [ -n "$cal" ]; then
+        # Each calibrated parameter replaces its key's line in the config; one the config lacks stops the case.
+        status="$("$py" - "$cal" "$cfg" <<'PY'
+import csv, re, sys
+cal, cfg = sys.argv[1], sys.argv[2]
+text = open(cfg).read()
+for row in csv.DictReader(open(cal)):
+    text, n = re.subn(r"(?m)^%s = [^#\n]*" % re.escape(row["parameter"]), "%s = %s " % (row["parameter"], row["value"]), text)
+    if n != 1:
+        print("%s: no key %s to set" % (cfg, row["parameter"]))
+        sys.exit()
+open(cfg, "w").write(text)
+print("ready")
+PY
+)"
+      fi
+      if [ "$status" = ready ] && [ "$left" -lt 60 ]; then status="not reached (${left} s left of $budget)"; fi
+      if [ "$status" = ready ]; then
+        stage "$m at $p kPa ($left s left of $budget)"
+        t0=$SECONDS
+        timeout -k 5 "$left" "$bin" triaxial "$cfg" -o "$out/$name" --overwrite > "$out/$name.log" 2>&1
+        rc=$?; status=done; [ $rc = 124 ] && status="cut by the budget"; [ $rc != 0 ] && [ $rc != 124 ] && status="failed ($rc)"
+        tr '\r' '\n' < "$out/$name.log" | grep -E "^time loop|q_peak" | tail -n 2
+        echo "$m,$p,$((SECONDS - t0)),$status,$cal" >> "$out/cases.csv"
+      else
+        echo "$m,$p,0,$status,$cal" >> "$out/cases.csv"
+      fi
+    done
+  done
+  "$py" - "$out" "$root/data" > "$out/table6.md" <<'PY'
+import csv, os, sys
+out, data = sys.argv[1], sys.argv[2]
+def rows(path):
+    return list(csv.DictReader(line for line in open(path) if not line.startswith("#")))
+lab = {(r["material"], r["sigma3_kPa"]): float(r["q_peak_kPa"]) for r in rows(os.path.join(data, "tang2025_table6_peak.csv"))}
+pfc = {(r["material"], r["sigma3_kPa"]): float(r["q_peak_kPa"]) for r in rows(os.path.join(data, "tang2025_table6_pfc3d.csv"))}
+print("| material | sigma3 kPa | lab q_peak kPa | here kPa | error | paper's PFC3D kPa | its error | parameters | wall time | status |")
+print("|---|---|---|---|---|---|---|---|---|---|")
+errors, theirs = {}, {}
+for m, p, secs, status, cal in csv.reader(open(os.path.join(out, "cases.csv"))):
+    key, here = (m, p), None
+    summary = os.path.join(out, "%s_%skPa" % (m.replace("-", ""), p), "summary.csv")
+    if status == "done" and os.path.exists(summary):
+        here = float(next(csv.DictReader(open(summary)))["q_peak_kPa"])
+    params = "; ".join("%s %.4g" % (r["parameter"], float(r["value"])) for r in csv.DictReader(open(cal))) if cal else "-"
+    err = 100 * (here / lab[key] - 1) if here is not None and key in lab else None
+    their = 100 * (pfc[key] / lab[key] - 1) if key in pfc and key in lab else None
+    if err is not None:
+        errors.setdefault(m, []).append(abs(err)); theirs.setdefault(m, []).append(abs(their))
+    print("| %s | %s | %s | %s | %s | %s | %s | %s | %dm%02ds | %s |" % (
+        m, p, "%.1f" % lab[key] if key in lab else "-", "%.1f" % here if here is not None else "-",
+        "%+.1f%%" % err if err is not None else "-", "%.1f" % pfc[key] if key in pfc else "-",
+        "%+.1f%%" % their if their is not None else "-", params, int(secs) // 60, int(secs) % 60, status))
+print()
+every = [e for m in errors for e in errors[m]]
+for m, e in list(errors.items()) + ([("all", every)] if len(errors) > 1 else []):
+    t = [x for k in (errors if m == "all" else [m]) for x in theirs[k]]
+    print("%s: mean |error| %.1f%%, at most %.1f%% over %d tests (the paper's PFC3D on the same: %.1f%%, %.1f%%)" % (
+        m, sum(e) / len(e), max(e), len(e), sum(t) / len(t), max(t)))
+if not every:
+    print("no test reached its end")
+PY
+  cat "$out/table6.md"
+  exit 0
+fi
+
 out="$(realpath -m "${3:?usage: perf/device_check.sh run REF OUT}")"
 build="$(realpath "${BUILD:-$root/build}")"; bin="$build/triaxdem"
 mkdir -p "$out"
 failed=""
-stage() { echo; echo "== $1 ($(date +%T))"; }
-# The first interpreter with h5py compares the checkpoints too (Debian's, or the GPU machine's own).
-py=python3
-for p in /usr/bin/python3 python3; do "$p" -c "import h5py" 2>/dev/null && { py="$p"; break; }; done
 
 stage "device and build"
 command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,memory.total,driver_version,clocks.max.sm --format=csv

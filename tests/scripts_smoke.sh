@@ -78,6 +78,16 @@ if [ "$part" != diagnoses ]; then
   check perf/device_check.sh bash -c "TINY=1 CPU_BUILD='$build' bash '$root/perf/device_check.sh' prepare '$work/dc_ref' &&
     bash '$root/perf/device_check.sh' pack '$build' '$work/dc_pack' &&
     TINY=1 BUILD='$work/dc_pack/build' bash '$root/perf/device_check.sh' run '$work/dc_ref' '$work/dc'"
+  # The full-scale Table 6 from the loop's parameters, here the tiny specimen at one pressure; the loop's calibrated.csv
+  # stands in as Table 5's S-1 values, S-2 has none (a row that says so).
+  mkdir -p "$work/t6loop/S-1_all/calibrate_x"
+  printf 'material,parameter,value,low95,high95\nS-1,mu_s,0.15,0.1,0.2\nS-1,mu_r,0.015,0,0.05\n' \
+    > "$work/t6loop/S-1_all/calibrate_x/calibrated.csv"
+  check "perf/device_check.sh table6" env TINY=1 BUILD="$build" MATERIALS="S-1 S-2" PRESSURES=100 \
+    bash "$root/perf/device_check.sh" table6 "$work/t6loop" "$work/t6"
+  grep -q '^| S-1 | 100 | 142.4 | [0-9.]* | .* | mu_s 0.15; mu_r 0.015 | .* | done |' "$work/t6/table6.md" &&
+    grep -q '^| S-2 | 100 | .* | not calibrated |' "$work/t6/table6.md" ||
+    { cat "$work/t6/table6.md"; echo "scripts_smoke: device_check table6 gave no row per case" >&2; exit 1; }
   # The peers' packing format and the instruction count, on a 216-ball packing, triaxdem alone (the peers are
   # Debian packages the CI does not install).
   sed -e 's/^count = .*/count = 216/' -e 's/^size_mm = .*/size_mm = [11.94, 11.94, 11.94]/' \
