@@ -69,6 +69,9 @@ for m in materials:
         log = open(out + ".log").read() if os.path.exists(out + ".log") else ""
         rounds = re.findall(r"fixed point after (\d+) round", log)
         rounds = rounds[-1] if rounds else ("not converged" if "Not converged" in log else "-")
+        chose = re.findall(r"Round (\d+)'s point is the answer", log)
+        if chose or "The last optimum stands." in log:
+            rounds += "; the membrane test's choice: " + ("round %s's point" % chose[-1] if chose else "the last optimum")
         secs = int(open(out + ".seconds").read()) if os.path.exists(out + ".seconds") else 0
         for row in csv.DictReader(open(found[-1])):
             held = row.get("held_out") == "1"

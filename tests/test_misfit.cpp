@@ -467,6 +467,83 @@ TEST(TwoFidelity, RoundsReachTheFixedPointWhereOneCorrectionMissesIt) {
   EXPECT_FALSE(once.converged);
   EXPECT_NE(once.text().find("Not converged: after 1 round the optimum still lies"), std::string::npos)
       << once.text();
+  EXPECT_FALSE(std::isfinite(once.last_membrane_chi2)) << "no membrane choice without the cell to evaluate it";
+  EXPECT_DOUBLE_EQ(once.last().values[0], once.rounds[0].fit.values[0]);
+}
+
+// Not converged, the membrane test itself chooses among the points it ran (FidelityRounds::chosen). In the case above
+// one plain round measures at the periodic optimum 0.56 and lands at F(0.56) = 0.359, where the membrane test's q
+// misses the lab's by 4% against 40%: the last optimum stands. A membrane test that read badly there (its chi2 made
+// 1e6 by the mock) hands the answer to round 1's point, with the cell's values and intervals recomputed there.
+TEST(TwoFidelity, NotConvergedTheMembraneTestChoosesAmongItsPoints) {
+  constexpr Real kTrue = 0.4;
+  const TriaxialTest curve = smooth_test(100e3);
+  auto scaled = [&](Real f) {
+    TriaxialTest t = curve;
+    for (Real& q : t.q) q *= f;
+    summarise(t);
+    return t;
+  };
+  auto cell = [&](Real mu) { return scaled(mu / 0.5); };
+  auto membrane = [&](Real mu) { return scaled(mu / 0.5 * (1 + mu)); };
+  const TriaxialTest lab = membrane(kTrue);
+  const Misfit m({lab}, NoiseOptions(), Ensemble{members_of(lab, 8, 0.01)}, 8, 0.1);
+  FreeParam mu;
+  mu.name = "mu_s";
+  mu.lo = 0.1;
+  mu.hi = 0.9;
+  Model base;
+  const CalibrateTo fit = [&](const Misfit& mf) {
+    return calibrate([&](const Model& at, Real) {
+      const TriaxialTest t = cell(get_param(at, "mu_s"));
+      return SimulatedPoint{{t}, mf.test_residuals(0, {t}), false};
+    }, base, {mu}, mf.data());
+  };
+  std::vector<Real> measured_at;
+  bool spoil_second = false;
+  const DiscrepancyAt measure = [&](const Model& at) {
+    measured_at.push_back(get_param(at, "mu_s"));
+    Prediction p;
+    p.members = members_of(membrane(measured_at.back()), 2, 0.01);
+    Discrepancy d = measure_discrepancy(m, {p}, Ensemble{members_of(cell(measured_at.back()), 4, 0.01)});
+    if (spoil_second && measured_at.size() == 2) d.membrane_chi2 = 1e6;
+    return d;
+  };
+  std::vector<Real> evaluated_at;
+  const EvaluateAt evaluate = [&](const Model& at, const Misfit& corrected) {
+    evaluated_at.push_back(get_param(at, "mu_s"));
+    const Ensemble e{members_of(cell(evaluated_at.back()), 4, 0.01)};
+    Evaluation ev;
+    ev.sim = {cell(evaluated_at.back())};
+    ev.r = corrected.residuals(e);
+    for (Real x : ev.r) ev.chi2 += x * x;
+    return ev;
+  };
+  const CalibrationResult periodic = fit(m);
+
+  const FidelityRounds stands = two_fidelity_rounds(periodic, m, {lab}, measure, fit, "t.toml", 1, evaluate);
+  ASSERT_EQ(measured_at.size(), 2u) << "the membrane test at round 1's point and at the last optimum";
+  EXPECT_DOUBLE_EQ(measured_at[1], stands.rounds[0].fit.values[0]);
+  ASSERT_TRUE(std::isfinite(stands.last_membrane_chi2));
+  EXPECT_LT(stands.last_membrane_chi2, stands.rounds[0].membrane_chi2) << stands.text();
+  EXPECT_EQ(stands.chosen, 1u);
+  EXPECT_DOUBLE_EQ(stands.last().values[0], stands.rounds[0].fit.values[0]);
+  EXPECT_TRUE(evaluated_at.empty()) << "the last optimum's own fit is kept";
+  EXPECT_NE(stands.text().find("The last optimum stands."), std::string::npos) << stands.text();
+
+  measured_at.clear();
+  spoil_second = true;
+  const FidelityRounds moved = two_fidelity_rounds(periodic, m, {lab}, measure, fit, "t.toml", 1, evaluate);
+  EXPECT_EQ(moved.chosen, 0u) << moved.text();
+  ASSERT_EQ(evaluated_at.size(), 1u);
+  EXPECT_DOUBLE_EQ(evaluated_at[0], moved.rounds[0].at[0]);
+  EXPECT_DOUBLE_EQ(moved.last().values[0], moved.rounds[0].at[0]);
+  EXPECT_DOUBLE_EQ(get_param(moved.last().model, "mu_s"), moved.rounds[0].at[0]);
+  // The cell there against the last correction: the data less the discrepancy of 0.56 ask for 0.359, so 0.56 lies
+  // far outside the interval the search found around 0.359, and the interval recomputed at it must hold it.
+  EXPECT_LE(moved.last().interval[0].first, moved.rounds[0].at[0]);
+  EXPECT_GE(moved.last().interval[0].second, moved.rounds[0].at[0]);
+  EXPECT_NE(moved.text().find("Round 1's point is the answer: mu_s 0.56"), std::string::npos) << moved.text();
 }
 
 // A generic discrepancy is fitted over the base's runs (host/fit/generic_discrepancy.hpp): data whose q is 1.2 times

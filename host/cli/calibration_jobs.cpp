@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "host/cli/calibration_session.hpp"
+#include "host/data/curve_reading.hpp"
 #include "host/fit/calibrate.hpp"
 #include "host/fit/calibration_report.hpp"
 #include "host/fit/diagnose.hpp"
@@ -136,15 +137,24 @@ CalibrationResult two_fidelity_fit(Session& ss, const Config& base, const std::s
                                    const CalibrationResult& r, const Fit& fit) {
   int round = 0;
   const FidelityRounds rounds = two_fidelity_rounds(r, misfit, tests, [&](const Model& at) {
-    std::printf("calibrate: %s: two fidelities, round %d: the membrane test and every periodic specimen at the "
-                "last optimum\n", material.c_str(), ++round);
+    std::string where;
+    for (const FreeParam& f : ss.free) where += (where.empty() ? " " : ", ") + f.name + fmt(" = %.4g", f.shown * get_param(at, f.name));
+    std::printf("calibrate: %s: two fidelities, membrane test %d: it and every periodic specimen at%s\n",
+                material.c_str(), ++round, where.c_str());
     const Discrepancy d = measure_discrepancy(misfit, ss.predict_at(base, at, tests),
                                               ss.lab.run_ensemble(at, tests, true));
     std::printf("%s", discrepancy_text(misfit, d, tests).c_str());
     return d;
   }, [&](const Misfit& corrected) {
     return fit(corrected, "calibrate (corrected, round " + std::to_string(round) + ")");
-  }, ss.predict_template->path);
+  }, ss.predict_template->path, kFidelityRounds, [&](const Model& at, const Misfit& corrected) {
+    const Ensemble e = ss.lab.run_ensemble(at, tests, true);
+    Evaluation ev;
+    for (const std::vector<TriaxialTest>& members : e) ev.sim.push_back(mean_curve(members));
+    ev.r = corrected.residuals(e);
+    for (Real x : ev.r) ev.chi2 += x * x;
+    return ev;
+  });
   const std::string text = rounds.text();
   std::printf("calibrate: %s: two fidelities:\n%s", material.c_str(), text.c_str());
   ss.discrepancy += "### " + material + "\n\n" + text + "\n";

@@ -101,8 +101,12 @@ struct Session : JobInputs {
   std::string failed_text() const;
   std::vector<std::string> free_names() const;
   /// The membrane test at `model` on every test of `tests`, q in the data's measure (a template must be set).
+  /// Each (point, test) runs once per job: a membrane run the two fidelities made is the prediction's where the
+  /// answer lies at a point they ran (membrane_runs).
   std::vector<Prediction> predict_at(const Config& base, const Model& model,
                                      const std::vector<TriaxialTest>& tests) const;
+  /// The membrane runs made, by the free parameters' values and the test (material, sigma3).
+  mutable std::map<std::string, Prediction> membrane_runs;
   Config matched(const Config& base, int workers);
   /// The report's line on the specimens' state.
   std::string state_text(const Misfit& m, const std::vector<TriaxialTest>& tests) const;

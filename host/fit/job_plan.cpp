@@ -249,9 +249,12 @@ JobPlan plan_job(const PlanInput& in) {
         // 1 to kFidelityRounds rounds (two_fidelity_rounds), the specimens built in the first.
         const double R = kFidelityRounds;
         const std::string rounds = ", 1 to " + std::to_string(kFidelityRounds) + " rounds";
-        plan.stages.push_back({material + ": two fidelities, membrane tests", what + rounds,
-                               "[calibrate] predict_specimens", test_steps * (R * T_n + kMembraneSpecimenOverTest),
-                               each, each + (R - 1) * tests_s});
+        // Where the rounds do not converge, once more at the last optimum (FidelityRounds::chosen); the prediction
+        // takes the membrane runs made at its point.
+        plan.stages.push_back({material + ": two fidelities, membrane tests",
+                               what + rounds + ", once more where they do not converge",
+                               "[calibrate] predict_specimens", test_steps * ((R + 1) * T_n + kMembraneSpecimenOverTest),
+                               each, each + R * tests_s});
         add.runs(material + ": two fidelities, periodic runs", "[calibrate] scatter_specimens", lab, tests, 1, S, S,
                  std::to_string(S * static_cast<int>(tests.size())) + " runs of " + n + " balls" + rounds);
         upto_rounds(plan.stages.back());

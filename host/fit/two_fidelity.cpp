@@ -69,6 +69,10 @@ Discrepancy measure_discrepancy(const Misfit& misfit, const std::vector<Predicti
   if (membrane.size() != misfit.tests() || periodic.size() != misfit.tests())
     throw std::logic_error("two-fidelity: runs for other tests than the misfit's");
   Discrepancy d;
+  Ensemble tested;
+  for (const Prediction& p : membrane) tested.push_back(p.members);
+  d.membrane_chi2 = 0;
+  for (Real r : misfit.residuals(tested)) d.membrane_chi2 += r * r;
   for (std::size_t k = 0; k < misfit.tests(); ++k) {
     const std::vector<TriaxialTest>& mem = membrane[k].members;
     if (mem.size() < 2 || periodic[k].size() < 2)
@@ -160,10 +164,21 @@ std::vector<Real> next_at(const std::vector<FidelityRound>& rounds, bool& secant
 
 }  // namespace
 
+std::size_t membrane_choice(const std::vector<FidelityRound>& rounds, Real last_chi2) {
+  std::size_t best = rounds.size();
+  Real chi2 = last_chi2;
+  for (std::size_t i = 0; i < rounds.size(); ++i)
+    if (rounds[i].membrane_chi2 < chi2 || (!std::isfinite(chi2) && std::isfinite(rounds[i].membrane_chi2)))
+      best = i, chi2 = rounds[i].membrane_chi2;
+  return best;
+}
+
 FidelityRounds two_fidelity_rounds(const CalibrationResult& periodic, const Misfit& misfit,
                                    const std::vector<TriaxialTest>& tests, const DiscrepancyAt& measure,
-                                   const CalibrateTo& fit, const std::string& template_path, int max_rounds) {
+                                   const CalibrateTo& fit, const std::string& template_path, int max_rounds,
+                                   const EvaluateAt& evaluate) {
   FidelityRounds out;
+  Misfit corrected = misfit;
   for (int round = 1; round <= max_rounds && !out.converged; ++round) {
     FidelityRound r;
     Model at = periodic.model;
@@ -177,7 +192,8 @@ FidelityRounds two_fidelity_rounds(const CalibrationResult& periodic, const Misf
     // Always the data as measured less this round's discrepancy: each round replaces the last one's correction.
     const Discrepancy d = measure(at);
     r.discrepancy = discrepancy_text(misfit, d, tests);
-    Misfit corrected = misfit;
+    r.membrane_chi2 = d.membrane_chi2;
+    corrected = misfit;
     corrected.add_discrepancy(d.delta, d.sd, "two fidelities, round " + std::to_string(round) +
                                                  ": the data less the membrane test's excess over the periodic cell "
                                                  "at the last optimum (" + template_path + "), with its standard error");
@@ -188,6 +204,22 @@ FidelityRounds two_fidelity_rounds(const CalibrationResult& periodic, const Misf
     r.moved = std::sqrt(std::max(Real(0), r.fit.region_rise(r.at))) / 2;
     out.converged = r.moved < kFixedPointMove;
     out.rounds.push_back(std::move(r));
+  }
+  if (out.rounds.empty()) return out;
+  out.answer = out.rounds.back().fit;
+  out.chosen = out.rounds.size();
+  if (out.converged || !evaluate) return out;
+  out.last_membrane_chi2 = measure(out.answer.model).membrane_chi2;
+  out.chosen = membrane_choice(out.rounds, out.last_membrane_chi2);
+  if (out.chosen < out.rounds.size()) {
+    // The chosen round's point with the periodic cell's values and intervals there, against the last correction.
+    const std::vector<Real>& at = out.rounds[out.chosen].at;
+    Model m = out.answer.model;
+    for (std::size_t k = 0; k < at.size(); ++k) set_param(m, out.answer.free[k].name, at[k]);
+    Evaluation e = evaluate(m, corrected);
+    e.u.clear();
+    for (std::size_t k = 0; k < at.size(); ++k) e.u.push_back(out.answer.free[k].unit(at[k]));
+    adopt_best(out.answer, e, m);
   }
   return out;
 }
@@ -211,9 +243,20 @@ std::string FidelityRounds::text() const {
                        " of its region's width from where its discrepancy was measured).\n"
                  : "Not converged: after " + n +
                        fmt(" the optimum still lies %.2f", rounds.back().moved) +
-                       " of its region's width from where its discrepancy was measured; the last round's is reported, "
-                       "and " +
-                       "the membrane prediction at it shows how far it holds.\n";
+                       " of its region's width from where its discrepancy was measured; " +
+                       (std::isfinite(last_membrane_chi2)
+                            ? std::string("the membrane test chose the answer (below)")
+                            : std::string("the last round's is reported, and the membrane prediction at it shows how "
+                                          "far it holds")) + ".\n";
+  if (!std::isfinite(last_membrane_chi2)) return s;
+  s += "\nThe membrane test itself, by its chi2 against the data as measured, at the points it ran:";
+  for (std::size_t i = 0; i < rounds.size(); ++i)
+    s += " round " + std::to_string(i + 1) + fmt("'s point %.1f;", rounds[i].membrane_chi2);
+  s += fmt(" the last optimum %.1f. ", last_membrane_chi2) +
+       (chosen == rounds.size() ? std::string("The last optimum stands.\n")
+                                : "Round " + std::to_string(chosen + 1) + "'s point is the answer: " +
+                                      values_text(answer) + fmt(" (the cell's chi2 there %.1f", answer.best.chi2) +
+                                      " against the last correction).\n");
   return s;
 }
 

@@ -12,6 +12,7 @@
 /// call the idea autoregressive co-kriging; here the correction is a measured offset per feature, not a fitted
 /// process (shared/notes/triaxial_measures.md, section 4).
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,9 @@ namespace dem {
 /// The membrane test's excess over the periodic cell in each feature of the misfit, with its standard error.
 struct Discrepancy {
   std::vector<std::vector<Real>> delta, sd;  ///< [test][feature], the feature's unit (Pa for q)
+  /// The membrane test's own chi2 against the data as measured (its specimens' mean, in the misfit's noise): how well
+  /// the test the lab ran fits where it was run, whatever the cell reads there.
+  Real membrane_chi2 = std::numeric_limits<Real>::quiet_NaN();
 };
 
 /// The base config with the cell of the reference test: `cli` (--reference-test), else the base config's
@@ -71,6 +75,7 @@ struct FidelityRound {
   /// metric; in one parameter, of its 95% interval): the fixed point's residual, zero where the discrepancy was
   /// measured at the optimum it gives, and small along a ridge the data leave free.
   Real moved = 0;
+  Real membrane_chi2 = std::numeric_limits<Real>::quiet_NaN();  ///< the membrane test's at `at` (Discrepancy)
 };
 
 /// Rounds until the corrected optimum lies within kFixedPointMove of its joint 95% region's width of where its
@@ -83,7 +88,14 @@ struct FidelityRound {
 struct FidelityRounds {
   std::vector<FidelityRound> rounds;
   bool converged = false;
-  const CalibrationResult& last() const { return rounds.back().fit; }
+  /// Not converged, with the membrane test as the reference (the issue's "the search's last points run the membrane
+  /// test itself"): the membrane test run at the last optimum too (its chi2 here), and the point among the rounds'
+  /// and that one where the membrane test fits the data as measured best becomes the answer: the membrane test's own
+  /// optimum among the points it ran, near the fixed point, at no search of its own. NaN where converged.
+  Real last_membrane_chi2 = std::numeric_limits<Real>::quiet_NaN();
+  std::size_t chosen = 0;      ///< the answer's point: a round's index (its `at`), or rounds.size() for the last optimum
+  CalibrationResult answer;    ///< the last round's fit, or, moved to the chosen round's point, adopt_best there
+  const CalibrationResult& last() const { return answer; }
   /// Every round in words, and whether the optimum reached its fixed point ("mu_s 0.105 [0.085, 0.189] ...").
   std::string text() const;
 };
@@ -94,15 +106,22 @@ inline constexpr Real kFixedPointMove = 0.1;
 using DiscrepancyAt = std::function<Discrepancy(const Model&)>;
 /// A calibration of the periodic cell against a misfit (the search, with its progress).
 using CalibrateTo = std::function<CalibrationResult(const Misfit&)>;
+/// The periodic cell's ensemble at a model against a misfit, as the search evaluates a point (its u left empty).
+using EvaluateAt = std::function<Evaluation(const Model&, const Misfit&)>;
+
+/// The point the membrane test fits best: the index of the round whose `at` has the lowest membrane chi2, or
+/// rounds.size() for the last optimum (`last_chi2`), which wins ties: it is the fixed-point iteration's own answer.
+std::size_t membrane_choice(const std::vector<FidelityRound>& rounds, Real last_chi2);
 
 /// From `periodic`, the calibration against the data as measured: each round measures the discrepancy at the last
 /// optimum (from the third round, the secant point of the last two), and calibrates to `misfit` (the data as
-/// measured) less it; the rounds stop at the fixed point or after
-/// `max_rounds` (not converged: the last round's optimum is the answer, and the report says so). The membrane test
-/// runs once a round, at the optimum it starts from; the prediction at the last optimum is the caller's.
+/// measured) less it; the rounds stop at the fixed point or after `max_rounds` (not converged: the last round's
+/// optimum is the answer, and the report says so; with `evaluate`, the membrane test runs at the last optimum too and
+/// the answer is the point it fits best, FidelityRounds::chosen). The membrane test runs once a round, at the
+/// optimum it starts from; the prediction at the answer is the caller's.
 FidelityRounds two_fidelity_rounds(const CalibrationResult& periodic, const Misfit& misfit,
                                    const std::vector<TriaxialTest>& tests, const DiscrepancyAt& measure,
                                    const CalibrateTo& fit, const std::string& template_path,
-                                   int max_rounds = kFidelityRounds);
+                                   int max_rounds = kFidelityRounds, const EvaluateAt& evaluate = {});
 
 }  // namespace dem
