@@ -137,6 +137,10 @@ TEST(CliEdges, AnUnsettledSpecimenIsRefusedUnlessAcceptedAndKeptForTheRerun) {
   EXPECT_EQ(o.code, 3) << o.output;
   EXPECT_NE(o.output.find("specimen: the run's own"), std::string::npos) << o.output;
   EXPECT_EQ(o.output.find("specimen layer"), std::string::npos) << "built again on resume:\n" << o.output;
+  // Step 0 comes before any step and was ignored (the test ran to its end, issue 65): refused, naming the option.
+  o = triaxdem("triaxial " + accepted + out + " --overwrite --stop-at-step 0", dir);
+  EXPECT_NE(o.code, 0) << o.output;
+  EXPECT_NE(o.output.find("--stop-at-step"), std::string::npos) << o.output;
 }
 
 // A SIGTERM (or Ctrl-C) while the specimen was being built was held until the whole build had ended (minutes to
@@ -207,6 +211,19 @@ TEST(CliEdges, CheckDescribesTheJobTheConfigIsFor) {
   o = triaxdem("check configs/periodic/periodic_S1_100kPa.toml", dir);
   EXPECT_NE(o.output.find("a periodic-cell triaxial test (triaxdem periodic):\n  cell: 1000 balls"), std::string::npos)
       << o.output;
+  // What `periodic` refuses, `check` refuses with the same words (it said OK to gravity in the cell, issue 65).
+  std::ifstream in(fs::path(TRIAXDEM_SOURCE_DIR) / "configs/periodic/periodic_S1_100kPa.toml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string::size_type g = text.find("gravity = [0.0, 0.0, 0.0]");
+  ASSERT_NE(g, std::string::npos);
+  std::ofstream(dir / "gravity.toml") << text.replace(g, 25, "gravity = [0.0, 0.0, -9.81]");
+  for (const char* job : {"check", "periodic"}) {
+    o = triaxdem(std::string(job) + " " + (dir / "gravity.toml").string() +
+                     (std::string(job) == "check" ? "" : " -o " + (dir / "g").string()), dir);
+    EXPECT_NE(o.code, 0) << job << "\n" << o.output;
+    EXPECT_NE(o.output.find("gravity.toml: [solver] gravity: must be [0, 0, 0] in the cell test"), std::string::npos)
+        << job << "\n" << o.output;
+  }
 }
 
 // `--free mu_s,mu_s` was taken as two parameters (a singular fit): refused with the option, and no result folder
@@ -246,6 +263,21 @@ TEST(CliEdges, SynthNeverWritesOverItsConfigNorOutOfRange) {
     EXPECT_EQ(o.code, 1) << strength;
     EXPECT_NE(o.output.find("out of the range of wear (allowed: [0, 0.9])"), std::string::npos) << o.output;
     EXPECT_FALSE(fs::exists(dir / "new.csv"));
+  }
+  // Taken silently before (issue 65): a NaN strength (replaced by a drawn one), a strength with no extension (dropped),
+  // one pressure given twice (merged into one test that calibrate refused). Each refused before any run.
+  const std::string synth = "synth --config " + config.string() + " -o " + (dir / "new.csv").string();
+  const std::pair<std::string, std::string> refused[] = {
+      {" --extension wear --strength nan", "--strength: nan is not a number"},
+      {" --extension none --strength 0.3", "synth --strength 0.3: --extension none has no strength"},
+      {" --pressures 100 100", "synth --pressures: 100 and 100 kPa are one pressure"}};
+  for (const auto& [args, said] : refused) {
+    o = triaxdem(synth + args, dir);
+    EXPECT_NE(o.code, 0) << args;
+    EXPECT_NE(o.output.find(said), std::string::npos) << args << "\n" << o.output;
+    EXPECT_EQ(o.output.find("a specimen each (packed first)"), std::string::npos)
+        << "work started: " << args << "\n" << o.output;
+    EXPECT_FALSE(fs::exists(dir / "new.csv")) << args;
   }
 }
 
@@ -431,6 +463,43 @@ TEST(CliEdges, AWalledCellTakesItsBallsAsTheDatasSpecimen) {
                                        "its walls' looser layer") != std::string::npos;
     EXPECT_EQ(smaller, std::string(file) == "big.csv") << file << "\n" << o.output;
   }
+}
+
+// Fewer summary values than free parameters are refused before any work (issue 65: one q_peak for mu_s and mu_r gave
+// both values and "chi2 0.0 on 1 data", exit 0); as many as the parameters are a fit with no test of it, accepted
+// (a pressure of Table 6 held out leaves two peaks for two frictions).
+TEST(CliEdges, FewerDataThanFreeParametersAreRefusedBeforeAnyWork) {
+  const fs::path dir = dem::test::scratch_dir("cli_few_data");
+  std::ofstream(dir / "one.csv") << "material,sigma3_kPa,q_peak_kPa\nA,100,300\n";
+  std::ofstream(dir / "two.csv") << "material,sigma3_kPa,q_peak_kPa\nA,100,300\nA,200,560\n";
+  for (const char* file : {"one.csv", "two.csv"}) {
+    const Outcome o = triaxdem("calibrate " + (dir / file).string() + " --config configs/calibration/base.toml "
+                               "--predict none -j 1 --plan -o " + (dir / "out").string(), dir);
+    const bool refused = o.output.find(std::string(file) + ": material A gives 1 summary value for 2 free parameters "
+                                       "([calibrate] free): fewer data than parameters") != std::string::npos;
+    EXPECT_EQ(refused, std::string(file) == "one.csv") << o.output;
+    EXPECT_EQ(o.code == 0, std::string(file) == "two.csv") << o.output;
+  }
+}
+
+// `--resume FOLDER` with other data than the folder's said "resuming..." and replaced the finished result's files
+// (issue 65): the folder's job_inputs.txt is checked before any work, naming what differs.
+TEST(CliEdges, AResumeWithOtherInputsIsRefused) {
+  const fs::path dir = dem::test::scratch_dir("cli_resume_inputs");
+  const fs::path folder = dir / "calibrate_20990101-000000";
+  fs::create_directories(folder);
+  std::ofstream(folder / "job_inputs.txt") << "data 0\n--material S-1\n";
+  const std::string job = "calibrate data/tang2025_table6_peak.csv --config configs/calibration/base.toml "
+                          "--predict none -j 1 --plan --resume " + folder.string();
+  Outcome o = triaxdem(job + " --material S-1", dir);
+  EXPECT_NE(o.code, 0) << o.output;
+  EXPECT_NE(o.output.find("calibrate_20990101-000000: the calibrate there ran with another data file (its bytes differ "
+                          "from data/tang2025_table6_peak.csv)"), std::string::npos) << o.output;
+  std::ofstream(folder / "job_inputs.txt") << "--material S-1\n";
+  o = triaxdem(job + " --material S-2", dir);
+  EXPECT_NE(o.output.find("ran with another --material ('S-1', now 'S-2')"), std::string::npos) << o.output;
+  o = triaxdem(job + " --material S-1", dir);
+  EXPECT_EQ(o.code, 0) << o.output;
 }
 
 // --hold-out leaves a pressure out of the fit and predicts it: the plan fits the other two tests and predicts all three;

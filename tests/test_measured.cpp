@@ -376,6 +376,33 @@ TEST(Measured, ImplausibleValuesAreRefusedWithLineAndColumn) {
   EXPECT_NE(e.find("bad.csv:2:q_3pct_kPa: 11000 kPa is implausible"), std::string::npos) << e;
 }
 
+// What no drained test shows is refused, naming the file, the test and what is allowed (issue 65): sigma3 in Pa
+// under a kPa header (the peak 0.0014 of it, where 0.05 is a friction angle of 1.4 deg), a peak at or below zero (every
+// q negative, a summary q_peak of -5 kPa, q zero throughout), eps_v zero on every row, a negative axial strain, and
+// curve and summary columns in one file. A peak of exactly 0.05 sigma3 is accepted: the bound is the bound.
+TEST(Measured, WhatNoDrainedTestShowsIsRefused) {
+  const std::string curve = "material,sigma3_kPa,eps_a_pct,q_kPa,eps_v_pct\n";
+  std::string e = error_of(curve + "A,100000,0,0,0\nA,100000,1,120,0.1\nA,100000,2,142,0.2\n");
+  // The peak is the smoothed curve's (a moving mean over +-0.25% strain), 120 kPa on these rows.
+  EXPECT_NE(e.find("bad.csv: A at 100000 kPa: the peak of its q 120 kPa is 0.0012 of sigma3 (allowed: at least 0.05 "
+                   "sigma3"), std::string::npos) << e;
+  EXPECT_NE(e.find("is sigma3 in Pa under a kPa header"), std::string::npos) << e;
+  e = error_of(curve + "A,100,0,-1,0\nA,100,1,-120,0.1\nA,100,2,-142,0.2\n");
+  EXPECT_NE(e.find("bad.csv: A at 100 kPa: the peak of its q is -120 kPa"), std::string::npos) << e;
+  EXPECT_NE(e.find("(compression positive; allowed: q_peak > 0)"), std::string::npos) << e;
+  e = error_of(curve + "A,100,0,0,0\nA,100,1,0,0\nA,100,2,0,0\n");
+  EXPECT_NE(e.find("the peak of its q is 0 kPa"), std::string::npos) << e;
+  e = error_of(curve + "A,100,0,0,0\nA,100,1,120,0\nA,100,2,142,0\n");
+  EXPECT_NE(e.find("bad.csv: A at 100 kPa: eps_v is zero on every row"), std::string::npos) << e;
+  e = error_of(curve + "A,100,-0.5,0,0\nA,100,1,120,0.1\nA,100,2,142,0.2\n");
+  EXPECT_NE(e.find("bad.csv:2:eps_a_pct: -0.5%: axial strain is >= 0"), std::string::npos) << e;
+  e = error_of("material,sigma3_kPa,q_peak_kPa\nA,100,-5\n");
+  EXPECT_NE(e.find("bad.csv: A at 100 kPa: q_peak is -5 kPa"), std::string::npos) << e;
+  e = error_of("material,sigma3_kPa,eps_a_pct,q_kPa,q_peak_kPa\nA,100,0,0,300\n");
+  EXPECT_NE(e.find("bad.csv:1:q_peak_kPa: q_peak is a summary column"), std::string::npos) << e;
+  EXPECT_DOUBLE_EQ(load_measured(write("low.csv", "material,sigma3_kPa,q_peak_kPa\nA,100,5\n")).tests[0].q_peak, 5e3);
+}
+
 // Pressures within 2% of a group's first test are one pressure: grouped, each test once, groups in order of
 // their first test; the reader says so when they are not exactly equal.
 TEST(Measured, NearEqualPressuresAreGroupedAsReplicates) {

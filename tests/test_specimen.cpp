@@ -53,6 +53,16 @@ TEST(Specimen, CacheRoundTripsBitForBitAndRefusesOtherKeys) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("bad.csv:4"), std::string::npos) << e.what();
   }
+  // A file cut at a line's end parses whole: the key's ball count refuses it (a specimen of 292 balls was used where
+  // the key said 452, issue 65).
+  save_specimen(path, sp, "v2 d 0.002 n 3 layers 1");
+  try {
+    load_specimen(path, "v2 d 0.002 n 3 layers 1", back);
+    FAIL() << "a specimen with fewer balls than its key says must be refused";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("damaged specimen file (2 balls where its key says 3); delete it"),
+              std::string::npos) << e.what();
+  }
   // The test's friction does not enter the key: the nine paper cases share one specimen.
   const Config s1 = load_config(std::string(TRIAXDEM_SOURCE_DIR) + "/configs/paper/S1_100kPa.toml");
   const Config s3 = load_config(std::string(TRIAXDEM_SOURCE_DIR) + "/configs/paper/S3_300kPa.toml");

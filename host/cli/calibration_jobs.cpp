@@ -8,6 +8,7 @@
 #include <map>
 #include <optional>
 #include <sstream>
+#include <stdexcept>
 
 #include "host/cli/calibration_session.hpp"
 #include "host/data/curve_reading.hpp"
@@ -189,6 +190,9 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
         progress.update(done - start, extra);
       });
       progress.finish("");
+      if (!std::isfinite(r.best.chi2))
+        throw std::runtime_error(what + " " + material + ": no point of the search gave a result (" +
+                                 ss.failed_text() + ")");
       return r;
     };
     CalibrationResult r = fit(misfit, "calibrate");
@@ -249,6 +253,9 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
                 ss.cell_text().c_str());
     const Misfit misfit = ss.misfit_of(base, material, tests);
     const Diagnosis dg = diagnose(ss.lab, model_of(base), ss.free, tests, misfit, true);
+    if (!std::isfinite(dg.base.best.chi2))
+      throw std::runtime_error("diagnose " + material + ": no point of the base search gave a result (" +
+                               ss.failed_text() + ")");
     std::printf("diagnose: %s: verdict: %s\n  %s\n", material.c_str(), dg.verdict.c_str(), dg.explanation.c_str());
     std::printf("%s", uncertainty_text(dg.base, material, "diagnose").c_str());
     std::string edge, widened;

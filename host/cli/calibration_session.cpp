@@ -152,10 +152,12 @@ JobInputs::JobInputs(const Config& base, const CalibrationOptions& o)
   if (two_fidelity)
     check_template_size(*predict_template, data.tests, o.predict.empty() ? base.path + ": [calibrate] predict" : "--predict");
   held_out = hold_out(o, data);
+  check_enough_data(o, data, free.size());
 }
 
 JobPlan JobInputs::announce_plan(const Config& base, const CalibrationOptions& o, const std::string& kind) const {
   check_folders(o, kind);
+  check_resumed_inputs(base, o, kind);
   PlanInput in;
   in.cell = stored_cell(base, o, data);
   in.materials = by_material(data, o.material);
@@ -196,7 +198,11 @@ Session::Session(const Config& base, const CalibrationOptions& o, const std::str
   lab.set_run_store(folder + "/runs");
   lab.set_q_measure(cell_q);
   if (!o.resume.empty())
-    std::printf("%s: resuming in %s: the runs stored there are read, not run again\n", kind.c_str(), folder.c_str());
+    std::printf("%s: resuming in %s: the runs stored there are read, not run again%s\n", kind.c_str(), folder.c_str(),
+                fs::exists(folder + "/job_inputs.txt") ? " (same data, config and options)"
+                                                       : "; the folder holds no record of its inputs, so they are not "
+                                                         "checked against this job's");
+  record_job_inputs(base, o, folder);
   if (lab.config().periodic.boundary == CellBoundary::walls) {
     const bool fixed = cell_q == QMeasure::kFixedArea;
     std::printf("%s: note: the walled cell compares its q over the %s cross-section (%s%s); its walls also give q "

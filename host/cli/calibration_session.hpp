@@ -71,9 +71,15 @@ struct JobInputs {
 /// What the job's data are taken to be (host/cli/data_scope.cpp). take_walled_size: between walls the specimen's size
 /// is part of the test, so tests without specimen_balls take the walled cell's balls (with a note), and a walled cell
 /// smaller than the data's specimen is said. hold_out: the tests at --hold-out's pressure out of `data`, returned;
-/// DataError where no test has it or a material the job calibrates would keep none.
+/// DataError where no test has it or a material the job calibrates would keep none. check_enough_data: DataError where
+/// a material's summary values are fewer than the free parameters (a ridge of fits, each with chi2 0).
 void take_walled_size(const Config& base, const CalibrationOptions& o, MeasuredData& data);
 std::vector<TriaxialTest> hold_out(const CalibrationOptions& o, MeasuredData& data);
+void check_enough_data(const CalibrationOptions& o, const MeasuredData& data, std::size_t free);
+/// The inputs that decide a job's runs (the data's bytes, the config's keys, the options), in the result folder's
+/// job_inputs.txt; a --resume with other inputs is refused before any work, naming what differs.
+void record_job_inputs(const Config& base, const CalibrationOptions& o, const std::string& folder);
+void check_resumed_inputs(const Config& base, const CalibrationOptions& o, const std::string& kind);
 
 /// What calibrate and diagnose share: the job's inputs, the simulator and a new result folder.
 struct Session : JobInputs {

@@ -2,8 +2,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "host/fit/two_fidelity.hpp"
+#include "host/io/io_hdf5.hpp"
 #include "host/util/text_format.hpp"
 
 namespace dem {
@@ -60,6 +69,70 @@ std::vector<TriaxialTest> hold_out(const CalibrationOptions& o, MeasuredData& da
   data.tests = kept;
   data.notes.push_back("held out: the tests at " + held_kPa + " are left out of the fit and predicted at the end");
   return held;
+}
+
+namespace {
+
+/// The inputs that decide a job's results, a line each ("data <hash of the file's bytes>"): a resumed folder's runs
+/// belong to the same lines.
+std::vector<std::pair<std::string, std::string>> job_inputs(const Config& base, const CalibrationOptions& o) {
+  std::ifstream in(o.data, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string free;
+  for (const std::string& f : o.free) free += f + " ";
+  return {{"data", std::to_string(std::hash<std::string>{}(bytes))},
+          {"config", std::to_string(std::hash<std::string>{}(base.fingerprint))},
+          {"--free", free},
+          {"--material", o.material},
+          {"--reference-test", o.reference_test},
+          {"--predict", o.predict},
+          {"--noise", o.noise},
+          {"--hold-out", std::isfinite(o.hold_out_kPa) ? fmt("%g", o.hold_out_kPa) : ""}};
+}
+
+std::string inputs_path(const std::string& folder) { return folder + "/job_inputs.txt"; }
+
+}  // namespace
+
+void record_job_inputs(const Config& base, const CalibrationOptions& o, const std::string& folder) {
+  std::string text;
+  for (const auto& [key, value] : job_inputs(base, o)) text += key + " " + value + "\n";
+  io::write_text_atomic(inputs_path(folder), text);
+}
+
+void check_resumed_inputs(const Config& base, const CalibrationOptions& o, const std::string& kind) {
+  if (o.resume.empty()) return;
+  std::ifstream in(inputs_path(o.resume));
+  if (!in) return;  // a folder from before the record: its inputs cannot be checked (the job says so when it resumes)
+  std::map<std::string, std::string> was;
+  for (std::string line; std::getline(in, line);) {
+    const std::string::size_type sp = line.find(' ');
+    if (sp != std::string::npos) was[line.substr(0, sp)] = line.substr(sp + 1);
+  }
+  for (const auto& [key, value] : job_inputs(base, o))
+    if (was.count(key) && was[key] != value)
+      throw std::invalid_argument("--resume " + o.resume + ": the " + kind + " there ran with another " +
+                                  (key == "data" ? "data file (its bytes differ from " + o.data + ")"
+                                   : key == "config" ? "config (" + base.path + " differs in a key that decides runs)"
+                                                     : key + " ('" + was[key] + "', now '" + value + "')") +
+                                  ": a resume continues the same job; start a new folder with -o");
+}
+
+void check_enough_data(const CalibrationOptions& o, const MeasuredData& data, std::size_t free) {
+  if (data.curves) return;  // a curve gives tens of compared values
+  std::map<std::string, std::size_t> values;
+  for (const TriaxialTest& t : data.tests) {
+    if (!o.material.empty() && t.material != o.material) continue;
+    for (Real v : {t.q_peak, t.eps_a_peak, t.q_end, t.max_dilatancy, t.e_ini, t.q_1pct, t.q_3pct})
+      values[t.material] += std::isfinite(v) ? 1 : 0;
+  }
+  for (const auto& [material, n] : values)
+    if (n < free)
+      throw DataError(data.path + ": material " + material + " gives " + std::to_string(n) + " summary value" +
+                      (n == 1 ? "" : "s") + " for " + std::to_string(free) + " free parameters ([calibrate] free): " +
+                      "fewer data than parameters leave a ridge of equal fits, each with chi2 0 (allowed: at least " +
+                      std::to_string(free) + "): give more tests or values (q_peak, eps_a_peak, q_end, ...), or free " +
+                      "fewer parameters");
 }
 
 }  // namespace dem

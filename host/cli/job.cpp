@@ -11,6 +11,7 @@
 #include "host/engine/packing.hpp"
 #include "host/engine/setup.hpp"
 #include "host/engine/stage_loop.hpp"
+#include "host/triax/periodic_triaxial.hpp"
 #include "host/triax/specimen.hpp"
 #include "host/util/progress.hpp"
 #include "host/triax/triaxial.hpp"
@@ -184,6 +185,7 @@ double packed_speed(const Config& cfg, long balls) {
 }  // namespace
 
 int check_job(const Config& cfg) {
+  if (cfg.has_periodic && !cfg.has_specimen) check_periodic_config(cfg);  // what `periodic` refuses, check refuses
   auto box = build_simulation(cfg, false);
   const Real dt = box->params().integ.dt, critical = box->critical_dt();
   const std::string dt_text = g3(dt) + " s (" +

@@ -127,8 +127,9 @@ void add_test_commands(CLI::App& app, Args& a, Commands& c) {
   c.run->add_flag("--resume", a.resume, "continue from the output folder's checkpoint.h5 to the step count");
   const char* overwrite_help = "replace another run's outputs in the output folder (refused without it)";
   c.run->add_flag("--overwrite", a.overwrite, overwrite_help)->excludes("--resume");
-  c.run->add_option("--stop-at-step", a.stop_at, "write a checkpoint after this step and stop (exit status 3)")
-      ->check(CLI::NonNegativeNumber);
+  c.run->add_option("--stop-at-step", a.stop_at, "write a checkpoint after this step and stop (exit status 3); "
+                    "steps count from 1")
+      ->check(CLI::PositiveNumber);
 
   c.specimen = app.add_subcommand("specimen", "build the [specimen] of a config by multilayer compaction");
   add_config_and_output(c.specimen, a);
@@ -138,8 +139,9 @@ void add_test_commands(CLI::App& app, Args& a, Commands& c) {
   add_config_and_output(c.triaxial, a);
   auto* triaxial_resume = c.triaxial->add_flag("--resume", a.resume, "continue from the output folder's checkpoint.h5");
   c.triaxial->add_flag("--overwrite", a.overwrite, overwrite_help)->excludes(triaxial_resume);
-  c.triaxial->add_option("--stop-at-step", a.stop_at, "write a checkpoint after this step and stop (exit status 3)")
-      ->check(CLI::NonNegativeNumber);
+  c.triaxial->add_option("--stop-at-step", a.stop_at, "write a checkpoint after this step and stop (exit status 3); "
+                    "steps count from 1")
+      ->check(CLI::PositiveNumber);
 
   c.periodic = app.add_subcommand("periodic", "periodic-cell drained triaxial test (no platens, no membrane)");
   add_config_and_output(c.periodic, a);
@@ -217,7 +219,11 @@ void add_calibration_commands(CLI::App& app, Args& a, Commands& c) {
   c.synth->add_flag("--overwrite", a.syn.overwrite, "replace an existing output file (never the config)");
   c.synth->add_option("--extension", a.syn.extension, dem::extension_names() + " or none");
   c.synth->add_option("--strength", a.syn.strength,
-                      "the extension's parameter in its config unit (default: drawn from the seed)");
+                      "the extension's parameter in its config unit (default: drawn from the seed)")
+      ->check(CLI::Validator([](std::string& s) -> std::string {
+        // nan parses as a double, and a NaN strength means "draw one": a given one must be a number.
+        return std::isfinite(std::strtod(s.c_str(), nullptr)) ? "" : s + " is not a number";
+      }, "NUMBER"));
   c.synth->add_option("--seed", a.syn.seed, "noise and strength seed");
   c.synth->add_option("--specimen-seed", a.syn.specimen_seed, "packing seed of the specimen (default: the config's "
                       "[run] seed + 100000, a specimen no calibration ensemble of that config uses)");

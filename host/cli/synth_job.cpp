@@ -1,5 +1,6 @@
 /// `triaxdem synth` (host/cli/calibration_jobs.hpp): synthetic measured curves of the base config's model with a hidden
 /// extension switched on, from specimens no calibration ensemble of that config uses.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -8,6 +9,7 @@
 
 #include "host/fit/calibrate.hpp"
 #include "host/cli/calibration_jobs.hpp"
+#include "host/config/model_keys.hpp"
 #include "host/fit/diagnose.hpp"
 #include "host/util/text_format.hpp"
 
@@ -25,6 +27,16 @@ int synth_job(const Config& base, const SynthOptions& o) {
     throw std::invalid_argument("synth -o " + o.output + ": that is the config (--config); name another file");
   if (fs::exists(o.output) && !o.overwrite)
     throw std::invalid_argument("synth -o " + o.output + ": the file exists (--overwrite replaces it)");
+  if (o.extension == "none" && !std::isnan(o.strength))
+    throw std::invalid_argument("synth --strength " + fmt("%g", o.strength) + ": --extension none has no strength "
+                                "(name the extension it is for: " + extension_names() + ")");
+  for (std::size_t i = 0; i < o.sigma3.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (std::fabs(o.sigma3[i] - o.sigma3[j]) < kReplicateTolerance * std::max(o.sigma3[i], o.sigma3[j]))
+        throw std::invalid_argument("synth --pressures: " + fmt("%g", 1e-3 * o.sigma3[j]) + " and " +
+                                    fmt("%g kPa", 1e-3 * o.sigma3[i]) + " are one pressure (within " +
+                                    fmt("%g%%", 100 * kReplicateTolerance) + ", as calibrate reads them): one test a "
+                                    "pressure, each given once");
   if (o.extension != "none") {
     const Extension& e = extension(o.extension);
     const FreeParam range = free_param(e.param);
@@ -43,7 +55,15 @@ int synth_job(const Config& base, const SynthOptions& o) {
              std::to_string(kGeneratorCellFactor) + " times the config's balls)";
   PeriodicLab lab(larger_cell(base, kGeneratorCellFactor), true, static_cast<int>(o.sigma3.size()), specimen);
   lab.set_progress("synth: the tests");
+  std::printf("synth: %zu tests of %zu balls, a specimen each (packed first), to %s\n", o.sigma3.size(), lab.balls(),
+              o.output.c_str());
   const std::vector<TriaxialTest> tests = synthetic_tests(lab, truth, o.sigma3, o.material, o.seed);
+  for (const TriaxialTest& t : tests)
+    if (t.q.empty())
+      throw std::runtime_error("synth: the test at " + fmt("%g kPa", 1e-3 * t.sigma3) + " stopped at a blow-up (" +
+                               std::to_string(lab.failed_runs()) + " of " + std::to_string(tests.size()) + " tests did; " +
+                               "nothing written): the contacts cannot carry that pressure; lower it, or stiffen them "
+                               "([material] emod_Pa) or raise [solver] overlap_limit where the overlaps are physics");
   write_measured_curves(o.output, tests, comment);
   std::printf("synth: %s -> %s\n", comment.c_str(), o.output.c_str());
   return 0;

@@ -128,6 +128,11 @@ void check_columns(const Columns& c, bool curves, const std::string& at) {
       fail(at, "", "missing column '" + q + "'" + (q == "material" ? "" : " (with its unit, e.g. " + q +
                                                    (q.rfind("eps", 0) == 0 ? "_pct" : "_kPa") + ")"));
   if (!curves && c.has("eps_v")) fail(at, c.name("eps_v"), "eps_v needs curves (an eps_a column)");
+  if (curves)
+    for (const std::string& q : kSummarySd)
+      if (c.has(q))
+        fail(at, c.name(q), q + " is a summary column, and a file with an eps_a column is curves, whose summary is read "
+                                "off the curves: give curves or summary points, one kind a file");
   if (c.has("void_ratio") && c.has("porosity")) fail(at, c.name("porosity"), "give void_ratio or porosity, not both");
   for (const ColumnSpec& s : c.specs)
     if (is_sd(s.quantity)) check_sd_column(c, curves, at, s.quantity);
@@ -250,6 +255,7 @@ TriaxialTest& test_of(const RowReader& r, MeasuredData& d, TestIndex& tests) {
 
 void read_curve_row(const RowReader& r, TriaxialTest& t) {
   const Real ea = strain(r, "eps_a");
+  if (ea < 0) r.refuse("eps_a", str(100 * ea) + "%: axial strain is >= 0 (compression positive, from the start of shear)");
   if (!t.eps_a.empty() && !(ea > t.eps_a.back()))
     r.refuse("eps_a", "axial strain must increase within a test (" + describe(t) + ")");
   t.eps_a.push_back(ea);
@@ -270,6 +276,23 @@ void read_summary_row(const RowReader& r, TriaxialTest& t) {
   t.q_3pct = stress(r, "q_3pct", t.sigma3);
   for (const std::string& q : kSummarySd)
     if (r.has(q + "_sd")) t.summary_sd[q] = r.sd(q);
+}
+
+/// What no drained test shows, refused after its rows are read: a peak at or below zero (a sign flipped), a peak under
+/// kMinPeakRatio sigma3 (a unit slipped), a volumetric strain zero on every row (not measured: leave the column out).
+void check_plausible(const std::string& path, const TriaxialTest& t, bool curves) {
+  const std::string at = path + ": " + describe(t) + ": ";
+  const std::string peak = curves ? "the peak of its q" : "q_peak";
+  if (!(t.q_peak > 0))
+    throw DataError(at + peak + " is " + str(t.q_peak / 1e3) + " kPa: a drained test's deviator rises above zero "
+                    "(compression positive; allowed: q_peak > 0): a sign flipped, or the wrong column?");
+  if (t.q_peak < kMinPeakRatio * t.sigma3)
+    throw DataError(at + peak + " " + str(t.q_peak / 1e3) + " kPa is " + str(t.q_peak / t.sigma3) + " of sigma3 (allowed: at "
+                    "least " + str(kMinPeakRatio) + " sigma3, a friction angle of 1.4 deg): is sigma3 in Pa under a kPa "
+                    "header, or q in another unit than its column says?");
+  if (curves && !t.eps_v.empty() && std::all_of(t.eps_v.begin(), t.eps_v.end(), [](Real v) { return v == 0; }))
+    throw DataError(at + "eps_v is zero on every row: a volume not measured; leave the eps_v column out (allowed: a "
+                    "measured volumetric strain)");
 }
 
 /// The file's q measure: one name, the same on every row.
@@ -369,6 +392,7 @@ MeasuredData load_measured(const std::string& path) {
                         std::to_string((t.eps_a.size() + kMaxCurveRows - 1) / kMaxCurveRows * 10) + "th row)");
       summarise(t);
     }
+  for (const TriaxialTest& t : d.tests) check_plausible(path, t, d.curves);
   note_replicates(d);
   if (!d.q_measure_given)
     d.notes.push_back(path + ": no q_measure column: q taken as fixed_area (platen force over the cross-section "

@@ -90,6 +90,10 @@ struct MeasuredData {
 
 /// Limits of plausible data: |q| <= kMaxStressRatio sigma3, |strain| <= kMaxStrain (fractions).
 constexpr Real kMaxStressRatio = 100, kMaxStrain = 1.0;
+/// The least peak a drained test reaches, as a share of sigma3: q_peak / sigma3 = 2 sin phi / (1 - sin phi) is 0.05 at
+/// a friction angle of 1.4 deg, below any granular material; a file under it holds sigma3 in Pa under a kPa header
+/// (the peak 1000 times too small) or q in another unit.
+constexpr Real kMinPeakRatio = 0.05;
 /// Tests of one material whose sigma3 differ by less than this fraction are replicates of one pressure.
 constexpr Real kReplicateTolerance = 0.02;
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -280,6 +281,12 @@ bool load_specimen(const std::string& path, const std::string& key, Specimen& sp
   }
   if (!key_ok) return false;
   if (out.balls.empty() || !(out.height > 0)) damaged("no balls or no height");
+  // A file cut at a line's end (a full disk, a copy stopped) parses whole: its key says how many balls it holds.
+  if (const std::string::size_type at = key.find(" n "); at != std::string::npos) {
+    const long want = std::strtol(key.c_str() + at + 3, nullptr, 10);
+    if (static_cast<long>(out.balls.size()) != want)
+      damaged(std::to_string(out.balls.size()) + " balls where its key says " + std::to_string(want));
+  }
   sp = std::move(out);
   return true;
 }
