@@ -41,6 +41,21 @@ TEST(Study, ConfigWithoutATestIsRefusedByName) {
   EXPECT_THROW(study_cases({"/nonexistent/folder"}), std::runtime_error);
 }
 
+// A study into a triaxial run's own folder mixed its cases' files with the run's (issue 65): refused before any case.
+TEST(Study, ARunsFolderIsNoStudysOutput) {
+  const auto dir = dem::test::scratch_dir("study_into_run");
+  std::ofstream(dir / "summary.csv") << "q_peak_kPa\n100\n";
+  StudyOptions opt;
+  opt.output = dir.string();
+  try {
+    study_job({std::string(TRIAXDEM_SOURCE_DIR) + "/tests/data/tiny_triaxial.toml"}, opt, "/nonexistent");
+    FAIL() << "a study into a run's folder";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(": a run's folder (summary.csv in it)"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "tiny_triaxial")) << "a case ran";
+}
+
 TEST(Study, SummaryRoundTripsInFileUnits) {
   const auto dir = dem::test::scratch_dir("study");
   TestSummary s;

@@ -201,8 +201,18 @@ TEST_F(Triaxial, MicromechanicsFromSavedStatesAndClearRefusals) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("0.0%, 1.0%, 5.0%"), std::string::npos) << e.what();
   }
+  // The same state again into the same folder (with another cube) replaced the first's files silently (issue 65):
+  // refused unless asked.
   try {
-    micro_job(dir.string(), 1.0, 30.0, 18, out.string());
+    micro_job(dir.string(), 1.0, 6.0, 18, out.string());
+    FAIL() << "an earlier micro's files replaced without --overwrite";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(": an earlier micro of this state wrote it: --overwrite replaces its files"),
+              std::string::npos) << e.what();
+  }
+  EXPECT_EQ(micro_job(dir.string(), 1.0, 6.0, 18, out.string(), true), 0);
+  try {
+    micro_job(dir.string(), 1.0, 30.0, 18, out.string(), true);
     FAIL() << "a 30 mm cube does not fit in a 16 mm specimen";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("does not fit"), std::string::npos) << e.what();

@@ -43,7 +43,9 @@ int run_periodic_job(const Config& cfg);
 /// the snapshot taken at that axial strain) or a snapshot file. Writes micro_<label>.csv (one row of the
 /// micro columns for the specimen and the cube), the distributions and the force chains into `output`
 /// and prints the headline numbers. Throws std::runtime_error with what was asked and what exists.
-int micro_job(const std::string& source, double at_pct, double rve_edge_mm, int rose_bins, const std::string& output);
+/// Files of an earlier micro of the same state in `output` are refused unless `overwrite`.
+int micro_job(const std::string& source, double at_pct, double rve_edge_mm, int rose_bins, const std::string& output,
+              bool overwrite = false);
 
 /// Runs the study; returns 0 when every case finished, 1 otherwise (the summary then lists the failures).
 /// study_summary.csv is rewritten whenever a case finishes, so a study stopped half-way leaves its table.

@@ -171,6 +171,7 @@ void add_study_commands(CLI::App& app, Args& a, Commands& c) {
   c.micro->add_option("--rve", a.micro_rve, "edge of the central cube, mm (default 20)");
   c.micro->add_option("--bins", a.micro_bins, "rose bins over 0-180 deg (default 18)")->check(CLI::Range(2, 3600));
   c.micro->add_option("-o,--output", a.micro_out, "output folder (default: the run folder or the snapshot's)");
+  c.micro->add_flag("--overwrite", a.overwrite, "replace the files of an earlier micro of the same state");
 }
 
 /// calibrate and diagnose (the same options) and synth.
@@ -251,7 +252,7 @@ int run_command(const Commands& c, Args& a) {
     const std::string out = !a.micro_out.empty() ? a.micro_out
                             : fs::is_directory(a.micro_source) ? a.micro_source
                                                                : fs::path(a.micro_source).parent_path().string();
-    return dem::micro_job(a.micro_source, a.micro_at, a.micro_rve, a.micro_bins, out.empty() ? "." : out);
+    return dem::micro_job(a.micro_source, a.micro_at, a.micro_rve, a.micro_bins, out.empty() ? "." : out, a.overwrite);
   }
   dem::Config cfg = dem::load_config(a.config_path);
   if (!a.output.empty()) cfg.run.output = a.output;

@@ -21,7 +21,8 @@ double label_strain(const std::string& label) {
 
 }  // namespace
 
-int micro_job(const std::string& source, double at_pct, double rve_edge_mm, int rose_bins, const std::string& output) {
+int micro_job(const std::string& source, double at_pct, double rve_edge_mm, int rose_bins, const std::string& output,
+              bool overwrite) {
   namespace fs = std::filesystem;
   std::string path = source;
   if (fs::is_directory(source)) {
@@ -50,6 +51,13 @@ int micro_job(const std::string& source, double at_pct, double rve_edge_mm, int 
   } else if (!fs::is_regular_file(source)) {
     throw std::runtime_error(source + ": no such run folder or snapshot file");
   }
+  const std::string label = fs::path(path).stem().string();
+  // An earlier micro of this state (another --rve or --bins, perhaps) is a result: replaced only when asked.
+  for (const std::string& name : {"micro_" + label + ".csv", "micro_coordination_" + label + ".csv",
+                                   "micro_rose_" + label + ".csv", "force_chains_" + label + ".vtk"})
+    if (!overwrite && fs::exists(fs::path(output) / name))
+      throw std::runtime_error(output + "/" + name + ": an earlier micro of this state wrote it: --overwrite replaces "
+                               "its files, or -o names another folder");
   const io::SnapshotFile f = io::read_snapshot(path);
   const ContactSet cs = contact_set(f, path);
   if (cs.contacts.empty()) throw std::runtime_error(path + ": the snapshot's contact list is empty");
@@ -70,7 +78,6 @@ int micro_job(const std::string& source, double at_pct, double rve_edge_mm, int 
   const ContactSet rve = restrict_to_cube(cs, Vec3(0, 0, 0.5 * (zmin + zmax)), edge);
   const MicroRow all = micro_row(cs, volume), cube = micro_row(rve, edge * edge * edge);
   fs::create_directories(output);
-  const std::string label = fs::path(path).stem().string();
   std::string text;
   for (const std::string& c : micro_columns()) text += c + ",";
   for (const std::string& c : micro_columns("rve_")) text += c + (c == micro_columns("rve_").back() ? "\n" : ",");

@@ -116,6 +116,11 @@ int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, c
   if (ranks::spread()) workers = ranks::size() - 1;  // the leader hands out the cases; each other rank runs one
   const int threads =
       opt.threads > 0 ? opt.threads : std::max(1, cores / (ranks::spread() ? ranks::per_node() : workers));
+  // A run's own folder (its series and checkpoint at the top) is no study's: their files would mix.
+  for (const char* own : {"series.csv", "summary.csv", "checkpoint.h5"})
+    if (fs::exists(fs::path(opt.output) / own))
+      throw std::runtime_error("study -o " + opt.output + ": a run's folder (" + own + " in it): a study writes a "
+                               "folder per case and its table there; name another folder");
   fs::create_directories(opt.output);
   if (ranks::spread()) std::printf("study: spread over %d MPI ranks\n", ranks::size());
   std::printf("study: %zu cases, %d at a time with %d OpenMP threads each; logs in %s/<case>/log.txt\n",
