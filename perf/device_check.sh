@@ -8,7 +8,9 @@
 # BUILD: the build whose binaries run (default build); CPU_BUILD: the one that prepares (default build).
 # TINY=1: a few hundred balls and steps, no membrane specimen and not the suite's tests, for CI on any build.
 # PARTS: which of the suite's tests run (default "kernels other"; "kernels" when device time is short), each part
-# for at most TEST_LIMIT s (90); FULL_LIMIT: seconds for the full-scale test from nothing (60).
+# for at most TEST_LIMIT s (90); FULL_LIMIT: seconds for the full-scale test from nothing (60). BUDGET: seconds for
+# the whole run (660), stages in order of value, what was reached in OUT/reached.txt; TABLE6=LOOP: the full-scale
+# Table 6 of the table6 mode as the last stage, in what is left of the budget.
 # Each stage has its own time limit, so that a slow stage costs its limit and not the rest.
 set -uo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -154,89 +156,142 @@ fi
 
 out="$(realpath -m "${3:?usage: perf/device_check.sh run REF OUT}")"
 build="$(realpath "${BUILD:-$root/build}")"; bin="$build/triaxdem"
-mkdir -p "$out"
+mkdir -p "$out"; : > "$out/reached.txt"
 failed=""
+# The stages in order of value (issue 64): the kernel and reference tests, the million-ball benchmark, the batch
+# beside one cell alone, a batched calibration, the CPU-GPU agreement, the rest of the suite, the full scale. BUDGET
+# (seconds, 660: 12 minutes of device time less the start) bounds them all: each stage runs under the least of its
+# own limit and what is left, a stage with less than its minimum left is not started, and reached.txt says which
+# stages ran, were cut or were not reached, so a short window still brings back the most valuable figures.
+budget="${BUDGET:-660}"
+left() { echo $((budget - SECONDS)); }
+# begin NAME MINIMUM: true where the stage starts (with at least MINIMUM s left); else the stage is marked not reached.
+begin() {
+  if [ "$(left)" -lt "$2" ]; then echo "not reached: $1 ($(left) s left of $budget)" | tee -a "$out/reached.txt"; return 1; fi
+  stage "$1 ($(left) s left of $budget)"; current="$1"; started=$SECONDS
+}
+# limit SECONDS: the stage's own limit, or what is left of the budget where that is less.
+limit() { local l; l=$(left); [ "$l" -lt "$1" ] && echo "$l" || echo "$1"; }
+done_stage() { echo "ran: $current ($((SECONDS - started)) s)" >> "$out/reached.txt"; }
 
 stage "device and build"
 command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,memory.total,driver_version,clocks.max.sm --format=csv
 "$bin" info || { echo "device_check: $bin does not start" >&2; exit 1; }
 
-# Launch overhead: 64 balls, where a step's time is its launches and waits. Then the benchmark packing's sizes.
-if [ "$tiny" = 1 ]; then overhead_steps=200; sizes="6 10"; steps=50; else overhead_steps=3000; sizes="38 100 215"; steps=200; fi
-stage "launch overhead (64 balls, $overhead_steps steps)"
-BUILD="$build" WORK="$out/scaling" K=4 STEPS="$overhead_steps" timeout -k 5 60 bash "$root/perf/scaling.sh"
+tests=$(find "$build/tests" -maxdepth 1 -type f -name 'triaxdem_tests_*' -perm -u+x 2>/dev/null | sort)
+kernels='HotPath.*:Reduce.*:ContactLaw.*:Detection.*:Dynamics.*:BlowUp.*:Membrane*:Stress.*:Micro.*:SimdLanes.*:Reference.*:PeriodicCell.*:IoHdf5.*:Checkpoint.*:Determinism.*:TriaxialMeasures.*'
+suite_part() {  # PART: the suite's kernel and reference tests, or the others
+  local part=$1 filter="$kernels"
+  [ "$part" = other ] && filter="-$kernels"
+  begin "the suite's $part tests" 30 || return 0
+  # The unit tests are one executable per layer (tests/CMakeLists.txt): each runs the part's tests it holds.
+  # The tests that run the program as a child find it through TRIAXDEM_BINARY (a packed build is not where it was built).
+  TRIAXDEM_BINARY="$bin" timeout -k 5 "$(limit "${TEST_LIMIT:-90}")" bash -c 'for t in $1; do "$t" --gtest_filter="$2"; done' _ "$tests" "$filter" \
+    > "$out/tests_$part.log" 2>&1; echo "exit status $? (124: stopped at the limit)"
+  echo "passed $(grep -c '^\[       OK \]' "$out/tests_$part.log"), failed $(grep -c '^\[  FAILED  \].*ms)$' "$out/tests_$part.log")"
+  grep -E '^\[  FAILED  \].*ms\)$|^\[  SKIPPED \]' "$out/tests_$part.log"
+  echo "slowest:"; sed -n 's/^\[       OK \] \(.*\) (\([0-9]*\) ms)$/\2 ms \1/p' "$out/tests_$part.log" | sort -rn | head -n 5
+  done_stage
+}
+parts=" ${PARTS:-kernels other} "
+[ -n "$tests" ] && [ "$tiny" != 1 ] && [[ "$parts" == *" kernels "* ]] && suite_part kernels
+
+# Launch overhead: 64 balls, where a step's time is its launches and waits. Then the benchmark packing's sizes, the
+# million first.
+if [ "$tiny" = 1 ]; then overhead_steps=200; sizes="10 6"; steps=50; else overhead_steps=3000; sizes="100 38 215"; steps=200; fi
 for k in $sizes; do
-  stage "particle-steps/s at $((k * k * k)) balls ($steps steps)"
-  BUILD="$build" WORK="$out/scaling" K="$k" STEPS="$steps" timeout -k 5 "$([ "$k" -gt 150 ] && echo 120 || echo 100)" bash "$root/perf/scaling.sh" | tail -n +2 || failed+=" scaling"
+  begin "particle-steps/s at $((k * k * k)) balls ($steps steps)" 20 || continue
+  BUILD="$build" WORK="$out/scaling" K="$k" STEPS="$steps" timeout -k 5 "$(limit "$([ "$k" -gt 150 ] && echo 120 || echo 100)")" bash "$root/perf/scaling.sh" | tail -n +2 || failed+=" scaling"
   rm -f "$out/scaling/out_k$k"/*.h5  # the snapshots of 10^7 balls are gigabytes
+  done_stage
 done
+if begin "launch overhead (64 balls, $overhead_steps steps)" 15; then
+  BUILD="$build" WORK="$out/scaling" K=4 STEPS="$overhead_steps" timeout -k 5 "$(limit 60)" bash "$root/perf/scaling.sh"
+  done_stage
+fi
 
-stage "periodic cell against the CPU's"
-timeout -k 5 60 "$bin" periodic "$ref/periodic.toml" -o "$out/periodic" --overwrite > "$out/periodic.log" 2>&1 || failed+=" periodic-run"
-grep "^time loop" "$out/periodic.log"
-"$py" "$root/tools/compare_runs.py" "$ref/periodic_cpu" "$out/periodic" || failed+=" periodic"
-
-# Today's way of running many calibration cells on one GPU: separate processes, each its own context and launches.
-# Their summed rate is the figure a batched simulation (issue 43 item 3) is measured against.
-cells="${CELLS:-16}"; [ "$tiny" = 1 ] && cells=2
-stage "$cells periodic cells as $cells processes at once"
-start=$(date +%s.%N)
-for i in $(seq "$cells"); do
-  timeout -k 5 120 "$bin" periodic "$ref/periodic.toml" -o "$out/cells/c$i" --overwrite > "$out/cells_$i.log" 2>&1 &
-done
-wait
-wall=$(awk -v s="$start" -v e="$(date +%s.%N)" 'BEGIN { print e - s }')
-# Each time loop's steps and particle-steps/s; the wall time holds the processes' starts, preparation and output too.
-cat "$out"/cells_*.log | sed -n 's/^time loop.*: \([0-9]*\) steps.*; \([0-9.e+]*\) particle-steps\/s.*/\1 \2/p' |
-  awk -v w="$wall" -v n="$(awk -F' = ' '$1 == "count" { print $2 }' "$ref/periodic.toml")" -v c="$cells" \
-  '{ s += $1; r += $2; k++ }
-   END { if (k == 0) { printf "%d cells of %d balls: none finished within its 120 s (%.1f s wall)\n", c, n, w; exit }
-         printf "%d cells of %d balls (%d finished): %.1f s wall for %d steps in all, %.3g particle-steps/s " \
-           "together; each time loop %.3g particle-steps/s on average\n", c, n, k, w, s, s * n / w, r / k }'
-rm -rf "$out/cells"
-
-# The same cells' way after issue 43 item 3: one process, one batch (host/engine/cell_batch.hpp), one launch per kernel
-# for all; bench_engine's BM_CellBatch against one cell alone (BM_TimeLoop/9/1), 729 balls each.
+# The calibration's cells as one batch (host/engine/cell_batch.hpp), one launch per kernel for all; bench_engine's
+# BM_CellBatch against one cell alone (BM_TimeLoop/9/1), 729 balls each.
 if [ -x "$build/perf/bench_engine" ]; then
   batches='BM_TimeLoop/9/1|BM_CellBatch/(1|64|512)/9'; [ "$tiny" = 1 ] && batches='BM_CellBatch/4/5'
-  stage "calibration cells as one batch ($batches)"
-  timeout -k 5 "$([ "$tiny" = 1 ] && echo 60 || echo 150)" "$build/perf/bench_engine" --benchmark_filter="$batches" \
-    --benchmark_min_time=0.5 2>&1 | grep -E "^BM_" || failed+=" batch"
+  if begin "calibration cells as one batch ($batches)" 30; then
+    timeout -k 5 "$(limit "$([ "$tiny" = 1 ] && echo 60 || echo 150)")" "$build/perf/bench_engine" --benchmark_filter="$batches" \
+      --benchmark_min_time=0.5 2>&1 | grep -E "^BM_" || failed+=" batch"
+    done_stage
+  fi
 fi
 
-if [ "$tiny" != 1 ]; then
-  stage "membrane triaxial test against the CPU's (steps $small_start-$small_stop)"
+# A calibration as users run it, its cells batched ([calibrate] batch auto): Table 6's S-1 on the shipped base, the
+# prediction left out (TINY: the tiny synthetic case of the script checks).
+if begin "a batched calibration" 60; then
+  cal_cfg="$root/configs/calibration/base.toml"; cal_data="$root/data/tang2025_table6_peak.csv"; cal_args="--material S-1"
+  if [ "$tiny" = 1 ]; then
+    sed -e 's/^ensemble = .*/ensemble = 1/' -e 's/^scatter_specimens = .*/scatter_specimens = 2/' \
+        -e 's/^target_axial_strain_pct = .*/target_axial_strain_pct = 1.0/' "$root/tests/data/hidden_effects.toml" > "$out/cal_base.toml"
+    "$bin" synth --config "$out/cal_base.toml" -o "$out/cal_data.csv" --overwrite --seed 1 --pressures 100 > "$out/synth.log" 2>&1
+    cal_cfg="$out/cal_base.toml"; cal_data="$out/cal_data.csv"; cal_args="--free mu_s"
+  fi
+  timeout -k 5 "$(limit 240)" "$bin" calibrate "$cal_data" --config "$cal_cfg" $cal_args --predict none -j 1 --yes \
+    -o "$out/calibration" > "$out/calibration.log" 2>&1
+  echo "exit status $? (124: stopped at the limit)"
+  tr '\r' '\n' < "$out/calibration.log" | grep -E "in all .* particle-steps|mu_s = |the job took|job's" | tail -n 5
+  done_stage
+fi
+
+if begin "periodic cell against the CPU's" 30; then
+  timeout -k 5 "$(limit 60)" "$bin" periodic "$ref/periodic.toml" -o "$out/periodic" --overwrite > "$out/periodic.log" 2>&1 || failed+=" periodic-run"
+  grep "^time loop" "$out/periodic.log"
+  "$py" "$root/tools/compare_runs.py" "$ref/periodic_cpu" "$out/periodic" || failed+=" periodic"
+  done_stage
+fi
+
+if [ "$tiny" != 1 ] && begin "membrane triaxial test against the CPU's (steps $small_start-$small_stop)" 30; then
   rm -rf "$out/small"; cp -r "$ref/small_start" "$out/small"
-  timeout -k 5 60 "$bin" triaxial "$small_cfg" -o "$out/small" --resume --stop-at-step "$small_stop" > "$out/small.log" 2>&1
+  timeout -k 5 "$(limit 60)" "$bin" triaxial "$small_cfg" -o "$out/small" --resume --stop-at-step "$small_stop" > "$out/small.log" 2>&1
   grep "^time loop" "$out/small.log"
   "$py" "$root/tools/compare_runs.py" "$ref/small_cpu" "$out/small" || failed+=" membrane"
+  done_stage
 fi
 
-tests=$(find "$build/tests" -maxdepth 1 -type f -name 'triaxdem_tests_*' -perm -u+x 2>/dev/null | sort)
-if [ -n "$tests" ] && [ "$tiny" != 1 ]; then
-  kernels='HotPath.*:Reduce.*:ContactLaw.*:Detection.*:Dynamics.*:BlowUp.*:Membrane*:Stress.*:Micro.*:SimdLanes.*:Reference.*:PeriodicCell.*:IoHdf5.*:Checkpoint.*:Determinism.*:TriaxialMeasures.*'
-  limit="${TEST_LIMIT:-90}"
-  for part in ${PARTS:-kernels other}; do
-    filter="$kernels"; [ "$part" = other ] && filter="-$kernels"
-    stage "the suite's $part tests (at most $limit s)"
-    # The unit tests are one executable per layer (tests/CMakeLists.txt): each runs the part's tests it holds.
-    # The tests that run the program as a child find it through TRIAXDEM_BINARY (a packed build is not where it was built).
-    TRIAXDEM_BINARY="$bin" timeout -k 5 "$limit" bash -c 'for t in $1; do "$t" --gtest_filter="$2"; done' _ "$tests" "$filter" \
-      > "$out/tests_$part.log" 2>&1; echo "exit status $? (124: stopped at the limit)"
-    echo "passed $(grep -c '^\[       OK \]' "$out/tests_$part.log"), failed $(grep -c '^\[  FAILED  \].*ms)$' "$out/tests_$part.log")"
-    grep -E '^\[  FAILED  \].*ms\)$|^\[  SKIPPED \]' "$out/tests_$part.log"
-    echo "slowest:"; sed -n 's/^\[       OK \] \(.*\) (\([0-9]*\) ms)$/\2 ms \1/p' "$out/tests_$part.log" | sort -rn | head -n 5
+# Today's other way of running many calibration cells on one GPU: separate processes, each its own context and
+# launches, the figure the batch is set against.
+cells="${CELLS:-16}"; [ "$tiny" = 1 ] && cells=2
+if begin "$cells periodic cells as $cells processes at once" 30; then
+  t0=$(date +%s.%N)
+  for i in $(seq "$cells"); do
+    timeout -k 5 "$(limit 120)" "$bin" periodic "$ref/periodic.toml" -o "$out/cells/c$i" --overwrite > "$out/cells_$i.log" 2>&1 &
   done
+  wait
+  wall=$(awk -v s="$t0" -v e="$(date +%s.%N)" 'BEGIN { print e - s }')
+  # Each time loop's steps and particle-steps/s; the wall time holds the processes' starts, preparation and output too.
+  cat "$out"/cells_*.log | sed -n 's/^time loop.*: \([0-9]*\) steps.*; \([0-9.e+]*\) particle-steps\/s.*/\1 \2/p' |
+    awk -v w="$wall" -v n="$(awk -F' = ' '$1 == "count" { print $2 }' "$ref/periodic.toml")" -v c="$cells" \
+    '{ s += $1; r += $2; k++ }
+     END { if (k == 0) { printf "%d cells of %d balls: none finished within its limit (%.1f s wall)\n", c, n, w; exit }
+           printf "%d cells of %d balls (%d finished): %.1f s wall for %d steps in all, %.3g particle-steps/s " \
+             "together; each time loop %.3g particle-steps/s on average\n", c, n, k, w, s, s * n / w, r / k }'
+  rm -rf "$out/cells"
+  done_stage
 fi
 
-if [ "$tiny" != 1 ]; then
-  full_limit="${FULL_LIMIT:-60}"
-  stage "full scale: the paper's S-1 test (53,704 beads) from nothing, as far as $full_limit s go"
-  timeout -k 5 "$full_limit" "$bin" triaxial "$root/configs/paper/S1_100kPa.toml" -o "$out/full" > "$out/full.log" 2>&1
-  echo "exit status $? (124: stopped at the limit)"
-  tr '\r' '\n' < "$out/full.log" | grep -E "^specimen: layer|time loop|q_peak" | tail -n 12
-  tr '\r' '\n' < "$out/full.log" | grep -E "layer|consolidat|shear|axial" | tail -n 1
-  [ -f "$out/full/timings.csv" ] && cat "$out/full/timings.csv"
+[ -n "$tests" ] && [ "$tiny" != 1 ] && [[ "$parts" == *" other "* ]] && suite_part other
+
+if [ -n "${TABLE6:-}" ]; then
+  # Table 6 at full scale from the loop's calibration (the table6 mode), with what is left of the budget.
+  if begin "Table 6 at full scale (the table6 mode)" 120; then
+    BUDGET="$(left)" bash "$0" table6 "$TABLE6" "$out/table6"
+    done_stage
+  fi
+elif [ "$tiny" != 1 ]; then
+  if begin "full scale: the paper's S-1 test (53,704 beads) from nothing" 60; then
+    timeout -k 5 "$(limit "${FULL_LIMIT:-60}")" "$bin" triaxial "$root/configs/paper/S1_100kPa.toml" -o "$out/full" > "$out/full.log" 2>&1
+    echo "exit status $? (124: stopped at the limit)"
+    tr '\r' '\n' < "$out/full.log" | grep -E "^specimen: layer|time loop|q_peak" | tail -n 12
+    tr '\r' '\n' < "$out/full.log" | grep -E "layer|consolidat|shear|axial" | tail -n 1
+    [ -f "$out/full/timings.csv" ] && cat "$out/full/timings.csv"
+    done_stage
+  fi
 fi
-stage "done"
+stage "done: $SECONDS s of $budget; reached.txt:"
+cat "$out/reached.txt"
 [ -z "$failed" ] || { echo "device_check: differed or failed:$failed"; exit 1; }

@@ -78,6 +78,12 @@ if [ "$part" != diagnoses ]; then
   check perf/device_check.sh bash -c "TINY=1 CPU_BUILD='$build' bash '$root/perf/device_check.sh' prepare '$work/dc_ref' &&
     bash '$root/perf/device_check.sh' pack '$build' '$work/dc_pack' &&
     TINY=1 BUILD='$work/dc_pack/build' bash '$root/perf/device_check.sh' run '$work/dc_ref' '$work/dc'"
+  grep -q "^ran: a batched calibration" "$work/dc/reached.txt" ||
+    { cat "$work/dc/reached.txt"; echo "scripts_smoke: device_check ran no batched calibration" >&2; exit 1; }
+  # A window of no time reaches no stage, and says so for each (the budget's bookkeeping, at no cost).
+  TINY=1 BUDGET=0 bash "$root/perf/device_check.sh" run "$work/dc_ref" "$work/dc0" > "$work/dc0.log" 2>&1
+  [ "$(grep -c '^not reached: ' "$work/dc0/reached.txt")" -ge 6 ] && ! grep -q '^ran: ' "$work/dc0/reached.txt" ||
+    { cat "$work/dc0.log"; echo "scripts_smoke: device_check with no budget ran a stage" >&2; exit 1; }
   # The full-scale Table 6 from the loop's parameters, here the tiny specimen at one pressure; the loop's calibrated.csv
   # stands in as Table 5's S-1 values, S-2 has none (a row that says so).
   mkdir -p "$work/t6loop/S-1_all/calibrate_x"

@@ -81,6 +81,20 @@ void write_four_point_curve(const fs::path& path) {
 
 }  // namespace
 
+// A full disk while writing HDF5 printed some 640 lines of HDF5's error stack and then crashed at exit (signal 11 in
+// H5F__close_cb, exit 139; issue 65): one clear error, exit 1, and the files written before it kept. A file size
+// limit stands in for the full disk (writes fail with EFBIG as with ENOSPC; SIGXFSZ ignored, as a full disk sends none).
+TEST(CliEdges, AFullDiskStopsTheRunWithOneClearError) {
+  const fs::path dir = dem::test::scratch_dir("cli_full_disk");
+  const Outcome o = triaxdem("run configs/default.toml -n 2000 -o " + (dir / "r").string(), dir,
+                             "trap '' XFSZ; ulimit -f 300; OMP_NUM_THREADS=1");
+  EXPECT_EQ(o.code, 1) << o.output;
+  EXPECT_NE(o.output.find("triaxdem: error: cannot write '" + (dir / "r").string() + "/"), std::string::npos)
+      << o.output;
+  EXPECT_EQ(o.output.find("HDF5-DIAG"), std::string::npos) << o.output;
+  EXPECT_TRUE(fs::exists(dir / "r" / "series.csv")) << "what was written before the disk filled is kept";
+}
+
 // Two runs started at once into one folder both went on and left a mixture of their files: a run locks its folder
 // before it writes, and a second is refused naming the first; the lock goes with the run.
 TEST(CliEdges, ASecondRunIntoARunningRunsFolderIsRefused) {
@@ -97,6 +111,17 @@ TEST(CliEdges, ASecondRunIntoARunningRunsFolderIsRefused) {
   EXPECT_EQ(o.code, 0) << o.output;
   EXPECT_TRUE(fs::exists(out / "series.csv"));
   EXPECT_FALSE(fs::exists(out / ".triaxdem.lock")) << "the run left its lock behind";
+  // The same for synth's one file: two at once into one file both exited 0, one file replacing the other (issue 65).
+  const fs::path file = dir / "same.csv";
+  {
+    const dem::io::FolderLock held = dem::io::FolderLock::of_file(file.string());
+    const Outcome s = triaxdem("synth --config configs/calibration/base.toml -o " + file.string(), dir);
+    EXPECT_EQ(s.code, 1) << s.output;
+    EXPECT_NE(s.output.find("output file '" + file.string() + "' is in use by another run (pid " +
+                            std::to_string(getpid())), std::string::npos) << s.output;
+  }
+  EXPECT_FALSE(fs::exists(file)) << "the refused synth wrote";
+  EXPECT_FALSE(fs::exists(dir / ".same.csv.lock")) << "the lock outlived its holder";
 }
 
 // `study -t 100000` and OMP_NUM_THREADS=100000 crashed every case with signal 11 and an empty log: counts beyond

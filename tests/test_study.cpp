@@ -1,6 +1,8 @@
 // The study command's pieces: which job runs a config, and the summary file each job leaves behind.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <filesystem>
 #include <cmath>
 #include <fstream>
@@ -275,4 +277,20 @@ TEST(Study, LongestCasesStartFirst) {
   for (std::size_t k = 1; k < order.size(); ++k) EXPECT_GE(cases[order[k - 1]].cost, cases[order[k]].cost);
   // S1_100kPa is case 0 and S1_300kPa case 2 (name order): the same specimen at three times the pressure.
   EXPECT_NEAR(cases[0].cost / cases[2].cost, std::sqrt(3.0), 1e-9);
+}
+
+// A study case of a minute printed nothing between "started" and "finished" (issue 65): while no piece ends, the pool
+// calls `waiting` for each running one every waiting_seconds. A child that sleeps 2.5 s under a 1 s period is
+// reported twice (at 1 and 2 s; up to 3 on a loaded machine).
+TEST(Study, ALongPieceIsReportedWhileItRuns) {
+  PoolWork w;
+  w.pieces = 1;
+  w.child = [](std::size_t, int) { ::usleep(2500000); };
+  std::vector<std::size_t> seen;
+  w.waiting = [&](std::size_t k) { seen.push_back(k); };
+  w.waiting_seconds = 1;
+  run_pool_here(w, "test");
+  EXPECT_GE(seen.size(), 2u);
+  EXPECT_LE(seen.size(), 3u);
+  for (std::size_t k : seen) EXPECT_EQ(k, 0u);
 }

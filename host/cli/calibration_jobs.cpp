@@ -139,7 +139,8 @@ CalibrationResult two_fidelity_fit(Session& ss, const Config& base, const std::s
   int round = 0;
   const FidelityRounds rounds = two_fidelity_rounds(r, misfit, tests, [&](const Model& at) {
     std::string where;
-    for (const FreeParam& f : ss.free) where += (where.empty() ? " " : ", ") + f.name + fmt(" = %.4g", f.shown * get_param(at, f.name));
+    for (const FreeParam& f : ss.free)
+      where += (where.empty() ? " " : ", ") + f.name + fmt(" = %.4g", f.shown * get_param(at, f.name));
     std::printf("calibrate: %s: two fidelities, membrane test %d: it and every periodic specimen at%s\n",
                 material.c_str(), ++round, where.c_str());
     const Discrepancy d = measure_discrepancy(misfit, ss.predict_at(base, at, tests),

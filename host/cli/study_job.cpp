@@ -9,6 +9,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <stdexcept>
 #include <thread>
 
@@ -170,6 +172,18 @@ int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, c
                 format_duration(secs).c_str());
     io::write_text_atomic(opt.output + "/study_summary.csv", study_table(cases, status, opt.output, compare).csv);
     progress.update(static_cast<long>(done));
+  };
+  w.waiting = [&](std::size_t k) {
+    // The case's own last progress line (its log holds \r-separated updates), so a long case is not a silent one.
+    std::ifstream in(folder(k) + "/log.txt");
+    std::string log((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    while (!log.empty() && (log.back() == '\n' || log.back() == '\r' || log.back() == ' ')) log.pop_back();
+    const std::size_t cut = log.find_last_of("\r\n");
+    const std::string last = cut == std::string::npos ? log : log.substr(cut + 1);
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - started[k]).count();
+    std::printf("study: %s running for %s: %s\n", cases[k].name.c_str(), format_duration(secs).c_str(),
+                last.empty() ? "(nothing in its log yet)" : last.c_str());
+    std::fflush(stdout);
   };
   run_pool(w, "study");
   progress.finish("");

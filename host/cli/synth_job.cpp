@@ -11,6 +11,7 @@
 #include "host/cli/calibration_jobs.hpp"
 #include "host/config/model_keys.hpp"
 #include "host/fit/diagnose.hpp"
+#include "host/util/folder_lock.hpp"
 #include "host/util/text_format.hpp"
 
 namespace dem {
@@ -25,6 +26,8 @@ int synth_job(const Config& base, const SynthOptions& o) {
   std::error_code ec;
   if (fs::exists(o.output) && fs::equivalent(o.output, base.path, ec))
     throw std::invalid_argument("synth -o " + o.output + ": that is the config (--config); name another file");
+  // Two synths started at once into one file both wrote it, the last one's kept: the second is refused here.
+  const io::FolderLock claim = io::FolderLock::of_file(o.output);
   if (fs::exists(o.output) && !o.overwrite)
     throw std::invalid_argument("synth -o " + o.output + ": the file exists (--overwrite replaces it)");
   if (o.extension == "none" && !std::isnan(o.strength))

@@ -17,6 +17,13 @@ namespace dem::io::h5 {
 
 namespace fs = std::filesystem;
 
+/// Set before any other HDF5 call (C++17 inline variable: once, at the start of the first program file that includes
+/// this). HDF5 prints its own error stack for every failed call (some 640 lines for one full disk), where the
+/// callers here report each failure once, naming the file; and a file whose close failed (a full disk) stays open
+/// inside the library, whose exit handler then flushes it again and crashed (signal 11 in H5F__close_cb): the
+/// library's exit handler is not installed, as every file here is closed before its data count.
+inline const bool kLibraryQuiet = (H5dont_atexit(), H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr), true);
+
 [[noreturn]] inline void fail(const std::string& path, const std::string& what) {
   throw std::runtime_error("cannot write '" + path + "': " + what);
 }

@@ -35,7 +35,17 @@ std::string this_holder() {
 
 }  // namespace
 
-FolderLock::FolderLock(const std::string& folder) : path_((std::filesystem::path(folder) / ".triaxdem.lock").string()) {
+FolderLock::FolderLock(const std::string& folder)
+    : FolderLock(folder, (std::filesystem::path(folder) / ".triaxdem.lock").string(), "output folder '" + folder + "'") {}
+
+FolderLock FolderLock::of_file(const std::string& file) {
+  const std::filesystem::path p(file);
+  const std::filesystem::path folder = p.parent_path().empty() ? std::filesystem::path(".") : p.parent_path();
+  return FolderLock(folder.string(), (folder / ("." + p.filename().string() + ".lock")).string(),
+                    "output file '" + file + "'");
+}
+
+FolderLock::FolderLock(const std::string& folder, std::string lock, const std::string& subject) : path_(std::move(lock)) {
   std::error_code ec;
   std::filesystem::create_directories(folder, ec);
   if (ec) throw std::runtime_error("output folder '" + folder + "': cannot be created (" + ec.message() + ")");
@@ -44,16 +54,15 @@ FolderLock::FolderLock(const std::string& folder) : path_((std::filesystem::path
   for (;;) {
     const int fd = open(path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
     if (fd < 0)
-      throw std::runtime_error("output folder '" + folder + "': cannot make its lock file (" +
-                               std::strerror(errno) + ")");
+      throw std::runtime_error(subject + ": cannot make its lock file (" + std::strerror(errno) + ")");
     if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
       const int err = errno;
       const std::string who = holder_of(fd);
       close(fd);
       if (err == EWOULDBLOCK)
-        throw std::runtime_error("output folder '" + folder + "' is in use by another run (" + who +
-                                 "): wait for it to end, or choose another folder with -o");
-      throw std::runtime_error("output folder '" + folder + "': cannot lock " + path_ + " (" + std::strerror(err) + ")");
+        throw std::runtime_error(subject + " is in use by another run (" + who +
+                                 "): wait for it to end, or choose another with -o");
+      throw std::runtime_error(subject + ": cannot lock " + path_ + " (" + std::strerror(err) + ")");
     }
     struct stat at_path {}, held {};
     if (stat(path_.c_str(), &at_path) == 0 && fstat(fd, &held) == 0 && at_path.st_ino == held.st_ino &&
@@ -66,7 +75,7 @@ FolderLock::FolderLock(const std::string& folder) : path_((std::filesystem::path
   const std::string me = this_holder();
   if (ftruncate(fd_, 0) != 0 || pwrite(fd_, me.data(), me.size(), 0) != static_cast<ssize_t>(me.size())) {
     release();
-    throw std::runtime_error("output folder '" + folder + "': cannot write its lock file " + path_);
+    throw std::runtime_error(subject + ": cannot write its lock file " + path_);
   }
 }
 

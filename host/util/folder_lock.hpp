@@ -14,6 +14,8 @@ class FolderLock {
   /// Creates the folder if needed and takes its lock. Throws std::runtime_error naming the folder and the run
   /// that holds it, or why the lock file cannot be made.
   explicit FolderLock(const std::string& folder);
+  /// The same claim on one output file (synth -o): FOLDER/.NAME.lock beside it.
+  static FolderLock of_file(const std::string& file);
   FolderLock(FolderLock&& o) noexcept;
   FolderLock& operator=(FolderLock&& o) noexcept;
   FolderLock(const FolderLock&) = delete;
@@ -23,6 +25,7 @@ class FolderLock {
   bool held() const { return fd_ >= 0; }
 
  private:
+  FolderLock(const std::string& folder, std::string lock, const std::string& subject);
   int fd_ = -1;
   std::string path_;
   void release();

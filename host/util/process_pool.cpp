@@ -125,9 +125,14 @@ void run_pool_here(const PoolWork& w, const char* what) {
     if (running.empty()) return;
     std::vector<pollfd> polled;
     for (const Child& c : running) polled.push_back({c.fd, POLLIN, 0});
-    if (::poll(polled.data(), polled.size(), -1) < 0) {
+    const int ready = ::poll(polled.data(), polled.size(), w.waiting ? 1000 * w.waiting_seconds : -1);
+    if (ready < 0) {
       if (errno == EINTR) continue;
       throw std::runtime_error(std::string(what) + ": cannot wait for the child processes (poll failed)");
+    }
+    if (ready == 0) {
+      for (const Child& c : running) w.waiting(c.j);
+      continue;
     }
     std::size_t k = 0;
     while (polled[k].revents == 0) ++k;

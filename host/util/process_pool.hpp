@@ -31,6 +31,10 @@ struct PoolWork {
   /// In the parent once piece j has ended: its exit status as a shell gives it (128 + the signal that ended it),
   /// or -1 where collect found its result cut short.
   std::function<void(std::size_t, int)> after;
+  /// In the parent, for each running piece, every `waiting_seconds` in which none ends (unset: nothing): a piece
+  /// that takes minutes says how it goes.
+  std::function<void(std::size_t)> waiting;
+  int waiting_seconds = 30;
 };
 
 /// Runs the pieces; `what` names them in the error when a pipe or a process cannot be made. In a job spread over
