@@ -95,7 +95,9 @@ TEST_P(HiddenEffect, DiagnosisNamesIt) {
 // not make (test_crosscode.cpp): it must name hertz in YADE's Hertz-Mindlin data and nothing in YADE's linear data,
 // whose preparation, rate, cell and rolling law differ from the simulator's (a harder null than the simulator's
 // own). Roughness hidden in this simulator's own data was the suite's third diagnosis until the suite passed 25
-// minutes on 2 cores; it is the cheapest of these to run by hand.
+// minutes on 2 cores; it is the cheapest of these to run by hand. Adhesion (100 kPa, the upper half of its range) is
+// back on the diagnosis's menu with q offset (an apparent cohesion, issue 63) as the generic rival it must beat: where
+// its data show it, it must still be named.
 INSTANTIATE_TEST_SUITE_P(LongOneCasePerExtension, HiddenEffect,
                          ::testing::Values(HiddenCase{"roughness", 1e-2, 1}, HiddenCase{"hertz", 3e-3, 1},
                                            HiddenCase{"adhesion", 1e5, 1}, HiddenCase{"none", 0, 1}),
