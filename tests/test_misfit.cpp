@@ -397,31 +397,43 @@ TEST(TwoFidelity, TheDataLessTheMeasuredExcessFitAndItsErrorIsCounted) {
 // step through the first two lands at 0.401, whose optimum F = 0.3997 lies 0.06 of its interval from it: converged.
 // The residuals are linear in a linear parameter, so each round's optimum is F(x) within 1e-3 (the surrogate's grid
 // and coordinate steps reach 1e-4 of the range). One round alone is reported as not converged.
-TEST(TwoFidelity, RoundsReachTheFixedPointWhereOneCorrectionMissesIt) {
-  constexpr Real kTrue = 0.4, kB = 1.0;
-  const TriaxialTest curve = smooth_test(100e3);
-  auto scaled = [&](Real f) {
+/// The fixed-point case of the two-fidelity tests: the cell reads mu / 0.5 of a smooth curve's q, the membrane test
+/// (1 + kB mu) times the cell, the lab's data are the membrane test at kTrue; the cell calibrated over mu_s in
+/// [0.1, 0.9].
+struct FixedPointCase {
+  static constexpr Real kTrue = 0.4, kB = 1.0;
+  TriaxialTest curve = smooth_test(100e3);
+  TriaxialTest scaled(Real f) const {
     TriaxialTest t = curve;
     for (Real& q : t.q) q *= f;
     summarise(t);
     return t;
-  };
-  auto cell = [&](Real mu) { return scaled(mu / 0.5); };
-  auto membrane = [&](Real mu) { return scaled(mu / 0.5 * (1 + kB * mu)); };
-  auto F = [&](Real x) { return kTrue * (1 + kB * kTrue) / (1 + kB * x); };
-  const TriaxialTest lab = membrane(kTrue);
-  const Misfit m({lab}, NoiseOptions(), Ensemble{members_of(lab, 8, 0.01)}, 8, 0.1);
-  FreeParam mu;
-  mu.name = "mu_s";
-  mu.lo = 0.1;
-  mu.hi = 0.9;
-  Model base;
-  const CalibrateTo fit = [&](const Misfit& mf) {
+  }
+  TriaxialTest cell(Real mu) const { return scaled(mu / 0.5); }
+  TriaxialTest membrane(Real mu) const { return scaled(mu / 0.5 * (1 + kB * mu)); }
+  TriaxialTest lab = membrane(kTrue);
+  Misfit m{{lab}, NoiseOptions(), Ensemble{members_of(lab, 8, 0.01)}, 8, 0.1};
+  CalibrateTo fit = [this](const Misfit& mf) {
+    FreeParam mu;
+    mu.name = "mu_s";
+    mu.lo = 0.1;
+    mu.hi = 0.9;
     return calibrate([&](const Model& at, Real) {
       const TriaxialTest t = cell(get_param(at, "mu_s"));
       return SimulatedPoint{{t}, mf.test_residuals(0, {t}), false};
-    }, base, {mu}, mf.data());
+    }, Model(), {mu}, mf.data());
   };
+};
+
+TEST(TwoFidelity, RoundsReachTheFixedPointWhereOneCorrectionMissesIt) {
+  const FixedPointCase c;
+  constexpr Real kTrue = FixedPointCase::kTrue, kB = FixedPointCase::kB;
+  auto cell = [&](Real mu) { return c.cell(mu); };
+  auto membrane = [&](Real mu) { return c.membrane(mu); };
+  auto F = [&](Real x) { return kTrue * (1 + kB * kTrue) / (1 + kB * x); };
+  const TriaxialTest& lab = c.lab;
+  const Misfit& m = c.m;
+  const CalibrateTo& fit = c.fit;
   std::vector<Real> measured_at;
   const DiscrepancyAt measure = [&](const Model& at) {
     measured_at.push_back(get_param(at, "mu_s"));
@@ -476,29 +488,12 @@ TEST(TwoFidelity, RoundsReachTheFixedPointWhereOneCorrectionMissesIt) {
 // misses the lab's by 4% against 40%: the last optimum stands. A membrane test that read badly there (its chi2 made
 // 1e6 by the mock) hands the answer to round 1's point, with the cell's values and intervals recomputed there.
 TEST(TwoFidelity, NotConvergedTheMembraneTestChoosesAmongItsPoints) {
-  constexpr Real kTrue = 0.4;
-  const TriaxialTest curve = smooth_test(100e3);
-  auto scaled = [&](Real f) {
-    TriaxialTest t = curve;
-    for (Real& q : t.q) q *= f;
-    summarise(t);
-    return t;
-  };
-  auto cell = [&](Real mu) { return scaled(mu / 0.5); };
-  auto membrane = [&](Real mu) { return scaled(mu / 0.5 * (1 + mu)); };
-  const TriaxialTest lab = membrane(kTrue);
-  const Misfit m({lab}, NoiseOptions(), Ensemble{members_of(lab, 8, 0.01)}, 8, 0.1);
-  FreeParam mu;
-  mu.name = "mu_s";
-  mu.lo = 0.1;
-  mu.hi = 0.9;
-  Model base;
-  const CalibrateTo fit = [&](const Misfit& mf) {
-    return calibrate([&](const Model& at, Real) {
-      const TriaxialTest t = cell(get_param(at, "mu_s"));
-      return SimulatedPoint{{t}, mf.test_residuals(0, {t}), false};
-    }, base, {mu}, mf.data());
-  };
+  const FixedPointCase c;
+  auto cell = [&](Real mu) { return c.cell(mu); };
+  auto membrane = [&](Real mu) { return c.membrane(mu); };
+  const TriaxialTest& lab = c.lab;
+  const Misfit& m = c.m;
+  const CalibrateTo& fit = c.fit;
   std::vector<Real> measured_at;
   bool spoil_second = false;
   const DiscrepancyAt measure = [&](const Model& at) {
