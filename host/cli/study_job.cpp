@@ -29,6 +29,16 @@ namespace fs = std::filesystem;
 
 namespace {
 
+/// A case's own last progress line (its log holds \r-separated updates), so that a long case is not a silent one.
+std::string last_log_line(const std::string& path) {
+  std::ifstream in(path);
+  std::string log((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  while (!log.empty() && (log.back() == '\n' || log.back() == '\r' || log.back() == ' ')) log.pop_back();
+  const std::size_t cut = log.find_last_of("\r\n");
+  const std::string last = cut == std::string::npos ? log : log.substr(cut + 1);
+  return last.empty() ? "(nothing in its log yet)" : last;
+}
+
 /// How a case starts: afresh, from its checkpoint (study --resume, or a rerun after its process was killed), or over
 /// the outputs a killed process left without a checkpoint.
 enum class Start : char { fresh, resume, overwrite };
@@ -174,15 +184,9 @@ int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, c
     progress.update(static_cast<long>(done));
   };
   w.waiting = [&](std::size_t k) {
-    // The case's own last progress line (its log holds \r-separated updates), so a long case is not a silent one.
-    std::ifstream in(folder(k) + "/log.txt");
-    std::string log((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    while (!log.empty() && (log.back() == '\n' || log.back() == '\r' || log.back() == ' ')) log.pop_back();
-    const std::size_t cut = log.find_last_of("\r\n");
-    const std::string last = cut == std::string::npos ? log : log.substr(cut + 1);
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - started[k]).count();
     std::printf("study: %s running for %s: %s\n", cases[k].name.c_str(), format_duration(secs).c_str(),
-                last.empty() ? "(nothing in its log yet)" : last.c_str());
+                last_log_line(folder(k) + "/log.txt").c_str());
     std::fflush(stdout);
   };
   run_pool(w, "study");
