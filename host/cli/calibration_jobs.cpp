@@ -42,6 +42,11 @@ std::string new_dated_folder(const std::string& parent, const std::string& prefi
 
 namespace {
 
+/// A search whose every point blew up has no answer: stopped with the blow-ups named, not reported as values.
+void require_a_result(const CalibrationResult& r, const std::string& what, const Session& ss) {
+  if (!std::isfinite(r.best.chi2)) throw std::runtime_error(what + " gave a result (" + ss.failed_text() + ")");
+}
+
 /// The extension a diagnosis reports against the base: the one its verdict names first, else the best by BIC
 /// (a candidate, to show what it would change).
 const ExtensionFit* top_fit(const Diagnosis& dg) {
@@ -191,9 +196,7 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
         progress.update(done - start, extra);
       });
       progress.finish("");
-      if (!std::isfinite(r.best.chi2))
-        throw std::runtime_error(what + " " + material + ": no point of the search gave a result (" +
-                                 ss.failed_text() + ")");
+      require_a_result(r, what + " " + material + ": no point of the search", ss);
       return r;
     };
     CalibrationResult r = fit(misfit, "calibrate");
@@ -254,9 +257,7 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
                 ss.cell_text().c_str());
     const Misfit misfit = ss.misfit_of(base, material, tests);
     const Diagnosis dg = diagnose(ss.lab, model_of(base), ss.free, tests, misfit, true);
-    if (!std::isfinite(dg.base.best.chi2))
-      throw std::runtime_error("diagnose " + material + ": no point of the base search gave a result (" +
-                               ss.failed_text() + ")");
+    require_a_result(dg.base, "diagnose " + material + ": no point of the base search", ss);
     std::printf("diagnose: %s: verdict: %s\n  %s\n", material.c_str(), dg.verdict.c_str(), dg.explanation.c_str());
     std::printf("%s", uncertainty_text(dg.base, material, "diagnose").c_str());
     std::string edge, widened;
