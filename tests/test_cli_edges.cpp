@@ -654,6 +654,9 @@ TEST(CliEdges, ACalibrationResumesFromItsStoredRuns) {
   Outcome o = triaxdem("synth" + config + " -o " + (dir / "data.csv").string() + " --extension none --seed 1 "
                        "--pressures 100", dir);
   ASSERT_EQ(o.code, 0) << o.output;
+  // synth ran 49 s in silence (issue 65): its first line says what it runs and about how long it takes.
+  EXPECT_NE(o.output.find("synth: 1 tests of"), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find(" on this machine\n"), std::string::npos) << o.output;
   // The data without their void ratio: no state match, whose packings took 34 of a calibration's 38 s; the run store
   // and its resumption are what this test checks, and the cell-bias check (specimen_balls kept) still stores runs.
   {

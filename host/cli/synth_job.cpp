@@ -11,7 +11,9 @@
 #include "host/cli/calibration_jobs.hpp"
 #include "host/config/model_keys.hpp"
 #include "host/fit/diagnose.hpp"
+#include "host/lab/run_cost.hpp"
 #include "host/util/folder_lock.hpp"
+#include "host/util/progress.hpp"
 #include "host/util/text_format.hpp"
 
 namespace dem {
@@ -56,10 +58,17 @@ int synth_job(const Config& base, const SynthOptions& o) {
                                                  : base.run.seed + kForeignSeedOffset;
   comment += ", a specimen per test (packing seeds from " + std::to_string(specimen) + ", " +
              std::to_string(kGeneratorCellFactor) + " times the config's balls)";
-  PeriodicLab lab(larger_cell(base, kGeneratorCellFactor), true, static_cast<int>(o.sigma3.size()), specimen);
+  const Config cell = larger_cell(base, kGeneratorCellFactor);
+  // Said before the packings: a packing and a test per pressure one after another, at the engine's speed a probe
+  // measures here.
+  const CellCost cost = measure_cell_cost(cell);
+  double seconds = 0;
+  for (Real s : o.sigma3) seconds += cost.packing_seconds() + cost.run_seconds(s);
+  std::printf("synth: %zu tests of %ld balls, a specimen each (packed first), to %s: about %s on this machine\n",
+              o.sigma3.size(), cost.balls, o.output.c_str(), format_duration(seconds).c_str());
+  std::fflush(stdout);
+  PeriodicLab lab(cell, true, static_cast<int>(o.sigma3.size()), specimen);
   lab.set_progress("synth: the tests");
-  std::printf("synth: %zu tests of %zu balls, a specimen each (packed first), to %s\n", o.sigma3.size(), lab.balls(),
-              o.output.c_str());
   const std::vector<TriaxialTest> tests = synthetic_tests(lab, truth, o.sigma3, o.material, o.seed);
   for (const TriaxialTest& t : tests)
     if (t.q.empty())
