@@ -636,6 +636,14 @@ TEST(Diagnosis, AnExtensionIsNamedOnlyWhereItBeatsTheGenericRival) {
   dg.generic[0].heldout = 101;  // within 6 of the extension on held-out data: not specific
   give_verdict(dg, 60, 2);
   EXPECT_EQ(dg.verdict, "none") << dg.explanation;
+  // No extension accepted at all (BIC 4 lower, 6 needed): the report still states the difference it found, in the
+  // generic shape that fits it best (issue 63: the cross-code files' report must say what differs).
+  dg.fits[0].bic = 104;
+  give_verdict(dg, 60, 2);
+  EXPECT_FALSE(dg.fits[0].accepted);
+  EXPECT_EQ(dg.verdict, "none") << dg.explanation;
+  EXPECT_NE(dg.explanation.find("The generic discrepancy that fits best is q scaled"), std::string::npos)
+      << dg.explanation;
 }
 
 // One member in place of the ensemble's mean moves the whitened residuals by (1 - 1/K) tr(Sigma^-1 Sigma_member) in

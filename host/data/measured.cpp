@@ -208,10 +208,6 @@ std::pair<Real, Real> void_ratio_of(const RowReader& r) {
   return {n / (1 - n), r.sd("porosity") / ((1 - n) * (1 - n))};
 }
 
-std::string describe(const TriaxialTest& t) {
-  return t.material + " at " + str(t.sigma3 / 1e3) + " kPa" + (t.replicate.empty() ? "" : ", test " + t.replicate);
-}
-
 /// The state is one per test, repeated on its rows: a row that differs is a typo or two tests under one key.
 void check_same_state(const RowReader& r, const TriaxialTest& row, const TriaxialTest& t, const std::string& first) {
   const std::string e = r.has("porosity") ? "porosity" : "void_ratio";
@@ -248,7 +244,7 @@ TriaxialTest& test_of(const RowReader& r, MeasuredData& d, TestIndex& tests) {
     return d.tests.emplace_back(key);
   }
   const std::string& first = tests.first_at[it->second];
-  if (!d.curves) fail(r.row.at, "", "material " + describe(key) + " given twice (first on " + first + ")");
+  if (!d.curves) fail(r.row.at, "", "material " + describe_test(key) + " given twice (first on " + first + ")");
   check_same_state(r, key, d.tests[it->second], first);
   return d.tests[it->second];
 }
@@ -257,7 +253,7 @@ void read_curve_row(const RowReader& r, TriaxialTest& t) {
   const Real ea = strain(r, "eps_a");
   if (ea < 0) r.refuse("eps_a", str(100 * ea) + "%: axial strain is >= 0 (compression positive, from the start of shear)");
   if (!t.eps_a.empty() && !(ea > t.eps_a.back()))
-    r.refuse("eps_a", "axial strain must increase within a test (" + describe(t) + ")");
+    r.refuse("eps_a", "axial strain must increase within a test (" + describe_test(t) + ")");
   t.eps_a.push_back(ea);
   t.q.push_back(stress(r, "q", t.sigma3));
   if (r.has("eps_v")) t.eps_v.push_back(strain(r, "eps_v"));
@@ -276,23 +272,6 @@ void read_summary_row(const RowReader& r, TriaxialTest& t) {
   t.q_3pct = stress(r, "q_3pct", t.sigma3);
   for (const std::string& q : kSummarySd)
     if (r.has(q + "_sd")) t.summary_sd[q] = r.sd(q);
-}
-
-/// What no drained test shows, refused after its rows are read: a peak at or below zero (a sign flipped), a peak under
-/// kMinPeakRatio sigma3 (a unit slipped), a volumetric strain zero on every row (not measured: leave the column out).
-void check_plausible(const std::string& path, const TriaxialTest& t, bool curves) {
-  const std::string at = path + ": " + describe(t) + ": ";
-  const std::string peak = curves ? "the peak of its q" : "q_peak";
-  if (!(t.q_peak > 0))
-    throw DataError(at + peak + " is " + str(t.q_peak / 1e3) + " kPa: a drained test's deviator rises above zero "
-                    "(compression positive; allowed: q_peak > 0): a sign flipped, or the wrong column?");
-  if (t.q_peak < kMinPeakRatio * t.sigma3)
-    throw DataError(at + peak + " " + str(t.q_peak / 1e3) + " kPa is " + str(t.q_peak / t.sigma3) + " of sigma3 (allowed: at "
-                    "least " + str(kMinPeakRatio) + " sigma3, a friction angle of 1.4 deg): is sigma3 in Pa under a kPa "
-                    "header, or q in another unit than its column says?");
-  if (curves && !t.eps_v.empty() && std::all_of(t.eps_v.begin(), t.eps_v.end(), [](Real v) { return v == 0; }))
-    throw DataError(at + "eps_v is zero on every row: a volume not measured; leave the eps_v column out (allowed: a "
-                    "measured volumetric strain)");
 }
 
 /// The file's q measure: one name, the same on every row.
@@ -331,6 +310,10 @@ void note_replicates(MeasuredData& d) {
 }
 
 }  // namespace
+
+std::string describe_test(const TriaxialTest& t) {
+  return t.material + " at " + str(t.sigma3 / 1e3) + " kPa" + (t.replicate.empty() ? "" : ", test " + t.replicate);
+}
 
 bool is_hdf5_path(const std::string& path) {
   const auto dot = path.rfind('.');
@@ -381,12 +364,12 @@ MeasuredData load_measured(const std::string& path) {
   if (d.curves)
     for (TriaxialTest& t : d.tests) {
       if (t.eps_a.size() < kMinCurveRows)
-        throw DataError(path + ": " + describe(t) + ": " + std::to_string(t.eps_a.size()) + " row" +
+        throw DataError(path + ": " + describe_test(t) + ": " + std::to_string(t.eps_a.size()) + " row" +
                         (t.eps_a.size() == 1 ? "" : "s") + " (allowed: at least " + std::to_string(kMinCurveRows) +
                         " rows of eps_a and q per test: a curve; give one row per test in a summary file, with "
                         "q_peak_<unit> and no eps_a column)");
       if (t.eps_a.size() > kMaxCurveRows)
-        throw DataError(path + ": " + describe(t) + ": " + std::to_string(t.eps_a.size()) + " rows (allowed: at most " +
+        throw DataError(path + ": " + describe_test(t) + ": " + std::to_string(t.eps_a.size()) + " rows (allowed: at most " +
                         std::to_string(kMaxCurveRows) + " per test: a curve shows no more at a million rows than at "
                         "ten thousand, and costs minutes to read; thin it, e.g. every " +
                         std::to_string((t.eps_a.size() + kMaxCurveRows - 1) / kMaxCurveRows * 10) + "th row)");
@@ -398,21 +381,6 @@ MeasuredData load_measured(const std::string& path) {
     d.notes.push_back(path + ": no q_measure column: q taken as fixed_area (platen force over the cross-section "
                              "after consolidation, as Tang et al. 2025 report it)");
   return d;
-}
-
-void check_pressures(const MeasuredData& d, const std::vector<Real>& sigma3) {
-  for (const TriaxialTest& t : d.tests) {
-    const bool known = std::any_of(sigma3.begin(), sigma3.end(),
-                                   [&](Real s) { return std::fabs(s - t.sigma3) <= 1e-9 * std::max(s, t.sigma3); });
-    if (!known) {
-      std::ostringstream m;
-      m << d.path << ": material " << t.material << " at sigma3 = " << t.sigma3 / 1e3
-        << " kPa: no config for this pressure (configs have:";
-      for (Real s : sigma3) m << " " << s / 1e3;
-      m << " kPa)";
-      throw DataError(m.str());
-    }
-  }
 }
 
 }  // namespace dem

@@ -192,6 +192,14 @@ struct ReferenceValues {
 /// Throws DataError naming the line and column.
 ReferenceValues load_reference(const std::string& path, const std::function<void(const std::string&)>& known);
 
+/// "material at 100 kPa, test b": a test as errors name it.
+std::string describe_test(const TriaxialTest& t);
+
+/// Refuses what no drained test shows, after its rows are read: a peak at or below zero (a sign flipped), a peak
+/// under kMinPeakRatio sigma3 (a unit slipped), a volumetric strain zero on every row of a curve (not measured).
+/// Throws DataError naming the file and the test.
+void check_plausible(const std::string& path, const TriaxialTest& t, bool curves);
+
 /// Refuses a test whose pressure is not among `sigma3` (Pa): names the file, the material and the pressure.
 void check_pressures(const MeasuredData& d, const std::vector<Real>& sigma3);
 

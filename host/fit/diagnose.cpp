@@ -197,6 +197,47 @@ void weigh(ExtensionFit& f, const Diagnosis& dg, const GenericFit* rival, bool t
   if (f.accepted) f.reason += line;
 }
 
+/// The best generic discrepancy in words, for a verdict that names no extension: the shape of what differs between
+/// the data and the base model, with no physics claimed (Brynjarsdottir and O'Hagan 2014: the discrepancy is
+/// stated, not explained away).
+std::string generic_difference(const Diagnosis& dg, const GenericFit* rival) {
+  if (!rival) return "";
+  return " The generic discrepancy that fits best is " + rival->shape.name + " (" + rival->shape.formula +
+         ", c = " + fmt("%.3g", rival->c) + "): chi2 " + fmt("%.1f", rival->chi2) + ", BIC lower by " +
+         fmt("%.1f", dg.base_bic - rival->bic) + ", held-out chi2 " + fmt("%.1f", dg.base_heldout) + " -> " +
+         fmt("%.1f", rival->heldout) + ".";
+}
+
+/// The explanation of a verdict "none" with enough data to test: candidates (accepted against the base, not against
+/// the rival) or no extension accepted at all; either way the generic difference found.
+std::string explain_none(const Diagnosis& dg, int n, const std::string& candidates, const ExtensionFit* best_bic,
+                         const GenericFit* rival) {
+  const bool fits = dg.base.best.chi2 <= dg.chi2_limit;
+  char line[600];
+  if (!candidates.empty()) {
+    std::snprintf(line, sizeof line,
+                  "%s (chi2 %.1f on %d data, 99%% limit %.1f), and extensions fit it better (%s), but none more "
+                  "specifically than the generic discrepancy %s (%s, c = %.3g), which lowers the chi2 to %.1f, the "
+                  "BIC by %.1f and the held-out chi2 from %.1f to %.1f: a difference no extension explains "
+                  "specifically. The extensions that fit it are candidates, not causes.",
+                  fits ? "The base model fits within the noise" : "The base model misses the data", dg.base.best.chi2,
+                  n, dg.chi2_limit, candidates.c_str(), rival->shape.name.c_str(), rival->shape.formula.c_str(),
+                  rival->c, rival->chi2, dg.base_bic - rival->bic, dg.base_heldout, rival->heldout);
+    return line;
+  }
+  std::snprintf(line, sizeof line,
+                fits ? "The calibrated base model fits within the data's noise (chi2 %.1f on %d data, below the "
+                       "99%% limit %.1f) and no extension passes both tests (the lowest BIC, %s, lowers it by %.1f "
+                       "and the held-out chi2 from %.1f to %.1f; a drop of 6 needed for each): no discrepancy "
+                       "beyond noise, and no extension is called for."
+                     : "The base model misses the data (chi2 %.1f on %d data, 99%% limit %.1f), but no extension "
+                       "explains it: none passes both tests (the lowest BIC, %s, lowers it by %.1f and the held-out "
+                       "chi2 from %.1f to %.1f; a drop of 6 needed for each).",
+                dg.base.best.chi2, n, dg.chi2_limit, best_bic ? best_bic->ext.name.c_str() : "-",
+                best_bic ? dg.base_bic - best_bic->bic : 0.0, dg.base_heldout, best_bic ? best_bic->heldout : 0.0);
+  return line + generic_difference(dg, rival);
+}
+
 }  // namespace
 
 void give_verdict(Diagnosis& dg, int n, int d) {
@@ -229,35 +270,12 @@ void give_verdict(Diagnosis& dg, int n, int d) {
     dg.explanation = line;
     return;
   }
-  std::string candidates;  // accepted against the base model, not against the generic rival
-  for (const ExtensionFit& f : dg.fits)
-    if (f.accepted && !f.specific) candidates += (candidates.empty() ? "" : ", ") + f.ext.name;
-  if (!top && !candidates.empty()) {
-    dg.verdict = "none";
-    std::snprintf(line, sizeof line,
-                  "%s (chi2 %.1f on %d data, 99%% limit %.1f), and extensions fit it better (%s), but none more "
-                  "specifically than the generic discrepancy %s (%s, c = %.3g), which lowers the chi2 to %.1f, the "
-                  "BIC by %.1f and the held-out chi2 from %.1f to %.1f: a difference no extension explains "
-                  "specifically. The extensions that fit it are candidates, not causes.",
-                  fits ? "The base model fits within the noise" : "The base model misses the data", dg.base.best.chi2,
-                  n, dg.chi2_limit, candidates.c_str(), rival->shape.name.c_str(), rival->shape.formula.c_str(),
-                  rival->c, rival->chi2, dg.base_bic - rival->bic, dg.base_heldout, rival->heldout);
-    dg.explanation = line;
-    return;
-  }
   if (!top) {
+    std::string candidates;  // accepted against the base model, not against the generic rival
+    for (const ExtensionFit& f : dg.fits)
+      if (f.accepted && !f.specific) candidates += (candidates.empty() ? "" : ", ") + f.ext.name;
     dg.verdict = "none";
-    std::snprintf(line, sizeof line,
-                  fits ? "The calibrated base model fits within the data's noise (chi2 %.1f on %d data, below the "
-                         "99%% limit %.1f) and no extension passes both tests (the lowest BIC, %s, lowers it by %.1f "
-                         "and the held-out chi2 from %.1f to %.1f; a drop of 6 needed for each): no discrepancy "
-                         "beyond noise, and no extension is called for."
-                       : "The base model misses the data (chi2 %.1f on %d data, 99%% limit %.1f), but no extension "
-                         "explains it: none passes both tests (the lowest BIC, %s, lowers it by %.1f and the held-out "
-                         "chi2 from %.1f to %.1f; a drop of 6 needed for each).",
-                  dg.base.best.chi2, n, dg.chi2_limit, best_bic ? best_bic->ext.name.c_str() : "-",
-                  best_bic ? dg.base_bic - best_bic->bic : 0.0, dg.base_heldout, best_bic ? best_bic->heldout : 0.0);
-    dg.explanation = line;
+    dg.explanation = explain_none(dg, n, candidates, best_bic, rival);
     return;
   }
   dg.verdict = top->ext.name;
