@@ -1,5 +1,5 @@
 /// The periodic cell's set-up (a Simulation on a periodic box, its specimen, the balls back out of it); the test
-/// itself is in periodic_triaxial.cpp, the `periodic` command in host/cli/test_jobs.cpp.
+/// itself is in periodic_triaxial.cpp, the `periodic` command in host/cli/triaxial_jobs.cpp.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
