@@ -4,7 +4,7 @@ every C++ suffix, in quotes or angle brackets) names a file of its own layer or 
 builds them (BUILD/layers.txt, from TRIAXDEM_LAYERS in CMakeLists.txt), and spells it from the source root
 ("host/<layer>/<file>" or "kernels/<layer>/<file>"); a header the build generates is left alone. A library from
 outside the project is included only at or above the layer that links it (BUILD/layer_libs.txt: library, then the
-layer or the one file that links it). Each test file includes nothing above the layer its executable links
+layer or the files, comma-separated, that link it). Each test file includes nothing above the layer its executable links
 (BUILD/test_layers.txt). Prints each offending include with its file and line, and the layer order.
 
     tests/layers_test.py SOURCE_DIR BUILD_DIR
@@ -73,9 +73,9 @@ class Guard:
             if self.rank.get(layer, -1) >= self.rank[owner]:
                 return ""
             return f"{where}: includes <{name}>: {lib} is linked by layer {owner}, above {layer}"
-        if rel == owner:
+        if rel in owner.split(","):
             return ""
-        return f"{where}: includes <{name}>: {lib} is linked by {owner} alone"
+        return f"{where}: includes <{name}>: {lib} is linked by {owner.replace(',', ' and ')} alone"
 
     def check_layers(self):
         bad = []

@@ -12,6 +12,7 @@
 #include <random>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
 
 #include "host/io/io_hdf5.hpp"
 #include "host/util/progress.hpp"
@@ -248,7 +249,13 @@ void give_verdict(Diagnosis& dg, int n, int d) {
   // extension that only fits the noise of the pressures it saw). Every extension that passes both is accepted;
   // the verdict names the accepted one of lowest BIC, with the accepted ones within 2 of its BIC as ties.
   const bool fits = dg.base.best.chi2 <= dg.chi2_limit;
-  // The rival of every extension: the generic discrepancy of lowest BIC (the same size, one parameter).
+  // The rival of every extension: the generic discrepancy of lowest BIC, of the same size. Both hold one parameter
+  // by their types; an extension of more (Extension::param a list) stops the build here until generic shapes of
+  // its size stand beside it, so that no extension is ever weighed against a smaller rival.
+  static_assert(std::is_same_v<decltype(Extension::param), std::string>,
+                "an extension with several parameters needs generic rivals of that many (generic_discrepancy.hpp)");
+  static_assert(std::is_same_v<decltype(GenericShape::apply), void (*)(TriaxialTest&, Real)>,
+                "a generic shape of several parameters is no rival of a one-parameter extension");
   const GenericFit* rival = nullptr;
   for (const GenericFit& g : dg.generic)
     if (!rival || g.bic < rival->bic) rival = &g;
