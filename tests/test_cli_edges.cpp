@@ -153,6 +153,13 @@ TEST(CliEdges, AnUnsettledSpecimenIsRefusedUnlessAcceptedAndKeptForTheRerun) {
   EXPECT_NE(o.output.find("[specimen] layer 1/3 stopped at max_steps_per_layer = 300 with the unbalanced ratio at"),
             std::string::npos) << o.output;
   EXPECT_NE(o.output.find("set accept_unsettled = true"), std::string::npos) << o.output;
+  // `specimen` blamed the void ratio first ("not reachable ... try a larger e"), which the step cap explains
+  // (issue 65): the cap's error alone.
+  o = triaxdem("specimen " + tiny_triaxial_file(dir, "max_steps_per_layer = 300\n").string() + " -o " +
+               (dir / "specimen").string(), dir);
+  EXPECT_EQ(o.code, 1) << o.output;
+  EXPECT_NE(o.output.find("stopped at max_steps_per_layer = 300"), std::string::npos) << o.output;
+  EXPECT_EQ(o.output.find("not reachable"), std::string::npos) << o.output;
   const std::string accepted =
       tiny_triaxial_file(dir, "max_steps_per_layer = 300\naccept_unsettled = true\n").string();
   o = triaxdem("triaxial " + accepted + out + " --overwrite --stop-at-step 2", dir);
@@ -249,6 +256,21 @@ TEST(CliEdges, CheckDescribesTheJobTheConfigIsFor) {
     EXPECT_NE(o.code, 0) << job << "\n" << o.output;
     EXPECT_NE(o.output.find("gravity.toml: [solver] gravity: must be [0, 0, 0] in the cell test"), std::string::npos)
         << job << "\n" << o.output;
+  }
+  // A box without walls under gravity: check said OK, and run stopped at the first ball out with a blow-up that
+  // blamed a wall (issue 65). Both refuse it before any step.
+  std::ifstream box_in(fs::path(TRIAXDEM_SOURCE_DIR) / "configs/default.toml");
+  std::string box((std::istreambuf_iterator<char>(box_in)), std::istreambuf_iterator<char>());
+  const std::string::size_type w = box.find("walls = true");
+  ASSERT_NE(w, std::string::npos);
+  std::ofstream(dir / "open.toml") << box.replace(w, 12, "walls = false");
+  for (const char* job : {"check", "run"}) {
+    o = triaxdem(std::string(job) + " " + (dir / "open.toml").string() +
+                     (std::string(job) == "check" ? "" : " -n 10 -o " + (dir / "open").string()), dir);
+    EXPECT_NE(o.code, 0) << job << "\n" << o.output;
+    EXPECT_NE(o.output.find("open.toml: [box] walls = false with [solver] gravity along z: nothing holds the balls"),
+              std::string::npos) << job << "\n" << o.output;
+    EXPECT_EQ(o.output.find("blow-up"), std::string::npos) << job << "\n" << o.output;
   }
 }
 
@@ -389,6 +411,27 @@ TEST(CliEdges, MicroOnAFolderThatIsNoRunSaysSo) {
   const Outcome o = triaxdem("micro " + dir.string(), dir);
   EXPECT_EQ(o.code, 1) << o.output;
   EXPECT_NE(o.output.find("not a triaxial run's folder (no snap_*.h5 in it)"), std::string::npos) << o.output;
+  // --rve -3 reached the cube's check as "a cube of edge -3 mm" (issue 65): the option is refused as typed.
+  const Outcome r = triaxdem("micro " + dir.string() + " --rve -3", dir);
+  EXPECT_NE(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("--rve"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("a cube of edge"), std::string::npos) << r.output;
+}
+
+// SIGTERM to calibrate ended it with exit 143 and no word, and its children ran on for 1-10 s (issue 65): it says
+// what stopped it and stops its children with it. `timeout` sends the signal part way into the calibration.
+TEST(CliEdges, SigtermSaysWhatItStoppedAndStopsTheChildren) {
+  const fs::path dir = dem::test::scratch_dir("cli_sigterm");
+  write_four_point_curve(dir / "d.csv");
+  const std::string out = (dir / "out").string();
+  const Outcome o = triaxdem("calibrate " + (dir / "d.csv").string() + " --config tests/data/hidden_effects.toml "
+                             "--predict none -j 2 -o " + out, dir, "OMP_NUM_THREADS=1 timeout -s TERM 8");
+  EXPECT_EQ(o.code, 124) << "not stopped by the signal: " << o.output;
+  EXPECT_NE(o.output.find("triaxdem: stopped by SIGTERM"), std::string::npos) << o.output;
+  // Every process of this calibration (the children are forks: the same command line) is gone within a second;
+  // the pattern's [/] keeps the shell that runs pgrep from matching itself.
+  const std::string left = "sleep 1; pgrep -f -- '-o [/]" + out.substr(1) + "' > /dev/null";
+  EXPECT_NE(std::system(left.c_str()), 0) << "a child of the stopped calibration runs on";
 }
 
 // A calibration refused after it had made its dated result folder left the folder behind, empty.

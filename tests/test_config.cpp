@@ -68,6 +68,11 @@ TEST(Config, WrongTypeUnknownTableAndSyntaxError) {
 // Non-ASCII characters: fine in strings and comments, refused elsewhere with the line and column (the fuzzer
 // found that Debian's toml++ 3.3.0 reaches undefined behaviour on U+0409 after a value: the input below).
 TEST(Config, NonAsciiOutsideStringsAndCommentsRefused) {
+  // An editor's UTF-8 byte order mark was called a non-ASCII character and told to write sigma3_kPa (issue 65): it
+  // is read past; UTF-16 is named.
+  EXPECT_EQ(error_of("\xEF\xBB\xBF[run]\nseed = 1\n"), "");
+  EXPECT_NE(error_of(std::string("\xFF\xFE[\0r\0", 6)).find("bad.toml:1:1: UTF-16 text (TOML is UTF-8)"),
+            std::string::npos);
   EXPECT_EQ(error_of("[run]  # \u03c3_3 = 100 kPa\nname = \"\u03c3\u2083 \\\" test\"\n"
                      "output = '''out/\u03bc'''\n"), "");
   std::string e = error_of("[run]\nseed = 1 \u0409\n");

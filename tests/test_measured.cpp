@@ -403,6 +403,26 @@ TEST(Measured, WhatNoDrainedTestShowsIsRefused) {
   EXPECT_DOUBLE_EQ(load_measured(write("low.csv", "material,sigma3_kPa,q_peak_kPa\nA,100,5\n")).tests[0].q_peak, 5e3);
 }
 
+// Files that are no UTF-8 text printed their raw bytes as a column's name ("\xff\xfem", "\x89HDF: unknown column"),
+// an empty header cell showed no name, a quoted cell with a comma only a cell count (issue 65, item 18): each now says
+// what the file is and how to write it.
+TEST(Measured, WhatIsNoCsvTextSaysWhatItIs) {
+  std::string e = error_of(std::string("\xFF\xFEm\0a\0", 6));
+  EXPECT_NE(e.find("bad.csv: UTF-16 text (allowed: UTF-8 or ASCII): save it as UTF-8"), std::string::npos) << e;
+  e = error_of(std::string("\x89HDF\r\n\x1a\n\0\0", 10));
+  EXPECT_NE(e.find("bad.csv: an HDF5 file under another name"), std::string::npos) << e;
+  EXPECT_NE(e.find("rename it to .h5"), std::string::npos) << e;
+  e = error_of(std::string("mat\0rial\n", 10));
+  EXPECT_NE(e.find("bad.csv: not text (a NUL byte"), std::string::npos) << e;
+  e = error_of("material,sigma3_kPa,q_peak_kPa,\nA,100,120,\n");
+  EXPECT_NE(e.find("a column without a name: a comma at the end of the header"), std::string::npos) << e;
+  e = error_of("material,sigma3_kPa,q_peak_kPa\n\"beads, rough\",100,120\n");
+  EXPECT_NE(e.find("has 4 cells, the header 3 (quotes are not read"), std::string::npos) << e;
+  // A spreadsheet's UTF-8 byte order mark is still read past.
+  const std::string bom = write("bom.csv", "\xEF\xBB\xBFmaterial,sigma3_kPa,q_peak_kPa\nA,100,120\n");
+  EXPECT_EQ(load_measured(bom).tests.size(), 1u);
+}
+
 // Pressures within 2% of a group's first test are one pressure: grouped, each test once, groups in order of
 // their first test; the reader says so when they are not exactly equal.
 TEST(Measured, NearEqualPressuresAreGroupedAsReplicates) {

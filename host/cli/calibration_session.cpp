@@ -196,6 +196,8 @@ Session::Session(const Config& base, const CalibrationOptions& o, const std::str
       output(o.resume.empty() ? o.output : resumed_parent(o.resume)) {
   ranks::check_shared_folder(folder);  // every rank reads the run store there
   lab.set_run_store(folder + "/runs");
+  set_stop_note("the runs so far are kept in " + folder + "/runs: the same command with --resume " + folder +
+                " continues");
   lab.set_q_measure(cell_q);
   if (!o.resume.empty())
     std::printf("%s: resuming in %s: the runs stored there are read, not run again%s\n", kind.c_str(), folder.c_str(),

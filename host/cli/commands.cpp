@@ -143,7 +143,7 @@ void study_options(CLI::App* cmd, Args& a) {
 void micro_options(CLI::App* cmd, Args& a) {
   cmd->add_option("source", a.micro_source, "run folder or snap_<step>.h5")->required();
   cmd->add_option("--at", a.micro_at, "axial strain of the saved state, % (with a run folder)");
-  cmd->add_option("--rve", a.micro_rve, "edge of the central cube, mm (default 20)");
+  cmd->add_option("--rve", a.micro_rve, "edge of the central cube, mm (default 20)")->check(CLI::PositiveNumber);
   cmd->add_option("--bins", a.micro_bins, "rose bins over 0-180 deg (default 18)")->check(CLI::Range(2, 3600));
   cmd->add_option("-o,--output", a.micro_out, "output folder (default: the run folder or the snapshot's)");
   cmd->add_flag("--overwrite", a.overwrite, "replace the files of an earlier micro of the same state");

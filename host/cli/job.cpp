@@ -153,11 +153,12 @@ int specimen_job(const Config& cfg) {
   std::printf("specimen: e = %.4f (target %.3f), height %.3f mm (target %.3f); layers.csv, porosity_profile.csv, "
               "snapshots.xdmf in %s\n", sp.void_ratio, cfg.specimen.void_ratio, sp.height * 1e3,
               cfg.specimen.height * 1e3, out.folder().c_str());
+  // A layer stopped at its step cap is the cause of whatever follows; the void ratio is blamed only when all settled.
+  require_settled(cfg, sp);
   if (sp.height > cfg.specimen.height * (1 + 1e-9))
     std::printf("specimen: WARNING: the top platen stopped above the target height: the void ratio %.3f is not "
                 "reachable in this mould with these beads without squeezing them (try a larger e)\n",
                 cfg.specimen.void_ratio);
-  require_settled(cfg, sp);
   return 0;
 }
 

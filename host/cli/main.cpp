@@ -15,6 +15,7 @@
 #include "host/config/provenance.hpp"
 #include "host/data/measured.hpp"
 #include "host/lab/periodic_lab.hpp"
+#include "host/util/process_pool.hpp"
 #include "host/util/ranks.hpp"
 
 namespace {
@@ -92,6 +93,7 @@ int main(int argc, char** argv) {
     dem::prepare_parallel_runs(a.cal.workers);
   }
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // progress reaches a log file as it happens
+  dem::stop_children_with_the_program();     // SIGTERM says what it stopped, and stops the children too
   std::optional<Kokkos::ScopeGuard> kokkos;
   if (cmd.kokkos) kokkos.emplace(argc, argv);
   try {

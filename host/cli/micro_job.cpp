@@ -9,6 +9,8 @@
 #include "host/io/io_hdf5.hpp"
 #include "host/triax/micro_report.hpp"
 
+#include "host/util/text_format.hpp"
+
 namespace dem {
 
 namespace {
@@ -47,7 +49,8 @@ int micro_job(const std::string& source, double at_pct, double rve_edge_mm, int 
     if (path.empty())
       throw std::runtime_error(source + ": no snapshot at axial strain " + std::to_string(at_pct) +
                                "% (the run saved states at: " + (have.empty() ? std::string("none in the shear") : have) +
-                               "; [triaxial] snapshot_strains_pct sets them)");
+                               "; [run] snapshot_every sets them in a membrane test, [periodic] snapshot_strains_pct in a "
+                               "periodic cell)");
   } else if (!fs::is_regular_file(source)) {
     throw std::runtime_error(source + ": no such run folder or snapshot file");
   }
@@ -71,10 +74,10 @@ int micro_job(const std::string& source, double at_pct, double rve_edge_mm, int 
   for (std::size_t q = 0; q < cs.x.size(); ++q) rmax = std::max(rmax, std::hypot(cs.x[q].x, cs.x[q].y));
   const Real edge = rve_edge_mm * 1e-3;
   if (!(edge > 0) || edge / std::sqrt(2.0) > rmax || edge > zmax - zmin)
-    throw std::runtime_error("representative volume: a cube of edge " + std::to_string(rve_edge_mm) +
-                             " mm does not fit in this specimen (ball centres within a radius of " +
-                             std::to_string(rmax * 1e3) + " mm, height " + std::to_string((zmax - zmin) * 1e3) +
-                             " mm)");
+    throw std::runtime_error("--rve " + fmt("%g", rve_edge_mm) + ": a cube of that edge (mm) does not fit in this "
+                             "specimen (ball centres within a radius of " + fmt("%.3g", rmax * 1e3) + " mm, height " +
+                             fmt("%.3g", (zmax - zmin) * 1e3) + " mm; allowed: above 0, at most " +
+                             fmt("%.3g", std::min(std::sqrt(2.0) * rmax, zmax - zmin) * 1e3) + " mm)");
   const ContactSet rve = restrict_to_cube(cs, Vec3(0, 0, 0.5 * (zmin + zmax)), edge);
   const MicroRow all = micro_row(cs, volume), cube = micro_row(rve, edge * edge * edge);
   fs::create_directories(output);

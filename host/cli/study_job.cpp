@@ -117,6 +117,8 @@ int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, c
   const std::vector<StudyCase> cases = study_cases(inputs);
   std::vector<MeasuredData> compare;  // read before anything runs: a bad file stops the study at once
   for (const std::string& f : opt.compare) compare.push_back(load_measured(f));
+  set_stop_note("the finished cases are kept in " + opt.output + ": the same command with --resume runs the rest, "
+                "the triaxial cases from their checkpoints");
   const int cores = std::max(1u, std::thread::hardware_concurrency());
   int workers = std::clamp(opt.workers > 0 ? opt.workers : cores / 2, 1, static_cast<int>(cases.size()));
   if (kOnDevice && workers > 1) {

@@ -61,6 +61,8 @@ void check_after_backslash(const std::string& text, std::size_t k, bool multi, c
 /// number, a boolean, a date, or junk such as 200''[''' followed by more) runs to a blank, ',', ']', '}', '#' or
 /// the line's end, quotes and brackets included, because toml++ reads it so before it refuses it.
 void check_ascii_outside_strings(const std::string& text, const std::string& path) {
+  if (text.rfind("\xFF\xFE", 0) == 0 || text.rfind("\xFE\xFF", 0) == 0)
+    throw ConfigError(path + ":1:1: UTF-16 text (TOML is UTF-8): save the file as UTF-8");
   long line = 1, col = 0;
   bool may_begin = true;  // a string, a value or a key may begin here
   bool in_key = true;     // a key is being read: a '.' joins the parts of a dotted key, and no value is bare

@@ -51,6 +51,8 @@ std::string file_text(const std::string& path) {
   if (text.size() > kMaxConfigBytes)
     throw ConfigError(path + ": larger than " + std::to_string(kMaxConfigBytes / 1024) +
                       " KiB (allowed: a config or noise file of at most that size)");
+  // An editor's UTF-8 byte order mark is no part of the first key (it was refused as a non-ASCII character).
+  if (text.rfind("\xEF\xBB\xBF", 0) == 0) text.erase(0, 3);
   return text;
 }
 

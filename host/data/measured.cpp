@@ -77,6 +77,9 @@ ColumnSpec parse_header(const std::string& at, const std::string& name) {
     auto it = kQuantities.find(is_sd(q) ? q.substr(0, q.size() - 3) : q);
     if (it != kQuantities.end()) return {q, unit_scale(at, name, q, *it->second, unit)};
   }
+  if (name.empty())
+    fail(at, "(an empty name)", "a column without a name: a comma at the end of the header, or two together? (allowed: "
+         "one name per column)");
   fail(at, name,
        "unknown column (allowed: material, test, sigma3_<unit>, eps_a_<unit>, q_<unit>, eps_v_<unit>, q_peak_<unit>, "
        "eps_a_peak_<unit>, q_end_<unit>, max_dilatancy, e_ini_<unit>, q_1pct_<unit>, q_3pct_<unit>, "
@@ -351,7 +354,11 @@ MeasuredData load_measured(const std::string& path) {
   for (const MeasuredTextTable::Row& row : table.rows) {
     if (row.cells.size() != cols.names.size())
       fail(row.at, "", "has " + std::to_string(row.cells.size()) + " cells, the header " +
-                           std::to_string(cols.names.size()));
+                           std::to_string(cols.names.size()) +
+                           (row.cells.size() > cols.names.size()
+                                ? " (quotes are not read: a comma inside a quoted cell splits it; name the material "
+                                  "without commas)"
+                                : ""));
     const RowReader r{cols, row};
     read_q_measure(r, d);
     TriaxialTest& t = test_of(r, d, tests);

@@ -10,12 +10,35 @@
 
 namespace dem {
 
+namespace {
+
+/// Refuses a file that is no UTF-8 or ASCII text, by its first bytes: its raw bytes would otherwise be printed as a
+/// column's name ("\xff\xfem", "\x89HDF: unknown column").
+void check_is_text(const std::string& path, std::ifstream& f) {
+  char head[8] = {};
+  f.read(head, sizeof head);
+  const std::string b(head, static_cast<std::size_t>(f.gcount()));
+  f.clear();
+  f.seekg(0);
+  if (b.rfind("\x89HDF", 0) == 0)
+    throw DataError(path + ": an HDF5 file under another name (allowed: HDF5 measured data named .h5 or .hdf5, "
+                    "text as .csv): rename it to .h5");
+  if (b.rfind("\xFF\xFE", 0) == 0 || b.rfind("\xFE\xFF", 0) == 0)
+    throw DataError(path + ": UTF-16 text (allowed: UTF-8 or ASCII): save it as UTF-8, in a spreadsheet as "
+                    "\"CSV UTF-8\"");
+  if (b.find('\0') != std::string::npos)
+    throw DataError(path + ": not text (a NUL byte in its first bytes; allowed: a CSV text file, or HDF5 named .h5)");
+}
+
+}  // namespace
+
 MeasuredTextTable read_csv_table(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
     throw DataError(path + ": not a regular file (measured data are a CSV or HDF5 file)");
-  std::ifstream f(path);
+  std::ifstream f(path, std::ios::binary);
   if (!f) throw DataError(path + ": cannot be read");
+  check_is_text(path, f);
   MeasuredTextTable t;
   std::string line;
   for (long n = 1; std::getline(f, line); ++n) {

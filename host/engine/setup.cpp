@@ -24,6 +24,13 @@ SimParams solver_params(const Config& cfg) {
 }
 
 std::unique_ptr<Simulation> build_simulation(const Config& cfg, bool verbose) {
+  // An open side under gravity holds nothing in: the first ball out stopped the run as a blow-up that blamed a wall.
+  if (!cfg.box.walls)
+    for (int k = 0; k < 3; ++k)
+      if (!cfg.box.periodic[k] && cfg.solver.gravity[k] != 0)
+        throw ConfigError(cfg.path + ": [box] walls = false with [solver] gravity along " + "xyz"[k] +
+                          ": nothing holds the balls in the box (allowed: walls = true, a box periodic along that "
+                          "axis, or no gravity along it)");
   std::vector<BallSpec> balls = make_packing(cfg);
   std::vector<WallSpec> walls = box_walls(cfg);
   SimParams prm = solver_params(cfg);

@@ -1,4 +1,5 @@
 #include "host/engine/simulation.hpp"
+#include "host/engine/part_sampling.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -114,9 +115,15 @@ void Simulation::rebuild() {
     msg << "blow-up at step " << step_ << ": particle " << hg(out) << " left the domain (centre at (" << hx(out, 0)
         << ", " << hx(out, 1) << ", " << hx(out, 2) << ") m, domain (" << d.lo[0] << ", " << d.lo[1] << ", "
         << d.lo[2] << ") to (" << d.hi[0] << ", " << d.hi[1] << ", " << d.hi[2]
-        << ") m). Likely cause: it passed through a wall or the membrane (a time step too large for the wall "
-           "stiffness, or a wall moving too fast); suggested fix: lower [solver] dt_safety or the wall speed, "
-           "or stiffen the wall material";
+        << ") m). Likely cause: "
+        << (step_ == 0 ? "the state the run starts from puts it there (no step has moved it): a damaged specimen "
+                         "cache or input; suggested fix: delete the cached specimen (.specimens) to build it again"
+            : walls_.n == 0 && mesh_.ntri == 0
+                ? "nothing bounds the domain on that side (no walls, no membrane); suggested fix: [box] walls = "
+                  "true, or a box periodic along that axis"
+                : "it passed through a wall or the membrane (a time step too large for the wall stiffness, or a "
+                  "wall moving too fast); suggested fix: lower [solver] dt_safety or the wall speed, or stiffen "
+                  "the wall material");
     throw BlowUp(msg.str());
   }
   bin_particles(p_, prm_.domain, 2 * rmax_ + prm_.skin, prm_.skin, cells_);
@@ -142,11 +149,6 @@ void Simulation::index_contacts() {
 }
 
 namespace {
-
-/// One step in this many has its parts timed, each behind a fence, and counts for as many: on a GPU a fence holds
-/// the host until the device is done, and the other steps go through without one. The parts' times are estimates
-/// (a stage of thousands of steps samples hundreds of them); the stage's wall time (stage_loop.hpp) is measured.
-constexpr long kTimedEvery = 16;
 
 /// The step's part timers: on a timed step, each lap's seconds behind a fence, counted `weight` times; else nothing.
 class PartClock {

@@ -1,4 +1,5 @@
 #include "host/engine/stage_loop.hpp"
+#include "host/engine/part_sampling.hpp"
 
 #include "host/util/progress.hpp"
 
@@ -64,7 +65,15 @@ StageEnd run_stage(Simulation& sim, const StageSteps& stage, CheckpointPlan* pla
   end.timing.balls = sim.particles().n;
   end.timing.steps = sim.step_count() - step0;
   end.timing.wall = seconds_since(t0);
-  end.timing.parts = sim.times().since(parts0);
+  // Each sampled step counts for kTimedEvery (Simulation::step): scaled to the steps the stage ran, so that a
+  // stage whose length is no multiple of it does not count its samples for steps it did not run (a short specimen
+  // layer showed host times below zero).
+  const long sampled = sampled_steps_before(sim.step_count()) - sampled_steps_before(step0);
+  const double f =
+      sampled > 0 ? static_cast<double>(end.timing.steps) / static_cast<double>(sampled * kTimedEvery) : 0;
+  StageTimes& t = end.timing.parts;
+  t = sim.times().since(parts0);
+  for (double* x : {&t.forces, &t.integrate, &t.boundaries, &t.membrane, &t.walls}) *x *= f;  // the rebuild: every time
   const double n = std::max(1, sim.particles().n);
   end.timing.ball_pairs = sim.ball_contacts().n / n;
   end.timing.wall_pairs = sim.wall_contacts().n / n;

@@ -81,7 +81,8 @@ struct Stages {
             const std::vector<TriaxialTest>& tests, double points, int low_k, int k, const std::string& what) {
     const double each = mean_over(tests, [&](Real s) { return c.run_seconds(s); });
     const double steps = mean_over(tests, [&](Real s) { return static_cast<double>(c.run_steps(s)); });
-    const double per_point_low = static_cast<double>(tests.size()) * low_k, per_point = static_cast<double>(tests.size()) * k;
+    const double per_point_low = static_cast<double>(tests.size()) * low_k;
+    const double per_point = static_cast<double>(tests.size()) * k;
     plan.stages.push_back({name, what, setting, points * per_point * steps * static_cast<double>(c.balls),
                            points * wall(per_point_low, each, at_once), points * wall(per_point, each, at_once)});
   }
@@ -143,59 +144,81 @@ struct MembraneCost {
   }
 };
 
-}  // namespace
 
-JobPlan plan_job(const PlanInput& in) {
+/// What every stage of a plan reads: the job, the lab's cell and the check's, the specimens and the state match.
+struct Planner {
+  const PlanInput& in;
   JobPlan plan;
   Stages add{plan, in.at_once};
   const CalibrateConfig& cc = in.cell.calibrate;
-  const int factor = static_cast<int>(std::max(cc.cell_factor, 1L));
-  Config cell = larger_cell(in.cell, factor);
-  bool void_ratio = false;
-  for (const auto& m : in.materials)
-    for (const TriaxialTest& t : m.second) void_ratio = void_ratio || std::isfinite(t.void_ratio);
-  // A matched state is prepared with a friction of its own: the packing then has a preparation stage.
-  if (void_ratio && cell.periodic.prep_mu_s < 0) cell.periodic.prep_mu_s = 0.5 * cell.ball.mu_s;
-  const CellCost lab = measure_cell_cost(cell);
-  const CellCost check = measure_cell_cost(larger_cell(cell, kCellCheckFactor));
-  const int S = static_cast<int>(cc.scatter_specimens);
-  const bool auto_ensemble = cc.ensemble == kAutoEnsemble;
-  const int K = auto_ensemble ? S : static_cast<int>(cc.ensemble);
-  const int K_low = auto_ensemble ? 1 : K;
-  const std::string n = std::to_string(lab.balls);
-  const int match_packings = 2 + MatchPlan{}.steps;
-  // What the packing store holds already: the match replayed on its packings, then the specimens at its friction.
-  Config matched = in.cell;
-  const bool match_stored = stored_match(in.cell, in.state_tests, match_plan(in.cell, in.at_once), matched);
-  const Config lab_cell = larger_cell(matched, factor);
-  const unsigned seed = in.cell.run.seed;
-  if (match_stored && void_ratio)
-    plan.notes.push_back("state match: its packings are in the packing store (preparation friction " +
-                         fmt("%.4g", matched.periodic.prep_mu_s) + ")");
-  if (void_ratio && !match_stored)
-    add.packings("state match", "the data's void_ratio", lab, match_packings * kStateMatchSpecimens,
+  int factor = 1;
+  Config cell;  ///< the lab's cell as the job grows it, with a preparation friction where matched
+  bool void_ratio = false;  ///< the data give void ratios: the specimens are matched to them
+  CellCost lab, check;
+  int S = 0, K = 0, K_low = 0;  ///< scatter specimens, ensemble (auto: 1 to S)
+  bool auto_ensemble = false;
+  std::string n;  ///< the lab's balls
+  int match_packings = 0;
+  bool match_stored = false;  ///< the packing store holds the state match's packings
+  Config lab_cell;            ///< the matched cell (as the store knows it)
+  unsigned seed = 0;
+  int shared = 0;  ///< specimens the match's last packing gives the scatter
+
+  explicit Planner(const PlanInput& input) : in(input) {
+    factor = static_cast<int>(std::max(cc.cell_factor, 1L));
+    cell = larger_cell(in.cell, factor);
+    for (const auto& m : in.materials)
+      for (const TriaxialTest& t : m.second) void_ratio = void_ratio || std::isfinite(t.void_ratio);
+    // A matched state is prepared with a friction of its own: the packing then has a preparation stage.
+    if (void_ratio && cell.periodic.prep_mu_s < 0) cell.periodic.prep_mu_s = 0.5 * cell.ball.mu_s;
+    lab = measure_cell_cost(cell);
+    check = measure_cell_cost(larger_cell(cell, kCellCheckFactor));
+    S = static_cast<int>(cc.scatter_specimens);
+    auto_ensemble = cc.ensemble == kAutoEnsemble;
+    K = auto_ensemble ? S : static_cast<int>(cc.ensemble);
+    K_low = auto_ensemble ? 1 : K;
+    n = std::to_string(lab.balls);
+    match_packings = 2 + MatchPlan{}.steps;
+    // What the packing store holds already: the match replayed on its packings, then the specimens at its friction.
+    Config matched = in.cell;
+    match_stored = stored_match(in.cell, in.state_tests, match_plan(in.cell, in.at_once), matched);
+    lab_cell = larger_cell(matched, factor);
+    seed = in.cell.run.seed;
+    shared = void_ratio ? kStateMatchSpecimens : 0;
+  }
+
+  /// The state match's packings, where the store does not hold them: `name`'s stage.
+  void match_packings_stage(const std::string& name) {
+    add.packings(name, "the data's void_ratio", lab, match_packings * kStateMatchSpecimens,
                  match_packings * kStateMatchSpecimens, kStateMatchSpecimens,
                  "up to " + std::to_string(match_packings) + " packings of " + std::to_string(kStateMatchSpecimens) +
                      " specimens");
-  // The match's last packing is the first specimens'; with the match known, the store says which are left.
-  const int shared = void_ratio ? kStateMatchSpecimens : 0;
-  const int to_pack = match_stored ? S - stored_specimens(lab_cell, seed, S) : S - shared;
-  add.packings("scatter specimens", "[calibrate] scatter_specimens", lab, to_pack, to_pack, to_pack,
-               std::to_string(to_pack) + " packings");
-  for (const auto& [material, tests] : in.materials) {
-    const std::string T = std::to_string(tests.size());
-    add.runs(material + ": scatter runs", "[calibrate] scatter_specimens", lab, tests, 1, S, S,
-             std::to_string(S * static_cast<int>(tests.size())) + " runs of " + n + " balls (" + std::to_string(S) +
-                 " specimens x " + T + " tests)");
-    // The check cells' own state match starts from a bracket around the lab's friction (4 packings) and falls back
-    // to the whole range (up to 2 + kCellCheckPrepSteps more). No check where the data's specimens have the cell's
-    // balls (measure_cell_bias).
+  }
+
+  /// The lab's own specimens: the state match and the scatter specimens.
+  void specimens() {
+    if (match_stored && void_ratio)
+      plan.notes.push_back("state match: its packings are in the packing store (preparation friction " +
+                           fmt("%.4g", lab_cell.periodic.prep_mu_s) + ")");
+    if (void_ratio && !match_stored) match_packings_stage("state match");
+    // The match's last packing is the first specimens'; with the match known, the store says which are left.
+    const int to_pack = match_stored ? S - stored_specimens(lab_cell, seed, S) : S - shared;
+    add.packings("scatter specimens", "[calibrate] scatter_specimens", lab, to_pack, to_pack, to_pack,
+                 std::to_string(to_pack) + " packings");
+  }
+
+  /// A material's cell's bias check: its own state match (from a bracket around the lab's friction, 4 packings,
+  /// falling back to the whole range, up to 2 + kCellCheckPrepSteps more), its specimens and runs. None where the
+  /// data's specimens have the cell's balls (measure_cell_bias).
+  void bias_check(const std::string& material, const std::vector<TriaxialTest>& tests) {
     const int check_low = 4, check_high = 4 + 2 + kCellCheckPrepSteps;
     const bool checked = std::any_of(tests.begin(), tests.end(), [&](const TriaxialTest& t) {
       return cell_bias_extrapolation(static_cast<Real>(lab.balls), kCellCheckFactor, t.specimen_balls) != 0;
     });
-    if (!checked)
+    if (!checked) {
       plan.notes.push_back(material + ": the data's specimens have the cell's " + n + " balls: no cell's bias check");
+      return;
+    }
     // The check's own match (measure_cell_bias' plan), replayed on the store where the lab's match is known.
     MatchPlan check_plan;
     check_plan.first_seed = seed + kCellCheckSeedOffset;
@@ -208,19 +231,73 @@ JobPlan plan_job(const PlanInput& in) {
     const int check_to_pack = check_stored ? kCellCheckSpecimens - stored_specimens(check_cell, check_plan.first_seed,
                                                                                     kCellCheckSpecimens)
                                            : kCellCheckSpecimens - shared;
-    if (void_ratio && checked && !check_stored)
-      add.packings(material + ": cell's bias check, state match", "the cell's bias check (kCellCheckFactor)", check,
-                   check_low * kStateMatchSpecimens, check_high * kStateMatchSpecimens, kStateMatchSpecimens,
+    const std::string setting = "the cell's bias check (kCellCheckFactor)";
+    if (void_ratio && !check_stored)
+      add.packings(material + ": cell's bias check, state match", setting, check, check_low * kStateMatchSpecimens,
+                   check_high * kStateMatchSpecimens, kStateMatchSpecimens,
                    std::to_string(check_low) + " to " + std::to_string(check_high) + " packings of " +
                        std::to_string(kStateMatchSpecimens) + " specimens");
-    if (checked) {
-      add.packings(material + ": cell's bias check, specimens", "the cell's bias check (kCellCheckFactor)", check,
-                   check_to_pack, check_to_pack, kCellCheckSpecimens, std::to_string(check_to_pack) + " packings");
-      add.runs(material + ": cell's bias check, runs", "the cell's bias check (kCellCheckFactor)", check, tests, 1,
-               kCellCheckSpecimens, kCellCheckSpecimens,
-               std::to_string(kCellCheckSpecimens * static_cast<int>(tests.size())) + " runs of " +
-                   std::to_string(check.balls) + " balls");
+    add.packings(material + ": cell's bias check, specimens", setting, check, check_to_pack, check_to_pack,
+                 kCellCheckSpecimens, std::to_string(check_to_pack) + " packings");
+    add.runs(material + ": cell's bias check, runs", setting, check, tests, 1, kCellCheckSpecimens,
+             kCellCheckSpecimens,
+             std::to_string(kCellCheckSpecimens * static_cast<int>(tests.size())) + " runs of " +
+                 std::to_string(check.balls) + " balls");
+  }
+
+  /// A material's membrane tests: two fidelities' rounds (with the periodic runs and the corrected search they
+  /// repeat) where the job fits them, then the prediction, held-out pressures included.
+  void membrane(const std::string& material, const std::vector<TriaxialTest>& tests, long points,
+                const std::string& search_what) {
+    const MembraneCost mem(*in.membrane);
+    const int P = static_cast<int>(cc.predict_specimens);
+    const std::string T = std::to_string(tests.size());
+    // Each specimen is built, then tested at every pressure, min(P, runs at once) specimens side by side.
+    const int side = std::min(in.at_once, P);
+    const double one = mean_over(tests, [&](Real s) { return mem.seconds(s); });
+    const double build = kMembraneSpecimenOverTest * one, tests_one = one * static_cast<double>(tests.size());
+    const double test_steps = mean_over(tests, [&](Real s) { return mem.steps(s); }) *
+                              static_cast<double>(mem.cell.balls) * P;  // one pressure's, on every specimen
+    const double T_n = static_cast<double>(tests.size());
+    const std::string what = std::to_string(P * static_cast<int>(tests.size())) + " membrane tests of " +
+                             std::to_string(mem.cell.balls) + " balls (" + std::to_string(P) + " specimens x " + T +
+                             " pressures, " + std::to_string(side) +
+                             " specimens at once; a specimen in .specimens is not built again)";
+    const double each = wall(P, build + tests_one, side), tests_s = wall(P, tests_one, side);
+    const bool rounds_run = in.two_fidelity && !in.diagnose;
+    if (rounds_run) {
+      // 1 to kFidelityRounds rounds (two_fidelity_rounds), the specimens built in the first.
+      const double R = kFidelityRounds;
+      const std::string rounds = ", 1 to " + std::to_string(kFidelityRounds) + " rounds";
+      // Where the rounds do not converge, once more at the last optimum (FidelityRounds::chosen); the prediction
+      // takes the membrane runs made at its point.
+      plan.stages.push_back({material + ": two fidelities, membrane tests",
+                             what + rounds + ", once more where they do not converge", "[calibrate] predict_specimens",
+                             test_steps * ((R + 1) * T_n + kMembraneSpecimenOverTest), each, each + R * tests_s});
+      add.runs(material + ": two fidelities, periodic runs", "[calibrate] scatter_specimens", lab, tests, 1, S, S,
+               std::to_string(S * static_cast<int>(tests.size())) + " runs of " + n + " balls" + rounds);
+      upto_rounds(plan.stages.back());
+      add.runs(material + ": search (corrected)", "[calibrate] ensemble", lab, tests, static_cast<double>(points),
+               K_low, K, search_what + rounds);
+      upto_rounds(plan.stages.back());
     }
+    // The specimens built for two fidelities are cached: the prediction tests only, the held-out pressures too.
+    double held = 0;
+    for (const TriaxialTest& t : in.held_out) held += t.material == material ? 1 : 0;
+    const double with_held = tests_one * (T_n + held) / T_n;
+    const double predict = wall(P, rounds_run ? with_held : build + with_held, side);
+    plan.stages.push_back({material + ": prediction", what + (held > 0 ? fmt(", %.0f held out", held) : ""),
+                           "[calibrate] predict_specimens", test_steps * (T_n + held + kMembraneSpecimenOverTest),
+                           predict, predict});
+  }
+
+  /// A material's stages: its scatter runs, the cell's bias check, the search, and what predicts.
+  void material(const std::string& material, const std::vector<TriaxialTest>& tests) {
+    const std::string T = std::to_string(tests.size());
+    add.runs(material + ": scatter runs", "[calibrate] scatter_specimens", lab, tests, 1, S, S,
+             std::to_string(S * static_cast<int>(tests.size())) + " runs of " + n + " balls (" + std::to_string(S) +
+                 " specimens x " + T + " tests)");
+    bias_check(material, tests);
     const long points = in.diagnose ? planned_points(in.free) + static_cast<long>(extensions().size()) * 6
                                     : planned_points(in.free);
     const std::string k = auto_ensemble ? "1 to " + std::to_string(K) : std::to_string(K);
@@ -228,87 +305,62 @@ JobPlan plan_job(const PlanInput& in) {
                                     " balls" + (in.diagnose ? " (the base model, then " +
                                                                   std::to_string(extensions().size()) + " extensions)"
                                                             : "");
-    add.runs(material + (in.diagnose ? ": diagnosis" : ": search"), auto_ensemble ? "[calibrate] ensemble (auto)" : "[calibrate] ensemble",
-             lab, tests, static_cast<double>(points), K_low, K, search_what);
+    add.runs(material + (in.diagnose ? ": diagnosis" : ": search"),
+             auto_ensemble ? "[calibrate] ensemble (auto)" : "[calibrate] ensemble", lab, tests,
+             static_cast<double>(points), K_low, K, search_what);
     if (in.membrane) {
-      const MembraneCost mem(*in.membrane);
-      const int P = static_cast<int>(cc.predict_specimens);
-      // Each specimen is built, then tested at every pressure, min(P, runs at once) specimens side by side.
-      const int side = std::min(in.at_once, P);
-      const double one = mean_over(tests, [&](Real s) { return mem.seconds(s); });
-      const double build = kMembraneSpecimenOverTest * one, tests_one = one * static_cast<double>(tests.size());
-      const double test_steps = mean_over(tests, [&](Real s) { return mem.steps(s); }) *
-                                static_cast<double>(mem.cell.balls) * P;  // one pressure's, on every specimen
-      const double T_n = static_cast<double>(tests.size());
-      const std::string what = std::to_string(P * static_cast<int>(tests.size())) + " membrane tests of " +
-                               std::to_string(mem.cell.balls) + " balls (" + std::to_string(P) + " specimens x " + T +
-                               " pressures, " + std::to_string(side) +
-                               " specimens at once; a specimen in .specimens is not built again)";
-      const double each = wall(P, build + tests_one, side), tests_s = wall(P, tests_one, side);
-      if (in.two_fidelity && !in.diagnose) {
-        // 1 to kFidelityRounds rounds (two_fidelity_rounds), the specimens built in the first.
-        const double R = kFidelityRounds;
-        const std::string rounds = ", 1 to " + std::to_string(kFidelityRounds) + " rounds";
-        // Where the rounds do not converge, once more at the last optimum (FidelityRounds::chosen); the prediction
-        // takes the membrane runs made at its point.
-        plan.stages.push_back({material + ": two fidelities, membrane tests",
-                               what + rounds + ", once more where they do not converge",
-                               "[calibrate] predict_specimens", test_steps * ((R + 1) * T_n + kMembraneSpecimenOverTest),
-                               each, each + R * tests_s});
-        add.runs(material + ": two fidelities, periodic runs", "[calibrate] scatter_specimens", lab, tests, 1, S, S,
-                 std::to_string(S * static_cast<int>(tests.size())) + " runs of " + n + " balls" + rounds);
-        upto_rounds(plan.stages.back());
-        add.runs(material + ": search (corrected)", "[calibrate] ensemble", lab, tests, static_cast<double>(points),
-                 K_low, K, search_what + rounds);
-        upto_rounds(plan.stages.back());
-      }
-      // The specimens built for two fidelities are cached: the prediction tests only, the held-out pressures too.
-      double held = 0;
-      for (const TriaxialTest& t : in.held_out) held += t.material == material ? 1 : 0;
-      const double with_held = tests_one * (T_n + held) / T_n;
-      const double predict = wall(P, in.two_fidelity && !in.diagnose ? with_held : build + with_held, side);
-      plan.stages.push_back({material + ": prediction", what + (held > 0 ? fmt(", %.0f held out", held) : ""),
-                             "[calibrate] predict_specimens", test_steps * (T_n + held + kMembraneSpecimenOverTest),
-                             predict, predict});
+      membrane(material, tests, points, search_what);
     } else if (in.walls) {
       const int P = static_cast<int>(cc.predict_specimens);
       add.runs(material + ": prediction (walls)", "[calibrate] predict_specimens", lab, tests, 1, P, P,
                std::to_string(P * static_cast<int>(tests.size())) + " runs of the walled cell of " + n + " balls");
     }
   }
-  if (in.walls) {  // the walled cell's own preparation to the data's state, once for all materials
+
+  /// The walled cell's own preparation to the data's state, once for all materials.
+  void walls_specimens() {
     const int P = static_cast<int>(cc.predict_specimens);
-    if (void_ratio)
-      add.packings("prediction (walls): state match", "the data's void_ratio", lab, match_packings * kStateMatchSpecimens,
-                   match_packings * kStateMatchSpecimens, kStateMatchSpecimens,
-                   "up to " + std::to_string(match_packings) + " packings of " + std::to_string(kStateMatchSpecimens) +
-                       " specimens");
+    if (void_ratio) match_packings_stage("prediction (walls): state match");
     add.packings("prediction (walls): specimens", "[calibrate] predict_specimens", lab, P - shared, P - shared, P,
                  std::to_string(std::max(0, P - shared)) + " packings");
   }
-  plan.notes.push_back(fmt("speed measured here: %.0f ns a particle-step", lab.ns_per_particle_step) +
-                       " in the cell of " + n + " balls, " + fmt("%.0f", check.ns_per_particle_step) + " in the check's of " +
-                       std::to_string(check.balls) + "; " + std::to_string(in.at_once) +
-                       (in.at_once > 1 ? " runs at once, one thread each" : " run at a time"));
-  plan.notes.push_back(fmt("a run of %.0f steps", static_cast<double>(lab.run_steps(cell.periodic.triax.sigma3))) +
-                       fmt(" at %g kPa", 1e-3 * cell.periodic.triax.sigma3) +
-                       fmt(" (%.0f s)", lab.run_seconds(cell.periodic.triax.sigma3)) +
-                       fmt(", a packing of %.0f steps", static_cast<double>(lab.packing_steps)) +
-                       fmt(" (%.0f s)", lab.packing_seconds()) + ": estimates (host/lab/run_cost.hpp)");
-  plan.notes.push_back("a search counts its planned points on the whole ensemble: one whose optimum lies on the edge "
-                       "of a range searches again beyond it and runs more, and points far above the best run one "
-                       "specimen only (Table 6's S-1 once ran 636 runs where 264 were planned, now 200)");
-  if (auto_ensemble)
-    plan.notes.push_back("ensemble \"auto\": the scatter runs choose 1 to " + std::to_string(S) +
-                         " specimens a point (the fewest whose mean's standard error is half the data's noise): the "
-                         "searches' times are that range");
-  if (cc.cell_factor == kAutoCell && auto_ensemble)
-    plan.notes.push_back("cell \"auto\": where all " + std::to_string(S) + " scatter specimens fall short, the cell "
-                         "grows (up to " + std::to_string(kMaxCellFactor) + " x its balls) and every later stage costs "
-                         "about that factor more: the job says so when it happens");
-  plan.notes.push_back("packings in the packing store (" + in.cell.packing_store + ") are read, not packed, and not "
-                       "counted above");
-  return plan;
+
+  /// What the counts rest on: the speed measured, a run's and a packing's steps, and the choices made on the way.
+  void notes() {
+    plan.notes.push_back(fmt("speed measured here: %.0f ns a particle-step", lab.ns_per_particle_step) +
+                         " in the cell of " + n + " balls, " + fmt("%.0f", check.ns_per_particle_step) +
+                         " in the check's of " + std::to_string(check.balls) + "; " + std::to_string(in.at_once) +
+                         (in.at_once > 1 ? " runs at once, one thread each" : " run at a time"));
+    plan.notes.push_back(fmt("a run of %.0f steps", static_cast<double>(lab.run_steps(cell.periodic.triax.sigma3))) +
+                         fmt(" at %g kPa", 1e-3 * cell.periodic.triax.sigma3) +
+                         fmt(" (%.0f s)", lab.run_seconds(cell.periodic.triax.sigma3)) +
+                         fmt(", a packing of %.0f steps", static_cast<double>(lab.packing_steps)) +
+                         fmt(" (%.0f s)", lab.packing_seconds()) + ": estimates (host/lab/run_cost.hpp)");
+    plan.notes.push_back("a search counts its planned points on the whole ensemble: one whose optimum lies on the "
+                         "edge of a range searches again beyond it and runs more, and points far above the best run "
+                         "one specimen only (Table 6's S-1 once ran 636 runs where 264 were planned, now 200)");
+    if (auto_ensemble)
+      plan.notes.push_back("ensemble \"auto\": the scatter runs choose 1 to " + std::to_string(S) +
+                           " specimens a point (the fewest whose mean's standard error is half the data's noise): "
+                           "the searches' times are that range");
+    if (cc.cell_factor == kAutoCell && auto_ensemble)
+      plan.notes.push_back("cell \"auto\": where all " + std::to_string(S) + " scatter specimens fall short, the "
+                           "cell grows (up to " + std::to_string(kMaxCellFactor) + " x its balls) and every later "
+                           "stage costs about that factor more: the job says so when it happens");
+    plan.notes.push_back("packings in the packing store (" + in.cell.packing_store + ") are read, not packed, and "
+                         "not counted above");
+  }
+};
+
+}  // namespace
+
+JobPlan plan_job(const PlanInput& in) {
+  Planner p(in);
+  p.specimens();
+  for (const auto& [material, tests] : in.materials) p.material(material, tests);
+  if (in.walls) p.walls_specimens();
+  p.notes();
+  return p.plan;
 }
 
 std::string JobPlan::text(const std::string& kind) const {

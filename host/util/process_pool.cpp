@@ -4,10 +4,12 @@
 #include "host/util/ranks.hpp"
 
 #include <poll.h>
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
@@ -23,6 +25,47 @@ namespace {
 
 PoolUse use_so_far;
 std::vector<PoolRecord> records;
+
+// The children running now, for a stop signal's handler: lock-free atomics, which a handler may read.
+constexpr int kMaxChildren = 1024;
+std::atomic<int> child_pids[kMaxChildren];
+char stop_note[1024];
+
+void remember_child(int pid) {
+  for (std::atomic<int>& p : child_pids) {
+    int free = 0;
+    if (p.compare_exchange_strong(free, pid)) return;
+  }
+}
+
+void forget_child(int pid) {
+  for (std::atomic<int>& p : child_pids) {
+    int was = pid;
+    if (p.compare_exchange_strong(was, 0)) return;
+  }
+}
+
+/// Async-signal-safe: write(2), kill(2), signal and raise only.
+void say(const char* text) {
+  std::size_t n = 0;
+  while (text[n]) ++n;
+  if (::write(2, text, n) < 0) return;
+}
+
+void on_stop_signal(int sig) {
+  say(sig == SIGINT ? "triaxdem: stopped by SIGINT" : "triaxdem: stopped by SIGTERM");
+  bool children = false;
+  for (std::atomic<int>& p : child_pids)
+    if (const int pid = p.load(); pid > 0) children = ::kill(pid, SIGTERM) == 0 || children;
+  say(children ? "; its child processes stopped with it" : "");
+  if (stop_note[0]) {
+    say("; ");
+    say(stop_note);
+  }
+  say("\n");
+  ::signal(sig, SIG_DFL);
+  ::raise(sig);
+}
 
 using Clock = std::chrono::steady_clock;
 
@@ -67,6 +110,9 @@ int start_child(const char* what, int& read_fd, const std::function<void(int)>& 
   const pid_t pid = ::fork();
   if (pid < 0) throw std::runtime_error(std::string(what) + ": cannot start a child process (fork failed)");
   if (pid == 0) {
+    ::signal(SIGINT, SIG_DFL);  // a child ends at the parent's word, saying nothing of its own
+    ::signal(SIGTERM, SIG_DFL);
+    for (std::atomic<int>& p : child_pids) p.store(0);  // the parent's children are not this one's
     ::close(fd[0]);
     body(fd[1]);
     std::fflush(nullptr);
@@ -74,6 +120,7 @@ int start_child(const char* what, int& read_fd, const std::function<void(int)>& 
   }
   ::close(fd[1]);
   read_fd = fd[0];
+  remember_child(pid);
   return pid;
 }
 
@@ -81,7 +128,19 @@ int wait_child(int pid) {
   int ws = 0;
   while (::waitpid(pid, &ws, 0) < 0 && errno == EINTR) {
   }
+  forget_child(pid);
   return WIFEXITED(ws) ? WEXITSTATUS(ws) : 128 + WTERMSIG(ws);
+}
+
+void stop_children_with_the_program() {
+  ::signal(SIGINT, on_stop_signal);
+  ::signal(SIGTERM, on_stop_signal);
+}
+
+void set_stop_note(const std::string& note) {
+  const std::size_t n = std::min(note.size(), sizeof stop_note - 1);
+  std::copy(note.begin(), note.begin() + static_cast<std::ptrdiff_t>(n), stop_note);
+  stop_note[n] = '\0';
 }
 
 void run_pool(const PoolWork& w, const char* what) {

@@ -49,6 +49,13 @@ void run_pool_here(const PoolWork& w, const char* what);
 int start_child(const char* what, int& read_fd, const std::function<void(int)>& body);
 /// Waits for a child started so; its exit status as a shell gives it (128 + the signal that ended it).
 int wait_child(int pid);
+
+/// SIGINT and SIGTERM from here on: the program says what stopped it and the job's note (set_stop_note), stops the
+/// child processes it is running, and ends as the signal ends it (exit status 128 + the signal). A stage that keeps
+/// checkpoints catches them for its time (StopSignals) and ends its own way. Children start with the default again.
+void stop_children_with_the_program();
+/// What a stop leaves and how to go on ("its runs so far are kept: --resume FOLDER continues"); "" for none.
+void set_stop_note(const std::string& note);
 /// The order the pieces start in: by cost, longest first, ties (and all, without a cost) in index order.
 std::vector<std::size_t> start_order(const PoolWork& w);
 
