@@ -1,5 +1,6 @@
 // Measured triaxial data (host/data/measured.hpp): the shipped Table 6, curves, and refusals with line and column.
 #include <gtest/gtest.h>
+#include <hdf5.h>
 
 #include <cmath>
 #include <filesystem>
@@ -204,6 +205,39 @@ TEST(Measured, Hdf5FormReadsLikeTheCsv) {
     EXPECT_NE(std::string(e.what()).find("curves.h5:/S-2/table row 8:eps_a_pct: axial strain must increase"),
               std::string::npos) << e.what();
   }
+}
+
+// h5py writes a Python str attribute as a variable-length string, which the reader refused ("not a fixed-length
+// string") without saying how to write it (issue 65): it is read like a fixed-length one. The file is written as
+// h5py writes it, with the C API: a group per material, its `table` of numbers, `columns` a variable-length string.
+TEST(Measured, Hdf5FromH5pyWithVariableLengthStringsReads) {
+  const std::string path = write("h5py.h5", "");
+  {
+    const hid_t f = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    const hid_t g = H5Gcreate2(f, "/S-1", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    const hsize_t dims[2] = {2, 2};
+    const double rows[4] = {100, 142.4, 200, 255.9};
+    const hid_t space = H5Screate_simple(2, dims, nullptr);
+    const hid_t d = H5Dcreate2(g, "table", H5T_NATIVE_DOUBLE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, rows);
+    const hid_t str = H5Tcopy(H5T_C_S1);
+    H5Tset_size(str, H5T_VARIABLE);
+    H5Tset_cset(str, H5T_CSET_UTF8);
+    const hid_t scalar = H5Screate(H5S_SCALAR);
+    const hid_t a = H5Acreate2(d, "columns", str, scalar, H5P_DEFAULT, H5P_DEFAULT);
+    const char* columns = "sigma3_kPa,q_peak_kPa";
+    H5Awrite(a, str, &columns);
+    H5Aclose(a);
+    H5Sclose(scalar);
+    H5Tclose(str);
+    H5Dclose(d);
+    H5Sclose(space);
+    H5Gclose(g);
+    H5Fclose(f);
+  }
+  const MeasuredData m = load_measured(path);
+  ASSERT_EQ(m.tests.size(), 2u);
+  EXPECT_DOUBLE_EQ(m.tests[1].q_peak, 255.9e3);
 }
 
 // Standard deviations in their own units, each turned into SI: per row in a curve file, per quantity in a

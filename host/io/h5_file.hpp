@@ -198,8 +198,9 @@ class H5Reader {
       throw std::runtime_error(path_ + ": cannot read dataset '" + name + "'");
     return out;
   }
-  /// A fixed-length string attribute of the object at `object` ("/" for the root); "" when absent. One string
-  /// (a scalar dataspace), of at most kMaxAttribute bytes: anything else is refused.
+  /// A string attribute of the object at `object` ("/" for the root), fixed or variable length (h5py writes a
+  /// Python str as the latter); "" when absent. One string (a scalar dataspace), of at most kMaxAttribute bytes:
+  /// anything else is refused.
   std::string string_attribute(const std::string& object, const std::string& name) const {
     if (H5Aexists_by_name(file_.get(), object.c_str(), name.c_str(), H5P_DEFAULT) <= 0) return "";
     const std::string what = path_ + ": attribute '" + name + "' of '" + object + "'";
@@ -208,8 +209,23 @@ class H5Reader {
     Handle type(H5Aget_type(attr.get()), H5Tclose);
     if (H5Sget_simple_extent_type(space.get()) != H5S_SCALAR)
       throw std::runtime_error(what + " is not a single value (allowed: one string)");
-    if (H5Tget_class(type.get()) != H5T_STRING || H5Tis_variable_str(type.get()) != 0)
-      throw std::runtime_error(what + " is not a fixed-length string");
+    if (H5Tget_class(type.get()) != H5T_STRING)
+      throw std::runtime_error(what + " is not a string (allowed: one string, fixed or variable length)");
+    if (H5Tis_variable_str(type.get()) > 0) {  // h5py's default for a Python str
+      Handle mem(H5Tcopy(H5T_C_S1), H5Tclose);
+      H5Tset_size(mem.get(), H5T_VARIABLE);
+      H5Tset_cset(mem.get(), H5Tget_cset(type.get()));
+      char* buf = nullptr;
+      if (H5Aread(attr.get(), mem.get(), &buf) < 0 || !buf) throw std::runtime_error(what + " cannot be read");
+      std::size_t n = 0;
+      while (n <= kMaxAttribute && buf[n]) ++n;
+      const std::string text(buf, n);
+      H5free_memory(buf);
+      if (n > kMaxAttribute)
+        throw std::runtime_error(what + " has more than " + std::to_string(kMaxAttribute) + " bytes (allowed: 1 to " +
+                                 std::to_string(kMaxAttribute) + ")");
+      return text;
+    }
     const std::size_t size = H5Tget_size(type.get());
     if (size == 0 || size > kMaxAttribute)
       throw std::runtime_error(what + " has " + std::to_string(size) + " bytes (allowed: 1 to " +
