@@ -79,6 +79,17 @@ void write_four_point_curve(const fs::path& path) {
                          "A,100,0,0,0\nA,100,1,60,0.1\nA,100,2,70,-0.1\nA,100,3,65,-0.3\n";
 }
 
+/// The shipped file `source` (from the source root) with its first `from` replaced by `to`, written to `out`.
+void write_edited(const std::string& source, const std::string& from, const std::string& to, const fs::path& out) {
+  std::string text = text_of(fs::path(TRIAXDEM_SOURCE_DIR) / source);
+  const std::string::size_type at = text.find(from);
+  if (at == std::string::npos) {
+    ADD_FAILURE() << source << " holds no '" << from << "'";
+    return;
+  }
+  std::ofstream(out) << text.replace(at, from.size(), to);
+}
+
 }  // namespace
 
 // A full disk while writing HDF5 printed some 640 lines of HDF5's error stack and then crashed at exit (signal 11 in
@@ -245,11 +256,8 @@ TEST(CliEdges, CheckDescribesTheJobTheConfigIsFor) {
   EXPECT_NE(o.output.find("a periodic-cell triaxial test (triaxdem periodic):\n  cell: 1000 balls"), std::string::npos)
       << o.output;
   // What `periodic` refuses, `check` refuses with the same words (it said OK to gravity in the cell, issue 65).
-  std::ifstream in(fs::path(TRIAXDEM_SOURCE_DIR) / "configs/periodic/periodic_S1_100kPa.toml");
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const std::string::size_type g = text.find("gravity = [0.0, 0.0, 0.0]");
-  ASSERT_NE(g, std::string::npos);
-  std::ofstream(dir / "gravity.toml") << text.replace(g, 25, "gravity = [0.0, 0.0, -9.81]");
+  write_edited("configs/periodic/periodic_S1_100kPa.toml", "gravity = [0.0, 0.0, 0.0]", "gravity = [0.0, 0.0, -9.81]",
+               dir / "gravity.toml");
   for (const char* job : {"check", "periodic"}) {
     o = triaxdem(std::string(job) + " " + (dir / "gravity.toml").string() +
                      (std::string(job) == "check" ? "" : " -o " + (dir / "g").string()), dir);
@@ -259,11 +267,7 @@ TEST(CliEdges, CheckDescribesTheJobTheConfigIsFor) {
   }
   // A box without walls under gravity: check said OK, and run stopped at the first ball out with a blow-up that
   // blamed a wall (issue 65). Both refuse it before any step.
-  std::ifstream box_in(fs::path(TRIAXDEM_SOURCE_DIR) / "configs/default.toml");
-  std::string box((std::istreambuf_iterator<char>(box_in)), std::istreambuf_iterator<char>());
-  const std::string::size_type w = box.find("walls = true");
-  ASSERT_NE(w, std::string::npos);
-  std::ofstream(dir / "open.toml") << box.replace(w, 12, "walls = false");
+  write_edited("configs/default.toml", "walls = true", "walls = false", dir / "open.toml");
   for (const char* job : {"check", "run"}) {
     o = triaxdem(std::string(job) + " " + (dir / "open.toml").string() +
                      (std::string(job) == "check" ? "" : " -n 10 -o " + (dir / "open").string()), dir);

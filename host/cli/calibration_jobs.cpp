@@ -42,6 +42,29 @@ std::string new_dated_folder(const std::string& parent, const std::string& prefi
 
 namespace {
 
+/// A folder as a path without a trailing separator ("out/calibrate_x/" names calibrate_x).
+fs::path folder_path(const std::string& folder) {
+  fs::path p = fs::path(folder).lexically_normal();
+  return p.has_filename() ? p : p.parent_path();
+}
+
+}  // namespace
+
+std::string resumed_folder(const std::string& folder, const std::string& kind) {
+  const std::string name = folder_path(folder).filename().string();
+  if (!fs::is_directory(folder) || name.rfind(kind + "_", 0) != 0)
+    throw std::invalid_argument("--resume " + folder + ": not a " + kind + "_<date> folder of an earlier " + kind +
+                                " (it gives the folder to continue in)");
+  return folder_path(folder).string();
+}
+
+std::string resumed_parent(const std::string& folder) {
+  const fs::path parent = folder_path(folder).parent_path();
+  return parent.empty() ? "." : parent.string();
+}
+
+namespace {
+
 /// A search whose every point blew up has no answer: stopped with the blow-ups named, not reported as values.
 void require_a_result(const CalibrationResult& r, const std::string& what, const Session& ss) {
   if (!std::isfinite(r.best.chi2)) throw std::runtime_error(what + " gave a result (" + ss.failed_text() + ")");

@@ -55,5 +55,10 @@ int synth_job(const Config& base, const SynthOptions& o);
 
 /// A new folder `<parent>/<prefix>_<YYYYmmdd-HHMMSS>` (a suffix -2, -3 ... if it exists): never an old one.
 std::string new_dated_folder(const std::string& parent, const std::string& prefix);
+/// The folder a resumed calibrate or diagnose (`kind`) continues in: one that a run of the same kind made. Throws
+/// std::invalid_argument naming --resume otherwise.
+std::string resumed_folder(const std::string& folder, const std::string& kind);
+/// The parent folder of a resumed folder: where its run left the specimens it shares with others.
+std::string resumed_parent(const std::string& folder);
 
 }  // namespace dem

@@ -22,27 +22,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// A folder as a path without a trailing separator ("out/calibrate_x/" names calibrate_x).
-fs::path folder_path(const std::string& folder) {
-  fs::path p = fs::path(folder).lexically_normal();
-  return p.has_filename() ? p : p.parent_path();
-}
-
-/// The folder a resumed calibrate or diagnose continues in: one that a run of the same kind made.
-std::string resumed_folder(const std::string& folder, const std::string& kind) {
-  const std::string name = folder_path(folder).filename().string();
-  if (!fs::is_directory(folder) || name.rfind(kind + "_", 0) != 0)
-    throw std::invalid_argument("--resume " + folder + ": not a " + kind + "_<date> folder of an earlier " + kind +
-                                " (it gives the folder to continue in)");
-  return folder_path(folder).string();
-}
-
-/// The parent folder of a resumed folder: where its run left the specimens it shares with others.
-std::string resumed_parent(const std::string& folder) {
-  const fs::path parent = folder_path(folder).parent_path();
-  return parent.empty() ? "." : parent.string();
-}
-
 /// The folders a job writes checked before any work (a refusal after the packings wasted them): the resumed folder
 /// is one of this kind's, or -o names a folder (or none yet) whose nearest existing parent can be written.
 void check_folders(const CalibrationOptions& o, const std::string& kind) {

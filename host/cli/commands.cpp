@@ -12,34 +12,23 @@
 #include <thread>
 
 #include "host/cli/commands.hpp"
-#include "host/fit/calibrate.hpp"
 #include "host/cli/calibration_jobs.hpp"
-#include "host/io/io_hdf5.hpp"
-#include "host/data/measured.hpp"
 #include "host/config/config.hpp"
 #include "host/config/model_keys.hpp"
 #include "host/cli/job.hpp"
-#include "host/triax/micro_report.hpp"
-#include "host/triax/periodic_triaxial.hpp"
-#include "host/config/provenance.hpp"
 #include "host/study/study.hpp"
-#include "host/triax/triaxial.hpp"
 #include "host/util/ranks.hpp"
 #include "host/util/text_format.hpp"
 
 namespace dem::cli {
+
+int machine_cores() { return static_cast<int>(std::max(1u, std::thread::hardware_concurrency())); }
 
 namespace {
 
 // Threads and processes beyond a few per core only slow a run down, and tens of thousands crash the OpenMP
 // runtime (signal 11, no message): counts are refused above this many per core.
 constexpr int kMaxPerCore = 8;
-
-}  // namespace
-
-int machine_cores() { return static_cast<int>(std::max(1u, std::thread::hardware_concurrency())); }
-
-namespace {
 
 std::string count_range(int lowest) {
   const int cores = machine_cores();
@@ -65,16 +54,6 @@ CLI::Validator count_on_this_machine(int lowest) {
       },
       "COUNT");
 }
-
-}  // namespace
-
-std::string omp_threads_problem() {
-  const char* env = std::getenv("OMP_NUM_THREADS");
-  if (!env || !*env || count_fits(env, 1, true)) return "";
-  return "OMP_NUM_THREADS=" + std::string(env) + " is no thread count for this machine (" + count_range(1) + ")";
-}
-
-namespace {
 
 /// A confining pressure in kPa: a finite number above 0.
 CLI::Validator pressure_kpa() {
@@ -274,6 +253,12 @@ int study(Args& a) {
 }
 
 }  // namespace
+
+std::string omp_threads_problem() {
+  const char* env = std::getenv("OMP_NUM_THREADS");
+  if (!env || !*env || count_fits(env, 1, true)) return "";
+  return "OMP_NUM_THREADS=" + std::string(env) + " is no thread count for this machine (" + count_range(1) + ")";
+}
 
 const std::vector<Command>& command_table() {
   static const std::vector<Command> table = {

@@ -21,10 +21,9 @@ double label_strain(const std::string& label) {
   return k == std::string::npos ? NAN : std::atof(label.c_str() + k + 6);
 }
 
-}  // namespace
-
-int micro_job(const std::string& source, double at_pct, double rve_edge_mm, int rose_bins, const std::string& output,
-              bool overwrite) {
+/// The snapshot file `source` names: itself, or in a run's folder the one saved at axial strain at_pct (%). Throws
+/// std::runtime_error naming the strains the run saved and the keys that set them.
+std::string snapshot_at(const std::string& source, double at_pct) {
   namespace fs = std::filesystem;
   std::string path = source;
   if (fs::is_directory(source)) {
@@ -48,12 +47,22 @@ int micro_job(const std::string& source, double at_pct, double rve_edge_mm, int 
                                "'triaxdem triaxial' run, or one snapshot file");
     if (path.empty())
       throw std::runtime_error(source + ": no snapshot at axial strain " + std::to_string(at_pct) +
-                               "% (the run saved states at: " + (have.empty() ? std::string("none in the shear") : have) +
-                               "; [run] snapshot_every sets them in a membrane test, [periodic] snapshot_strains_pct in a "
-                               "periodic cell)");
+                               "% (the run saved states at: " +
+                               (have.empty() ? std::string("none in the shear") : have) +
+                               "; [run] snapshot_every sets them in a membrane test, [periodic] snapshot_strains_pct "
+                               "in a periodic cell)");
   } else if (!fs::is_regular_file(source)) {
     throw std::runtime_error(source + ": no such run folder or snapshot file");
   }
+  return path;
+}
+
+}  // namespace
+
+int micro_job(const std::string& source, double at_pct, double rve_edge_mm, int rose_bins, const std::string& output,
+              bool overwrite) {
+  namespace fs = std::filesystem;
+  const std::string path = snapshot_at(source, at_pct);
   const std::string label = fs::path(path).stem().string();
   // An earlier micro of this state (another --rve or --bins, perhaps) is a result: replaced only when asked.
   for (const std::string& name : {"micro_" + label + ".csv", "micro_coordination_" + label + ".csv",

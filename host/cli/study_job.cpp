@@ -110,6 +110,31 @@ void print_efficiency(int workers) {
               workers, ranks::spread() ? "ranks" : "workers", 100 * use.busy / std::max(use.offered, 1e-9));
 }
 
+/// Cases at once and OpenMP threads each: the options', else the cores shared out (one case at a time on a GPU,
+/// one a rank where spread over MPI ranks, the leader handing them out).
+std::pair<int, int> share_cores(const StudyOptions& opt, std::size_t cases) {
+  const int cores = std::max(1u, std::thread::hardware_concurrency());
+  int workers = std::clamp(opt.workers > 0 ? opt.workers : cores / 2, 1, static_cast<int>(cases));
+  if (kOnDevice && workers > 1) {
+    if (opt.workers > 1)
+      std::printf("study: one case at a time on the GPU, not %d: processes that share a GPU time-slice it and run "
+                  "slower together than one after another\n", opt.workers);
+    workers = 1;
+  }
+  if (ranks::spread()) workers = ranks::size() - 1;
+  const int threads =
+      opt.threads > 0 ? opt.threads : std::max(1, cores / (ranks::spread() ? ranks::per_node() : workers));
+  return {workers, threads};
+}
+
+/// A run's own folder (its series and checkpoint at the top) is no study's: their files would mix.
+void refuse_run_folder(const std::string& output) {
+  for (const char* own : {"series.csv", "summary.csv", "checkpoint.h5"})
+    if (fs::exists(fs::path(output) / own))
+      throw std::runtime_error("study -o " + output + ": a run's folder (" + own + " in it): a study writes a "
+                               "folder per case and its table there; name another folder");
+}
+
 }  // namespace
 
 int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, const char* self_exe) {
@@ -119,22 +144,9 @@ int study_job(const std::vector<std::string>& inputs, const StudyOptions& opt, c
   for (const std::string& f : opt.compare) compare.push_back(load_measured(f));
   set_stop_note("the finished cases are kept in " + opt.output + ": the same command with --resume runs the rest, "
                 "the triaxial cases from their checkpoints");
-  const int cores = std::max(1u, std::thread::hardware_concurrency());
-  int workers = std::clamp(opt.workers > 0 ? opt.workers : cores / 2, 1, static_cast<int>(cases.size()));
-  if (kOnDevice && workers > 1) {
-    if (opt.workers > 1)
-      std::printf("study: one case at a time on the GPU, not %d: processes that share a GPU time-slice it and run "
-                  "slower together than one after another\n", opt.workers);
-    workers = 1;
-  }
-  if (ranks::spread()) workers = ranks::size() - 1;  // the leader hands out the cases; each other rank runs one
-  const int threads =
-      opt.threads > 0 ? opt.threads : std::max(1, cores / (ranks::spread() ? ranks::per_node() : workers));
-  // A run's own folder (its series and checkpoint at the top) is no study's: their files would mix.
-  for (const char* own : {"series.csv", "summary.csv", "checkpoint.h5"})
-    if (fs::exists(fs::path(opt.output) / own))
-      throw std::runtime_error("study -o " + opt.output + ": a run's folder (" + own + " in it): a study writes a "
-                               "folder per case and its table there; name another folder");
+  const std::pair<int, int> share = share_cores(opt, cases.size());
+  const int workers = share.first, threads = share.second;
+  refuse_run_folder(opt.output);
   fs::create_directories(opt.output);
   if (ranks::spread()) std::printf("study: spread over %d MPI ranks\n", ranks::size());
   std::printf("study: %zu cases, %d at a time with %d OpenMP threads each; logs in %s/<case>/log.txt\n",
