@@ -20,6 +20,8 @@
 #include "host/fit/misfit.hpp"
 #include "host/fit/job_plan.hpp"
 #include "host/lab/run_cost.hpp"
+#include "host/lab/run_store.hpp"
+#include "host/util/forked_runs.hpp"
 #include "host/triax/periodic_triaxial.hpp"
 #include "test_util.hpp"
 
@@ -262,6 +264,36 @@ TEST(Calibrate, ParallelRunsEqualSequentialRuns) {
   for (int k = 0; k < kPressures; ++k) EXPECT_EQ(each[k].q, one[k][k % 2].q) << "sigma3 " << like[k].sigma3;
 }
 
+// The run store's files carry a checksum of their bytes: a run's curves with a byte changed, cut short, or followed by
+// bytes the reader leaves are not read (the run is computed again), whatever the reader alone would accept.
+TEST(RunStore, AFileIsReadOnlyAsItWasSealed) {
+  namespace fs = std::filesystem;
+  const std::string path = (test::scratch_dir("run_store") / "s" / "a.run").string();
+  const double values[] = {1.5, 2.5, 3.5};
+  write_stored(path, std::string(reinterpret_cast<const char*>(values), sizeof values));
+  const auto read_two = [&]() {  // a reader of the first two values alone: it would accept a longer file
+    double got[2] = {0, 0};
+    return read_stored(path, [&](int fd) { return get_bytes(fd, got, sizeof got); });
+  };
+  const auto read_three = [&](double* got) {
+    return read_stored(path, [&](int fd) { return get_bytes(fd, got, 3 * sizeof(double)); });
+  };
+  double got[3] = {0, 0, 0};
+  ASSERT_TRUE(read_three(got));
+  EXPECT_EQ(got[2], 3.5);
+  EXPECT_FALSE(read_two()) << "the reader left a sealed value unread";
+  {
+    std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(9);
+    f.put('\x7f');
+  }
+  EXPECT_FALSE(read_three(got)) << "a changed byte";
+  write_stored(path, std::string(reinterpret_cast<const char*>(values), sizeof values));
+  fs::resize_file(path, fs::file_size(path) - 8);  // the seal cut off: the three values alone
+  EXPECT_FALSE(read_three(got)) << "a file without its seal";
+  EXPECT_FALSE(read_stored((fs::path(path).parent_path() / "none.run").string(), [](int) { return true; }));
+}
+
 // A calibration packed its specimens anew in every stage and every job (57% of a walled calibration's time, the state
 // match's last packing twice): the packing store keeps each specimen under a hash of what decides it, a later lab
 // reads it with its bits, and a damaged file (a byte changed, cut short) is packed again rather than used.
@@ -413,12 +445,14 @@ TEST(Calibrate, BlownUpRunsAreCountedWithTheirPressure) {
   EXPECT_EQ(lab.runs(), 2);
   EXPECT_EQ(lab.failed_runs(), 2);
   EXPECT_EQ(lab.highest_failed_sigma3(), 200e3);
+  EXPECT_TRUE(lab.mostly_failed());  // a calibration stops here with an error, never a result
   for (const auto& runs : out) EXPECT_FALSE(std::isfinite(runs.at(0).q_peak));
   Model stiff;
   stiff.law = cfg.ball;
   lab.run_ensemble(stiff, like);
   EXPECT_EQ(lab.runs(), 4);
   EXPECT_EQ(lab.failed_runs(), 2) << "runs that end are not counted";
+  EXPECT_FALSE(lab.mostly_failed()) << "half of the runs, not more";
 }
 
 // The preparation friction is matched on the mean void ratio of the lab's first kStateMatchSpecimens specimens

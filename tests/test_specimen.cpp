@@ -3,6 +3,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <iterator>
 
 #include <cmath>
 
@@ -63,6 +65,28 @@ TEST(Specimen, CacheRoundTripsBitForBitAndRefusesOtherKeys) {
     EXPECT_NE(std::string(e.what()).find("damaged specimen file (2 balls where its key says 3); delete it"),
               std::string::npos) << e.what();
   }
+  // Sealed: a ball moved by an edit (issue 65: one ball 0.5 m away blew the run up, blamed on the walls) is refused,
+  // a line added below the seal too; a file without its checksum line (cut short) is not used but built again.
+  save_specimen(path, sp, "key A");
+  const auto edited = [&](const std::function<std::string(std::string)>& edit) {
+    std::ifstream in(path);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::ofstream((dir / "edited.csv").string()) << edit(text);
+    return (dir / "edited.csv").string();
+  };
+  const auto refusal = [&](const std::string& file) -> std::string {
+    try {
+      load_specimen(file, "key A", back);
+    } catch (const std::runtime_error& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+  EXPECT_NE(refusal(edited([](std::string t) { return t.replace(t.find("0.0050000000000000001"), 3, "0.5"); })).find(
+                "edited or damaged after triaxdem wrote it"), std::string::npos);
+  EXPECT_NE(refusal(edited([](std::string t) { return t + "1,2,3,4,5\n"; })).find("a line below its checksum line"),
+            std::string::npos);
+  EXPECT_FALSE(load_specimen(edited([](std::string t) { return t.substr(0, t.rfind("# checksum")); }), "key A", back));
   // The test's friction does not enter the key: the nine paper cases share one specimen.
   const Config s1 = load_config(std::string(TRIAXDEM_SOURCE_DIR) + "/configs/paper/S1_100kPa.toml");
   const Config s3 = load_config(std::string(TRIAXDEM_SOURCE_DIR) + "/configs/paper/S3_300kPa.toml");

@@ -65,9 +65,15 @@ std::string resumed_parent(const std::string& folder) {
 
 namespace {
 
-/// A search whose every point blew up has no answer: stopped with the blow-ups named, not reported as values.
+/// A search whose every point, or most of whose runs, blew up has no answer: stopped with the blow-ups named, not
+/// reported as values.
 void require_a_result(const CalibrationResult& r, const std::string& what, const Session& ss) {
-  if (!std::isfinite(r.best.chi2)) throw std::runtime_error(what + " gave a result (" + ss.failed_text() + ")");
+  if (!std::isfinite(r.best.chi2))
+    throw std::runtime_error(what + ": no point of the search gave a result (" + ss.failed_text() + ")");
+  if (ss.lab.mostly_failed())
+    throw std::runtime_error(what + ": " + std::to_string(ss.lab.failed_runs()) + " of " +
+                             std::to_string(ss.lab.runs()) + " runs stopped at a blow-up, more than half: no result "
+                             "is given on the few that ended (" + ss.failed_text() + ")");
 }
 
 /// The extension a diagnosis reports against the base: the one its verdict names first, else the best by BIC
@@ -219,7 +225,7 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
         progress.update(done - start, extra);
       });
       progress.finish("");
-      require_a_result(r, what + " " + material + ": no point of the search", ss);
+      require_a_result(r, what + " " + material, ss);
       return r;
     };
     CalibrationResult r = fit(misfit, "calibrate");
@@ -280,7 +286,7 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
                 ss.cell_text().c_str());
     const Misfit misfit = ss.misfit_of(base, material, tests);
     const Diagnosis dg = diagnose(ss.lab, model_of(base), ss.free, tests, misfit, true);
-    require_a_result(dg.base, "diagnose " + material + ": no point of the base search", ss);
+    require_a_result(dg.base, "diagnose " + material + " (the base model's search)", ss);
     std::printf("diagnose: %s: verdict: %s\n  %s\n", material.c_str(), dg.verdict.c_str(), dg.explanation.c_str());
     std::printf("%s", uncertainty_text(dg.base, material, "diagnose").c_str());
     std::string edge, widened;

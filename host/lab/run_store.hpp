@@ -14,11 +14,13 @@ namespace dem {
 /// hashes in what else decides the file.
 std::uint64_t store_hash(const Config& cfg);
 
-/// Reads a stored file through `read` (given its descriptor); false where there is none or `read` finds it cut short.
+/// Reads a stored file through `read` (given its descriptor); false where there is none, where it does not match the
+/// checksum write_stored sealed it with (a note on stderr says it is computed again), or where `read` does not take
+/// exactly the sealed bytes.
 bool read_stored(const std::string& path, const std::function<bool(int fd)>& read);
 
-/// Writes `bytes` to `path` atomically (io::write_text_atomic), making its folder at the first file: a killed
-/// calibration leaves whole files only. Throws std::runtime_error naming the path.
+/// Writes `bytes` and their FNV-1a checksum to `path` atomically (io::write_text_atomic), making its folder at the
+/// first file: a killed calibration leaves whole files only, and a file damaged later is never read. Throws std::runtime_error naming the path.
 void write_stored(const std::string& path, const std::string& bytes);
 
 /// A run's curves through a child's pipe: its row count, void ratio, eps_a, q and eps_v (a run that blew up: every

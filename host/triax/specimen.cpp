@@ -14,6 +14,7 @@
 #include "host/engine/checkpoint.hpp"
 #include "host/io/io_hdf5.hpp"
 #include "host/engine/packing.hpp"
+#include "host/util/fnv1a.hpp"
 #include "host/util/progress.hpp"
 #include "host/engine/setup.hpp"
 #include "host/engine/simulation.hpp"
@@ -238,7 +239,8 @@ void save_specimen(const std::string& path, const Specimen& sp, const std::strin
   o << "\nx_m,y_m,z_m,radius_m,density_kg_m3\n";
   for (const BallSpec& b : sp.balls)
     o << b.x.x << "," << b.x.y << "," << b.x.z << "," << b.radius << "," << b.density << "\n";
-  io::write_text_atomic(path, o.str());
+  const std::string text = o.str();
+  io::write_text_atomic(path, text + "# checksum " + hex16(fnv1a(text.data(), text.size())) + "\n");
 }
 
 bool load_specimen(const std::string& path, const std::string& key, Specimen& sp) {
@@ -252,10 +254,21 @@ bool load_specimen(const std::string& path, const std::string& key, Specimen& sp
   };
   Specimen out;
   bool key_ok = false;
+  std::uint64_t sum = kFnv1aOffset;  // of every line above the checksum's
+  std::string sealed;
   while (std::getline(f, line)) {
     ++n;
+    if (!sealed.empty()) damaged("a line below its checksum line");
     std::istringstream s(line);
     std::string tag, word;
+    if (line.rfind("# checksum ", 0) == 0) {
+      sealed = line.substr(11);
+      if (sealed != hex16(sum))
+        damaged("its checksum says " + sealed + ", its lines " + hex16(sum) + ": edited or damaged after triaxdem "
+                "wrote it");
+      continue;
+    }
+    sum = fnv1a("\n", 1, fnv1a(line.data(), line.size(), sum));
     if (line.rfind("# key ", 0) == 0) {
       if (line.substr(6) != key) return false;
       key_ok = true;
@@ -281,6 +294,11 @@ bool load_specimen(const std::string& path, const std::string& key, Specimen& sp
   }
   if (!key_ok) return false;
   if (out.balls.empty() || !(out.height > 0)) damaged("no balls or no height");
+  if (sealed.empty()) {  // cut short above its last line, or written before specimens were sealed: never used
+    std::fprintf(stderr, "specimen: %s has no checksum line (cut short, or written by an earlier triaxdem): built "
+                 "again\n", path.c_str());
+    return false;
+  }
   // A file cut at a line's end (a full disk, a copy stopped) parses whole: its key says how many balls it holds.
   if (const std::string::size_type at = key.find(" n "); at != std::string::npos) {
     const long want = std::strtol(key.c_str() + at + 3, nullptr, 10);

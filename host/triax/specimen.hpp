@@ -47,8 +47,9 @@ Specimen build_specimen(const Config& cfg, bool verbose);
 std::string specimen_key(const Config& cfg);
 
 /// Writes / reads a specimen as CSV (x_m, y_m, z_m, radius_m, density_kg_m3 per ball; the layer reports,
-/// height and key in '#' lines). The write is atomic; load_specimen returns false when the file is missing
-/// or was built for another key, and throws std::runtime_error naming the file and line when it is damaged.
+/// height, key and a checksum of the lines above it in '#' lines). The write is atomic; load_specimen returns false
+/// when the file is missing, was built for another key or has no checksum (a note says so), and throws
+/// std::runtime_error naming the file and line when it is damaged or edited.
 void save_specimen(const std::string& path, const Specimen& sp, const std::string& key);
 bool load_specimen(const std::string& path, const std::string& key, Specimen& sp);
 
