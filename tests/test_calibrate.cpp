@@ -545,8 +545,7 @@ TEST(Calibrate, AMatchNearAKnownFrictionBracketsItAndStoresItsPackings) {
   long packings = 0;
   for (const auto& f : fs::directory_iterator(near.store)) {
     ++packings;
-    std::ofstream(f.path(), std::ios::binary | std::ios::trunc).write(reinterpret_cast<const char*>(&target),
-                                                                      sizeof target);
+    write_stored(f.path().string(), std::string(reinterpret_cast<const char*>(&target), sizeof target));  // sealed
   }
   EXPECT_LE(packings, 3) << "two ends and one halving reach 1/16 from a bracket of 1/8";
   Real planted = 0;

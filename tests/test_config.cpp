@@ -8,6 +8,7 @@
 #include "host/config/config.hpp"
 #include "host/cli/job.hpp"
 #include "host/engine/setup.hpp"
+#include "host/fit/calibrate.hpp"
 #include "host/fit/two_fidelity.hpp"
 #include "test_util.hpp"
 
@@ -55,6 +56,46 @@ TEST(Config, OutOfRangeNamesAllowedRange) {
   EXPECT_NE(error_of("[solver]\ndamping = 1.5\n").find("damping"), std::string::npos);
   const std::string layers = error_of("[specimen]\nlayer_stop_ratio = 2\n");
   EXPECT_NE(layers.find("layer_stop_ratio: value 2 out of range (allowed: [0, 1])"), std::string::npos) << layers;
+}
+
+// A law is chosen by name and takes its own keys: another law's key is refused naming the keys this one takes,
+// hertz_mindlin without its modulus is refused, and the walls follow the balls' law unless [wall_material] says.
+TEST(Config, TheContactLawIsChosenByNameAndTakesItsOwnKeys) {
+  const std::string hm = "[material]\nlaw = \"hertz_mindlin\"\nshear_modulus_Pa = 25e9\npoisson = 0.22\n";
+  const dem::Config c = dem::load_config(write_config("hm.toml", hm));
+  EXPECT_EQ(c.ball.law, dem::kHertzMindlin);
+  EXPECT_EQ(c.ball.shear_modulus, 25e9);
+  EXPECT_EQ(c.wall.law, dem::kHertzMindlin);
+  EXPECT_EQ(dem::load_config(write_config("hm_walls.toml", hm + "[wall_material]\nlaw = \"rrlinear\"\n")).wall.law,
+            dem::kRRLinear);
+  std::string e = error_of(hm + "emod_Pa = 1e8\n");
+  EXPECT_NE(e.find("[material] emod_Pa: emod_Pa belongs to law \"rrlinear\"; law = \"hertz_mindlin\" takes "
+                   "shear_modulus_Pa, poisson instead"), std::string::npos) << e;
+  e = error_of("[material]\nshear_modulus_Pa = 25e9\n");
+  EXPECT_NE(e.find("[material] shear_modulus_Pa: shear_modulus_Pa belongs to law \"hertz_mindlin\"; law = "
+                   "\"rrlinear\" takes emod_Pa, kratio, hertz_overlap, roughness instead"), std::string::npos) << e;
+  e = error_of("[material]\nlaw = \"hertz_mindlin\"\n");
+  EXPECT_NE(e.find("[material] shear_modulus_Pa: law = \"hertz_mindlin\" needs the balls' shear modulus"),
+            std::string::npos) << e;
+  e = error_of("[material]\nlaw = \"hertz_mindlin\"\nshear_modulus_Pa = 25e9\n");
+  EXPECT_NE(e.find("[material] poisson: law = \"hertz_mindlin\" needs the balls' shear modulus and Poisson ratio"),
+            std::string::npos) << e;
+  e = error_of("[wall_material]\nlaw = \"hertz_mindlin\"\n");
+  EXPECT_NE(e.find("[wall_material] shear_modulus_Pa: law = \"hertz_mindlin\" needs"), std::string::npos) << e;
+  // --free and synth's extensions take the keys of the base's law only (the free_param both call).
+  dem::Model base;
+  base.law = c.ball;
+  try {
+    dem::free_param("emod_Pa", base);
+    ADD_FAILURE() << "emod_Pa freed on a hertz_mindlin material";
+  } catch (const std::invalid_argument& x) {
+    EXPECT_NE(std::string(x.what()).find("emod_Pa belongs to law \"rrlinear\""), std::string::npos) << x.what();
+  }
+  EXPECT_THROW(dem::free_param("roughness", base), std::invalid_argument);
+  EXPECT_EQ(dem::free_param("shear_modulus_Pa", base).lo, 25e9 / 3);
+  e = error_of("[material]\nlaw = \"hertz\"\n");
+  EXPECT_NE(e.find("[material] law: 'hertz' is not allowed (allowed: hertz_mindlin, rrlinear)"), std::string::npos)
+      << e;
 }
 
 TEST(Config, WrongTypeUnknownTableAndSyntaxError) {

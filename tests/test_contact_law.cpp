@@ -9,6 +9,7 @@
 #include <cstring>
 #include <limits>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "host/engine/builder.hpp"
@@ -457,9 +458,52 @@ TEST(ContactLaw, HertzForceGrowsAsOverlapToThreeHalves) {
   const double kt = 1.5 * kn * std::sqrt(4e-6 / dref);
   EXPECT_NEAR(norm(h.fs), kt / 1.5 * 0.01 * 1e-7, 1e-12 * kt / 1.5 * 1e-9);
   // The critical time step uses the stiffest contact up to the overlap guard.
-  EXPECT_NEAR(NormalElastic::max_stiffness(p, R, R, 0.25 * R), 1.5 * kn * std::sqrt(25.0), 1e-13 * kn);
+  EXPECT_NEAR(NormalElastic::max_stiffness(p, R, R, 0.25 * R).kn, 1.5 * kn * std::sqrt(25.0), 1e-13 * kn);
   p.hertz_overlap = 0;
-  EXPECT_EQ(NormalElastic::max_stiffness(p, R, R, 0.25 * R), kn);
+  EXPECT_EQ(NormalElastic::max_stiffness(p, R, R, 0.25 * R).kn, kn);
+}
+
+// hertz_mindlin, a law of its own, against Hertz's and Mindlin's formulas written out here from G and nu (PFC's hertz
+// model's form: E* = G / (1 - nu), R* = R1 R2 / (R1 + R2)): Fn = 4/3 E* sqrt(R*) d^1.5, the tangent 2 E* a, a =
+// sqrt(R* d), the shear spring Mindlin's 8 G* a, G* = G / (2 (2 - nu)). Pure arithmetic on a few doubles: 1e-13.
+TEST(ContactLaw, HertzMindlinLawIsHertzsAndMindlins) {
+  ContactParams p = test::law(1e8, 1.5, 0.3, 0.0);
+  p.law = kHertzMindlin;
+  p.shear_modulus = 25e9;  // glass
+  p.poisson = 0.22;
+  const double G = p.shear_modulus, nu = p.poisson, estar = G / (1 - nu), gstar = G / (2 * (2 - nu));
+  for (const auto& [r1, r2] : {std::pair<double, double>{1e-3, 1e-3}, {1e-3, 0.6e-3}, {1e-3, 0.0}}) {
+    const double rstar = r2 > 0 ? r1 * r2 / (r1 + r2) : r1;
+    for (double d : {1e-8, 1e-7, 2e-6}) {
+      ContactKinematics k = kin(p, Vec3(0, 0, 1), d, r1, r2, 1e-7);
+      k.kn = ContactLaws::stiffness(p, r1, r2);
+      const NormalResponse nr = NormalHertzMindlin::response(p, k);
+      const double a = std::sqrt(rstar * d), fn = 4.0 / 3.0 * estar * std::sqrt(rstar) * std::pow(d, 1.5);
+      EXPECT_NEAR(nr.fn, fn, 1e-13 * fn) << r2 << " " << d;
+      EXPECT_NEAR(nr.k, 2 * estar * a, 1e-13 * estar * a);
+      EXPECT_NEAR(nr.ks, 8 * gstar * a, 1e-13 * gstar * a);
+      // One step of tangential velocity v loads the shear spring by ks v dt; the normal force is Hertz's.
+      k.vrel = Vec3(0.01, 0, 0);
+      ContactHistory h;
+      const ContactOutput out = ContactLaws::eval(p, k, h);
+      EXPECT_NEAR(norm(h.fs), 8 * gstar * a * 0.01 * 1e-7, 1e-12 * 8 * gstar * a * 1e-9);
+      EXPECT_NEAR(-out.force.z, fn, 1e-13 * fn);
+    }
+    // The stiffest contact up to the overlap guard, for the time step: the tangents at that overlap.
+    const MaxStiffness m = ContactLaws::max_stiffness(p, r1, r2, 0.01 * r1);
+    EXPECT_NEAR(m.kn, 2 * estar * std::sqrt(rstar * 0.01 * r1), 1e-13 * m.kn);
+    EXPECT_NEAR(m.ks, 8 * gstar * std::sqrt(rstar * 0.01 * r1), 1e-13 * m.ks);
+  }
+  // The rrlinear pair through the same table is RRLinear, bit for bit.
+  ContactParams lin = test::law(1e8, 1.5, 0.3, 0.02);
+  ContactKinematics k = kin(lin, unit(Vec3(1, 2, 2)), 1e-6, 1e-3, 0.9e-3, 1e-7);
+  k.vrel = Vec3(0.01, -0.02, 0.005);
+  k.dtheta = Vec3(1e-4, 0, 2e-4);
+  ContactHistory h1, h2;
+  const ContactOutput a = RRLinear::eval(lin, k, h1), b = ContactLaws::eval(lin, k, h2);
+  EXPECT_EQ(std::memcmp(&a, &b, sizeof a), 0);
+  EXPECT_EQ(std::memcmp(&h1.fs, &h2.fs, sizeof h1.fs), 0);
+  EXPECT_EQ(std::memcmp(&h1.mr, &h2.mr, sizeof h1.mr), 0);
 }
 
 // Rough-surface compliance: bulk overlap d^2 / (d + 2 sigma). Soft while d << sigma (Fn ~ kn d^2 / 2 sigma),

@@ -41,7 +41,8 @@ std::vector<const ModelKey*> law_extensions() {
 
 /// A random touching contact: in turn the base law, the dashpot and each extension of the table at the strongest
 /// strength the diagnosis tries; every seventh is a wall, every third starts with no history and some have history
-/// along n (it must vanish) or loads past the caps.
+/// along n (it must vanish) or loads past the caps. Of each three packs of lanes one is of rrlinear contacts, one of
+/// hertz_mindlin and one of both laws in turn (ContactLaws runs both and keeps each lane's).
 LawCase random_case(std::mt19937_64& rng, int t) {
   static const std::vector<const ModelKey*> extensions = law_extensions();
   std::uniform_real_distribution<double> u(-1, 1);
@@ -60,7 +61,13 @@ LawCase random_case(std::mt19937_64& rng, int t) {
   c.k.r2 = t % 7 == 0 ? 0 : 1e-3 * (1 + 0.2 * u(rng));
   c.k.m1 = 1e-5;
   c.k.m2 = c.k.r2 > 0 ? 1.2e-5 : 0;
-  c.k.kn = RRLinear::stiffness(c.p, c.k.r1, c.k.r2);
+  const int pack = t / kContactLanes;
+  if (pack % 3 == 1 || (pack % 3 == 2 && t % 2 == 1)) {
+    c.p.law = kHertzMindlin;
+    c.p.shear_modulus = 1e9 * (1.5 + u(rng));
+    c.p.poisson = 0.25 * (1 + u(rng));
+  }
+  c.k.kn = ContactLaws::stiffness(c.p, c.k.r1, c.k.r2);
   c.k.vrel = Vec3(u(rng), u(rng), u(rng));
   c.k.dtheta = 1e-3 * Vec3(u(rng), u(rng), u(rng));
   c.k.dt = 1e-7;
@@ -98,10 +105,10 @@ TEST(SimdLanes, EachLaneGivesTheScalarLawsBits) {
     H.fs = vlanes([](const LawCase& q) { return q.h.fs; });
     H.mr = vlanes([](const LawCase& q) { return q.h.mr; });
     for (int s = 0; s < kHistorySlots; ++s) H.slot[s] = lanes([s](const LawCase& q) { return q.h.slot[s]; });
-    const ContactOutputT<T> out = RRLinear::eval(P, K, H);
+    const ContactOutputT<T> out = ContactLaws::eval(P, K, H);
     for (int k = 0; k < kContactLanes; ++k) {
       ContactHistory h = c[k].h;
-      const ContactOutput ref = RRLinear::eval(c[k].p, c[k].k, h);
+      const ContactOutput ref = ContactLaws::eval(c[k].p, c[k].k, h);
       const auto at = [&](const Vec3T<T>& a) { return lane(a, k); };
       ASSERT_TRUE(same_bits(at(out.force), ref.force)) << "contact " << t0 + k;
       ASSERT_TRUE(same_bits(at(out.moment), ref.moment)) << "contact " << t0 + k;

@@ -44,7 +44,7 @@ int synth_job(const Config& base, const SynthOptions& o) {
                                     "pressure, each given once");
   if (o.extension != "none") {
     const Extension& e = extension(o.extension);
-    const FreeParam range = free_param(e.param);
+    const FreeParam range = free_param(e.param, truth);  // an extension of another law than the base's is refused
     if (!std::isnan(o.strength) && !(o.strength >= range.shown * range.lo && o.strength <= range.shown * range.hi))
       throw std::invalid_argument("synth --strength " + fmt("%g", o.strength) + ": out of the range of " + e.param +
                                   " (allowed: [" + fmt("%g", range.shown * range.lo) + ", " +

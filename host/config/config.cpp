@@ -6,6 +6,8 @@
 #include "host/config/toml_reader.hpp"
 
 #include <algorithm>
+#include <iterator>
+#include <set>
 #include <cmath>
 #include <map>
 #include <sstream>
@@ -14,9 +16,32 @@ namespace dem {
 
 namespace {
 
-void read_contact(TableReader& r, ContactParams& c) {
-  for (const ModelKey& k : model_keys())
-    if (k.field) r.number(k.key, c.*k.field, k.lo, k.hi, k.scale, k.open_lo);
+/// A material's law ([material] law, kContactLawNames) and the keys of that law and of every law; a key of another
+/// law is refused, naming the keys this one takes. hertz_mindlin's constants have no default: they are given, or
+/// taken from `from` (the balls' material, for the walls) where it has that law.
+void read_contact(TableReader& r, ContactParams& c, const ContactParams* from = nullptr) {
+  std::string law = kContactLawNames[static_cast<int>(c.law)];
+  r.string("law", law, std::set<std::string>(std::begin(kContactLawNames), std::end(kContactLawNames)));
+  c.law = static_cast<Real>(std::find(std::begin(kContactLawNames), std::end(kContactLawNames), law) -
+                            std::begin(kContactLawNames));
+  for (const ModelKey& k : model_keys()) {
+    if (!k.field) continue;
+    Real other = 0;  // a key of another law: read (and listed by config_keys) only to be refused
+    const bool mine = !*k.law || law == k.law;
+    r.number(k.key, mine ? c.*k.field : other, k.lo, k.hi, k.scale, k.open_lo);
+    if (!mine && r.has(k.key)) {
+      try {
+        require_law_of(k, c.law);
+      } catch (const std::invalid_argument& e) {
+        r.fail(k.key, e.what());
+      }
+    }
+  }
+  if (c.law == kHertzMindlin && !(from && from->law == kHertzMindlin))
+    for (const char* key : {"shear_modulus_Pa", "poisson"})
+      if (!r.has(key))
+        r.fail(key, "law = \"hertz_mindlin\" needs the balls' shear modulus and Poisson ratio: shear_modulus_Pa "
+                    "(allowed: (0, 1e13] Pa) and poisson (allowed: [0, 0.5])");
   r.finish();
 }
 
@@ -93,7 +118,7 @@ void read_materials(const Tables& read, Config& c) {
   read_contact(mat, c.ball);
   c.wall = c.ball;
   TableReader wmat = read("wall_material");
-  read_contact(wmat, c.wall);
+  read_contact(wmat, c.wall, &c.ball);
 }
 
 /// [solver].

@@ -20,13 +20,16 @@ const std::vector<ModelKey>& model_keys() {
   static const std::vector<ModelKey> keys = {
       {"mu_s", &C::mu_s, "-", 0, 10, false, 1, true, 0.02, 1.0, true, "", {}, "", true},
       {"mu_r", &C::mu_r, "-", 0, 10, false, 1, true, 0.0, 0.2, false, "", {}, "", true},
-      {"emod_Pa", &C::emod, "Pa", 0, 1e13, true, 1, true, 1e6, 1e10, true, "", {}, "", true},
-      {"kratio", &C::kratio, "-", 0, 1e3, true, 1, true, 1.0, 4.0, false, "", {}, "", true},
+      {"emod_Pa", &C::emod, "Pa", 0, 1e13, true, 1, true, 1e6, 1e10, true, "", {}, "", true, true, "rrlinear"},
+      {"kratio", &C::kratio, "-", 0, 1e3, true, 1, true, 1.0, 4.0, false, "", {}, "", true, true, "rrlinear"},
+      {"shear_modulus_Pa", &C::shear_modulus, "Pa", 0, 1e13, true, 1, true, 1e6, 1e11, true, "", {}, "", true, true,
+       "hertz_mindlin"},
+      {"poisson", &C::poisson, "-", 0, 0.5, false, 1, false, 0, 0.5, false, "", {}, "", true, true, "hertz_mindlin"},
       {"beta_n", &C::beta_n, "-", 0, 1, false, 1, false, 0, 0, false, "", {}, "", true},
       {"hertz_overlap", &C::hertz_overlap, "r", 0, 0.5, false, 1, true, 3e-4, 0.03, true, "hertz", {1e-3, 3e-3, 1e-2},
-       "initial stiffness that grows faster with confinement than the linear contacts give", false},
+       "initial stiffness that grows faster with confinement than the linear contacts give", false, true, "rrlinear"},
       {"roughness", &C::roughness, "r", 0, 0.1, false, 1, true, 1e-4, 5e-2, true, "roughness", {1e-3, 3e-3, 1e-2},
-       "soft initial response, most at low confinement; peak and residual hardly change", true},
+       "soft initial response, most at low confinement; peak and residual hardly change", true, true, "rrlinear"},
       {"wear", &C::wear, "-", 0, 0.99, false, 1, true, 0.0, 0.9, false, "wear", {0.2, 0.4, 0.6},
        "a residual strength that falls below the peak more than sliding alone explains", true},
       {"wear_slip", &C::wear_slip, "r", 0, 10, true, 1, true, 0.005, 0.5, true, "", {}, "", true},
@@ -59,6 +62,20 @@ std::string free_key_names() {
   for (const ModelKey& k : model_keys())
     if (k.fit) names += (names.empty() ? "" : ", ") + std::string(k.key);
   return names;
+}
+
+std::string law_key_names(const std::string& law) {
+  std::string names;
+  for (const ModelKey& k : model_keys())
+    if (law == k.law) names += (names.empty() ? "" : ", ") + std::string(k.key);
+  return names;
+}
+
+void require_law_of(const ModelKey& k, Real law) {
+  const std::string mine = kContactLawNames[static_cast<int>(law)];
+  if (!*k.law || mine == k.law) return;
+  throw std::invalid_argument(std::string(k.key) + " belongs to law \"" + k.law + "\"; law = \"" + mine +
+                              "\" takes " + law_key_names(mine) + " instead");
 }
 
 }  // namespace dem

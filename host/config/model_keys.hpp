@@ -32,6 +32,8 @@ struct ModelKey {
   /// The diagnosis tries it (and synth makes data with it). An extension that names another code's data, which lack
   /// it, is a parameter to calibrate, not a verdict to offer.
   bool diagnosed = true;
+  /// The contact law it belongs to (kContactLawNames); "" for every law's.
+  const char* law = "";
 };
 
 /// The table: the base law first, then its extensions and the membrane.
@@ -43,5 +45,12 @@ const ModelKey& model_key(const std::string& key);
 /// or the keys a calibration may free.
 std::string extension_names();
 std::string free_key_names();
+
+/// The keys of law `law` alone ("shear_modulus_Pa, poisson"), for messages.
+std::string law_key_names(const std::string& law);
+
+/// A key of another law than the pair's ([material] law) is refused: throws std::invalid_argument naming the key's
+/// law and the keys the pair's law takes. Does nothing for a key of every law.
+void require_law_of(const ModelKey& k, Real law);
 
 }  // namespace dem

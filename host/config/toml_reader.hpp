@@ -33,6 +33,8 @@ class TableReader {
     throw ConfigError(s.str());
   }
 
+  /// Whether the table holds the key (read or not).
+  bool has(const std::string& key) const { return t_ && t_->contains(key); }
   /// A number in [lo, hi]; `scale` converts the file's unit to SI.
   void number(const std::string& key, Real& out, Real lo, Real hi, Real scale = 1, bool open_lo = false) {
     const toml::node* n = get(key, "number");

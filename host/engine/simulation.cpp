@@ -92,8 +92,7 @@ Real Simulation::critical_dt() const {
         for (int b = 0; b < static_cast<int>(params.extent(1)); ++b) {
           const ContactParams& cp = params(mat(i), b);
           // Ball-wall is the stiffest contact; a Hertzian one stiffens up to the overlap guard.
-          const Real kn = NormalElastic::max_stiffness(cp, r(i), 0, overlap_max * r(i));
-          const Real ks = kn / cp.kratio;
+          const auto [kn, ks] = ContactLaws::max_stiffness(cp, r(i), 0, overlap_max * r(i));
           const Real krot = ks * r(i) * r(i) + ks * r(i) * r(i);  // shear lever + rolling spring (Rbar = R)
           const Real t = kc::min(kc::sqrt(m(i) / kn), kc::sqrt(in(i) / krot));
           acc = t < acc ? t : acc;

@@ -25,7 +25,7 @@ const std::vector<Extension>& extensions() {
     std::vector<Extension> out;
     for (const ModelKey& k : model_keys())
       if (*k.extension && k.diagnosed)
-        out.push_back({k.extension, k.key, {k.strengths.begin(), k.strengths.end()}, k.signature, k.from_off});
+        out.push_back({k.extension, k.key, {k.strengths.begin(), k.strengths.end()}, k.signature, k.from_off, k.law});
     return out;
   }();
   return list;
@@ -355,7 +355,13 @@ Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreePa
   Evaluation base_runs = dg.base.best;  // the best run of the base model, also among the extension fits' runs
   const std::function<void()> report_runs = [&] { report(best_chi2); };
   const FitContext cx{lab, dg.base, base_model, base_at, measured, misfit, report_runs};
+  const std::string law = kContactLawNames[static_cast<int>(base.law.law)];
   for (const Extension& e : extensions()) {
+    if (!e.law.empty() && e.law != law) {
+      say("diagnose: %-9s extends law %s, not this material's %s: not tried\n", e.name.c_str(), e.law.c_str(),
+          law.c_str());
+      continue;
+    }
     dg.fits.push_back(fit_extension(e, cx, base_runs));
     const ExtensionFit& f = dg.fits.back();
     say("diagnose: %-9s %s = %.3g: chi2 %.1f, BIC %.1f (base %.1f), held-out chi2 %.1f (base %.1f)\n",

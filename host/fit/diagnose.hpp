@@ -41,6 +41,7 @@ struct Extension {
   std::vector<Real> levels;
   std::string signature;
   bool from_off = true;   ///< the parameter going to 0 turns it off smoothly (not so for Hertz)
+  std::string law;        ///< the contact law it extends (ModelKey::law); "" for every law
 };
 
 const std::vector<Extension>& extensions();

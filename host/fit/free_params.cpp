@@ -42,9 +42,10 @@ const ParamSpec& spec(const std::string& name) {
 FreeParam free_param(const std::string& name) { return spec(name).range; }
 
 FreeParam free_param(const std::string& name, const Model& base) {
+  require_law_of(model_key(name), base.law.law);
   FreeParam f = free_param(name);
   const Real v = get_param(base, name);
-  if ((name == "mu_s" || name == "emod_Pa") && v > 0) {
+  if ((name == "mu_s" || name == "emod_Pa" || name == "shear_modulus_Pa") && v > 0) {
     f.lo = v / 3;
     f.hi = 3 * v;
     f.log = true;

@@ -11,6 +11,7 @@
 #include <sstream>
 #include <string>
 
+#include "host/config/model_keys.hpp"
 #include "host/engine/checkpoint.hpp"
 #include "host/io/io_hdf5.hpp"
 #include "host/engine/packing.hpp"
@@ -169,7 +170,7 @@ Specimen build_specimen(const Config& cfg, bool verbose) {
                    {ball_law, wall_law, wall_law, wall_law}, 2, prm);
     sim.set_dt(time_step(cfg.solver, sim.critical_dt(), cfg.path));
     const Real f_limit = 0.01 * cfg.particles.diameter / 2 *
-                         NormalElastic::stiffness(wall_law, cfg.particles.diameter / 2, 0);
+                         ContactLaws::servo_stiffness(wall_law, cfg.particles.diameter / 2, 0);
     Progress progress("specimen layer " + std::to_string(k + 1) + "/" + std::to_string(sc.layers),
                       std::lround((z0 + h_loose - z1) * 1e6));
     ContactParams settle_law = ball_law;
@@ -224,6 +225,13 @@ std::string specimen_key(const Config& cfg) {
     << sv.gravity[0] << " " << sv.gravity[1] << " " << sv.gravity[2] << " dts " << sv.dt_safety << " dt " << sv.dt
     << " ms " << sv.mass_scale << " skin " << sv.skin;
   if (sc.layer_stop_ratio > 0) k << " lstop " << sc.layer_stop_ratio;  // absent: the keys of earlier specimens hold
+  for (const ContactParams* p : {&cfg.ball, &cfg.wall}) {  // another law: its name and own keys (model_keys)
+    if (p->law == kRRLinear) continue;
+    const std::string law = kContactLawNames[static_cast<int>(p->law)];
+    k << " law " << law;
+    for (const ModelKey& m : model_keys())
+      if (law == m.law) k << " " << m.key << " " << p->*m.field;
+  }
   return k.str();
 }
 

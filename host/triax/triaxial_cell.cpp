@@ -44,7 +44,7 @@ Cell make_cell(const Config& cfg, const Specimen& sp) {
   c.sim->set_membrane(c.membrane, mp);
   c.sim->set_cell_pressure(cfg.triaxial.sigma3);
   c.sim->set_dt(time_step(cfg.solver, c.sim->critical_dt(), cfg.path));
-  c.kn_wall = NormalElastic::stiffness(cfg.wall, cfg.particles.diameter / 2, 0);
+  c.kn_wall = ContactLaws::servo_stiffness(cfg.wall, cfg.particles.diameter / 2, 0);
   c.solid_volume = solid_volume(sp.balls);
   for (const BallSpec& b : sp.balls) c.mean_radius += b.radius / sp.balls.size();
   return c;

@@ -89,16 +89,16 @@ struct BallForce : MaxOverlap {
     kin.vrel = vj - vi - cross(a * wi + b * wj, kin.n) + dom.affine_velocity(d);
     kin.dtheta = dt * (wj - wi);
     kin.dt = dt;
-    kin.kn = RRLinear::stiffness(prm, ri, rj);
+    kin.kn = ContactLaws::stiffness(prm, ri, rj);
     ContactHistoryT<T> h;  // flags start clear: the law sets or clears every ContactFlag bit of a touching contact
     const bool full = lanes == W;
     h.fs = load_lanes<T>(c.fs, s0, cs, full);
     h.mr = load_lanes<T>(c.mr, s0, cs, full);
     // Only the slots the pack's parameters use are read or changed: the others stay as stored.
-    const unsigned slots = RRLinear::slots(prm);
+    const unsigned slots = ContactLaws::slots(prm);
     for (int q = 0; q < kHistorySlots; ++q)
       if (slots & (1u << q)) h.slot[q] = from_lanes<T>([&](int k) { return c.slot[q](cs[k]); });
-    const ContactOutputT<T> out = RRLinear::eval(prm, kin, h);
+    const ContactOutputT<T> out = ContactLaws::eval(prm, kin, h);
     const Vec3T<T> nxf = cross(kin.n, out.force);
     const Vec3T<T> mt = b * nxf - out.moment, mo = a * nxf + out.moment;
     const auto store_results = [&](auto at) {
@@ -211,7 +211,7 @@ struct WallForce : MaxOverlap {
     k.dtheta = -dt * wi;
     k.dt = dt;
     const ContactParams& prm = params(material(i), wmat);
-    k.kn = RRLinear::stiffness(prm, ri, 0);
+    k.kn = ContactLaws::stiffness(prm, ri, 0);
     const ContactOutput out = apply_law(c, s, prm, k);
     store(c.mt, s, cross(r1, out.force) + out.moment);
     const value_type mine{overlap / ri, s};

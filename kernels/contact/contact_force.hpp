@@ -9,7 +9,7 @@
 
 namespace dem {
 
-/// Ball-ball forces with law RRLinear, kContactLanes contacts per work item (simd.hpp): writes each contact's
+/// Ball-ball forces with each pair's law (ContactLaws), kContactLanes contacts per work item (simd.hpp): writes each contact's
 /// force and moments on both sides (fc, mo, mt) for the gather (accumulate.hpp), and the largest overlap ratio to
 /// `worst`, in device memory: the host does not wait.
 void compute_ball_forces(const Particles& p, ContactList& c, const ParamTableView& params, const Domain& dom, Real dt,
@@ -65,10 +65,10 @@ KOKKOS_INLINE_FUNCTION void store_law(const ContactList& c, At at, const Contact
 KOKKOS_FORCEINLINE_FUNCTION ContactOutput apply_law(const ContactList& c, int s, const ContactParams& prm,
                                                const ContactKinematics& k) {
   ContactHistory h{load(c.fs, s), load(c.mr, s), c.flags(s)};
-  const unsigned slots = RRLinear::slots(prm);
+  const unsigned slots = ContactLaws::slots(prm);
   for (int q = 0; q < kHistorySlots; ++q)
     if (slots & (1u << q)) h.slot[q] = c.slot[q](s);
-  const ContactOutput out = RRLinear::eval(prm, k, h);
+  const ContactOutput out = ContactLaws::eval(prm, k, h);
   store_law(c, LaneRow{s, 0}, h, out, slots);
   return out;
 }

@@ -12,6 +12,12 @@
 ///   kr = ks Rbar^2,      1/Rbar = 1/R1 + 1/R2 (Rbar = R1 at walls), M <- M - kr dtheta_bend, |M| <= mu_r Rbar Fn
 /// No tension, no twist resistance, no rolling dashpot.
 ///
+/// A law of its own, `hertz_mindlin` (PFC's hertz, YADE's Law2_ScGeom_MindlinPhys_Mindlin), swaps the normal part:
+///   E* = G / (1 - nu) (two balls of one material: E / (2 (1 - nu^2))), R* = R1 R2 / (R1 + R2) (R1 at a wall),
+///   Fn = 4/3 E* sqrt(R*) delta^(3/2), tangent kn = 2 E* a with a = sqrt(R* delta),
+///   ks = 8 G* a = kn 2 (1 - nu) / (2 - nu) (Mindlin's no-slip stiffness, G* = G / (2 (2 - nu))),
+/// and keeps the tangential, rolling and twisting parts (kr = ks Rbar^2 follows the load; YADE's krot is constant).
+///
 /// Model extensions (physics_reference.md section 4), each off by default and set per material pair; with
 /// all of them off the arithmetic is the rrlinear model's, bit for bit:
 ///   Hertz-Mindlin stiffness (hertz_overlap = delta_ref / r > 0): Fn = kn delta^(3/2) / delta_ref^(1/2), the
@@ -43,6 +49,9 @@
 ///     holds no friction. Between balls only (a wall's r2 = 0): the membrane and the platens are not sticky. Per
 ///     contact it is a stress over the ball's cross-section, so at confinement sigma3 it acts as about c / sigma3 of
 ///     extra confinement: an apparent cohesion, largest relative to low sigma3, from the first strain on.
+#include <tuple>
+#include <type_traits>
+
 #include "kernels/core/contact_params.hpp"
 #include "kernels/core/vec3.hpp"
 
@@ -59,11 +68,14 @@ using Arg = typename Same<T>::type;
 /// The parameters of W material pairs as lanes: pair(k) gives lane k's.
 template <class T, class Pair>
 KOKKOS_INLINE_FUNCTION ContactParamsT<T> params_of_lanes(const Pair& pair) {
-  static_assert(sizeof(ContactParams) == 11 * sizeof(Real), "a new ContactParams field must be copied here");
+  static_assert(sizeof(ContactParams) == 14 * sizeof(Real), "a new ContactParams field must be copied here");
   const auto field = [&](Real ContactParams::*m) { return from_lanes<T>([&](int k) { return pair(k).*m; }); };
   ContactParamsT<T> P;
+  P.law = field(&ContactParams::law);
   P.emod = field(&ContactParams::emod);
   P.kratio = field(&ContactParams::kratio);
+  P.shear_modulus = field(&ContactParams::shear_modulus);
+  P.poisson = field(&ContactParams::poisson);
   P.mu_s = field(&ContactParams::mu_s);
   P.mu_r = field(&ContactParams::mu_r);
   P.beta_n = field(&ContactParams::beta_n);
@@ -121,18 +133,31 @@ KOKKOS_INLINE_FUNCTION auto cap_to(Vec3T<T>& a, const T& cap) {
   return capped;
 }
 
-/// Normal force and its tangent stiffness dFn/doverlap (N, N/m); the shear and rolling springs scale with it.
+/// Normal force, its tangent stiffness dFn/doverlap and the shear stiffness that goes with it (N, N/m, N/m): the
+/// shear, rolling and twisting springs take ks.
 template <class T>
 struct NormalResponseT {
   T fn;
   T k;
+  T ks;
 };
 using NormalResponse = NormalResponseT<Real>;
+
+/// The largest tangent normal and shear stiffness of a contact (N/m), for the critical time step.
+struct MaxStiffness {
+  Real kn, ks;
+};
 
 /// The radius r of the deformability method: the smaller ball's, or the ball's at a wall.
 template <class T>
 KOKKOS_INLINE_FUNCTION T contact_radius(const T& r1, const Arg<T>& r2) {
   return select(r2 > T(0), kc::min(r1, r2), r1);
+}
+
+/// The effective radius R1 R2 / (R1 + R2), R1 at a wall: Rbar of the rolling spring and R* of Hertz's contact.
+template <class T>
+KOKKOS_INLINE_FUNCTION T effective_radius(const T& r1, const Arg<T>& r2) {
+  return select(r2 > T(0), r1 * r2 / (r1 + r2), r1);
 }
 
 /// Elastic normal spring: linear with the deformability method's kn, optionally Hertzian and rough.
@@ -143,18 +168,23 @@ struct NormalElastic {
     const T L = select(r2 > T(0), r1 + r2, r1);
     return Real(M_PI) * r * r * p.emod / L;
   }
+  /// A spring of the pair for a servo's gain (N/m): kn, linear up to the extensions.
+  KOKKOS_INLINE_FUNCTION static Real servo_stiffness(const ContactParams& p, Real r1, Real r2) {
+    return stiffness(p, r1, r2);
+  }
   /// Largest tangent stiffness up to an overlap of overlap_max (m), for the critical time step.
-  KOKKOS_INLINE_FUNCTION static Real max_stiffness(const ContactParams& p, Real r1, Real r2, Real overlap_max) {
-    const Real kn = stiffness(p, r1, r2);
-    if (p.hertz_overlap == Real(0)) return kn;  // roughness only softens
-    const Real dref = p.hertz_overlap * contact_radius(r1, r2);
-    return kc::max(kn, Real(1.5) * kn * kc::sqrt(overlap_max / dref));
+  KOKKOS_INLINE_FUNCTION static MaxStiffness max_stiffness(const ContactParams& p, Real r1, Real r2,
+                                                           Real overlap_max) {
+    Real kn = stiffness(p, r1, r2);
+    if (p.hertz_overlap != Real(0))  // roughness only softens
+      kn = kc::max(kn, Real(1.5) * kn * kc::sqrt(overlap_max / (p.hertz_overlap * contact_radius(r1, r2))));
+    return {kn, kn / p.kratio};
   }
   /// Elastic normal force (>= 0) and tangent stiffness of a touching contact (k.overlap > 0, k.kn set).
   template <class T>
   KOKKOS_INLINE_FUNCTION static NormalResponseT<T> response(const ContactParamsT<T>& p, const ContactKinematicsT<T>& k) {
     const auto rough = p.roughness > T(0), hertz = p.hertz_overlap > T(0);
-    if (!any(rough | hertz)) return {k.kn * k.overlap, k.kn};
+    if (!any(rough | hertz)) return {k.kn * k.overlap, k.kn, k.kn / p.kratio};
     const T r = contact_radius(k.r1, k.r2);
     T d = k.overlap, dd = 1;  // bulk overlap and d(bulk overlap)/d(overlap)
     if (any(rough)) {
@@ -164,9 +194,10 @@ struct NormalElastic {
     }
     if (any(hertz)) {
       const T root = kc::sqrt(d / (p.hertz_overlap * r));
-      return {select(hertz, k.kn * d * root, k.kn * d), select(hertz, Real(1.5) * k.kn * root * dd, k.kn * dd)};
+      const T kt = select(hertz, Real(1.5) * k.kn * root * dd, k.kn * dd);
+      return {select(hertz, k.kn * d * root, k.kn * d), kt, kt / p.kratio};
     }
-    return {k.kn * d, k.kn * dd};
+    return {k.kn * d, k.kn * dd, k.kn * dd / p.kratio};
   }
   /// The adhesive pull of a touching pair of balls (N, >= 0; 0 at walls), subtracted from the normal force.
   template <class T>
@@ -184,7 +215,35 @@ struct NormalElastic {
   }
 };
 
-/// Incremental shear spring (ks = kt / kappa*) with a Coulomb cap on the elastic normal force; the friction
+/// Hertz's normal spring with Mindlin's shear stiffness (the top of the file); the dashpot and adhesion as
+/// NormalElastic's. kn of the kinematics is 4/3 E* sqrt(R*) (N/m^1.5).
+struct NormalHertzMindlin : NormalElastic {
+  template <class T>
+  KOKKOS_INLINE_FUNCTION static T stiffness(const ContactParamsT<T>& p, const Arg<T>& r1, const Arg<T>& r2) {
+    return Real(4.0 / 3.0) * p.shear_modulus / (1 - p.poisson) * kc::sqrt(effective_radius(r1, r2));
+  }
+  template <class T>
+  KOKKOS_INLINE_FUNCTION static T shear_ratio(const ContactParamsT<T>& p) {
+    return 2 * (1 - p.poisson) / (2 - p.poisson);
+  }
+  /// For a servo's gain: the tangent stiffness at an overlap of 0.1% of r, about that of glass beads at 100 kPa.
+  KOKKOS_INLINE_FUNCTION static Real servo_stiffness(const ContactParams& p, Real r1, Real r2) {
+    return Real(1.5) * stiffness(p, r1, r2) * kc::sqrt(Real(1e-3) * contact_radius(r1, r2));
+  }
+  KOKKOS_INLINE_FUNCTION static MaxStiffness max_stiffness(const ContactParams& p, Real r1, Real r2,
+                                                           Real overlap_max) {
+    const Real kn = Real(1.5) * stiffness(p, r1, r2) * kc::sqrt(overlap_max);
+    return {kn, kn * shear_ratio(p)};
+  }
+  template <class T>
+  KOKKOS_INLINE_FUNCTION static NormalResponseT<T> response(const ContactParamsT<T>& p, const ContactKinematicsT<T>& k) {
+    const T root = kc::sqrt(k.overlap);
+    const T kt = Real(1.5) * k.kn * root;
+    return {k.kn * k.overlap * root, kt, kt * shear_ratio(p)};
+  }
+};
+
+/// Incremental shear spring (ks from the normal part) with a Coulomb cap on the elastic normal force; the friction
 /// coefficient weakens with the contact's sliding distance when wear > 0.
 struct TangentialCoulomb {
   template <class T>
@@ -200,7 +259,7 @@ struct TangentialCoulomb {
   template <class T>
   KOKKOS_INLINE_FUNCTION static Vec3T<T> update(const ContactParamsT<T>& p, const ContactKinematicsT<T>& k,
                                                 const NormalResponseT<T>& nr, ContactHistoryT<T>& h) {
-    const T ks = nr.k / p.kratio;
+    const T ks = nr.ks;
     Vec3T<T> fs = rotate_into_plane(h.fs, k.n) + ks * k.dt * tangential(k.vrel, k.n);
     const auto worn = p.wear != T(0);
     if (!any(worn)) {
@@ -219,18 +278,14 @@ struct TangentialCoulomb {
   }
 };
 
-/// Rolling resistance linear (Iwashita and Oda): bend rotation only, kr = ks Rbar^2 (ks from the tangent
-/// stiffness), cap mu_r Rbar Fn.
+/// Rolling resistance linear (Iwashita and Oda): bend rotation only, kr = ks Rbar^2 (ks from the normal part),
+/// cap mu_r Rbar Fn.
 struct RollingLinear {
-  template <class T>
-  KOKKOS_INLINE_FUNCTION static T rbar(const T& r1, const Arg<T>& r2) {
-    return select(r2 > T(0), r1 * r2 / (r1 + r2), r1);
-  }
   template <class T>
   KOKKOS_INLINE_FUNCTION static Vec3T<T> update(const ContactParamsT<T>& p, const ContactKinematicsT<T>& k,
                                                 const NormalResponseT<T>& nr, ContactHistoryT<T>& h) {
-    const T rb = rbar(k.r1, k.r2);
-    const T kr = nr.k / p.kratio * rb * rb;
+    const T rb = effective_radius(k.r1, k.r2);
+    const T kr = nr.ks * rb * rb;
     Vec3T<T> mr = rotate_into_plane(h.mr, k.n) + kr * tangential(k.dtheta, k.n);
     set_flag(h.flags, cap_to(mr, p.mu_r * rb * nr.fn), kRolling);
     h.mr = mr;
@@ -250,9 +305,9 @@ struct TwistingLinear {
                                             const NormalResponseT<T>& nr, ContactHistoryT<T>& h, Vec3T<T>& moment) {
     const auto on = p.twist != T(0);
     if (!any(on)) return;
-    const T rb = RollingLinear::rbar(k.r1, k.r2);
+    const T rb = effective_radius(k.r1, k.r2);
     const T cap = p.twist * rb * nr.fn;
-    const T trial = h.slot[kTwistSlot] + nr.k / p.kratio * rb * rb * dot(k.dtheta, k.n);
+    const T trial = h.slot[kTwistSlot] + nr.ks * rb * rb * dot(k.dtheta, k.n);
     const auto capped = trial * trial > cap * cap;
     const T mt = select(capped, select(trial > T(0), cap, -cap), trial);
     h.slot[kTwistSlot] = select(on, mt, h.slot[kTwistSlot]);
@@ -262,6 +317,7 @@ struct TwistingLinear {
 
 template <class Normal, class Tangential, class Rolling, class Twisting>
 struct ContactLaw {
+  using NormalPart = Normal;
   /// The history slots that parameters p use (bits 1 << HistorySlot): the kernels load and store only these.
   template <class T>
   KOKKOS_INLINE_FUNCTION static unsigned slots(const ContactParamsT<T>& p) {
@@ -293,5 +349,92 @@ struct ContactLaw {
 };
 
 using RRLinear = ContactLaw<NormalElastic, TangentialCoulomb, RollingLinear, TwistingLinear>;
+using HertzMindlin = ContactLaw<NormalHertzMindlin, TangentialCoulomb, RollingLinear, TwistingLinear>;
+
+/// One lane's choice of a or b where m holds, for every field of a contact's history or output.
+template <class M, class T>
+KOKKOS_INLINE_FUNCTION ContactHistoryT<T> select(const M& m, const ContactHistoryT<T>& a, const ContactHistoryT<T>& b) {
+  ContactHistoryT<T> out;
+  out.fs = select(m, a.fs, b.fs);
+  out.mr = select(m, a.mr, b.mr);
+  out.flags = select_flags(m, a.flags, b.flags);
+  for (int q = 0; q < kHistorySlots; ++q) out.slot[q] = select(m, a.slot[q], b.slot[q]);
+  return out;
+}
+template <class M, class T>
+KOKKOS_INLINE_FUNCTION ContactOutputT<T> select(const M& m, const ContactOutputT<T>& a, const ContactOutputT<T>& b) {
+  ContactOutputT<T> out;
+  out.force = select(m, a.force, b.force);
+  out.moment = select(m, a.moment, b.moment);
+  out.fn = select(m, a.fn, b.fn);
+  return out;
+}
+
+/// The laws a pair may choose, in ContactLawId's order: each kernel call goes to the law of the pair's `law` field.
+/// Lanes of one law (nearly always) run that law alone, with its bits; lanes of two laws run both on copies of the
+/// history and keep each lane's own. A new law is one `using` above, one entry here and one name in
+/// contact_params.hpp.
+template <class... Laws>
+struct LawTable {
+  /// The history slots any of the laws uses with parameters p.
+  template <class T>
+  KOKKOS_INLINE_FUNCTION static unsigned slots(const ContactParamsT<T>& p) {
+    return (Laws::slots(p) | ...);
+  }
+  template <class T>
+  KOKKOS_INLINE_FUNCTION static T stiffness(const ContactParamsT<T>& p, const Arg<T>& r1, const Arg<T>& r2) {
+    return each_law(p, [&](auto law) { return decltype(law)::stiffness(p, r1, r2); });
+  }
+  template <class T>
+  KOKKOS_FORCEINLINE_FUNCTION static ContactOutputT<T> eval(const ContactParamsT<T>& p, const ContactKinematicsT<T>& k,
+                                                           ContactHistoryT<T>& h) {
+    ContactHistoryT<T> out_h = h;
+    const ContactOutputT<T> out = each_law(p, [&](auto law) {
+      ContactHistoryT<T> mine = h;
+      const ContactOutputT<T> o = decltype(law)::eval(p, k, mine);
+      const auto own = p.law == T(index_of<decltype(law)>());
+      out_h = all(own) ? mine : select(own, mine, out_h);
+      return o;
+    });
+    h = out_h;
+    return out;
+  }
+  /// For one pair (scalar parameters): a servo's spring and the critical time step's largest stiffness.
+  KOKKOS_INLINE_FUNCTION static Real servo_stiffness(const ContactParams& p, Real r1, Real r2) {
+    return each_law(p, [&](auto law) { return decltype(law)::NormalPart::servo_stiffness(p, r1, r2); });
+  }
+  KOKKOS_INLINE_FUNCTION static MaxStiffness max_stiffness(const ContactParams& p, Real r1, Real r2, Real overlap) {
+    MaxStiffness m{};
+    each_law(p, [&](auto law) {
+      m = decltype(law)::NormalPart::max_stiffness(p, r1, r2, overlap);
+      return Real(0);
+    });
+    return m;
+  }
+
+ private:
+  template <class Law>
+  static constexpr int index_of() {
+    int k = 0, at = -1;
+    ((std::is_same<Law, Laws>::value ? at = k : 0, ++k), ...);
+    return at;
+  }
+  /// f(Law{}) for the laws the lanes of p use, each lane's result from its own law (f returns a Real, a pack or a
+  /// ContactOutput).
+  template <class P, class F>
+  KOKKOS_FORCEINLINE_FUNCTION static auto each_law(const P& p, const F& f) {
+    using R = decltype(f(first_law()));
+    R out{};
+    bool set = false;
+    ((any(p.law == decltype(p.law)(index_of<Laws>()))
+          ? (out = set ? select(p.law == decltype(p.law)(index_of<Laws>()), f(Laws{}), out) : f(Laws{}), set = true)
+          : false),
+     ...);
+    return out;
+  }
+  static auto first_law() { return std::tuple_element_t<0, std::tuple<Laws...>>{}; }
+};
+static_assert(kContactLaws == 2, "each ContactLawId needs its law in ContactLaws, in the enum's order");
+using ContactLaws = LawTable<RRLinear, HertzMindlin>;
 
 }  // namespace dem

@@ -5,11 +5,19 @@
 
 namespace dem {
 
+/// The contact laws a material pair may choose ([material] law), by the value of ContactParams::law; each is a
+/// composition of sub-models in contact_law.hpp (ContactLaws lists them in this order).
+enum ContactLawId : int { kRRLinear, kHertzMindlin, kContactLaws };
+inline constexpr const char* kContactLawNames[kContactLaws] = {"rrlinear", "hertz_mindlin"};
+
 /// Parameters of one material pair. Units: Pa, -, -, -, -, then as each field says. T is Real, or a pack of W pairs' values (simd.hpp).
 template <class T>
 struct ContactParamsT {
-  T emod = 1e8;     ///< effective modulus E* of the deformability method (Pa)
-  T kratio = 1.5;   ///< kappa* = kn / ks
+  T law = kRRLinear;  ///< the ContactLawId, as a Real: the pair table and its hashes hold Reals only (no padding)
+  T emod = 1e8;     ///< rrlinear: effective modulus E* of the deformability method (Pa)
+  T kratio = 1.5;   ///< rrlinear: kappa* = kn / ks
+  T shear_modulus = 0;  ///< hertz_mindlin: the balls' shear modulus G (Pa)
+  T poisson = 0;        ///< hertz_mindlin: the balls' Poisson ratio nu
   T mu_s = 0.5;     ///< sliding friction coefficient
   T mu_r = 0.0;     ///< rolling friction coefficient
   T beta_n = 0.0;   ///< normal viscous damping ratio (PFC dp_nratio); 0 = off, force never tensile

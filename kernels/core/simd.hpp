@@ -138,6 +138,8 @@ struct LaneFlags {
 KOKKOS_INLINE_FUNCTION void set_flag(std::uint8_t& f, bool on, std::uint8_t bit) {
   f = on ? std::uint8_t(f | bit) : std::uint8_t(f & ~bit);
 }
+/// The flags of a where m holds, of b elsewhere.
+KOKKOS_INLINE_FUNCTION std::uint8_t select_flags(bool m, std::uint8_t a, std::uint8_t b) { return m ? a : b; }
 #ifdef TRIAXDEM_HOST_PACKS
 /// The flag bytes of four contacts, widened to lanes so that setting a bit where a mask holds is one vector op.
 struct Flags4 {
@@ -153,6 +155,11 @@ inline void set_flag(Flags4& f, const Mask4& on, std::uint8_t bit) {
   f.bits = (f.bits & ~b) | (on.m & b);
 }
 inline void set_flag(Flags4& f, bool on, std::uint8_t bit) { set_flag(f, Mask4{Mask4::V{} - (on ? 1 : 0)}, bit); }
+inline Flags4 select_flags(const Mask4& m, const Flags4& a, const Flags4& b) {
+  Flags4 out;
+  out.bits = (a.bits & m.m) | (b.bits & ~m.m);
+  return out;
+}
 #endif
 
 /// Unrolls a loop over the lanes, so that each lane's index is a constant and its value stays in registers.
