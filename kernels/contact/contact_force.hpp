@@ -9,9 +9,9 @@
 
 namespace dem {
 
-/// Ball-ball forces with each pair's law (ContactLaws), kContactLanes contacts per work item (simd.hpp): writes each contact's
-/// force and moments on both sides (fc, mo, mt) for the gather (accumulate.hpp), and the largest overlap ratio to
-/// `worst`, in device memory: the host does not wait.
+/// Ball-ball forces with each pair's law (ContactLaws), kContactLanes contacts per work item (simd.hpp): writes each
+/// contact's force and moments on both sides (fc, mo, mt) for the gather (accumulate.hpp), and the largest overlap
+/// ratio to `worst`, in device memory: the host does not wait.
 void compute_ball_forces(const Particles& p, ContactList& c, const ParamTableView& params, const Domain& dom, Real dt,
                          const OverlapResultView& worst);
 /// The same for the one specimen of `one` (SpecimenTable: its cell by value or in device memory, its time step).
