@@ -309,6 +309,18 @@ void give_verdict(Diagnosis& dg, int n, int d) {
                       fmt("%.1f", rival->heldout) + " against " + fmt("%.1f", top->heldout) + "): its shape is specific.";
 }
 
+namespace {
+/// Whether extension e extends the base's law (the menu tries only those); says so where it does not.
+bool extends_law_of(const Extension& e, const Model& base, bool verbose) {
+  const std::string law = kContactLawNames[static_cast<int>(base.law.law)];
+  if (e.law.empty() || e.law == law) return true;
+  if (verbose)
+    std::printf("diagnose: %-9s extends law %s, not this material's %s: not tried\n", e.name.c_str(), e.law.c_str(),
+                law.c_str());
+  return false;
+}
+}  // namespace
+
 Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free0,
                    const std::vector<TriaxialTest>& measured, const Misfit& misfit, bool verbose) {
   Diagnosis dg;
@@ -355,13 +367,8 @@ Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreePa
   Evaluation base_runs = dg.base.best;  // the best run of the base model, also among the extension fits' runs
   const std::function<void()> report_runs = [&] { report(best_chi2); };
   const FitContext cx{lab, dg.base, base_model, base_at, measured, misfit, report_runs};
-  const std::string law = kContactLawNames[static_cast<int>(base.law.law)];
   for (const Extension& e : extensions()) {
-    if (!e.law.empty() && e.law != law) {
-      say("diagnose: %-9s extends law %s, not this material's %s: not tried\n", e.name.c_str(), e.law.c_str(),
-          law.c_str());
-      continue;
-    }
+    if (!extends_law_of(e, base, verbose)) continue;
     dg.fits.push_back(fit_extension(e, cx, base_runs));
     const ExtensionFit& f = dg.fits.back();
     say("diagnose: %-9s %s = %.3g: chi2 %.1f, BIC %.1f (base %.1f), held-out chi2 %.1f (base %.1f)\n",
