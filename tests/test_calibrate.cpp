@@ -1,4 +1,4 @@
-/// Calibration machinery (host/fit/calibrate.hpp, host/fit/diagnose.hpp, host/cli/calibration_jobs.hpp) without the
+/// Calibration machinery (host/fit/calibrate.hpp, host/fit/diagnose.hpp, host/study/calibration_jobs.hpp) without the
 /// simulator: the response surface, the box minimiser, the misfit, the parameter registry, the chi2 quantile,
 /// dated result folders and the synthetic-data writer.
 #include <gtest/gtest.h>
@@ -13,8 +13,8 @@
 #include <string>
 
 #include "host/fit/calibrate.hpp"
-#include "host/cli/calibration_jobs.hpp"
-#include "host/cli/calibration_session.hpp"
+#include "host/study/calibration_jobs.hpp"
+#include "host/study/calibration_session.hpp"
 #include "host/fit/diagnose.hpp"
 #include "host/data/measured.hpp"
 #include "host/fit/misfit.hpp"

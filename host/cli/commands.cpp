@@ -12,7 +12,7 @@
 #include <thread>
 
 #include "host/cli/commands.hpp"
-#include "host/cli/calibration_jobs.hpp"
+#include "host/study/calibration_jobs.hpp"
 #include "host/config/config.hpp"
 #include "host/config/model_keys.hpp"
 #include "host/cli/job.hpp"

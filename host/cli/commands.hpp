@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "host/cli/calibration_jobs.hpp"
+#include "host/study/calibration_jobs.hpp"
 #include "host/study/study.hpp"
 
 namespace CLI {

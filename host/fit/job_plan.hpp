@@ -1,7 +1,7 @@
 #pragma once
 /// What a calibration or a diagnosis will run, stage by stage, and about how long it takes on this machine, told
 /// before the first packing (calibrate and diagnose print it; --plan prints it and stops). Counts follow the stages
-/// as host/cli/calibration_jobs.cpp runs them; times are the particle-steps of host/lab/run_cost.hpp at the speed
+/// as host/study/calibration_jobs.cpp runs them; times are the particle-steps of host/lab/run_cost.hpp at the speed
 /// its probe measures here. Where a choice made on the way decides the size of a stage (an "auto" ensemble), the
 /// stage gives its range.
 #include <map>

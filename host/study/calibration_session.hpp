@@ -1,5 +1,5 @@
 #pragma once
-/// What `calibrate` and `diagnose` share (host/cli/calibration_jobs.cpp): the data, the free parameters, the
+/// What `calibrate` and `diagnose` share (host/study/calibration_jobs.cpp): the data, the free parameters, the
 /// reference test's simulator, the noise, the prediction that ends them, and a new result folder.
 #include <chrono>
 #include <filesystem>
@@ -9,7 +9,7 @@
 #include <system_error>
 #include <vector>
 
-#include "host/cli/calibration_jobs.hpp"
+#include "host/study/calibration_jobs.hpp"
 #include "host/fit/calibrate.hpp"
 #include "host/fit/job_plan.hpp"
 #include "host/fit/misfit.hpp"
@@ -68,7 +68,7 @@ struct JobInputs {
   JobPlan announce_plan(const Config& base, const CalibrationOptions& o, const std::string& kind) const;
 };
 
-/// What the job's data are taken to be (host/cli/data_scope.cpp). take_walled_size: between walls the specimen's size
+/// What the job's data are taken to be (host/study/data_scope.cpp). take_walled_size: between walls the specimen's size
 /// is part of the test, so tests without specimen_balls take the walled cell's balls (with a note), and a walled cell
 /// smaller than the data's specimen is said. hold_out: the tests at --hold-out's pressure out of `data`, returned;
 /// DataError where no test has it or a material the job calibrates would keep none. check_enough_data: DataError where

@@ -1,4 +1,4 @@
-/// `triaxdem synth` (host/cli/calibration_jobs.hpp): synthetic measured curves of the base config's model with a hidden
+/// `triaxdem synth` (host/study/calibration_jobs.hpp): synthetic measured curves of the base config's model with a hidden
 /// extension switched on, from specimens no calibration ensemble of that config uses.
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 #include <string>
 
 #include "host/fit/calibrate.hpp"
-#include "host/cli/calibration_jobs.hpp"
+#include "host/study/calibration_jobs.hpp"
 #include "host/config/model_keys.hpp"
 #include "host/fit/diagnose.hpp"
 #include "host/lab/run_cost.hpp"

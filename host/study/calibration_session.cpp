@@ -1,4 +1,4 @@
-#include "host/cli/calibration_session.hpp"
+#include "host/study/calibration_session.hpp"
 
 #include <unistd.h>
 

@@ -1,4 +1,4 @@
-#include "host/cli/calibration_jobs.hpp"
+#include "host/study/calibration_jobs.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -10,7 +10,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "host/cli/calibration_session.hpp"
+#include "host/study/calibration_session.hpp"
+#include "host/study/diagnosis_report.hpp"
 #include "host/data/curve_reading.hpp"
 #include "host/fit/calibrate.hpp"
 #include "host/fit/calibration_report.hpp"
@@ -74,94 +75,6 @@ void require_a_result(const CalibrationResult& r, const std::string& what, const
     throw std::runtime_error(what + ": " + std::to_string(ss.lab.failed_runs()) + " of " +
                              std::to_string(ss.lab.runs()) + " runs stopped at a blow-up, more than half: no result "
                              "is given on the few that ended (" + ss.failed_text() + ")");
-}
-
-/// The extension a diagnosis reports against the base: the one its verdict names first, else the best by BIC
-/// (a candidate, to show what it would change).
-const ExtensionFit* top_fit(const Diagnosis& dg) {
-  const ExtensionFit* top = nullptr;
-  for (const ExtensionFit& f : dg.fits)
-    if (dg.verdict.rfind(f.ext.name, 0) == 0) return &f;
-  for (const ExtensionFit& f : dg.fits)
-    if (!top || f.bic < top->bic) top = &f;
-  return top;
-}
-
-/// The diagnosis report's opening: the simulator, the free parameters, the misfit and noise, the reference values
-/// and the notes on the data.
-std::string diagnosis_intro(const Session& ss, const Config& base, const CalibrationOptions& o) {
-  std::ostringstream md;
-  md << "# Diagnosis of " << o.data << "\n\n"
-     << "Simulator: the cell triaxial test in " << ss.cell_text() << ", an ensemble of " << ss.lab.members()
-     << " specimens of " << ss.lab.balls() << " balls (packing seeds from " << base.run.seed
-     << "), each prepared once; every parameter point runs them all and compares their mean. Free base parameters:";
-  for (const FreeParam& f : ss.free) md << " " << f.name;
-  md << ". Misfit: chi2 over " << (ss.data.curves ? "q and eps_v at fixed axial strains (0.02% to 15%)"
-                                                  : "the summary quantities given")
-     << ", with the data's noise, the measured specimen's own scatter and the simulator's standard error "
-        "(host/fit/misfit.hpp); noise: " << (ss.noise.mode == "lab" ? ss.noise.lab_name : "the data's") << ".\n\n";
-  if (!ss.ref.values.empty())
-    md << "Reference values: " << ss.ref.path << (ss.ref.comment.empty() ? "" : ": " + ss.ref.comment)
-       << " The calibrated values belong to this simulator (its cell, density and boundary), the reference values to "
-          "the model they were calibrated with: a difference between them measures the two simulators as much as "
-          "the data.\n\n";
-  for (const std::string& n : ss.data.notes) md << "Note on the data: " << n << "\n\n";
-  return md.str();
-}
-
-/// The table of the base model and each extension fit (parameters, chi2, BIC, held-out chi2, runs), into the report
-/// and as rows of models.csv.
-void write_models(const Session& ss, const std::string& material, const Diagnosis& dg, std::size_t tests,
-                  std::ostream& md, std::ostream& csv) {
-  md << "| model | parameters | chi2 | BIC | held-out chi2 | runs |\n|---|---|---|---|---|---|\n| base | ";
-  for (std::size_t k = 0; k < ss.free.size(); ++k) {
-    md << ss.free[k].name << " = " << fmt("%.4g", ss.free[k].shown * dg.base.values[k]) << " ";
-    csv << material << ",base," << ss.free[k].name << "," << fmt("%.6g", ss.free[k].shown * dg.base.values[k]) << ","
-        << fmt("%.3f", dg.base.best.chi2) << "," << fmt("%.3f", dg.base_bic) << "," << fmt("%.3f", dg.base_heldout)
-        << "," << dg.base.design.size() * tests << "\n";
-  }
-  md << "| " << fmt("%.1f", dg.base.best.chi2) << " | " << fmt("%.1f", dg.base_bic) << " | "
-     << fmt("%.1f", dg.base_heldout) << " | " << dg.base.design.size() * tests * ss.lab.members() << " |\n";
-  for (const ExtensionFit& f : dg.fits) {
-    md << "| " << f.ext.name << " | ";
-    for (std::size_t k = 0; k < ss.free.size(); ++k)
-      md << ss.free[k].name << " = " << fmt("%.4g", ss.free[k].shown * f.values[k]) << " ";
-    const Real shown = free_param(f.ext.param).shown;
-    md << f.ext.param << " = " << fmt("%.3g", shown * f.strength) << " | " << fmt("%.1f", f.best.chi2) << " | "
-       << fmt("%.1f", f.bic) << " | " << fmt("%.1f", f.heldout) << " | " << f.runs << " |\n";
-    csv << material << "," << f.ext.name << "," << f.ext.param << "," << fmt("%.6g", shown * f.strength) << ","
-        << fmt("%.3f", f.best.chi2) << "," << fmt("%.3f", f.bic) << "," << fmt("%.3f", f.heldout) << "," << f.runs
-        << "\n";
-  }
-  // The generic discrepancies, each extension's rival: fitted over the base's runs, no runs of their own.
-  for (const GenericFit& g : dg.generic) {
-    md << "| generic: " << g.shape.name << " | ";
-    for (std::size_t k = 0; k < ss.free.size(); ++k)
-      md << ss.free[k].name << " = " << fmt("%.4g", ss.free[k].shown * g.values[k]) << " ";
-    md << "c = " << fmt("%.3g", g.c) << " in " << g.shape.formula << " | " << fmt("%.1f", g.chi2) << " | "
-       << fmt("%.1f", g.bic) << " | " << fmt("%.1f", g.heldout) << " | 0 |\n";
-    csv << material << ",generic: " << g.shape.name << ",c," << fmt("%.6g", g.c) << "," << fmt("%.3f", g.chi2) << ","
-        << fmt("%.3f", g.bic) << "," << fmt("%.3f", g.heldout) << ",0\n";
-  }
-}
-
-/// The calibrated values beside the reference values, for the base model and the extension the verdict names.
-std::string reference_table(const Session& ss, const std::string& material, const Diagnosis& dg) {
-  if (ss.ref.values.empty()) return "";
-  std::ostringstream md;
-  const ExtensionFit* named = nullptr;  // the extension the verdict names first, if any
-  for (const ExtensionFit& f : dg.fits)
-    if (dg.verdict.rfind(f.ext.name, 0) == 0) named = &f;
-  md << "\nCalibrated values beside the reference (" << ss.ref.path << "):\n\n| parameter | base model | "
-     << (named ? "base + " + named->ext.name + " | " : "") << "reference |\n|---|---|" << (named ? "---|" : "")
-     << "---|\n";
-  for (std::size_t k = 0; k < ss.free.size(); ++k) {
-    const Real ref = ss.reference(material, ss.free[k].name);
-    md << "| " << ss.free[k].name << " | " << fmt("%.4g", ss.free[k].shown * dg.base.values[k]) << " | "
-       << (named ? fmt("%.4g", ss.free[k].shown * named->values[k]) + " | " : "")
-       << (std::isfinite(ref) ? fmt("%g", ref) : std::string("-")) << " |\n";
-  }
-  return md.str();
 }
 
 /// Two fidelities from the periodic optimum `r`: the membrane test's discrepancy at each optimum and the cell
@@ -276,9 +189,7 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
   if (ss.two_fidelity)
     std::printf("diagnose: note: the diagnosis fits the periodic cell; two fidelities apply to calibrate (the "
                 "membrane prediction at the end shows what the boundary adds)\n");
-  std::ostringstream md, csv;
-  md << diagnosis_intro(ss, base, o);
-  csv << "material,model,parameter,value,chi2,bic,heldout_chi2,runs\n";
+  DiagnosisReport report(ss, base, o);
   std::vector<TriaxialTest> all_meas, all_sim, all_ext;
   std::map<std::string, Calibrated> models;
   for (const auto& [material, tests] : by_material(ss.data, o.material)) {
@@ -289,58 +200,32 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
     require_a_result(dg.base, "diagnose " + material + " (the base model's search)", ss);
     std::printf("diagnose: %s: verdict: %s\n  %s\n", material.c_str(), dg.verdict.c_str(), dg.explanation.c_str());
     std::printf("%s", uncertainty_text(dg.base, material, "diagnose").c_str());
-    std::string edge, widened;
-    for (const std::string& note : dg.base.widened) {
-      std::printf("diagnose: %s: %s\n", material.c_str(), note.c_str());
-      widened += (widened.empty() ? "" : "; ") + note;
-    }
+    for (const std::string& note : dg.base.widened) std::printf("diagnose: %s: %s\n", material.c_str(), note.c_str());
+    std::string edge;
     for (const std::string& name : dg.base.at_edge()) edge += (edge.empty() ? "" : ", ") + name;
     if (!edge.empty())
       std::printf("diagnose: %s: WARNING: %s at the edge of the search range\n", material.c_str(), edge.c_str());
-    md << "## " << material << "\n\n"
-       << (misfit.cell_bias_finding().empty() ? "" : "**Finding: the cell's bias.** " + misfit.cell_bias_finding() + "\n\n")
-       << "**Verdict: " << dg.verdict << ".** " << dg.explanation << "\n\n"
-       << noise_table(misfit, tests)
-       << (widened.empty() ? "" : "Search ranges: " + widened + ".\n\n")
-       << (edge.empty() ? "" : "**Warning:** the base model's " + edge + " lies at the edge of its search range: the "
-                               "optimum may lie outside, and part of the misfit may be the range's, not the model's.\n\n");
-    write_models(ss, material, dg, tests.size(), md, csv);
-    md << reference_table(ss, material, dg);
-    md << "\nEach extension against the base model, and, where it passes, against the generic discrepancy of lowest BIC "
-          "(a shape with no physics and one parameter, fitted over the base's runs: an extension is named only where "
-          "it beats that rival by the same margins, docs/calibration.md, Diagnosis):\n\n";
-    for (const ExtensionFit& f : dg.fits) md << "- **" << f.ext.name << "**: " << f.reason << "\n";
-    for (const std::string& n : dg.notes) md << "- " << n << "\n";
-    md << "\nThe base model's calibrated values:\n\n```\n" << uncertainty_text(dg.base, material, "diagnose")
-       << "```\n";
-    md << "\n" << ss.state_text(misfit, tests);
-    const ExtensionFit* top = top_fit(dg);
-    if (top) {
-      md << gain_tables(misfit, tests, dg.base.best, top->best,
-                        top->ext.name + (dg.verdict == "none" ? " (candidate, not named)" : ""));
+    if (const ExtensionFit* top = report.add_material(material, tests, misfit, dg)) {
       all_ext.insert(all_ext.end(), top->best.sim.begin(), top->best.sim.end());
       std::printf("diagnose: %s: gain of %s: chi2 %.1f -> %.1f, held-out chi2 %.1f -> %.1f (diagnosis.md has it by "
                   "pressure, strain range and quantity)\n", material.c_str(), top->ext.name.c_str(),
                   dg.base.best.chi2, top->best.chi2, dg.base_heldout, top->heldout);
     }
-    md << "\n";
     all_meas.insert(all_meas.end(), tests.begin(), tests.end());
     all_sim.insert(all_sim.end(), dg.base.best.sim.begin(), dg.base.best.sim.end());
     models[material] = Calibrated{tests, dg.base.model, dg.base.best.sim, {}};
   }
-  if (ss.lab.failed_runs() > 0) md << "**Warning:** " << ss.failed_text() << ".\n\n";
-  md << "![measured and simulated: the base model in full lines, the extended one dashed](calibration.png)\n";
+  report.close();
   if (all_ext.size() == all_meas.size())
     write_measured_curves(ss.folder + "/extended_curves.csv", all_ext, "simulated by the extended model of each material");
-  io::write_text_atomic(ss.folder + "/diagnosis.md", md.str());
-  io::write_text_atomic(ss.folder + "/models.csv", csv.str());
+  report.write();
   std::printf("diagnose: %s in %s; report in %s/diagnosis.md\n", ss.runs_text().c_str(),
               format_duration(ss.lab.seconds()).c_str(), ss.folder.c_str());
   if (const std::string w = ss.workers_text(); !w.empty()) std::printf("diagnose: %s\n", w.c_str());
   ss.finish(all_meas, all_sim, "the calibrated base model");
   // The report stands before the membrane tests run; their section is added when they end.
   const std::string prediction = ss.predict_boundary(base, models);
-  if (!prediction.empty()) io::write_text_atomic(ss.folder + "/diagnosis.md", md.str() + "\n" + prediction);
+  if (!prediction.empty()) report.write(prediction);
   ss.write_pools();
   std::printf("diagnose: %s\n", ss.plan_text().c_str());
   return 0;
