@@ -12,6 +12,7 @@
 #include <random>
 
 #include "host/engine/micro.hpp"
+#include "host/engine/stress.hpp"
 #include "host/triax/micro_report.hpp"
 #include "test_util.hpp"
 

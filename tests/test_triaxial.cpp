@@ -12,6 +12,7 @@
 #include <string>
 
 #include "host/cli/job.hpp"
+#include "host/engine/stress.hpp"
 #include "host/triax/micro_report.hpp"
 #include "host/triax/triaxial.hpp"
 #include "host/triax/triaxial_measure.hpp"

@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "host/engine/stress.hpp"
 #include "host/io/io_hdf5.hpp"
 
 namespace dem {
@@ -119,8 +120,7 @@ Networks networks(const ContactSet& s, Real volume) {
       ++n.contacts;
       n.mean_fn += c.fn;
       n.mean_ft += norm(c.ft);
-      const Tensor t = outer(c.branch, c.fn * c.normal + c.ft);
-      for (int q = 0; q < 9; ++q) n.stress[q] += t[q] / volume;
+      add_love_weber(n.stress, c, volume);
     }
     for (std::size_t q = 0; q < touched.size(); ++q) n.particles += touched[q] && ball_inside(s, static_cast<int>(q));
     if (n.contacts > 0) {
@@ -216,35 +216,6 @@ std::vector<RoseBin> rose(const ContactSet& s, int bins, Network net) {
     r[k].count /= 2;
   }
   return r;
-}
-
-Tensor love_weber(const ContactSet& s, Real volume, bool include_boundary) {
-  Tensor t{};
-  for (const ContactRecord& c : s.contacts) {
-    if ((c.boundary != Boundary::kNone && !include_boundary) || !c.in_volume) continue;
-    const Tensor o = outer(c.branch, c.fn * c.normal + c.ft);
-    for (int q = 0; q < 9; ++q) t[q] += o[q] / volume;
-  }
-  return t;
-}
-
-Tensor boundary_stress(const ContactSet& s, Real volume) {
-  Tensor t{};
-  for (const ContactRecord& c : s.contacts) {
-    if (c.boundary == Boundary::kNone || !c.in_volume) continue;
-    const Tensor o = outer(c.point, c.fn * c.normal + c.ft);
-    for (int q = 0; q < 9; ++q) t[q] += o[q] / volume;
-  }
-  return t;
-}
-
-Real axial_deviator(const Tensor& t) { return t[8] - (t[0] + t[4]) / 2; }
-
-Real mean_stress(const Tensor& t) { return (t[0] + t[4] + t[8]) / 3; }
-
-Real stress_ratio(const Tensor& s) {
-  const Real p = mean_stress(s);
-  return p > 0 ? axial_deviator(s) / p : 0;
 }
 
 Real sff_stress_ratio(const Anisotropy& a) {

@@ -95,23 +95,6 @@ struct RoseBin {
 };
 std::vector<RoseBin> rose(const ContactSet& s, int bins, Network net = Network::kAll);
 
-/// Love-Weber stress (1/V) sum branch (x) f over the contacts given (Pa, compression positive).
-/// With boundary contacts included it is the specimen's mean stress.
-Tensor love_weber(const ContactSet& s, Real volume, bool include_boundary);
-
-/// Boundary stress (1/V) sum x_c (x) f over the boundary contacts (platens, membrane): each contact point times
-/// the force the ball exerts on the boundary, about the origin (Pa, compression positive): the stress a lab
-/// would read off its boundaries with the enclosed volume V. By the average-stress theorem (Newton's law for
-/// each ball, summed; shared/notes/triaxial_measures.md section 3) love_weber(s, V, true) exceeds it by exactly
-/// (1/V) sum_p x_p (x) F_p, F_p each ball's net contact force: the two agree as far as the balls are at rest.
-Tensor boundary_stress(const ContactSet& s, Real volume);
-
-/// Axial deviator t_zz - (t_xx + t_yy)/2 of a tensor, z the specimen's axis: q of a stress.
-Real axial_deviator(const Tensor& t);
-/// Mean of the diagonal, tr / 3: p of a stress.
-Real mean_stress(const Tensor& t);
-/// Triaxial stress ratio q/p of a stress tensor (p = tr/3); zero when p <= 0.
-Real stress_ratio(const Tensor& s);
 /// q/p of the stress-force-fabric relation, sigma / p = I + (2/5)(a^c + a^n + 3/2 a^t), taken with the
 /// tensors: for tensors coaxial with the stress it is (2/5)(a_c + a_n + 3/2 a_t), and where they are not
 /// (an isotropic state, whose anisotropies point anywhere) the scalars' signs mean nothing.

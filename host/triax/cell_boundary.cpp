@@ -1,5 +1,6 @@
 #include "host/triax/cell_boundary.hpp"
 
+#include "host/engine/stress.hpp"
 #include "kernels/core/reduce.hpp"
 #include "host/engine/packing.hpp"
 #include "host/triax/periodic_triaxial.hpp"
@@ -58,15 +59,7 @@ Real cell_volume(const Simulation& sim) {
 
 std::array<Real, 3> cell_stress(Simulation& sim) {
   if (!walled(sim)) return sim.contact_stress_diagonal(sim.domain().volume());
-  const std::vector<Vec3> f = sim.wall_forces();  // by the balls on each wall
-  const std::array<Real, 3> l = cell_lengths(sim);
-  std::array<Real, 3> s{};
-  for (int d = 0; d < 3; ++d) {
-    // The balls push the lower wall towards -d and the upper one towards +d.
-    const Real push = 0.5 * (f[2 * d + 1][d] - f[2 * d][d]);
-    s[d] = push / (l[(d + 1) % 3] * l[(d + 2) % 3]);
-  }
-  return s;
+  return walled_cell_stress(sim.wall_forces(), cell_lengths(sim));
 }
 
 std::array<Real, 3> boundary_stiffness(Simulation& sim) {

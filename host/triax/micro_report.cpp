@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <type_traits>
 
+#include "host/engine/stress.hpp"
 #include "host/io/io_hdf5.hpp"
 
 namespace dem {

@@ -12,6 +12,7 @@
 #include "host/engine/membrane_mesh.hpp"
 #include "host/engine/setup.hpp"
 #include "host/engine/stage_loop.hpp"
+#include "host/engine/stress.hpp"
 #include "host/data/measured.hpp"
 #include "host/triax/micro_report.hpp"
 #include "host/util/progress.hpp"
@@ -44,25 +45,23 @@ std::vector<double> series_row(const TriaxialRecord& r, Real sigma3, Real e0) {
           (sigma3 + r.q / 3) / 1e3, (1 + e0) * (1 - r.eps_v) - 1, friction_angle_deg(r.q, sigma3)};
 }
 
-/// The record's deviators as labs report them and the specimen's mean stress over the enclosed `volume`, from
-/// the platen force (r.sigma1, r.sigma3_balls and the strains set) and the contacts. `a0`: the cross-section
-/// after consolidation, V0 / h0.
-void measure_stresses(const Cell& c, const TriaxialConfig& tc, const ContactSet& cs, Real volume, Real a0,
-                      TriaxialRecord& r) {
+/// The record's deviators as labs report them and the specimen's stresses over the enclosed `volume` (its contacts'
+/// on the device, specimen_stress), from the platen force (r.sigma1, r.sigma3_balls and the strains set). `a0`: the
+/// cross-section after consolidation, V0 / h0.
+void measure_stresses(const Cell& c, const TriaxialConfig& tc, Real volume, Real a0, TriaxialRecord& r) {
   const Real force = r.sigma1 * c.area;
   r.q_area = force / right_cylinder_area(a0, r.eps_a, r.eps_v) - tc.sigma3;
   r.q_parabolic = force / parabolic_mid_area(a0, r.eps_a, r.eps_v) - tc.sigma3;
   r.q_membrane = r.q_area + tc.sigma3 - r.sigma3_balls;
   r.sigma3_hoop = tc.sigma3 + membrane_hoop_stress(tc.membrane_modulus, tc.membrane_thickness,
                                                    std::sqrt(4 * a0 / M_PI), r.eps_a, r.eps_v);
-  const Tensor lw = love_weber(cs, volume, true), b = boundary_stress(cs, volume);
-  const Tensor net = net_force_stress(*c.sim, volume);
-  r.q_lw = axial_deviator(lw);
-  r.p_lw = mean_stress(lw);
-  r.q_boundary = axial_deviator(b);
-  r.p_boundary = mean_stress(b);
-  r.q_net = axial_deviator(net);
-  r.p_net = mean_stress(net);
+  const SpecimenStress s = specimen_stress(*c.sim, volume);
+  r.q_lw = axial_deviator(s.love_weber);
+  r.p_lw = mean_stress(s.love_weber);
+  r.q_boundary = axial_deviator(s.boundary);
+  r.p_boundary = mean_stress(s.boundary);
+  r.q_net = axial_deviator(s.net_force);
+  r.p_net = mean_stress(s.net_force);
 }
 
 /// Isotropic consolidation from the state in `st` (a resumed run's, or step 0): cell pressure on the membrane, stress
@@ -201,7 +200,7 @@ void take_record(const ShearRecorder& sh, Real eps_a, long k, LazyContacts& cont
       (sh.v0_envelope - envelope_volume(sim, top_z, cell.mean_radius, tc.membrane_segments)) / sh.v0_envelope;
   r.unbalanced = sim.unbalanced_ratio();
   r.kinetic = sim.stats().kinetic;
-  measure_stresses(cell, tc, contacts.get(), volume, sh.v0 / sh.h0, r);
+  measure_stresses(cell, tc, volume, sh.v0 / sh.h0, r);
   sh.res.records.push_back(r);
   std::vector<double> row = series_row(r, tc.sigma3, sh.st.void_ratio);
   const int next_snap = sh.st.next_snap;

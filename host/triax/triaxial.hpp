@@ -34,7 +34,7 @@ struct TriaxialRecord {
   Real sigma3_hoop = 0; ///< Pa, cell pressure + a lab's thin-shell estimate of the membrane's hoop stress
   // The specimen's mean stress, over the enclosed volume V.
   Real q_lw = 0, p_lw = 0;              ///< Pa, Love-Weber stress of every contact (platens, membrane included)
-  Real q_boundary = 0, p_boundary = 0;  ///< Pa, from the boundary contacts alone (micro.hpp: boundary_stress)
+  Real q_boundary = 0, p_boundary = 0;  ///< Pa, from the boundary contacts alone (stress.hpp: specimen_stress)
   /// Pa, (1/V) sum_p x_p (x) F_p of the balls' net contact forces F_p (what inertia, damping and weight leave
   /// unbalanced), by which the average-stress theorem has the Love-Weber stress exceed the boundary's.
   Real q_net = 0, p_net = 0;

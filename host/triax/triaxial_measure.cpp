@@ -72,22 +72,6 @@ Real membrane_hoop_stress(Real young, Real thickness, Real d0, Real eps_a, Real 
   return hoop > 0 ? 2 * young * thickness * hoop / d0 : 0;
 }
 
-Tensor net_force_stress(Simulation& sim, Real volume) {
-  const Particles& p = sim.particles_with_forces();
-  auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), p.x);
-  auto f = Kokkos::create_mirror_view_and_copy(HostSpace(), p.f);
-  auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), p.gid);
-  // In gid order, not the particles' (each rebuild's): the sum's rounding does not depend on when that was. The gids
-  // are 0 to n - 1 (to_host_by_gid).
-  std::vector<int> by_gid(static_cast<std::size_t>(p.n));
-  for (int i = 0; i < p.n; ++i) by_gid[gid(i)] = i;
-  Tensor t{};
-  for (const int i : by_gid)
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) t[3 * a + b] += x(i, a) * f(i, b) / volume;
-  return t;
-}
-
 io::SurfaceSnapshot membrane_surface(const Membrane& m) {
   auto nx = Kokkos::create_mirror_view_and_copy(HostSpace(), m.mesh.node_x);
   auto tri = Kokkos::create_mirror_view_and_copy(HostSpace(), m.mesh.tri);
@@ -97,22 +81,6 @@ io::SurfaceSnapshot membrane_surface(const Membrane& m) {
   for (int t = 0; t < m.mesh.ntri; ++t)
     for (int d = 0; d < 3; ++d) s.triangles.push_back(tri(t, d));
   return s;
-}
-
-Real lateral_stress(Simulation& sim, const Membrane& m, const std::vector<Vec3>& f) {
-  auto nx = Kokkos::create_mirror_view_and_copy(HostSpace(), m.mesh.node_x);
-  auto tri = Kokkos::create_mirror_view_and_copy(HostSpace(), m.mesh.tri);
-  auto fixed = Kokkos::create_mirror_view_and_copy(HostSpace(), m.fixed);
-  const int w0 = sim.num_walls();
-  Real fn = 0, area = 0;
-  for (int t = 0; t < m.mesh.ntri; ++t) {
-    if (fixed(tri(t, 0)) || fixed(tri(t, 1)) || fixed(tri(t, 2))) continue;
-    const Vec3 a = load(nx, tri(t, 0)), b = load(nx, tri(t, 1)), d = load(nx, tri(t, 2));
-    const Vec3 s = 0.5 * cross(b - a, d - a);  // area vector, outward (counter-clockwise seen from outside)
-    fn += dot(f[w0 + t], s) / norm(s);
-    area += norm(s);
-  }
-  return area > 0 ? fn / area : 0;
 }
 
 Real envelope_volume(Simulation& sim, Real top, Real mean_radius, int slabs) {

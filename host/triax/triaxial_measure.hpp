@@ -1,8 +1,7 @@
 #pragma once
-/// What the triaxial test measures beyond the platen forces: the deviator as labs compute it from the platen
-/// force (area and membrane corrections), the lateral stress the balls receive through the membrane, the
-/// volume of the balls' own envelope, balls that left the membrane, and the membrane as a surface for the
-/// snapshots.
+/// What the triaxial test measures beyond the stresses (host/engine/stress.hpp): the cross-sections and the membrane's
+/// hoop stress with which labs correct the deviator from the platen force, the volume of the balls' own envelope,
+/// balls that left the membrane, and the membrane as a surface for the snapshots.
 #include <vector>
 
 #include "host/io/io_hdf5.hpp"
@@ -30,21 +29,8 @@ Real parabolic_mid_area(Real a0, Real eps_a, Real eps_v);
 /// cylinder and D0 its diameter after consolidation. Zero where the membrane would be compressed: it wrinkles.
 Real membrane_hoop_stress(Real young, Real thickness, Real d0, Real eps_a, Real eps_v);
 
-/// (1/V) sum_p x_p (x) F_p over the balls (Pa, compression positive, about the origin), F_p each ball's net
-/// contact force as the integrator gathered it in the last step: the term by which the Love-Weber stress of
-/// every contact exceeds the boundary stress (micro.hpp: boundary_stress). Zero for balls at rest.
-Tensor net_force_stress(Simulation& sim, Real volume);
-
 /// The membrane as a triangle surface for the snapshots (ParaView shows it with the balls).
 io::SurfaceSnapshot membrane_surface(const Membrane& m);
-
-/// Lateral stress the balls exert on the membrane (Pa): the outward normal component of the ball-facet forces
-/// over the area of the facets clear of the end rings. It differs from the cell pressure by what the
-/// membrane itself carries (hoop and axial tension of a deforming membrane, inertia). The end bands are left
-/// out: the balls cannot fill the corner between platen and membrane, so there the tied rings and the
-/// platen edge carry part of the pressure, as a lab's platens do.
-/// `wall_forces`: Simulation::wall_forces() of this step.
-Real lateral_stress(Simulation& sim, const Membrane& m, const std::vector<Vec3>& wall_forces);
 
 /// Volume of the balls' envelope (m^3), measured without the membrane: the specimen between the bottom
 /// platen (z = 0) and `top` cut into `slabs` slabs, each slab's cross-section the convex hull of its balls

@@ -49,79 +49,9 @@
 ///     holds no friction. Between balls only (a wall's r2 = 0): the membrane and the platens are not sticky. Per
 ///     contact it is a stress over the ball's cross-section, so at confinement sigma3 it acts as about c / sigma3 of
 ///     extra confinement: an apparent cohesion, largest relative to low sigma3, from the first strain on.
-#include <tuple>
-#include <type_traits>
-
-#include "kernels/core/contact_params.hpp"
-#include "kernels/core/vec3.hpp"
+#include "kernels/contact/law_table.hpp"
 
 namespace dem {
-
-/// Makes a parameter non-deduced, so that a Real or an int argument converts to the law's T.
-template <class T>
-struct Same {
-  using type = T;
-};
-template <class T>
-using Arg = typename Same<T>::type;
-
-/// The parameters of W material pairs as lanes: pair(k) gives lane k's.
-template <class T, class Pair>
-KOKKOS_INLINE_FUNCTION ContactParamsT<T> params_of_lanes(const Pair& pair) {
-  static_assert(sizeof(ContactParams) == 14 * sizeof(Real), "a new ContactParams field must be copied here");
-  const auto field = [&](Real ContactParams::*m) { return from_lanes<T>([&](int k) { return pair(k).*m; }); };
-  ContactParamsT<T> P;
-  P.law = field(&ContactParams::law);
-  P.emod = field(&ContactParams::emod);
-  P.kratio = field(&ContactParams::kratio);
-  P.shear_modulus = field(&ContactParams::shear_modulus);
-  P.poisson = field(&ContactParams::poisson);
-  P.mu_s = field(&ContactParams::mu_s);
-  P.mu_r = field(&ContactParams::mu_r);
-  P.beta_n = field(&ContactParams::beta_n);
-  P.hertz_overlap = field(&ContactParams::hertz_overlap);
-  P.roughness = field(&ContactParams::roughness);
-  P.wear = field(&ContactParams::wear);
-  P.wear_slip = field(&ContactParams::wear_slip);
-  P.twist = field(&ContactParams::twist);
-  P.adhesion = field(&ContactParams::adhesion);
-  return P;
-}
-
-/// Geometry and kinematics of one contact, seen from particle 1 ("i"); body 2 is a particle or a wall.
-/// n points from 1 to 2; vrel is the velocity of 2 relative to 1 at the contact point; dtheta the
-/// relative rotation increment (w2 - w1) dt. R2 = 0 marks a wall.
-template <class T>
-struct ContactKinematicsT {
-  Vec3T<T> n;
-  T overlap;   ///< m, > 0 when touching
-  T kn;        ///< N/m, normal stiffness of this pair (Normal::stiffness, computed once per contact)
-  T r1, r2;    ///< m
-  T m1, m2;    ///< kg, masses (m2 = 0 at walls), for the dashpot's reduced mass
-  Vec3T<T> vrel;      ///< m/s
-  Vec3T<T> dtheta;    ///< rad
-  Real dt;            ///< s
-};
-using ContactKinematics = ContactKinematicsT<Real>;
-
-/// History carried by a contact between steps (contact-plane vectors stored in global coordinates).
-template <class T>
-struct ContactHistoryT {
-  Vec3T<T> fs;                          ///< shear force on particle 1 (N)
-  Vec3T<T> mr;                          ///< rolling moment on particle 1 (N m)
-  typename LaneFlags<T>::type flags{};  ///< ContactFlag bits
-  T slot[kHistorySlots] = {};           ///< the extensions' scalar history, by HistorySlot
-};
-using ContactHistory = ContactHistoryT<Real>;
-
-/// What a law returns for particle 1: total force and the extra (non-lever) moment.
-template <class T>
-struct ContactOutputT {
-  Vec3T<T> force;    ///< N, on particle 1
-  Vec3T<T> moment;   ///< N m, on particle 1, excluding the lever arm of force
-  T fn = 0;          ///< N, elastic normal force (dashpot excluded), >= 0
-};
-using ContactOutput = ContactOutputT<Real>;
 
 /// Scales a down to magnitude `cap` if it is longer (to zero if cap <= 0); returns where it was. Compares squares,
 /// so an elastic contact's value never passes through a square root.
@@ -132,21 +62,6 @@ KOKKOS_INLINE_FUNCTION auto cap_to(Vec3T<T>& a, const T& cap) {
   if (any(capped)) a = select(capped, select(cap > T(0), (cap / kc::sqrt(m2)) * a, Vec3T<T>()), a);
   return capped;
 }
-
-/// Normal force, its tangent stiffness dFn/doverlap and the shear stiffness that goes with it (N, N/m, N/m): the
-/// shear, rolling and twisting springs take ks.
-template <class T>
-struct NormalResponseT {
-  T fn;
-  T k;
-  T ks;
-};
-using NormalResponse = NormalResponseT<Real>;
-
-/// The largest tangent normal and shear stiffness of a contact (N/m), for the critical time step.
-struct MaxStiffness {
-  Real kn, ks;
-};
 
 /// The radius r of the deformability method: the smaller ball's, or the ball's at a wall.
 template <class T>
@@ -354,102 +269,7 @@ struct ContactLaw {
 using RRLinear = ContactLaw<NormalElastic, TangentialCoulomb, RollingLinear, TwistingLinear>;
 using HertzMindlin = ContactLaw<NormalHertzMindlin, TangentialCoulomb, RollingLinear, TwistingLinear>;
 
-/// One lane's choice of a or b where m holds, for every field of a contact's history or output.
-template <class M, class T>
-KOKKOS_INLINE_FUNCTION ContactHistoryT<T> select(const M& m, const ContactHistoryT<T>& a, const ContactHistoryT<T>& b) {
-  ContactHistoryT<T> out;
-  out.fs = select(m, a.fs, b.fs);
-  out.mr = select(m, a.mr, b.mr);
-  out.flags = select_flags(m, a.flags, b.flags);
-  for (int q = 0; q < kHistorySlots; ++q) out.slot[q] = select(m, a.slot[q], b.slot[q]);
-  return out;
-}
-template <class M, class T>
-KOKKOS_INLINE_FUNCTION ContactOutputT<T> select(const M& m, const ContactOutputT<T>& a, const ContactOutputT<T>& b) {
-  ContactOutputT<T> out;
-  out.force = select(m, a.force, b.force);
-  out.moment = select(m, a.moment, b.moment);
-  out.fn = select(m, a.fn, b.fn);
-  return out;
-}
-
-/// The laws a pair may choose, in ContactLawId's order: each kernel call goes to the law of the pair's `law` field.
-/// Lanes of one law (nearly always) run that law alone, with its bits; lanes of two laws run both on copies of the
-/// history and keep each lane's own. A new law is one `using` above, one entry here and one name in
-/// contact_params.hpp.
-template <class... Laws>
-struct LawTable {
-  /// The history slots any of the laws uses with parameters p.
-  template <class T>
-  KOKKOS_INLINE_FUNCTION static unsigned slots(const ContactParamsT<T>& p) {
-    return (Laws::slots(p) | ...);
-  }
-  template <class T>
-  KOKKOS_INLINE_FUNCTION static T stiffness(const ContactParamsT<T>& p, const Arg<T>& r1, const Arg<T>& r2) {
-    return each_law(p, [&](auto law) { return decltype(law)::stiffness(p, r1, r2); });
-  }
-  template <class T>
-  KOKKOS_FORCEINLINE_FUNCTION static ContactOutputT<T> eval(const ContactParamsT<T>& p, const ContactKinematicsT<T>& k,
-                                                           ContactHistoryT<T>& h) {
-    // Every lane of one law (all but packs that straddle two laws): that law on the history itself, no copies (the
-    // copies and selects below cost 14% of the force kernel's instructions when always taken).
-    ContactOutputT<T> out;
-    bool done = false;
-    ((!done && all(p.law == T(index_of<Laws>())) ? (out = Laws::eval(p, k, h), done = true) : false), ...);
-    return done ? out : eval_mixed(p, k, h);
-  }
-  /// For one pair (scalar parameters): a servo's spring and the critical time step's largest stiffness.
-  KOKKOS_INLINE_FUNCTION static Real servo_stiffness(const ContactParams& p, Real r1, Real r2) {
-    return each_law(p, [&](auto law) { return decltype(law)::NormalPart::servo_stiffness(p, r1, r2); });
-  }
-  KOKKOS_INLINE_FUNCTION static MaxStiffness max_stiffness(const ContactParams& p, Real r1, Real r2, Real overlap) {
-    MaxStiffness m{};
-    each_law(p, [&](auto law) {
-      m = decltype(law)::NormalPart::max_stiffness(p, r1, r2, overlap);
-      return Real(0);
-    });
-    return m;
-  }
-
- private:
-  /// Lanes of several laws: each law present on a copy of the history, each lane keeping its own law's.
-  template <class T>
-  KOKKOS_INLINE_FUNCTION static ContactOutputT<T> eval_mixed(const ContactParamsT<T>& p,
-                                                             const ContactKinematicsT<T>& k, ContactHistoryT<T>& h) {
-    ContactHistoryT<T> out_h = h;
-    const ContactOutputT<T> out = each_law(p, [&](auto law) {
-      ContactHistoryT<T> mine = h;
-      const ContactOutputT<T> o = decltype(law)::eval(p, k, mine);
-      const auto own = p.law == T(index_of<decltype(law)>());
-      out_h = all(own) ? mine : select(own, mine, out_h);
-      return o;
-    });
-    h = out_h;
-    return out;
-  }
-  template <class Law>
-  static constexpr int index_of() {
-    int k = 0, at = -1;
-    ((std::is_same<Law, Laws>::value ? at = k : 0, ++k), ...);
-    return at;
-  }
-  /// f(Law{}) for the laws the lanes of p use, each lane's result from its own law (f returns a Real, a pack or a
-  /// ContactOutput).
-  template <class P, class F>
-  KOKKOS_FORCEINLINE_FUNCTION static auto each_law(const P& p, const F& f) {
-    using R = decltype(f(first_law()));
-    R out{};
-    bool set = false;
-    ((!set && all(p.law == decltype(p.law)(index_of<Laws>())) ? (out = f(Laws{}), set = true) : false), ...);
-    if (set) return out;
-    ((any(p.law == decltype(p.law)(index_of<Laws>()))
-          ? (out = set ? select(p.law == decltype(p.law)(index_of<Laws>()), f(Laws{}), out) : f(Laws{}), set = true)
-          : false),
-     ...);
-    return out;
-  }
-  static auto first_law() { return std::tuple_element_t<0, std::tuple<Laws...>>{}; }
-};
+/// The laws, in ContactLawId's order (law_table.hpp: LawTable).
 static_assert(kContactLaws == 2, "each ContactLawId needs its law in ContactLaws, in the enum's order");
 using ContactLaws = LawTable<RRLinear, HertzMindlin>;
 

@@ -26,7 +26,7 @@ constexpr int kReduceBlock = 256;
 Kokkos::View<Real*, MemSpace> reduce_scratch(std::size_t count);
 /// Device room for one root's values (kMaxReduceValues), apart from the scratch, for reductions whose root the
 /// host reads.
-constexpr int kMaxReduceValues = 16;
+constexpr int kMaxReduceValues = 27;  // a specimen's three stress tensors (specimen_stress)
 Kokkos::View<Real*, MemSpace> reduce_root();
 /// Copies reduce_root's first `count` values to the host's `out`.
 void read_root(Real* out, int count);
