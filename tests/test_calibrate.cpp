@@ -402,6 +402,35 @@ TEST(JobPlan, PackingsInTheStoreAreNotCounted) {
   EXPECT_LT(after.high(), before.high());
 }
 
+// A diagnosis plans the runs of the extensions it will try, which are its law's: hertz_overlap and roughness extend
+// rrlinear only (host/config/model_keys.cpp), so a hertz_mindlin cell plans two extensions fewer, six points each.
+TEST(JobPlan, ADiagnosisCountsOnlyItsLawsExtensions) {
+  Config cfg = test::tiny_cell_config();
+  TriaxialTest t;
+  t.material = "A";
+  t.sigma3 = 100e3;
+  t.specimen_balls = 100;  // the cell's own: no check cells to plan
+  PlanInput in;
+  in.materials["A"] = {t};
+  in.free = 2;
+  in.diagnose = true;
+  auto work = [&](const Config& c) {
+    in.cell = c;
+    for (const PlanStage& s : plan_job(in).stages)
+      if (s.name == "A: diagnosis") return s.work;
+    return std::string();
+  };
+  const long all = static_cast<long>(extensions().size());
+  EXPECT_EQ(work(cfg).find(std::to_string(planned_points(2) + 6 * all) + " points x 1 tests"), 0u) << work(cfg);
+  EXPECT_NE(work(cfg).find("then " + std::to_string(all) + " extensions"), std::string::npos) << work(cfg);
+  cfg.ball.law = kHertzMindlin;
+  cfg.ball.shear_modulus = 25e9;
+  cfg.ball.poisson = 0.22;
+  cfg.wall = cfg.ball;
+  EXPECT_EQ(work(cfg).find(std::to_string(planned_points(2) + 6 * (all - 2)) + " points x 1 tests"), 0u) << work(cfg);
+  EXPECT_NE(work(cfg).find("then " + std::to_string(all - 2) + " extensions"), std::string::npos) << work(cfg);
+}
+
 // A job's plan counts a run's shear steps before it runs: the estimate is the stage's own count (the end strain at
 // the rate set from the inertial number at sigma3, with the time step of the cell's balls), at two pressures; the
 // probe measures a finite speed. A shear counted by engineering strain (0.01 / (rate dt)) is 0.5% short and fails.

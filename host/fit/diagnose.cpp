@@ -321,6 +321,13 @@ bool extends_law_of(const Extension& e, const Model& base, bool verbose) {
 }
 }  // namespace
 
+std::vector<Extension> extensions_of(const Model& base) {
+  std::vector<Extension> out;
+  for (const Extension& e : extensions())
+    if (extends_law_of(e, base, false)) out.push_back(e);
+  return out;
+}
+
 Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free0,
                    const std::vector<TriaxialTest>& measured, const Misfit& misfit, bool verbose) {
   Diagnosis dg;
@@ -328,10 +335,11 @@ Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreePa
   auto say = [&](const char* fmt, auto... a) {
     if (verbose) std::printf(fmt, a...);
   };
+  const std::size_t tried = extensions_of(base).size();
   say("diagnose: calibrating the base model (%d free parameters) on %zu tests, then %zu extensions\n", d,
-      measured.size(), extensions().size());
-  const long planned = static_cast<long>(measured.size()) * lab.members() *
-                       (planned_points(d) + static_cast<long>(extensions().size()) * 6);
+      measured.size(), tried);
+  const long planned =
+      static_cast<long>(measured.size()) * lab.members() * (planned_points(d) + static_cast<long>(tried) * 6);
   const long runs0 = lab.runs();
   Progress progress("diagnose", planned);
   Real best_chi2 = 0;

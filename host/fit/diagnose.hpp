@@ -45,6 +45,8 @@ struct Extension {
 };
 
 const std::vector<Extension>& extensions();
+/// The extensions a diagnosis of `base` tries, in the order of extensions(): those of its contact law.
+std::vector<Extension> extensions_of(const Model& base);
 const Extension& extension(const std::string& name);  ///< throws std::invalid_argument naming the allowed ones
 
 struct ExtensionFit {

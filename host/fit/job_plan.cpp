@@ -298,12 +298,12 @@ struct Planner {
              std::to_string(S * static_cast<int>(tests.size())) + " runs of " + n + " balls (" + std::to_string(S) +
                  " specimens x " + T + " tests)");
     bias_check(material, tests);
-    const long points = in.diagnose ? planned_points(in.free) + static_cast<long>(extensions().size()) * 6
-                                    : planned_points(in.free);
+    const long tried = in.diagnose ? static_cast<long>(extensions_of(model_of(in.cell)).size()) : 0;
+    const long points = planned_points(in.free) + tried * 6;
     const std::string k = auto_ensemble ? "1 to " + std::to_string(K) : std::to_string(K);
     const std::string search_what = std::to_string(points) + " points x " + T + " tests x " + k + " specimens of " + n +
                                     " balls" + (in.diagnose ? " (the base model, then " +
-                                                                  std::to_string(extensions().size()) + " extensions)"
+                                                                  std::to_string(tried) + " extensions)"
                                                             : "");
     add.runs(material + (in.diagnose ? ": diagnosis" : ": search"),
              auto_ensemble ? "[calibrate] ensemble (auto)" : "[calibrate] ensemble", lab, tests,
