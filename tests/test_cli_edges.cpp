@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -151,6 +152,26 @@ TEST(CliEdges, ThreadAndJobCountsBeyondTheMachineAreRefused) {
   EXPECT_NE(o.output.find("OMP_NUM_THREADS=100000 is no thread count for this machine (allowed: 1 to "),
             std::string::npos) << o.output;
   EXPECT_EQ(triaxdem("info", dir, "OMP_NUM_THREADS=1").code, 0);
+}
+
+// The main job (the README's first command) ran for minutes with progress but never said before it began what it
+// would run and about how long: it prints its plan, the balls, steps and time of its consolidation and shear on this
+// machine, before the specimen's layers (here refused at their step cap, so the test takes a second).
+TEST(CliEdges, TheTriaxialJobTellsItsCostBeforeTheWork) {
+  const fs::path dir = dem::test::scratch_dir("cli_triaxial_plan");
+  const Outcome o = triaxdem("triaxial " + tiny_triaxial_file(dir, "max_steps_per_layer = 300\n").string() + " -o " +
+                             (dir / "run").string(), dir);
+  const std::size_t plan = o.output.find("triaxial: plan: "), layers = o.output.find("specimen layer");
+  ASSERT_NE(plan, std::string::npos) << o.output;
+  EXPECT_LT(plan, layers) << o.output;
+  const std::string line = o.output.substr(plan, o.output.find('\n', plan) - plan);
+  long balls = 0;
+  double steps = 0;
+  ASSERT_EQ(std::sscanf(line.c_str(), "triaxial: plan: %ld balls, consolidation to %*f kPa and shear to %*f%% axial "
+                                      "strain: %lf steps", &balls, &steps), 2) << line;
+  EXPECT_GT(balls, 0) << line;
+  EXPECT_GT(steps, 0) << line;
+  EXPECT_NE(line.find(" on this machine"), std::string::npos) << line;
 }
 
 // A specimen whose layer the step cap stopped before it came to rest warned and went on (exit 0): it is refused,

@@ -11,8 +11,6 @@
 #include "host/lab/periodic_lab.hpp"
 #include "host/lab/run_cost.hpp"
 #include "host/lab/state_match.hpp"
-#include "host/triax/specimen.hpp"
-#include "host/triax/triaxial.hpp"
 #include "host/util/progress.hpp"
 #include "host/util/text_format.hpp"
 
@@ -118,32 +116,6 @@ int stored_specimens(Config cell, unsigned first, int count) {
   }
   return n;
 }
-
-/// A membrane test's particle-step over a periodic cell's of the same balls: the membrane's facets, its nodes and the
-/// platens. The small S-1 case at one thread (28 November): 83,450 steps of 3,662 balls in 1 min 48 s, 350 ns a
-/// particle-step, against the cell probe's 150.
-constexpr Real kMembraneStepOverCell = 2.3;
-
-/// A membrane test's cost: its specimen's balls, the time step and speed of a cell of them, and its shear's steps as
-/// the test plans them (shear_plan) at each pressure, a consolidation share more.
-struct MembraneCost {
-  Config cfg;
-  CellCost cell;
-  explicit MembraneCost(const Config& membrane) : cfg(membrane) {
-    cfg.particles.count = specimen_ball_count(membrane);
-    cell = measure_cell_cost(cfg);
-  }
-  double steps(Real sigma3) const {
-    Config c = cfg;
-    c.triaxial.sigma3 = sigma3;
-    const ShearPlan p = shear_plan(c, cell.dt);
-    return (1 + kConsolidationShare) * static_cast<double>(p.ramp + p.steps);
-  }
-  double seconds(Real sigma3) const {
-    return 1e-9 * kMembraneStepOverCell * cell.ns_per_particle_step * cell.balls * steps(sigma3);
-  }
-};
-
 
 /// What every stage of a plan reads: the job, the lab's cell and the check's, the specimens and the state match.
 struct Planner {

@@ -6,6 +6,8 @@
 
 #include "host/engine/builder.hpp"
 #include "host/triax/periodic_triaxial.hpp"
+#include "host/triax/specimen.hpp"
+#include "host/triax/triaxial.hpp"
 
 namespace dem {
 
@@ -86,6 +88,22 @@ CellCost measure_cell_cost(const Config& cell, double probe_seconds) {
   const Real gas = closing(solid, gas_end, gas_rate) + closing(gas_end, kPackedSolidFraction, rate);
   c.packing_steps = static_cast<long>(kPackingStepsOverGas * gas);
   return c;
+}
+
+MembraneCost::MembraneCost(const Config& membrane) : cfg(membrane) {
+  cfg.particles.count = specimen_ball_count(membrane);
+  cell = measure_cell_cost(cfg);
+}
+
+double MembraneCost::steps(Real sigma3) const {
+  Config c = cfg;
+  c.triaxial.sigma3 = sigma3;
+  const ShearPlan p = shear_plan(c, cell.dt);
+  return (1 + kConsolidationShare) * static_cast<double>(p.ramp + p.steps);
+}
+
+double MembraneCost::seconds(Real sigma3) const {
+  return 1e-9 * kMembraneStepOverCell * cell.ns_per_particle_step * cell.balls * steps(sigma3);
 }
 
 }  // namespace dem

@@ -40,6 +40,22 @@ struct CellCost {
   PeriodicTriaxialParams triax;     ///< the cell's test parameters
 };
 
+/// A membrane test's particle-step over a periodic cell's of the same balls: the membrane's facets, its nodes and the
+/// platens. The small S-1 case at one thread (28 November): 83,450 steps of 3,662 balls in 1 min 48 s, 350 ns a
+/// particle-step, against the cell probe's 150.
+constexpr Real kMembraneStepOverCell = 2.3;
+
+/// A membrane test's cost (a job's prediction, the `triaxial` command's plan): its specimen's balls, the time step
+/// and speed of a cell of them, and its shear's steps as the test plans them (shear_plan) at each pressure, a
+/// consolidation share more. The specimen's layers are not counted.
+struct MembraneCost {
+  Config cfg;
+  CellCost cell;
+  explicit MembraneCost(const Config& membrane);
+  double steps(Real sigma3) const;
+  double seconds(Real sigma3) const;
+};
+
 /// The cost of `cell` (a periodic or walled cell config): its time step from a lattice of its balls pressed together
 /// (as the runs' contacts are), the speed from stepping that lattice for about `probe_seconds` (at least 50 steps).
 CellCost measure_cell_cost(const Config& cell, double probe_seconds = 0.3);
