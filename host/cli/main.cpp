@@ -15,6 +15,7 @@
 #include "host/config/provenance.hpp"
 #include "host/data/measured.hpp"
 #include "host/lab/periodic_lab.hpp"
+#include "host/util/busy_machine.hpp"
 #include "host/util/process_pool.hpp"
 #include "host/util/ranks.hpp"
 
@@ -95,7 +96,13 @@ int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // progress reaches a log file as it happens
   dem::stop_children_with_the_program();     // SIGTERM says what it stopped, and stops the children too
   std::optional<Kokkos::ScopeGuard> kokkos;
-  if (cmd.kokkos) kokkos.emplace(argc, argv);
+  if (cmd.kokkos) {
+    kokkos.emplace(argc, argv);
+    // Steps run here, on this process's threads (a calibration's runs are children of one thread each).
+    const int threads = cmd.parallel_runs ? 1 : Kokkos::DefaultExecutionSpace().concurrency();
+    if (const std::string note = dem::busy_machine_note(threads); !note.empty())
+      std::fprintf(stderr, "triaxdem: %s\n", note.c_str());
+  }
   try {
     return cmd.run(a);
   } catch (const dem::DataError& e) {
