@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "host/engine/cell_services.hpp"
 #include "host/engine/simulation.hpp"
 
 namespace dem {
@@ -96,13 +97,9 @@ void Simulation::set_cell_servo(const CellServoSpec& spec) {
 
 void Simulation::servo_step() {
   const bool fresh = servo_calls_++ % servo_.stiffness_every == 0;
-  const CellImage image{cell_};
-  Real* sums = servo_sums_.data();  // device memory: the host passes it on, never reads it
-  if (fresh)
-    owner_sums_to<3>("dem::sim::servo_stiffness", StiffnessTerms<CellImage>{p_.x, p_.radius, image},
-                     sums + CellServoSums::kStiffnessSums);
-  owner_sums_to<3>("dem::sim::servo_stress", LoveWeberTerms<3, CellImage>{p_.x, image},
-                   sums + CellServoSums::kStressSums);
+  // Device memory: the host passes it on, never reads it.
+  cell_servo_sums([&](const char* label, const auto& terms, Real* root) { owner_sums_to<3>(label, terms, root); },
+                  p_.x, p_.radius, CellImage{cell_}, fresh, servo_sums_.data());
   cell_servo_rates(cell_, servo_, servo_sums_, fresh, prm_.integ.dt);
   cell_stale_ = true;
 }

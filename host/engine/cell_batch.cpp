@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "host/engine/builder.hpp"
+#include "host/engine/cell_services.hpp"
 #include "kernels/contact/contact_sums.hpp"
 #include "kernels/core/buffers.hpp"
 #include "kernels/neighbor/history_remap.hpp"
@@ -368,8 +369,7 @@ Real CellBatch::unbalanced_ratio(int s) const {
     if (!fresh_) force_sums_ = contact_sums<2>("dem::batch::contact_force_sum", ForceTerms());
   }
   const std::array<Real, 2>& f = force_sums_[static_cast<std::size_t>(s)];
-  if (f[1] == 0) return 1;
-  return (sp.stats.unbalanced / sp.count) / (f[0] / f[1]);
+  return dem::unbalanced_ratio(sp.stats.unbalanced, sp.count, f[0], f[1]);
 }
 
 long CellBatch::touching(int s) const {

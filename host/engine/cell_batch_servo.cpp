@@ -1,7 +1,9 @@
 // A batch's servos on the device (CellBatch::set_cell_servo): their slots, their launches before a step, and the
 // host's reads of the cells they changed.
+#include <type_traits>
+
 #include "host/engine/cell_batch.hpp"
-#include "kernels/contact/contact_sums.hpp"
+#include "host/engine/cell_services.hpp"
 
 namespace dem {
 
@@ -56,21 +58,15 @@ void CellBatch::servo_step() {
     sp.stale = true;
   }
   if (!any) return;
-  const SpecimenImages images{p_.specimen, dev_spec_};
-  Real* sums = servo_sums_.data();  // device memory: the host passes it on, never reads it
-  const int stride = CellServoSums::kCount;
   if (fresh_) {
     Kokkos::deep_copy(servo_sums_, Real(0));  // no contacts yet: no sums (per_volume's zeros)
   } else {
-    if (fresh) {
-      const StiffnessTerms<SpecimenImages> terms{p_.x, p_.radius, images};
-      segmented_reduce_lanes_to<3, 0, 1>("dem::batch::servo_stiffness", owner_tree_,
-                                         OwnerSums<3, StiffnessTerms<SpecimenImages>>{owners(), terms},
-                                         sums + CellServoSums::kStiffnessSums, stride);
-    }
-    segmented_reduce_lanes_to<3, 0, 1>("dem::batch::servo_stress", owner_tree_,
-                                       OwnerSums<3, LoveWeberTerms<3, SpecimenImages>>{owners(), {p_.x, images}},
-                                       sums + CellServoSums::kStressSums, stride);
+    // Device memory, a row per specimen: the host passes it on, never reads it.
+    cell_servo_sums([&](const char* label, const auto& terms, Real* root) {
+          using Terms = std::decay_t<decltype(terms)>;
+          segmented_reduce_lanes_to<3, 0, 1>(label, owner_tree_, OwnerSums<3, Terms>{owners(), terms}, root,
+                                             CellServoSums::kCount);
+        }, p_.x, p_.radius, SpecimenImages{p_.specimen, dev_spec_}, fresh, servo_sums_.data());
   }
   cell_servo_rates(dev_spec_, servo_slots_, servo_sums_);
 }

@@ -1,5 +1,6 @@
 #include "host/engine/simulation.hpp"
 #include "host/engine/part_sampling.hpp"
+#include "host/engine/cell_services.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -316,8 +317,7 @@ Real Simulation::unbalanced_ratio() const {
   if (p_.n == 0) return 0;
   Real s[2];
   owner_sums("dem::sim::contact_force_sum", ForceTerms(), s);
-  if (s[1] == 0) return 1;
-  return (stats().unbalanced / p_.n) / (s[0] / s[1]);
+  return dem::unbalanced_ratio(stats().unbalanced, p_.n, s[0], s[1]);
 }
 
 std::array<long, 2> Simulation::touching() const {
