@@ -63,7 +63,8 @@ class CellBatch {
   /// Every specimen's Love-Weber stress diagonal (xx, yy, zz; Pa) over its cell's volume: what
   /// Simulation::contact_stress_diagonal gives each alone, in one launch and one copy (kept until the next step).
   const std::vector<std::array<Real, 3>>& contact_stress_diagonals() const;
-  /// Every specimen's servo stiffness K_dd (Pa): what cell_stiffness gives each alone (kept until the next step).
+  /// Every specimen's servo stiffness K_dd (Pa): what Simulation::cell_stiffness gives each alone (kept until the next
+  /// step).
   const std::vector<std::array<Real, 3>>& cell_stiffnesses() const;
   /// Specimen s's unbalanced-force ratio and touching ball-ball contacts: Simulation::unbalanced_ratio and
   /// touching()[0] alone (all specimens' sums in one launch, kept until the next step).

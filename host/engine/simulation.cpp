@@ -297,6 +297,14 @@ std::array<Real, 3> Simulation::contact_stress_diagonal(Real volume) const {
   return love_weber_stress<3>("dem::sim::contact_stress_diagonal", *this, volume);
 }
 
+std::array<Real, 3> Simulation::cell_stiffness() const {
+  const Domain dom = domain();
+  Real k[3];
+  owner_sums("dem::sim::cell_stiffness", StiffnessTerms<OneImage>{p_.x, p_.radius, OneImage{MinImage(dom)}}, k);
+  const Real V = dom.volume();
+  return {k[0] / V, k[1] / V, k[2] / V};
+}
+
 Simulation::WallLoads Simulation::wall_loads(bool facets) const {
   const int nobj = walls_.n + (facets ? mesh_.ntri : 0);
   WallLoads out{std::vector<Vec3>(static_cast<std::size_t>(nobj)), std::vector<int>(static_cast<std::size_t>(nobj), 0)};

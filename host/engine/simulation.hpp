@@ -180,6 +180,9 @@ class Simulation {
   std::array<Real, 9> contact_stress(Real volume) const;
   /// Its diagonal (xx, yy, zz) alone, bit for bit the same values, at a third of the sums: a servo's every step.
   std::array<Real, 3> contact_stress_diagonal(Real volume) const;
+  /// The cell servo's stiffness K_dd = (1/V) sum_c (Fn/overlap) l_d^2 over the touching ball-ball contacts (Pa), V
+  /// the cell's volume: what CellBatch::cell_stiffnesses gives a batch's specimens.
+  std::array<Real, 3> cell_stiffness() const;
 
   /// Rigid wall velocity (m/s) and position (m) control. Setting a velocity ends a servo on the device.
   void set_wall_velocity(int w, const Vec3& v);

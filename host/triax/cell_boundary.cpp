@@ -63,7 +63,7 @@ std::array<Real, 3> cell_stress(Simulation& sim) {
 }
 
 std::array<Real, 3> boundary_stiffness(Simulation& sim) {
-  if (!walled(sim)) return cell_stiffness(sim);
+  if (!walled(sim)) return sim.cell_stiffness();
   Real k[6];
   sim.owner_sums("dem::cell::wall_stiffness", WallStiffnessTerms{sim.particles().x, sim.particles().radius, sim.walls()},
                  k);

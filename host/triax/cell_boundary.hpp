@@ -6,10 +6,11 @@
 ///   stress sigma_dd  periodic: Love-Weber of the ball-ball contacts over the cell's volume (the specimen's
 ///                    interior); walls: the mean normal force on the two walls over the face area L_e L_f, as a
 ///                    walled test measures it at its boundary
-///   stiffness K_dd   periodic: (1/V) sum_c kn l_d^2 (cell_stiffness); walls: k_d L_d / (2 A_d), k_d the mean over
-///                    the two walls of sum kn of their contacts: moving each wall in by L_d deps / 2 loads it by at
-///                    most k_d L_d deps / 2 (the balls behind it held still), so K_dd bounds d sigma_dd / d eps_dd
-///                    from above, as cell_stiffness does, and the servo's alpha <= 1 keeps its loop stable
+///   stiffness K_dd   periodic: (1/V) sum_c kn l_d^2 (Simulation::cell_stiffness); walls: k_d L_d / (2 A_d), k_d
+///                    the mean over the two walls of sum kn of their contacts: moving each wall in by L_d deps / 2
+///                    loads it by at most k_d L_d deps / 2 (the balls behind it held still), so K_dd bounds
+///                    d sigma_dd / d eps_dd from above, as the periodic one does, and the servo's alpha <= 1 keeps its
+///                    loop stable
 ///   rates            periodic: the cell's homogeneous strain rate; walls: each wall moves at rate_d L_d / 2,
 ///                    away from the centre for a positive (extension) rate
 /// Walls are numbered x-, x+, y-, y+, z-, z+ (cell_walls); a walled cell has no periodic axis.

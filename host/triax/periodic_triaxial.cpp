@@ -13,15 +13,6 @@
 
 namespace dem {
 
-std::array<Real, 3> cell_stiffness(Simulation& sim) {
-  const Domain dom = sim.domain();
-  Real k[3];
-  sim.owner_sums("dem::periodic::cell_stiffness",
-                 StiffnessTerms<OneImage>{sim.particles().x, sim.particles().radius, OneImage{MinImage(dom)}}, k);
-  const Real V = dom.volume();
-  return {k[0] / V, k[1] / V, k[2] / V};
-}
-
 PeriodicTriaxialParams resolve_periodic_params(Simulation& sim, PeriodicTriaxialParams prm) {
   auto bad = [](const std::string& what) { throw std::invalid_argument("periodic triaxial: " + what); };
   const Domain& dom = sim.domain();

@@ -120,9 +120,6 @@ std::vector<BatchedTest> run_periodic_batch(const std::vector<Simulation*>& sims
                                             const std::vector<PeriodicTriaxialParams>& prms,
                                             bool consolidate_only = false, std::array<long, 2>* steps = nullptr);
 
-/// K_ii = (1/V) sum_c (Fn/overlap) l_i^2 over touching ball-ball contacts (Pa): the servo's stiffness.
-std::array<Real, 3> cell_stiffness(Simulation& sim);
-
 /// "a periodic cell" or "a cuboid between six walls", for messages.
 const char* cell_name(CellBoundary b);
 
