@@ -18,6 +18,21 @@
 
 namespace dem {
 
+namespace {
+
+/// The cost before the work: the engine's speed on a probe of these balls (measure_cell_cost) times the steps the
+/// test plans. The specimen's layers come first, unless cached, with their own progress.
+void print_triaxial_plan(const Config& cfg) {
+  const MembraneCost cost(cfg);
+  const Real sigma3 = cfg.triaxial.sigma3;
+  std::printf("triaxial: plan: %ld balls, consolidation to %.0f kPa and shear to %.1f%% axial strain: %.3g steps, "
+              "%.2g particle-steps, about %s on this machine (the specimen's layers first, unless cached)\n",
+              cost.cell.balls, sigma3 / 1e3, 100 * cfg.triaxial.axial_strain_end, cost.steps(sigma3),
+              cost.steps(sigma3) * static_cast<double>(cost.cell.balls), format_duration(cost.seconds(sigma3)).c_str());
+}
+
+}  // namespace
+
 int triaxial_job(const Config& cfg, bool resume, long stop_at_step) {
   if (!cfg.has_specimen) throw ConfigError(cfg.path + ": [specimen]: table missing (the triaxial job needs it)");
   io::Output out(cfg.run.output);
@@ -30,16 +45,8 @@ int triaxial_job(const Config& cfg, bool resume, long stop_at_step) {
   }
   StopSignals signals;
   try {
-    // The cost before the work. The estimate is the engine's speed on a probe of these balls (measure_cell_cost) times
-    // the steps the test plans; the specimen's layers come first, unless cached, with their own progress.
-    const MembraneCost cost(cfg);
-    const Real sigma3 = cfg.triaxial.sigma3;
-    std::printf("triaxial: plan: %ld balls, consolidation to %.0f kPa and shear to %.1f%% axial strain: %.3g steps, "
-                "%.2g particle-steps, about %s on this machine (the specimen's layers first, unless cached)\n",
-                cost.cell.balls, sigma3 / 1e3, 100 * cfg.triaxial.axial_strain_end, cost.steps(sigma3),
-                cost.steps(sigma3) * static_cast<double>(cost.cell.balls), format_duration(cost.seconds(sigma3)).c_str());
-    // Specimens are shared through a cache beside the output folder (the nine paper cases build one), and each run
-    // keeps its own copy, which a resume reads first.
+    print_triaxial_plan(cfg);
+    // Specimens are shared through a cache beside the output folder; each run keeps a copy, which a resume reads first.
     const Specimen sp = cached_specimen(cfg, (std::filesystem::path(out.folder()).parent_path() / ".specimens").string(),
                                         true, out.folder() + "/specimen.csv");
     std::printf("specimen: %zu balls, e = %.4f, height %.3f mm (layers.csv, porosity_profile.csv)\n",

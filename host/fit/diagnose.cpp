@@ -1,7 +1,5 @@
 #include "host/fit/diagnose.hpp"
 
-#include "host/config/model_keys.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -19,26 +17,6 @@
 #include "host/util/text_format.hpp"
 
 namespace dem {
-
-const std::vector<Extension>& extensions() {
-  static const std::vector<Extension> list = [] {
-    std::vector<Extension> out;
-    for (const ModelKey& k : model_keys())
-      if (*k.extension && k.diagnosed)
-        out.push_back({k.extension, k.key, {k.strengths.begin(), k.strengths.end()}, k.signature, k.from_off, k.law});
-    return out;
-  }();
-  return list;
-}
-
-const Extension& extension(const std::string& name) {
-  std::string names;
-  for (const Extension& e : extensions()) {
-    if (e.name == name) return e;
-    names += (names.empty() ? "" : ", ") + e.name;
-  }
-  throw std::invalid_argument("unknown extension '" + name + "' (allowed: " + names + ")");
-}
 
 namespace {
 
@@ -309,25 +287,6 @@ void give_verdict(Diagnosis& dg, int n, int d) {
                       fmt("%.1f", rival->heldout) + " against " + fmt("%.1f", top->heldout) + "): its shape is specific.";
 }
 
-namespace {
-/// Whether extension e extends the base's law (the menu tries only those); says so where it does not.
-bool extends_law_of(const Extension& e, const Model& base, bool verbose) {
-  const std::string law = kContactLawNames[static_cast<int>(base.law.law)];
-  if (e.law.empty() || e.law == law) return true;
-  if (verbose)
-    std::printf("diagnose: %-9s extends law %s, not this material's %s: not tried\n", e.name.c_str(), e.law.c_str(),
-                law.c_str());
-  return false;
-}
-}  // namespace
-
-std::vector<Extension> extensions_of(const Model& base) {
-  std::vector<Extension> out;
-  for (const Extension& e : extensions())
-    if (extends_law_of(e, base, false)) out.push_back(e);
-  return out;
-}
-
 Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free0,
                    const std::vector<TriaxialTest>& measured, const Misfit& misfit, bool verbose) {
   Diagnosis dg;
@@ -335,7 +294,8 @@ Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreePa
   auto say = [&](const char* fmt, auto... a) {
     if (verbose) std::printf(fmt, a...);
   };
-  const std::size_t tried = extensions_of(base).size();
+  const std::vector<Extension> menu = extensions_of(base, verbose);
+  const std::size_t tried = menu.size();
   say("diagnose: calibrating the base model (%d free parameters) on %zu tests, then %zu extensions\n", d,
       measured.size(), tried);
   const long planned =
@@ -375,8 +335,7 @@ Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreePa
   Evaluation base_runs = dg.base.best;  // the best run of the base model, also among the extension fits' runs
   const std::function<void()> report_runs = [&] { report(best_chi2); };
   const FitContext cx{lab, dg.base, base_model, base_at, measured, misfit, report_runs};
-  for (const Extension& e : extensions()) {
-    if (!extends_law_of(e, base, verbose)) continue;
+  for (const Extension& e : menu) {
     dg.fits.push_back(fit_extension(e, cx, base_runs));
     const ExtensionFit& f = dg.fits.back();
     say("diagnose: %-9s %s = %.3g: chi2 %.1f, BIC %.1f (base %.1f), held-out chi2 %.1f (base %.1f)\n",

@@ -45,8 +45,9 @@ struct Extension {
 };
 
 const std::vector<Extension>& extensions();
-/// The extensions a diagnosis of `base` tries, in the order of extensions(): those of its contact law.
-std::vector<Extension> extensions_of(const Model& base);
+/// The extensions a diagnosis of `base` tries, in the order of extensions(): those of its contact law (`verbose`: says
+/// which it does not try). extensions(), extension() and this: host/fit/extension_menu.cpp.
+std::vector<Extension> extensions_of(const Model& base, bool verbose = false);
 const Extension& extension(const std::string& name);  ///< throws std::invalid_argument naming the allowed ones
 
 struct ExtensionFit {
