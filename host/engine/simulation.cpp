@@ -276,33 +276,34 @@ void Simulation::set_membrane(const Membrane& m, const MembraneIntegrateParams& 
 }
 
 namespace {
-/// The Love-Weber sums of the ball-ball contacts over `volume`: all nine components (N = 9, row-major) or the
-/// diagonal alone (N = 3). Each component is summed in the same order either way, so it has the same bits.
-template <int N>
-std::array<Real, N> love_weber_stress(const char* label, const Simulation& sim, Real volume) {
+/// N sums of a cell's contact terms (OwnerSums), each over `volume`: the Love-Weber sums of the ball-ball contacts,
+/// all nine components (N = 9, row-major) or the diagonal alone (N = 3), each component summed in the same order
+/// either way, so with the same bits; the servo's stiffness.
+template <int N, class Terms>
+std::array<Real, N> per_volume(const char* label, const Simulation& sim, const Terms& terms, Real volume) {
   Real s[N];
-  // The image worked out once per launch, as the pair loops do.
-  sim.owner_sums(label, LoveWeberTerms<N, OneImage>{sim.particles().x, OneImage{MinImage(sim.domain())}}, s);
+  sim.owner_sums(label, terms, s);
   std::array<Real, N> out;
   for (int q = 0; q < N; ++q) out[q] = s[q] / volume;
   return out;
 }
 }  // namespace
 
+// The image is worked out once per launch, as the pair loops do.
 std::array<Real, 9> Simulation::contact_stress(Real volume) const {
-  return love_weber_stress<9>("dem::sim::contact_stress", *this, volume);
+  return per_volume<9>("dem::sim::contact_stress", *this,
+                       LoveWeberTerms<9, OneImage>{p_.x, OneImage{MinImage(domain())}}, volume);
 }
 
 std::array<Real, 3> Simulation::contact_stress_diagonal(Real volume) const {
-  return love_weber_stress<3>("dem::sim::contact_stress_diagonal", *this, volume);
+  return per_volume<3>("dem::sim::contact_stress_diagonal", *this,
+                       LoveWeberTerms<3, OneImage>{p_.x, OneImage{MinImage(domain())}}, volume);
 }
 
 std::array<Real, 3> Simulation::cell_stiffness() const {
   const Domain dom = domain();
-  Real k[3];
-  owner_sums("dem::sim::cell_stiffness", StiffnessTerms<OneImage>{p_.x, p_.radius, OneImage{MinImage(dom)}}, k);
-  const Real V = dom.volume();
-  return {k[0] / V, k[1] / V, k[2] / V};
+  return per_volume<3>("dem::sim::cell_stiffness", *this,
+                       StiffnessTerms<OneImage>{p_.x, p_.radius, OneImage{MinImage(dom)}}, dom.volume());
 }
 
 Simulation::WallLoads Simulation::wall_loads(bool facets) const {

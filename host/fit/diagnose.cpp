@@ -287,6 +287,23 @@ void give_verdict(Diagnosis& dg, int n, int d) {
                       fmt("%.1f", rival->heldout) + " against " + fmt("%.1f", top->heldout) + "): its shape is specific.";
 }
 
+namespace {
+
+/// The extension fits worse than a new base fit are at the base point: their values and held-out chi2 are the base's.
+void fall_back_to_base(Diagnosis& dg, int d, int n) {
+  for (ExtensionFit& f : dg.fits)
+    if (f.best.chi2 > dg.base.best.chi2) {
+      f.best = dg.base.best;
+      f.strength = 0;
+      f.values = dg.base.values;
+      f.values.push_back(0);
+      f.bic = bic(f.best.chi2, d + 1, n);
+      f.heldout = dg.base_heldout;
+    }
+}
+
+}  // namespace
+
 Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free0,
                    const std::vector<TriaxialTest>& measured, const Misfit& misfit, bool verbose) {
   Diagnosis dg;
@@ -354,15 +371,7 @@ Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreePa
     at_best = evaluate_surfaces(surf, dg.base.best.u);
     dg.base_bic = bic(dg.base.best.chi2, d, n);
     dg.base_heldout = heldout_chi2(base_model, d, measured, base_at, lab, misfit);
-    for (ExtensionFit& f : dg.fits)
-      if (f.best.chi2 > dg.base.best.chi2) {  // now at the base point: its values and held-out chi2 are the base's
-        f.best = dg.base.best;
-        f.strength = 0;
-        f.values = dg.base.values;
-        f.values.push_back(0);
-        f.bic = bic(f.best.chi2, d + 1, n);
-        f.heldout = dg.base_heldout;
-      }
+    fall_back_to_base(dg, d, n);
   }
 
   if (verbose) progress.finish("");

@@ -201,9 +201,7 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
     std::printf("diagnose: %s: verdict: %s\n  %s\n", material.c_str(), dg.verdict.c_str(), dg.explanation.c_str());
     std::printf("%s", uncertainty_text(dg.base, material, "diagnose").c_str());
     for (const std::string& note : dg.base.widened) std::printf("diagnose: %s: %s\n", material.c_str(), note.c_str());
-    std::string edge;
-    for (const std::string& name : dg.base.at_edge()) edge += (edge.empty() ? "" : ", ") + name;
-    if (!edge.empty())
+    if (const std::string edge = edge_names(dg.base); !edge.empty())
       std::printf("diagnose: %s: WARNING: %s at the edge of the search range\n", material.c_str(), edge.c_str());
     if (const ExtensionFit* top = report.add_material(material, tests, misfit, dg)) {
       all_ext.insert(all_ext.end(), top->best.sim.begin(), top->best.sim.end());

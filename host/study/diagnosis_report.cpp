@@ -25,6 +25,12 @@ const ExtensionFit* top_fit(const Diagnosis& dg) {
 
 }  // namespace
 
+std::string edge_names(const CalibrationResult& r) {
+  std::string edge;
+  for (const std::string& name : r.at_edge()) edge += (edge.empty() ? "" : ", ") + name;
+  return edge;
+}
+
 DiagnosisReport::DiagnosisReport(const Session& ss, const Config& base, const CalibrationOptions& o) : ss_(ss) {
   std::ostream& md = md_;
   md << "# Diagnosis of " << o.data << "\n\n"
@@ -106,9 +112,9 @@ std::string DiagnosisReport::reference_table(const std::string& material, const 
 
 const ExtensionFit* DiagnosisReport::add_material(const std::string& material, const std::vector<TriaxialTest>& tests,
                                                   const Misfit& misfit, const Diagnosis& dg) {
-  std::string edge, widened;
+  std::string widened;
   for (const std::string& note : dg.base.widened) widened += (widened.empty() ? "" : "; ") + note;
-  for (const std::string& name : dg.base.at_edge()) edge += (edge.empty() ? "" : ", ") + name;
+  const std::string edge = edge_names(dg.base);
   md_ << "## " << material << "\n\n"
       << (misfit.cell_bias_finding().empty() ? "" : "**Finding: the cell's bias.** " + misfit.cell_bias_finding() + "\n\n")
       << "**Verdict: " << dg.verdict << ".** " << dg.explanation << "\n\n"

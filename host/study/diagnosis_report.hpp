@@ -11,6 +11,9 @@
 
 namespace dem {
 
+/// The names of the free parameters whose optimum lies at the edge of their search range, ", "-joined ("" where none).
+std::string edge_names(const CalibrationResult& r);
+
 class DiagnosisReport {
  public:
   /// The opening: the simulator, the free parameters, the misfit and noise, the reference values, the data's notes.
