@@ -21,6 +21,7 @@
 #include "host/fit/job_plan.hpp"
 #include "host/lab/run_cost.hpp"
 #include "host/lab/run_store.hpp"
+#include "host/lab/wall_layer.hpp"
 #include "host/util/forked_runs.hpp"
 #include "host/triax/periodic_triaxial.hpp"
 #include "test_util.hpp"
@@ -541,6 +542,52 @@ TEST(Calibrate, StateIsMatchedOnTheMeanOfTheLabsFirstSpecimens) {
   Real big_sum = 0;
   for (int k = 0; k < kStateMatchSpecimens; ++k) big_sum += big_lab.prepared_void_ratio(k);
   EXPECT_EQ(big_match.reached, big_sum / kStateMatchSpecimens);
+}
+
+// A walled cell of fewer balls than the data's specimens is matched as a specimen of their balls would pack: the
+// void ratio it reaches is its specimens' void_ratio_at_size (host/lab/wall_layer.hpp) at the data's balls, bit for
+// bit the lab's, and the config's "whole" (or a periodic cell, which has no walls' layer) matches the cell's own.
+TEST(Calibrate, ASmallerWalledCellIsMatchedAsASpecimenOfTheDatasBalls) {
+  Config cfg = test::tiny_cell_config();
+  cfg.periodic.boundary = CellBoundary::walls;
+  cfg.box.periodic = {false, false, false};
+  MatchPlan plan = match_plan(cfg, 1);
+  plan.steps = 2;
+  std::vector<TriaxialTest> data(1);
+  data[0].specimen_balls = 8 * static_cast<Real>(cfg.particles.count);
+  // A cell of 100 balls between walls is half layer: the two matches reach different void ratios, each target
+  // inside its own match's reach.
+  auto inside = [&](Real balls) {
+    MatchPlan p = plan;
+    p.data_balls = balls;
+    const auto [e0, e1] = preparation_reach(cfg, p);
+    return e0 + 0.4 * (e1 - e0);
+  };
+  auto reached_by = [&](const Config& c, StateMatch& m, Real balls) {
+    const PeriodicLab lab(matched_state(c, data, m, false, plan), false, kStateMatchSpecimens, c.run.seed);
+    Real sum = 0;
+    for (int k = 0; k < kStateMatchSpecimens; ++k)
+      sum += std::isfinite(balls) ? void_ratio_at_size(lab.specimen(k).balls, lab.specimen(k).cell, balls)
+                                  : lab.prepared_void_ratio(k);
+    return sum / kStateMatchSpecimens;
+  };
+  data[0].void_ratio = inside(data[0].specimen_balls);
+  StateMatch interior;
+  EXPECT_EQ(reached_by(cfg, interior, data[0].specimen_balls), interior.reached);
+  EXPECT_EQ(interior.data_balls, data[0].specimen_balls);
+  EXPECT_LT(std::fabs(interior.reached - data[0].void_ratio), 0.5 * std::fabs(data[0].void_ratio - inside(NAN)))
+      << "matched on the cell's own void ratio, which misses it by a layer's share";
+  Config whole_cfg = cfg;
+  whole_cfg.calibrate.walled_match = "whole";
+  data[0].void_ratio = inside(NAN);
+  StateMatch whole;
+  EXPECT_EQ(reached_by(whole_cfg, whole, NAN), whole.reached);
+  EXPECT_TRUE(std::isnan(whole.data_balls));
+  // Of the cell's own balls there is no other size to match.
+  data[0].specimen_balls = static_cast<Real>(cfg.particles.count);
+  StateMatch own;
+  EXPECT_EQ(reached_by(cfg, own, NAN), own.reached);
+  EXPECT_TRUE(std::isnan(own.data_balls));
 }
 
 // A match near a friction already known (the cell-bias check's larger cells, near the lab's own): the halvings

@@ -284,6 +284,7 @@ void read_calibrate(const Tables& read, Config& c) {
   cal.string("predict", c.calibrate.predict);
   cal.integer("predict_specimens", c.calibrate.predict_specimens, 1, 16);
   cal.string("reference_test", c.calibrate.reference_test, {"periodic", "walls", "two_fidelity"});
+  cal.string("walled_match", c.calibrate.walled_match, {"interior", "whole"});
   cal.finish();
 }
 

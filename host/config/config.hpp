@@ -181,6 +181,10 @@ struct CalibrateConfig {
   /// inside a specimen, not the lab's boundary) or "two_fidelity" (the cell corrected by the `predict` membrane
   /// test at its optimum, then calibrated again).
   std::string reference_test = "periodic";
+  /// How a walled cell smaller than the data's specimen is matched to the data's void ratio (host/lab/state_match.hpp):
+  /// "interior" (as a specimen of the data's balls would pack, its walls' looser layer scaled to the data's size,
+  /// host/lab/wall_layer.hpp) or "whole" (the cell's own void ratio: its interior packs denser than the data's).
+  std::string walled_match = "interior";
 };
 
 /// The [periodic] table: the periodic-cell triaxial test (host/triax/periodic_triaxial.hpp).

@@ -62,9 +62,10 @@ std::string bias_finding(const std::vector<QuantityBias>& by, bool walls, Real n
   const std::string size = std::isfinite(data_balls) ? fmt("%.0f", data_balls) + " balls" : "an unlimited size";
   const std::string cause =
       walls ? fmt("the walled cell of %.0f balls is smaller than the data's specimen (", n) + size +
-                  "): the walls' looser layer is a larger share of it (the share falls as N^-1/3), so matched to the "
-                  "data's void ratio its interior packs denser than the data's. A walled cell of the data's balls "
-                  "([particles] count) removes it"
+                  "): the walls' looser layer is a larger share of it (the share falls as N^-1/3); matched whole to "
+                  "the data's void ratio its interior packs denser than the data's, and matched on its interior the "
+                  "layer still carries a larger share of the strain. A walled cell of the data's balls ([particles] "
+                  "count) removes it"
             : fmt("a periodic cell of %.0f balls does not respond as a specimen of ", n) + size +
                   " (finite size). A larger cell ([calibrate] cell_factor, or [particles] count) shrinks it";
   return "The simulator's cell differs from a specimen of the data's size by more than the data's noise, the larger "

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <stdexcept>
 #include <optional>
@@ -147,6 +148,10 @@ StateMatch PeriodicLab::grow_cell(int factor, const StateMatch& state) {
     plan.first_seed = first_seed_;
     plan.specimens = state.specimens;
     plan.workers = workers_;
+    // A walled cell matched on its interior stays so while it is still smaller than the data's specimen.
+    if (!(state.data_balls > static_cast<Real>(cfg_.particles.count) * 1.01))
+      grown.data_balls = std::numeric_limits<Real>::quiet_NaN();
+    plan.data_balls = grown.data_balls;
     cfg_.periodic.prep_mu_s = grown.prep_mu_s = prep_friction_for(cfg_, state.target, grown.reached, verbose_, plan);
   }
   pack(specimens(), verbose_);

@@ -109,7 +109,9 @@ class PeriodicLab {
   double seconds() const { return seconds_; }
   std::size_t balls() const { return specimens_.front().balls.size(); }
   /// Void ratio of member k's specimen after its preparation (at the preparation pressure).
-  Real prepared_void_ratio(int k) const { return specimens_[static_cast<std::size_t>(k)].void_ratio; }
+  Real prepared_void_ratio(int k) const { return specimen(k).void_ratio; }
+  /// Member k's specimen as packed and prepared.
+  const PackedCell& specimen(int k) const { return specimens_[static_cast<std::size_t>(k)]; }
 
  private:
   Config cfg_;

@@ -13,10 +13,16 @@
 #include "host/lab/periodic_lab.hpp"
 #include "host/util/progress.hpp"
 #include "host/lab/run_store.hpp"
+#include "host/lab/wall_layer.hpp"
 
 namespace dem {
 
 namespace {
+/// A specimen's void ratio as the plan matches it: the whole cell's, or a walled cell's at the data's size.
+Real matched_void_ratio(const PackedCell& s, const MatchPlan& plan) {
+  return std::isfinite(plan.data_balls) ? void_ratio_at_size(s.balls, s.cell, plan.data_balls) : s.void_ratio;
+}
+
 /// The plan's specimens' mean void ratio after their preparation, summed in seed order: packed as a lab packs
 /// its specimens, so that the mean matched is the mean of a lab's first specimens, bit for bit.
 Real prepared_void_ratio(const Config& cfg, const MatchPlan& plan) {
@@ -28,12 +34,12 @@ Real prepared_void_ratio(const Config& cfg, const MatchPlan& plan) {
       c.run.seed = plan.first_seed + static_cast<unsigned>(k);
       PackedCell s;
       if (!read_packing(c, s)) throw NotPacked("no stored packing for seed " + std::to_string(c.run.seed));
-      sum += s.void_ratio;
+      sum += matched_void_ratio(s, plan);
     }
     return sum / static_cast<Real>(n);
   }
   const PeriodicLab lab(larger_cell(cfg, plan.cell_factor), false, n, plan.first_seed, n, plan.workers);
-  for (int k = 0; k < n; ++k) sum += lab.prepared_void_ratio(k);
+  for (int k = 0; k < n; ++k) sum += matched_void_ratio(lab.specimen(k), plan);
   return sum / static_cast<Real>(n);
 }
 
@@ -45,6 +51,7 @@ std::string stored_packing_path(const Config& c, const MatchPlan& plan) {
   h = fnv1a(v, sizeof v, h);
   const long n[] = {c.particles.count, plan.cell_factor, plan.specimens, static_cast<long>(plan.first_seed)};
   h = fnv1a(n, sizeof n, h);
+  if (std::isfinite(plan.data_balls)) h = fnv1a(&plan.data_balls, sizeof plan.data_balls, h);
   return plan.store + "/packing_" + hex16(h) + ".e";
 }
 
@@ -115,6 +122,22 @@ Real prep_friction_for(const Config& base, Real target, Real& reached, bool verb
   return bisect(0, 1, e_lo, e_hi);
 }
 
+namespace {
+/// The data's specimens' balls (their mean) where the plan's cell is walled, smaller and matched on its interior;
+/// NaN where it is matched whole.
+Real interior_match_balls(const Config& base, const std::vector<TriaxialTest>& tests, const MatchPlan& plan) {
+  const Real none = std::numeric_limits<Real>::quiet_NaN();
+  if (base.periodic.boundary != CellBoundary::walls || base.calibrate.walled_match != "interior") return none;
+  Real sum = 0;
+  int n = 0;
+  for (const TriaxialTest& t : tests)
+    if (std::isfinite(t.void_ratio) && std::isfinite(t.specimen_balls)) sum += t.specimen_balls, ++n;
+  const Real cell = static_cast<Real>(base.particles.count * std::max(plan.cell_factor, 1));
+  // Within a percent the sizes are one (a data file's count against the config's), and the whole cell is matched.
+  return n > 0 && sum / n > cell * 1.01 ? sum / n : none;
+}
+}  // namespace
+
 Config matched_state(const Config& base, const std::vector<TriaxialTest>& tests, StateMatch& m, bool verbose,
                      const MatchPlan& plan) {
   m = StateMatch{};
@@ -124,12 +147,18 @@ Config matched_state(const Config& base, const std::vector<TriaxialTest>& tests,
   if (m.tests == 0) return base;
   m.target = sum / m.tests;
   m.specimens = plan.specimens;
+  MatchPlan own = plan;
+  own.data_balls = m.data_balls = interior_match_balls(base, tests, plan);
   Config c = base;
-  c.periodic.prep_mu_s = m.prep_mu_s = prep_friction_for(base, m.target, m.reached, verbose, plan);
+  c.periodic.prep_mu_s = m.prep_mu_s = prep_friction_for(base, m.target, m.reached, verbose, own);
   if (verbose)
     std::printf("triaxdem: the data's void ratio %.4f (mean of %d tests): preparation friction %.4g packs %.4f "
-                "(mean of %d specimens)\n",
-                m.target, m.tests, m.prep_mu_s, m.reached, m.specimens);
+                "(mean of %d specimens%s)\n",
+                m.target, m.tests, m.prep_mu_s, m.reached, m.specimens,
+                std::isfinite(m.data_balls)
+                    ? (", on their interior, as specimens of " + std::to_string(std::lround(m.data_balls)) + " balls")
+                          .c_str()
+                    : "");
   return c;
 }
 

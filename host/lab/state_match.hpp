@@ -32,6 +32,9 @@ struct MatchPlan {
   Real around = -1;
   /// A run store (PeriodicLab::set_run_store) that keeps each packing's mean void ratio; "" keeps nothing.
   std::string store;
+  /// Where finite, the specimens are walled cells matched as specimens of this many balls would be, on their
+  /// interior (void_ratio_at_size; matched_state sets it, StateMatch::data_balls says it); NaN: on the whole cell.
+  Real data_balls = std::numeric_limits<Real>::quiet_NaN();
   /// Packs nothing: reads the packings from the packing store (Config::packing_store) and throws NotPacked at one it
   /// lacks. A job's plan replays its matches so, to count only the packings still to make.
   bool stored_only = false;
@@ -74,10 +77,16 @@ struct StateMatch {
   Real reached = std::numeric_limits<Real>::quiet_NaN();    ///< the matched specimens' mean after preparation
   int specimens = 0;                                        ///< how many were matched
   Real prep_mu_s = std::numeric_limits<Real>::quiet_NaN();
+  /// The data's specimen's balls where a walled cell of fewer was matched on its interior (MatchPlan::data_balls):
+  /// `target` is then the data's void ratio and `reached` the cell's specimens' at the data's size; NaN: whole cells.
+  Real data_balls = std::numeric_limits<Real>::quiet_NaN();
 };
 
 /// The base config with the preparation friction that packs the mean void ratio of the tests that give one
-/// (prep_friction_for); the base config itself when none does.
+/// (prep_friction_for); the base config itself when none does. A walled cell of fewer balls than the tests'
+/// specimens (their mean specimen_balls) is matched on its interior (MatchPlan::data_balls) unless [calibrate]
+/// walled_match is "whole": matched whole, its walls' looser layer, a larger share of it, packs its interior denser
+/// than the data's.
 Config matched_state(const Config& base, const std::vector<TriaxialTest>& tests, StateMatch& m, bool verbose,
                      const MatchPlan& plan);
 

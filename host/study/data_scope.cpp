@@ -33,11 +33,16 @@ void take_walled_size(const Config& base, const CalibrationOptions& o, MeasuredD
   Real largest = 0;
   for (const TriaxialTest& t : data.tests) largest = std::max(largest, t.specimen_balls);
   if (largest > balls * 1.01)
-    data.notes.push_back("the walled cell of " + fmt("%.0f", balls) + " balls is smaller than the data's specimen of " +
-                         fmt("%.0f", largest) + ": its walls' looser layer is a larger share of it (the share falls as "
-                         "N^-1/3), so matched to the data's void ratio its interior packs denser; the cell's bias check "
-                         "measures the difference, with both preparation frictions, and a walled cell of the data's "
-                         "balls ([particles] count) avoids it");
+    data.notes.push_back(
+        "the walled cell of " + fmt("%.0f", balls) + " balls is smaller than the data's specimen of " +
+        fmt("%.0f", largest) + ": its walls' looser layer is a larger share of it (the share falls as N^-1/3), so " +
+        (cell.calibrate.walled_match == "interior"
+             ? std::string("it is matched to the data's void ratio as a specimen of the data's balls would pack, its "
+                           "layer measured and scaled to their size ([calibrate] walled_match = \"interior\")")
+             : std::string("matched whole to the data's void ratio ([calibrate] walled_match = \"whole\") its "
+                           "interior packs denser")) +
+        "; the cell's bias check measures what differs, with both preparation frictions, and a walled cell of the "
+        "data's balls ([particles] count) avoids it");
   if (took)
     data.notes.push_back("no specimen_balls: the walled cell takes its " + fmt("%.0f", balls) +
                          " balls as the data's specimen (between walls the size is part of the test, and the cell's "

@@ -1,7 +1,7 @@
 #!/bin/bash
 # Regenerates the YADE cross-code triaxial curves in this folder (single-threaded, niced).
 # Usage: tests/data/crosscode/make_crosscode_data.sh [file-stem ...]   (default: all six)
-#   stems: linear_seed1 hertz_seed1 linear_seed2 hertz_seed2 walled_seed1 walled_seed2;   logs go to /tmp/crosscode_<stem>.log
+#   stems: linear_seed1 hertz_seed1 linear_seed2 hertz_seed2 walled_seed1 walled_seed2 walled4k_seed1;   logs go to /tmp/crosscode_<stem>.log
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 if ! command -v yade >/dev/null 2>&1; then
@@ -24,6 +24,7 @@ for s in "${stems[@]}"; do
     hertz_seed2)  run $s hertz  2 1000 100,250,400 hz ;;
     walled_seed1) run $s linear 1 1000 100,200,300 wall yade_walled_triax.py ;;
     walled_seed2) run $s linear 2 1000 80,150,250  wall yade_walled_triax.py ;;
+    walled4k_seed1) run $s linear 1 4000 100,200,300 wall yade_walled_triax.py ;;
     *) echo "unknown stem $s" >&2; exit 2 ;;
   esac
 done

@@ -34,12 +34,14 @@ def debian_version():
         return '?'
 
 
-def write_csv(path, header, rows, material, q_measure=None):
+def write_csv(path, header, rows, material, q_measure=None, balls=None):
     """The header lines (each starting with '#'), the column line and the rows; q_measure, where given, on every row
-    (which deviator q is: fixed_area or area_corrected)."""
-    extra = ',' + q_measure if q_measure else ''
+    (which deviator q is: fixed_area or area_corrected), and balls as specimen_balls (between walls the specimen's
+    size is part of the test)."""
+    extra = (',' + q_measure if q_measure else '') + (',%d' % balls if balls else '')
     with open(path, 'w') as f:
         f.write('\n'.join(header) + '\n')
-        f.write('material,sigma3_kPa,eps_a_pct,q_kPa,eps_v_pct,void_ratio' + (',q_measure' if q_measure else '') + '\n')
+        f.write('material,sigma3_kPa,eps_a_pct,q_kPa,eps_v_pct,void_ratio' + (',q_measure' if q_measure else '') +
+                (',specimen_balls' if balls else '') + '\n')
         for r in rows:
             f.write('%s,%.6g,%.6g,%.6g,%.6g,%.6g%s\n' % (material, r[0], r[1], r[2], r[3], r[4], extra))

@@ -212,6 +212,6 @@ for s in summary:
     hdr.append('# test sigma3 %g kPa: e0 %.4f, Z %.3f, rate %.4g 1/s, %d shear steps, q_peak/sigma3 %.3f, max |lateral stress - sigma3|/sigma3 at records %.3g, wall %.0f s' %
                (s[0], s[1], s[2], s[3], s[4], s[7] / s[0], s[6], s[5]))
 hdr.append('# total wall time %.0f s (one core)' % (time.time() - t_all))
-write_csv(OUT, hdr, rows, MATNAME, 'area_corrected')  # q over the current face area
+write_csv(OUT, hdr, rows, MATNAME, 'area_corrected', NBALLS)  # q over the current face area
 log('wrote', OUT, len(rows), 'rows')
 sys.exit(0)
