@@ -551,6 +551,9 @@ TEST(Calibrate, ASmallerWalledCellIsMatchedAsASpecimenOfTheDatasBalls) {
   Config cfg = test::tiny_cell_config();
   cfg.periodic.boundary = CellBoundary::walls;
   cfg.box.periodic = {false, false, false};
+  // The matches pack the same frictions' specimens (the ends, the halvings): packed once, then read back.
+  cfg.fingerprint = "walled-match-test";
+  cfg.packing_store = (test::scratch_dir("walled_match") / "cells").string();
   MatchPlan plan = match_plan(cfg, 1);
   plan.steps = 2;
   std::vector<TriaxialTest> data(1);
