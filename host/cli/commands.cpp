@@ -9,9 +9,9 @@
 #include <filesystem>
 #include <iostream>
 #include <string>
-#include <thread>
 
 #include "host/cli/commands.hpp"
+#include "host/util/busy_machine.hpp"
 #include "host/study/calibration_jobs.hpp"
 #include "host/config/config.hpp"
 #include "host/config/model_keys.hpp"
@@ -21,8 +21,6 @@
 #include "host/util/text_format.hpp"
 
 namespace dem::cli {
-
-int machine_cores() { return static_cast<int>(std::max(1u, std::thread::hardware_concurrency())); }
 
 namespace {
 

@@ -49,9 +49,6 @@ const std::vector<Command>& command_table();
 /// "study, calibrate and diagnose": the commands that spread over MPI ranks.
 std::string over_ranks_names();
 
-/// This machine's cores (at least 1).
-int machine_cores();
-
 /// OMP_NUM_THREADS as the OpenMP runtime would take it, checked before the runtime starts. Empty: fine.
 std::string omp_threads_problem();
 

@@ -67,7 +67,7 @@ int main(int argc, char** argv) {
     given.push_back(app.add_subcommand(cmd.name, cmd.help));
     cmd.options(given.back(), a);
   }
-  a.cal.workers = dem::cli::machine_cores();
+  a.cal.workers = dem::machine_cores();
   if (argc > 1 && argv[1][0] != '-') {
     if (const std::string problem = unknown_command(app, argv[1]); !problem.empty()) {
       std::fprintf(stderr, "triaxdem: %s\n", problem.c_str());

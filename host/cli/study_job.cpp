@@ -12,12 +12,12 @@
 #include <fstream>
 #include <iterator>
 #include <stdexcept>
-#include <thread>
 
 #include "host/cli/job.hpp"
 #include "host/engine/checkpoint.hpp"
 #include "host/io/io_hdf5.hpp"
 #include "host/study/study.hpp"
+#include "host/util/busy_machine.hpp"
 #include "host/util/process_pool.hpp"
 #include "host/util/progress.hpp"
 #include "host/util/ranks.hpp"
@@ -113,7 +113,7 @@ void print_efficiency(int workers) {
 /// Cases at once and OpenMP threads each: the options', else the cores shared out (one case at a time on a GPU,
 /// one a rank where spread over MPI ranks, the leader handing them out).
 std::pair<int, int> share_cores(const StudyOptions& opt, std::size_t cases) {
-  const int cores = std::max(1u, std::thread::hardware_concurrency());
+  const int cores = machine_cores();
   int workers = std::clamp(opt.workers > 0 ? opt.workers : cores / 2, 1, static_cast<int>(cases));
   if (kOnDevice && workers > 1) {
     if (opt.workers > 1)

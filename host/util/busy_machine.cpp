@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <thread>
@@ -22,11 +23,12 @@ std::string busy_machine_note(double load, int cores, int threads, const char* b
   return note;
 }
 
+int machine_cores() { return static_cast<int>(std::max(1u, std::thread::hardware_concurrency())); }
+
 std::string busy_machine_note(int threads) {
   double load = 0;
   if (!(std::ifstream("/proc/loadavg") >> load)) return "";
-  const int cores = static_cast<int>(std::thread::hardware_concurrency());
-  return cores > 0 ? busy_machine_note(load, cores, threads, std::getenv("OMP_PROC_BIND")) : "";
+  return busy_machine_note(load, machine_cores(), threads, std::getenv("OMP_PROC_BIND"));
 }
 
 }  // namespace dem

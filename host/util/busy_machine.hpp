@@ -6,6 +6,9 @@
 
 namespace dem {
 
+/// This machine's cores (at least 1): what a run's threads and workers are shared out of.
+int machine_cores();
+
 /// The note to print before the work, or "" where the threads have the cores to themselves: `load` the machine's
 /// 1-minute load average (the other processes': this one has not run yet), `cores` its cores, `threads` this run's,
 /// `bind` OMP_PROC_BIND's value (null: unset).
