@@ -551,6 +551,7 @@ TEST(Calibrate, ASmallerWalledCellIsMatchedAsASpecimenOfTheDatasBalls) {
   Config cfg = test::tiny_cell_config();
   cfg.periodic.boundary = CellBoundary::walls;
   cfg.box.periodic = {false, false, false};
+  cfg.calibrate.walled_match = "interior";
   // The matches pack the same frictions' specimens (the ends, the halvings): packed once, then read back.
   cfg.fingerprint = "walled-match-test";
   cfg.packing_store = (test::scratch_dir("walled_match") / "cells").string();

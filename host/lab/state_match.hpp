@@ -84,9 +84,9 @@ struct StateMatch {
 
 /// The base config with the preparation friction that packs the mean void ratio of the tests that give one
 /// (prep_friction_for); the base config itself when none does. A walled cell of fewer balls than the tests'
-/// specimens (their mean specimen_balls) is matched on its interior (MatchPlan::data_balls) unless [calibrate]
-/// walled_match is "whole": matched whole, its walls' looser layer, a larger share of it, packs its interior denser
-/// than the data's.
+/// specimens (their mean specimen_balls) is matched on its interior (MatchPlan::data_balls) where [calibrate]
+/// walled_match is "interior"; matched whole (the default), its walls' looser layer, a larger share of it, packs its
+/// interior denser than the data's.
 Config matched_state(const Config& base, const std::vector<TriaxialTest>& tests, StateMatch& m, bool verbose,
                      const MatchPlan& plan);
 
