@@ -10,6 +10,7 @@
 #include "host/triax/periodic_triaxial.hpp"
 #include "host/util/forked_runs.hpp"
 #include "host/util/progress.hpp"
+#include "host/lab/wall_layer.hpp"
 
 namespace dem {
 
@@ -149,7 +150,7 @@ StateMatch PeriodicLab::grow_cell(int factor, const StateMatch& state) {
     plan.specimens = state.specimens;
     plan.workers = workers_;
     // A walled cell matched on its interior stays so while it is still smaller than the data's specimen.
-    if (!(state.data_balls > static_cast<Real>(cfg_.particles.count) * 1.01))
+    if (!larger_specimen(state.data_balls, static_cast<Real>(cfg_.particles.count)))
       grown.data_balls = std::numeric_limits<Real>::quiet_NaN();
     plan.data_balls = grown.data_balls;
     cfg_.periodic.prep_mu_s = grown.prep_mu_s = prep_friction_for(cfg_, state.target, grown.reached, verbose_, plan);

@@ -133,8 +133,7 @@ Real interior_match_balls(const Config& base, const std::vector<TriaxialTest>& t
   for (const TriaxialTest& t : tests)
     if (std::isfinite(t.void_ratio) && std::isfinite(t.specimen_balls)) sum += t.specimen_balls, ++n;
   const Real cell = static_cast<Real>(base.particles.count * std::max(plan.cell_factor, 1));
-  // Within a percent the sizes are one (a data file's count against the config's), and the whole cell is matched.
-  return n > 0 && sum / n > cell * 1.01 ? sum / n : none;
+  return n > 0 && larger_specimen(sum / n, cell) ? sum / n : none;
 }
 }  // namespace
 

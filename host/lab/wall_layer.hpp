@@ -27,6 +27,10 @@ namespace dem {
 /// diameters gave D 0.024-0.038, 2 the largest (docs/calibration.md, The walls' layer).
 inline constexpr Real kWallLayerDiameters = 2;
 
+/// Whether a specimen of `data_balls` is larger than a cell of `cell_balls` (false for NaN): within a percent (a data
+/// file's count against a config's) the two are one size, and a walled cell has no other size to be matched to.
+inline bool larger_specimen(Real data_balls, Real cell_balls) { return data_balls > cell_balls * 1.01; }
+
 /// D above: the walls' deficit in solid fraction of the balls packed in a walled cell [0, cell) (m).
 Real wall_layer_deficit(const std::vector<BallSpec>& balls, const std::array<Real, 3>& cell);
 

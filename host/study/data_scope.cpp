@@ -13,6 +13,7 @@
 
 #include "host/fit/two_fidelity.hpp"
 #include "host/io/io_hdf5.hpp"
+#include "host/lab/wall_layer.hpp"
 #include "host/util/text_format.hpp"
 
 namespace dem {
@@ -32,7 +33,7 @@ void take_walled_size(const Config& base, const CalibrationOptions& o, MeasuredD
     }
   Real largest = 0;
   for (const TriaxialTest& t : data.tests) largest = std::max(largest, t.specimen_balls);
-  if (largest > balls * 1.01)
+  if (larger_specimen(largest, balls))
     data.notes.push_back(
         "the walled cell of " + fmt("%.0f", balls) + " balls is smaller than the data's specimen of " +
         fmt("%.0f", largest) + ": its walls' looser layer is a larger share of it (the share falls as N^-1/3), so " +
