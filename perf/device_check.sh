@@ -7,6 +7,8 @@
 #   perf/device_check.sh table6 LOOP OUT   # any build: Table 6 at full scale with the closed loop's parameters
 # BUILD: the build whose binaries run (default build); CPU_BUILD: the one that prepares (default build).
 # TINY=1: a few hundred balls and steps, no membrane specimen and not the suite's tests, for CI on any build.
+# SIZES: the benchmark's cube edges in balls (default "100 38 215"); CAL_LIMIT: seconds for the batched calibration
+# (240; 0 leaves the stage out); CELLS: cells run as processes at once (16; 0 leaves the stage out).
 # PARTS: which of the suite's tests run (default "kernels other"; "kernels" when device time is short), each part
 # for at most TEST_LIMIT s (90); FULL_LIMIT: seconds for the full-scale test from nothing (60). BUDGET: seconds for
 # the whole run (660), stages in order of value, what was reached in OUT/reached.txt; TABLE6=LOOP: the full-scale
@@ -198,7 +200,7 @@ parts=" ${PARTS:-kernels other} "
 
 # Launch overhead: 64 balls, where a step's time is its launches and waits. Then the benchmark packing's sizes, the
 # million first.
-if [ "$tiny" = 1 ]; then overhead_steps=200; sizes="10 6"; steps=50; else overhead_steps=3000; sizes="100 38 215"; steps=200; fi
+if [ "$tiny" = 1 ]; then overhead_steps=200; sizes="10 6"; steps=50; else overhead_steps=3000; sizes="${SIZES:-100 38 215}"; steps=200; fi
 for k in $sizes; do
   begin "particle-steps/s at $((k * k * k)) balls ($steps steps)" 20 || continue
   BUILD="$build" WORK="$out/scaling" K="$k" STEPS="$steps" timeout -k 5 "$(limit "$([ "$k" -gt 150 ] && echo 120 || echo 100)")" bash "$root/perf/scaling.sh" | tail -n +2 || failed+=" scaling"
@@ -223,7 +225,7 @@ fi
 
 # A calibration as users run it, its cells batched ([calibrate] batch auto): Table 6's S-1 on the shipped base, the
 # prediction left out (TINY: the tiny synthetic case of the script checks).
-if begin "a batched calibration" 60; then
+if [ "${CAL_LIMIT:-240}" -gt 0 ] && begin "a batched calibration" 60; then
   cal_cfg="$root/configs/calibration/base.toml"; cal_data="$root/data/tang2025_table6_peak.csv"; cal_args="--material S-1"
   if [ "$tiny" = 1 ]; then
     sed -e 's/^ensemble = .*/ensemble = 1/' -e 's/^scatter_specimens = .*/scatter_specimens = 2/' \
@@ -231,7 +233,7 @@ if begin "a batched calibration" 60; then
     "$bin" synth --config "$out/cal_base.toml" -o "$out/cal_data.csv" --overwrite --seed 1 --pressures 100 > "$out/synth.log" 2>&1
     cal_cfg="$out/cal_base.toml"; cal_data="$out/cal_data.csv"; cal_args="--free mu_s"
   fi
-  timeout -k 5 "$(limit 240)" "$bin" calibrate "$cal_data" --config "$cal_cfg" $cal_args --predict none -j 1 --yes \
+  timeout -k 5 "$(limit "${CAL_LIMIT:-240}")" "$bin" calibrate "$cal_data" --config "$cal_cfg" $cal_args --predict none -j 1 --yes \
     -o "$out/calibration" > "$out/calibration.log" 2>&1
   echo "exit status $? (124: stopped at the limit)"
   tr '\r' '\n' < "$out/calibration.log" | grep -E "in all .* particle-steps|mu_s = |the job took|job's" | tail -n 5
@@ -256,7 +258,7 @@ fi
 # Today's other way of running many calibration cells on one GPU: separate processes, each its own context and
 # launches, the figure the batch is set against.
 cells="${CELLS:-16}"; [ "$tiny" = 1 ] && cells=2
-if begin "$cells periodic cells as $cells processes at once" 30; then
+if [ "$cells" -gt 0 ] && begin "$cells periodic cells as $cells processes at once" 30; then
   t0=$(date +%s.%N)
   for i in $(seq "$cells"); do
     timeout -k 5 "$(limit 120)" "$bin" periodic "$ref/periodic.toml" -o "$out/cells/c$i" --overwrite > "$out/cells_$i.log" 2>&1 &

@@ -165,9 +165,9 @@ struct LawTable {
     return out;
   }
   template <class Law>
-  static constexpr int index_of() {
+  KOKKOS_INLINE_FUNCTION static constexpr int index_of() {
     int k = 0, at = -1;
-    ((std::is_same<Law, Laws>::value ? at = k : 0, ++k), ...);
+    ((at = std::is_same<Law, Laws>::value ? k : at, ++k), ...);
     return at;
   }
   /// f(Law{}) for the laws the lanes of p use, each lane's result from its own law (f returns a Real, a pack or a

@@ -20,6 +20,7 @@
 namespace dem {
 
 constexpr int kReduceBlock = 256;
+constexpr std::size_t kGpuSharedPerBlock = 48 * 1024;
 
 /// Device scratch for the tree's block results, of at least `count` Reals: one buffer, grown and never shrunk,
 /// so that a step allocates nothing. Kernels run in order, so one reduction's use ends before the next begins.
@@ -83,9 +84,10 @@ struct TreeLevel {
   Real* out;
   Real* roots;
   int root_stride;  ///< Reals from one segment's root to the next's
+  int scratch_level;
 
   KOKKOS_INLINE_FUNCTION void operator()(const ReduceTeam& t) const {
-    const TeamScratch s(t.team_scratch(0), NV * B);
+    const TeamScratch s(t.team_scratch(scratch_level), NV * B);
     const ReduceBlock blk = blocks(t.league_rank());
     Kokkos::parallel_for(Kokkos::TeamThreadRange(t, B / W), [&](const int g) {
       const int i = blk.begin + g * W;
@@ -123,14 +125,19 @@ template <int NSUM, int NMAX, int W, class F, class Blocks>
 void tree_level(const char* label, int nblock, const F& f, const Blocks& blocks, Real* out, Real* roots,
                 int root_stride = NSUM + NMAX) {
   using Level = TreeLevel<NSUM, NMAX, W, F, Blocks>;
+  const std::size_t bytes = TeamScratch::shmem_size(Level::NV * kReduceBlock);
 #ifdef TRIAXDEM_HOST_PACKS
   const int team = 1;  // a CPU thread walks its block: teams of threads would only add barriers
+  const int level = 0;
 #else
   const int team = kReduceBlock / W;
+  // A GPU block gets 48 KiB of shared memory unless the kernel opts in to more, which Kokkos 3.4 does not: a block of
+  // more values (a specimen's 27 stress sums, 55 KB) goes to the team's scratch in global memory. The same tree and
+  // the same operations, so the same bits.
+  const int level = bytes > kGpuSharedPerBlock ? 1 : 0;
 #endif
-  const auto policy = Kokkos::TeamPolicy<ExecSpace>(nblock, team)
-                          .set_scratch_size(0, Kokkos::PerTeam(TeamScratch::shmem_size(Level::NV * kReduceBlock)));
-  Kokkos::parallel_for(label, policy, Level{f, blocks, out, roots, root_stride});
+  const auto policy = Kokkos::TeamPolicy<ExecSpace>(nblock, team).set_scratch_size(level, Kokkos::PerTeam(bytes));
+  Kokkos::parallel_for(label, policy, Level{f, blocks, out, roots, root_stride, level});
 }
 
 }  // namespace detail
