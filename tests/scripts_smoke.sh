@@ -126,10 +126,17 @@ if [ "$part" != tools ]; then
     DIAG_CONFIG="$base" PRESSURES=100 BENCH_STEPS=20 NP=1 bash "$root/perf/stage_profile.sh"
   grep -q "^shear .* | " "$work/stage_profile.sh.log" && grep -q "^diagnose: .* runs" "$work/stage_profile.sh.log" ||
     { cat "$work/stage_profile.sh.log"; echo "scripts_smoke: stage_profile gave no shear stage or no diagnosis" >&2; exit 1; }
-  # The data on a cell of the simulator's size: the generator's larger cell is the sweep's default, not what this checks.
-  check perf/hidden_sweep "$build/perf/hidden_sweep" --config "$base" --seeds 1 --hidden none -j 1 --data-cell-factor 1 \
-    -o "$work/sweep.csv"
-  exists "$work/sweep.csv"
+  # The sweep through the identification table's script (one null case; the data on a cell of the simulator's size:
+  # the generator's larger cell is the sweep's default, not what this checks), then the script again: nothing left.
+  check perf/identification_table.sh env BUILD="$build" OUT="$work/ident" LEVELS=precise HIDDEN_SEEDS= NULL_SEEDS=1 \
+    JOBS=1 SWEEP_ARGS="--config $base --data-cell-factor 1" bash "$root/perf/identification_table.sh"
+  ran+=(perf/hidden_sweep)
+  grep -q "^none,0,1,none,.*,[0-9]*$" "$work/ident/precise.csv" && grep -q "^- false alarms: \*\*0 of 1\*\*" \
+    "$work/identification_table.sh.log" ||
+    { cat "$work/identification_table.sh.log"; echo "scripts_smoke: identification_table gave no null row" >&2; exit 1; }
+  env BUILD="$build" OUT="$work/ident" LEVELS=precise HIDDEN_SEEDS= NULL_SEEDS=1 bash "$root/perf/identification_table.sh" \
+    > "$work/ident_again.log"
+  grep -q " 0 cases left" "$work/ident_again.log" || { echo "scripts_smoke: identification_table ran a case it had" >&2; exit 1; }
   # Table 6 by the loop: each case's plan (a case runs 30-60 minutes), then the table, whose rows say "not run".
   check perf/table6_loop.sh env BUILD="$build" WORK="$work/table6" MATERIALS=S-1 CASES="all 300" JOBS=1 PLAN=1 \
     bash "$root/perf/table6_loop.sh"
