@@ -113,6 +113,9 @@ PY
         timeout -k 5 "$left" "$bin" triaxial "$cfg" -o "$out/$name" --overwrite > "$out/$name.log" 2>&1
         rc=$?; status=done; [ $rc = 124 ] && status="cut by the budget"; [ $rc != 0 ] && [ $rc != 124 ] && status="failed ($rc)"
         tr '\r' '\n' < "$out/$name.log" | grep -E "^time loop|q_peak" | tail -n 2
+        # Each stage's nanoseconds a particle-step in each part (the host's share among them) in the log itself: the
+        # runs' folders are too large to come back whole from a device.
+        [ -f "$out/$name/timings.csv" ] && grep -E "^(stage|consolidation|shear)," "$out/$name/timings.csv"
         echo "$m,$p,$((SECONDS - t0)),$status,$cal" >> "$out/cases.csv"
       else
         echo "$m,$p,0,$status,$cal" >> "$out/cases.csv"
