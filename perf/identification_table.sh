@@ -64,11 +64,19 @@ if [ "$plan" != 1 ]; then
     t0=$SECONDS; tmp="$out/.$level.$seed.csv"
     echo "identification_table: $level seed $seed: $n cases (about $((n * each)) s); $left s of the budget left" \
          "(ETA for this seed $(date -d "+$((n * each)) seconds" +%H:%M))"
-    # The sweep's own progress goes to its log; its cases' rows to a file of their own, appended when all are done.
+    # The sweep's own progress (a line a case, unbuffered: its stdout is a file) goes to its log, whose last line is
+    # shown when it changes; its cases' rows to a file of their own, appended when all are done.
+    log="$out/.$level.$seed.log"; shown=""
     # shellcheck disable=SC2086
-    "$sweep" --hidden "$(cases "$level" "$seed" | tr ' ' ,)" --seeds "$seed" --noise-scale "$(noise "$level")" \
-      -j "$jobs" -o "$tmp" ${SWEEP_ARGS:-} > "$out/.$level.$seed.log" 2>&1 ||
-      { tail -n 20 "$out/.$level.$seed.log"; echo "identification_table: $level seed $seed failed"; exit 1; }
+    stdbuf -o0 -e0 "$sweep" --hidden "$(cases "$level" "$seed" | tr ' ' ,)" --seeds "$seed" --noise-scale "$(noise "$level")" \
+      -j "$jobs" -o "$tmp" ${SWEEP_ARGS:-} > "$log" 2>&1 &
+    pid=$!
+    while kill -0 "$pid" 2>/dev/null; do
+      sleep 5
+      line="$(tr '\r' '\n' < "$log" | grep "^hidden sweep [0-9]" | tail -n 1 | cut -c1-140 || true)"
+      [ -n "$line" ] && [ "$line" != "$shown" ] && echo "identification_table: $level seed $seed: $line" && shown="$line"
+    done
+    wait "$pid" || { tail -n 20 "$log"; echo "identification_table: $level seed $seed failed"; exit 1; }
     secs=$(( (SECONDS - t0) / n ))
     if [ ! -f "$out/$level.csv" ]; then head -n 1 "$tmp" | sed 's/$/,commit,seconds/' > "$out/$level.csv"
     elif [ "$(head -n 1 "$tmp"),commit,seconds" != "$(head -n 1 "$out/$level.csv")" ]; then
@@ -77,7 +85,7 @@ if [ "$plan" != 1 ]; then
     # A seed run again (another commit's rows for it were partial) replaces them.
     awk -F, -v s="$seed" 'NR == 1 || $3 != s' "$out/$level.csv" > "$out/.$level.keep" && mv "$out/.$level.keep" "$out/$level.csv"
     tail -n +2 "$tmp" | sed "s/\$/,$commit,$secs/" >> "$out/$level.csv"
-    rm -f "$tmp" "$out/.$level.$seed.log"
+    rm -f "$tmp" "$log"
     ran=$((ran + n))
     echo "identification_table: $level seed $seed done in $(( (SECONDS - t0) / 60 ))m$(( (SECONDS - t0) % 60 ))s" \
          "($ran cases this run): $(tail -n "$n" "$out/$level.csv" | cut -d, -f1,4 | tr '\n' ' ')"
