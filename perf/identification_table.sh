@@ -85,7 +85,7 @@ if [ "$plan" != 1 ]; then
     # A seed run again (another commit's rows for it were partial) replaces them.
     awk -F, -v s="$seed" 'NR == 1 || $3 != s' "$out/$level.csv" > "$out/.$level.keep" && mv "$out/.$level.keep" "$out/$level.csv"
     tail -n +2 "$tmp" | sed "s/\$/,$commit,$secs/" >> "$out/$level.csv"
-    rm -f "$tmp" "$log"
+    rm -f "$tmp" "$tmp".* "$log"  # the sweep writes its pools beside its rows
     ran=$((ran + n))
     echo "identification_table: $level seed $seed done in $(( (SECONDS - t0) / 60 ))m$(( (SECONDS - t0) % 60 ))s" \
          "($ran cases this run): $(tail -n "$n" "$out/$level.csv" | cut -d, -f1,4 | tr '\n' ' ')"
