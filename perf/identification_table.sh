@@ -53,14 +53,11 @@ echo "identification_table: ${#units[@]} seeds, $left_cases cases left (levels: 
      "-j $jobs on this machine, $((left_cases * each / 60)) minutes in all; this budget ($budget s) reaches about" \
      "$((budget / each)) cases. Rows of another commit than $commit: $other"
 if [ "$plan" != 1 ]; then
-  start=$SECONDS; ran=0
+  start=$SECONDS; ran=0; skipped=0
   for u in "${units[@]}"; do
     IFS=: read -r level seed n <<< "$u"
     left=$((budget - (SECONDS - start))); each=$(mean_case)
-    if [ "$left" -lt $((n * each)) ]; then
-      echo "identification_table: $level seed $seed ($n cases, about $((n * each)) s) not started: $left s of the budget left"
-      continue
-    fi
+    if [ "$left" -lt $((n * each)) ]; then skipped=$((skipped + 1)); continue; fi
     t0=$SECONDS; tmp="$out/.$level.$seed.csv"
     echo "identification_table: $level seed $seed: $n cases (about $((n * each)) s); $left s of the budget left" \
          "(ETA for this seed $(date -d "+$((n * each)) seconds" +%H:%M))"
@@ -90,6 +87,7 @@ if [ "$plan" != 1 ]; then
     echo "identification_table: $level seed $seed done in $(( (SECONDS - t0) / 60 ))m$(( (SECONDS - t0) % 60 ))s" \
          "($ran cases this run): $(tail -n "$n" "$out/$level.csv" | cut -d, -f1,4 | tr '\n' ' ')"
   done
+  [ "$skipped" = 0 ] || echo "identification_table: $skipped seeds not started: the budget left less than their cases' time"
 fi
 args=()
 for level in $levels; do [ -s "$out/$level.csv" ] && args+=(--level "$level=$out/$level.csv"); done
