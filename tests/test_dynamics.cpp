@@ -2,8 +2,11 @@
 /// energy conservation and static equilibrium, each compared with its closed-form solution.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <random>
+#include <string>
+#include <thread>
 #include <vector>
 
 #include "host/engine/builder.hpp"
@@ -581,12 +584,15 @@ TEST(WallServo, SpeedIsTheGainOnTheErrorWithinTheClampAndTiedNodesFollow) {
 // out below zero (short specimen layers printed -13.6 ns a particle-step, issue 65). Scaled to the steps the stage
 // ran, the parts of such a stage are the one step's, timed inside the stage's wall time: they fit in it on any
 // machine, however noisy.
-TEST(Stage, ThePartsOfAShortStageFitInItsWallTime) {
+namespace {
+
+/// One ball at rest on a plane: a stage's steps with next to no work of their own.
+Simulation resting_ball() {
   const double R = 1e-3, emod = 1e8;
   const double m = ball_mass(R), knw = kPi * R * emod;
   std::vector<BallSpec> b(1);
   b[0].radius = R;
-  b[0].x = Vec3(0, 0, R - m * kG / knw);  // at rest on the plane
+  b[0].x = Vec3(0, 0, R - m * kG / knw);
   std::vector<WallSpec> w(1);
   w[0].kind = kPlane;
   w[0].point = Vec3(0, 0, 0);
@@ -594,6 +600,13 @@ TEST(Stage, ThePartsOfAShortStageFitInItsWallTime) {
   Simulation sim(make_particles(b), make_walls(w), FacetMesh(), {test::law(emod, 1.5, 0.5, 0.0, 0.0)}, 1,
                  sim_params(0.1 * R, 0.0, Vec3(0, 0, -kG)));
   sim.set_dt(0.2 * sim.critical_dt());
+  return sim;
+}
+
+}  // namespace
+
+TEST(Stage, ThePartsOfAShortStageFitInItsWallTime) {
+  Simulation sim = resting_ball();
   for (int k = 0; k < 3; ++k) {
     while (sim.step_count() % kTimedEvery != 0) sim.step(false);  // the stage's one step is a sampled one
     StageSteps one;
@@ -604,4 +617,30 @@ TEST(Stage, ThePartsOfAShortStageFitInItsWallTime) {
     ASSERT_EQ(e.timing.steps, 1);
     EXPECT_GE(e.timing.host(), 0) << "parts " << e.timing.parts.loop() << " s in a wall time of " << e.timing.wall;
   }
+}
+
+// The host's work is told apart by where it is spent (timings.csv's host_control_ns, host_after_ns), so that a GPU
+// run's host share says whether the servo or the records hold it. A stage whose work after a step sleeps 2 ms must
+// show at least that there, and its control (nothing) less; sleeping can only last longer than asked, and both
+// parts are timed inside the stage's wall time.
+TEST(Stage, TheHostsWorkIsSplitIntoControlAndTheWorkAfterAStep) {
+  Simulation sim = resting_ball();
+  const int steps = 5;
+  const double nap = 2e-3;
+  StageSteps stage;
+  stage.first = sim.step_count() + 1;
+  stage.last = sim.step_count() + steps;
+  stage.before = [](long) { return StepPlan{}; };
+  stage.after = [nap](long, bool) {
+    std::this_thread::sleep_for(std::chrono::duration<double>(nap));
+    return false;
+  };
+  const StageTiming t = run_stage(sim, stage, nullptr).timing;
+  ASSERT_EQ(t.steps, steps);
+  EXPECT_GE(t.after, steps * nap);
+  EXPECT_LT(t.control, t.after);
+  EXPECT_EQ(t.checkpoints, 0.0) << "no checkpoint plan";
+  EXPECT_LE(t.control + t.after, t.wall);
+  const std::string csv = timings_csv({t});
+  EXPECT_NE(csv.find("host_control_ns,host_after_ns,host_checkpoint_ns"), std::string::npos) << csv;
 }

@@ -12,24 +12,44 @@ namespace dem {
 
 namespace {
 
+/// Adds the wall seconds of its scope to a sum.
+class WallClock {
+ public:
+  explicit WallClock(double& sum) : sum_(sum), t0_(std::chrono::steady_clock::now()) {}
+  ~WallClock() { sum_ += seconds_since(t0_); }
+  WallClock(const WallClock&) = delete;
+  WallClock& operator=(const WallClock&) = delete;
+
+ private:
+  double& sum_;
+  std::chrono::steady_clock::time_point t0_;
+};
+
 StageEnd run_steps(Simulation& sim, const StageSteps& stage, CheckpointPlan* plan) {
   long n = stage.first;
+  StageTiming t;  // the host's parts; run_stage fills in the rest
+  const auto ended = [&t](long last, bool done) { return StageEnd{last, done, t}; };
   try {
     for (; n <= stage.last; ++n) {
       StepPlan next;
       {
         const SyncScope part(SyncPart::kControl);
+        const WallClock clock(t.control);
         next = stage.before(n);
       }
-      if (next.done) return {n - 1, true, {}};
+      if (next.done) return ended(n - 1, true);
       {
         const SyncScope part(SyncPart::kStep);
         sim.step(next.measure);
       }
       const SyncScope part(SyncPart::kRecord);
-      if (stage.after && stage.after(n, next.measure)) return {n, true, {}};
+      {
+        const WallClock clock(t.after);
+        if (stage.after && stage.after(n, next.measure)) return ended(n, true);
+      }
       if (!plan || !stage.checkpoint) continue;
       if (plan->due(sim.step_count())) {
+        const WallClock clock(t.checkpoints);
         stage.checkpoint(n);
         plan->clock.written();
       }
@@ -39,15 +59,17 @@ StageEnd run_steps(Simulation& sim, const StageSteps& stage, CheckpointPlan* pla
     if (stage.save_blowup) stage.save_blowup();
     throw;
   }
-  return {n - 1, false, {}};
+  return ended(n - 1, false);
 }
 
 /// Nanoseconds per particle-step of each part of a stage, in the columns' order: rebuild, ball-ball, ball-wall,
-/// membrane, gather + integration, boundaries, the host's work between steps.
-std::array<double, 7> ns_per_part(const StageTiming& t) {
+/// membrane, gather + integration, boundaries, the host's work between steps, and of it the stage's control, its
+/// work after a step and its checkpoints.
+std::array<double, 10> ns_per_part(const StageTiming& t) {
   const double work = static_cast<double>(t.balls) * static_cast<double>(t.steps);
   const StageTimes& p = t.parts;
-  std::array<double, 7> ns{p.rebuild, p.forces, p.walls, p.membrane, p.integrate, p.boundaries, t.host()};
+  std::array<double, 10> ns{p.rebuild,  p.forces,  p.walls,   p.membrane,    p.integrate,
+                            p.boundaries, t.host(), t.control, t.after, t.checkpoints};
   for (double& x : ns) x = work > 0 ? 1e9 * x / work : 0;
   return ns;
 }
@@ -83,18 +105,20 @@ StageEnd run_stage(Simulation& sim, const StageSteps& stage, CheckpointPlan* pla
 std::string timings_csv(const std::vector<StageTiming>& stages) {
   std::string s = "stage,balls,steps,wall_s,particle_steps_per_s,rebuilds,rebuild_ns,ball_ball_ns,ball_wall_ns,"
                   "membrane_ns,gather_integrate_ns,boundaries_ns,host_ns,ball_pairs_per_ball,wall_pairs_per_ball,"
-                  "launches_per_step,syncs_per_step,allocations_per_step,syncs_per_rebuild,record_syncs_per_step\n";
+                  "launches_per_step,syncs_per_step,allocations_per_step,syncs_per_rebuild,record_syncs_per_step,"
+                  "host_control_ns,host_after_ns,host_checkpoint_ns\n";
   char line[512];
   for (const StageTiming& t : stages) {
     const auto ns = ns_per_part(t);
     const double steps = std::max(1L, t.steps), rebuilds = std::max(1L, t.parts.rebuilds);
     const SyncCounts each = t.per_step_part();
     std::snprintf(line, sizeof line,
-                  "%s,%ld,%ld,%.3f,%.4g,%ld,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.3f,%.3f,%.3f,%.3f,%.3f,%.2f,%.3f\n",
+                  "%s,%ld,%ld,%.3f,%.4g,%ld,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.3f,%.3f,%.3f,%.3f,%.3f,%.2f,%.3f,%.2f,%.2f,"
+                  "%.2f\n",
                   t.name.c_str(), t.balls, t.steps, t.wall, t.rate(), t.parts.rebuilds, ns[0], ns[1], ns[2], ns[3],
                   ns[4], ns[5], ns[6], t.ball_pairs, t.wall_pairs, each.launches / steps, each.syncs() / steps,
                   each.allocations / steps, t.syncs[static_cast<int>(SyncPart::kRebuild)].syncs() / rebuilds,
-                  t.syncs[static_cast<int>(SyncPart::kRecord)].syncs() / steps);
+                  t.syncs[static_cast<int>(SyncPart::kRecord)].syncs() / steps, ns[7], ns[8], ns[9]);
     s += line;
   }
   return s;

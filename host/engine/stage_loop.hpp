@@ -48,6 +48,10 @@ struct StageTiming {
   double ball_pairs = 0, wall_pairs = 0;
   /// What the stage's steps made the host wait for, by part of the loop (sync_counts.hpp).
   SyncTally syncs{};
+  /// Wall seconds of the host's work by where it is spent: the stage's control before a step (servo, boundary
+  /// speeds), its work after one (records, micromechanics, snapshots, progress) and its checkpoints. On a GPU the
+  /// host waits there for the steps launched before, so a part's time includes the device work it waits for.
+  double control = 0, after = 0, checkpoints = 0;
   /// Per step, the step's and its control's (a servo's) counts: what every step pays, rebuilds and records left out.
   SyncCounts per_step_part() const {
     return syncs[static_cast<int>(SyncPart::kControl)] + syncs[static_cast<int>(SyncPart::kStep)];
