@@ -36,6 +36,25 @@ View same_size(View& kept, std::size_t n, const char* label) {
   return kept;
 }
 
+/// A host View of `v`'s extents kept by the caller, to fill and copy to v: v itself where the host can reach it (as
+/// Kokkos::create_mirror_view), else `kept`, made again only where v's extents differ from it.
+template <class View>
+typename View::HostMirror kept_mirror(typename View::HostMirror& kept, const View& v) {
+  if (Kokkos::SpaceAccessibility<HostSpace, typename View::memory_space>::accessible) return Kokkos::create_mirror_view(v);
+  bool same = kept.data() != nullptr || v.size() == 0;
+  for (unsigned r = 0; r < View::rank; ++r) same = same && kept.extent(r) == v.extent(r);
+  if (!same) kept = Kokkos::create_mirror(v);
+  return kept;
+}
+
+/// What `v` holds, readable on the host, in kept_mirror's View (as Kokkos::create_mirror_view_and_copy).
+template <class View>
+typename View::HostMirror kept_host_copy(typename View::HostMirror& kept, const View& v) {
+  const typename View::HostMirror h = kept_mirror(kept, v);
+  if (!Kokkos::SpaceAccessibility<HostSpace, typename View::memory_space>::accessible) Kokkos::deep_copy(h, v);
+  return h;
+}
+
 /// Sets a rank-1 View's entries to zero in a kernel (a deep_copy of a value waits for the device).
 template <class View>
 void zero(const View& v, const char* label) {

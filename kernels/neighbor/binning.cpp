@@ -80,7 +80,7 @@ void bin_specimens(Particles& p, const std::vector<SpecimenBin>& specimens, Cell
   if (ns == 0) throw std::invalid_argument("bin_specimens: no specimen");
   if (static_cast<int>(cells.specimens.extent(0)) != ns)
     cells.specimens = SpecimenCellsView("dem::binning::specimens", ns);
-  auto hs = Kokkos::create_mirror_view(cells.specimens);
+  const auto hs = kept_mirror(cells.specimens_host, cells.specimens);
   int nc = 0;
   bool wrap = false;
   for (int s = 0; s < ns; ++s) {

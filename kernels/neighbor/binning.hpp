@@ -56,6 +56,7 @@ struct CellList {
   /// The binning's scratch, kept for the next rebuild (buffers.hpp): cells, counts, cursors, the permutation, and
   /// the particles' other set of Views that the permutation writes to.
   IndexView cell_buf, start_buf, cursor_buf, perm_buf;
+  SpecimenCellsView::HostMirror specimens_host;
   Particles spare;
 };
 

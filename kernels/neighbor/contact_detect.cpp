@@ -118,7 +118,7 @@ PairKeyView run_search(Search s, int n, const char* label, ListBuffers* buffers)
   const int total = exclusive_scan("dem::detect::scan", s.count, s.offset, n);
   s.keys = room(b.set[b.next].key, total, "dem::detect::keys");
   Kokkos::parallel_for(label, Kokkos::RangePolicy<ExecSpace, typename Search::TagFill>(0, n), s);
-  sort_keys(s.keys);
+  sort_keys(s.keys, b.sort);
   return s.keys;
 }
 
@@ -126,8 +126,8 @@ PairKeyView run_search(Search s, int n, const char* label, ListBuffers* buffers)
 
 FacetBins bin_facets(const FacetMesh& mesh, const CellGrid& g, Real reach, FacetBins& kept) {
   const int nc = g.ncell();
-  auto hx = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.node_x);
-  auto ht = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.tri);
+  const auto hx = kept_host_copy(kept.node_x_host, mesh.node_x);
+  const auto ht = kept_host_copy(kept.tri_host, mesh.tri);
   std::vector<std::pair<int, int>> entries;  // (cell, facet)
   for (int t = 0; t < mesh.ntri; ++t) {
     int lo[3], hi[3];
@@ -148,10 +148,14 @@ FacetBins bin_facets(const FacetMesh& mesh, const CellGrid& g, Real reach, Facet
         for (int cx = lo[0]; cx <= hi[0]; ++cx) entries.emplace_back(g.index(cx, cy, cz), t);
   }
   std::sort(entries.begin(), entries.end());
-  FacetBins b{room(kept.start, nc + 1, "dem::detect::facet_start"),
-              room(kept.facet, entries.size(), "dem::detect::facet")};
-  auto hs = Kokkos::create_mirror_view(b.start);
-  auto hf = Kokkos::create_mirror_view(b.facet);
+  FacetBins b;
+  b.start = room(kept.start, nc + 1, "dem::detect::facet_start");
+  b.facet = room(kept.facet, entries.size(), "dem::detect::facet");
+  // Host Views of the whole buffers, which grow seldom; the bins' entries change in number at each rebuild.
+  const auto hs_all = kept_mirror(kept.start_host, kept.start);
+  const auto hf_all = kept_mirror(kept.facet_host, kept.facet);
+  const auto hs = Kokkos::subview(hs_all, std::make_pair(std::size_t(0), b.start.extent(0)));
+  const auto hf = Kokkos::subview(hf_all, std::make_pair(std::size_t(0), b.facet.extent(0)));
   std::size_t k = 0;
   for (int c = 0; c <= nc; ++c) {
     hs(c) = static_cast<int>(k);

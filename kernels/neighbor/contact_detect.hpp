@@ -12,6 +12,10 @@ namespace dem {
 struct FacetBins {
   IndexView start;   ///< ncell + 1 offsets
   IndexView facet;
+  /// bin_facets' host Views, kept in the caller's FacetBins between rebuilds (a GPU's host copies are allocations).
+  IndexView::HostMirror start_host, facet_host;
+  Vec3View::HostMirror node_x_host;
+  Index3View::HostMirror tri_host;
 };
 
 /// Bins the mesh's facets into the cells of `grid` (on the host: a membrane has a few thousand facets), into the

@@ -27,15 +27,22 @@ KOKKOS_INLINE_FUNCTION int key_lower_bound(const Keys& keys, int n, std::uint64_
   return lo;
 }
 
+/// bin_sort_keys' scratch, kept between rebuilds so that a sort after the first allocates nothing where the keys
+/// have not outgrown it (on a GPU an allocation holds the host until the device is idle).
+struct KeySortBuffers {
+  IndexView count, fill, offset;  ///< per bin: its keys, those placed so far, its first position
+  PairKeyView sorted;
+};
+
 /// Sorts contact keys ascending (they are unique, so every method gives the same order): std::sort where the
 /// keys live in host memory, bin_sort_keys elsewhere.
-void sort_keys(const PairKeyView& keys);
+void sort_keys(const PairKeyView& keys, KeySortBuffers& kept);
 
-/// Kokkos::BinSort over bins uniform in hi * span + lo (span: the largest lo + 1), a numbering in the keys' order
-/// that is dense wherever the gids are. Kokkos::sort's bins are uniform in the raw key, so the few objects of
-/// ball-wall keys (object << 32) put all of a wall's contacts in one bin, which BinSort orders by a bubble sort in
-/// one thread: quadratic in the balls on the wall (0.4 s a rebuild at 53,704 balls on an H100).
-void bin_sort_keys(const PairKeyView& keys);
+/// A counting sort over bins uniform in hi * span + lo (span: the largest lo + 1), a numbering in the keys' order
+/// that is dense wherever the gids are, then each bin's few keys in order. Bins uniform in the raw key (Kokkos::sort's)
+/// put all of a wall's contacts in one bin (ball-wall keys are object << 32 | gid), which Kokkos::BinSort orders by
+/// a bubble sort in one thread: quadratic in the balls on the wall (0.4 s a rebuild at 53,704 balls on an H100).
+void bin_sort_keys(const PairKeyView& keys, KeySortBuffers& kept);
 
 struct ContactList {
   PairKeyView key;
@@ -65,6 +72,7 @@ struct ContactList {
 /// have exactly n.
 struct ListBuffers {
   IndexView count, offset;
+  KeySortBuffers sort;
   ContactList set[2];
   int next = 0;  ///< the set the next list is written into
 };
