@@ -659,9 +659,9 @@ TEST(Detection, KeySortsGiveTheOrderOfStdSort) {
 
 // A GPU's rebuild sorts with bin_sort_keys, whose buffers are kept (KeySortBuffers in ListBuffers): a later sort of
 // as many keys or fewer allocates nothing and copies nothing (what it may read back: the keys' range, two reductions
-// that set the bins, and the scan of the bins' counts, which the counter takes for a read). Kokkos::BinSort allocated its counts, offsets,
-// permutation and a copy of the keys at every sort (a GPU rebuild counted 10-13 allocations, the CPU's 1-5).
-// Counted on the CPU, where the calls are the same.
+// that set the bins, and the scan of the bins' counts, which the counter takes for a read). Kokkos::BinSort
+// allocated its counts, offsets, permutation and a copy of the keys at every sort (a GPU rebuild counted 10-13
+// allocations, the CPU's 1-5). Counted on the CPU, where the calls are the same.
 TEST(Detection, AKeySortAfterTheFirstAllocatesNothing) {
   ASSERT_TRUE(count_syncs()) << "a profiling tool holds Kokkos' callbacks";
   std::vector<std::uint64_t> keys = scrambled_keys();

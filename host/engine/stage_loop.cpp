@@ -113,8 +113,8 @@ std::string timings_csv(const std::vector<StageTiming>& stages) {
     const double steps = std::max(1L, t.steps), rebuilds = std::max(1L, t.parts.rebuilds);
     const SyncCounts each = t.per_step_part();
     std::snprintf(line, sizeof line,
-                  "%s,%ld,%ld,%.3f,%.4g,%ld,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.3f,%.3f,%.3f,%.3f,%.3f,%.2f,%.3f,%.2f,%.2f,"
-                  "%.2f\n",
+                  "%s,%ld,%ld,%.3f,%.4g,%ld,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.2f,%.3f,%.3f,%.3f,%.3f,%.3f,%.2f,%.3f,"
+                  "%.2f,%.2f,%.2f\n",
                   t.name.c_str(), t.balls, t.steps, t.wall, t.rate(), t.parts.rebuilds, ns[0], ns[1], ns[2], ns[3],
                   ns[4], ns[5], ns[6], t.ball_pairs, t.wall_pairs, each.launches / steps, each.syncs() / steps,
                   each.allocations / steps, t.syncs[static_cast<int>(SyncPart::kRebuild)].syncs() / rebuilds,

@@ -40,7 +40,8 @@ View same_size(View& kept, std::size_t n, const char* label) {
 /// Kokkos::create_mirror_view), else `kept`, made again only where v's extents differ from it.
 template <class View>
 typename View::HostMirror kept_mirror(typename View::HostMirror& kept, const View& v) {
-  if (Kokkos::SpaceAccessibility<HostSpace, typename View::memory_space>::accessible) return Kokkos::create_mirror_view(v);
+  if (Kokkos::SpaceAccessibility<HostSpace, typename View::memory_space>::accessible)
+    return Kokkos::create_mirror_view(v);
   bool same = kept.data() != nullptr || v.size() == 0;
   for (unsigned r = 0; r < View::rank; ++r) same = same && kept.extent(r) == v.extent(r);
   if (!same) kept = Kokkos::create_mirror(v);

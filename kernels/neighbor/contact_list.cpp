@@ -91,7 +91,8 @@ void bin_sort_keys(const PairKeyView& keys, KeySortBuffers& kept) {
     }
   });
   // A copy in a kernel: a deep_copy waits for the device.
-  Kokkos::parallel_for("dem::contacts::sort_back", RangePolicy(0, n), KOKKOS_LAMBDA(const int i) { keys(i) = sorted(i); });
+  Kokkos::parallel_for("dem::contacts::sort_back", RangePolicy(0, n),
+      KOKKOS_LAMBDA(const int i) { keys(i) = sorted(i); });
 }
 
 void sort_keys(const PairKeyView& keys, KeySortBuffers& kept) {
