@@ -43,10 +43,12 @@ StageEnd run_steps(Simulation& sim, const StageSteps& stage, CheckpointPlan* pla
         sim.step(next.measure);
       }
       const SyncScope part(SyncPart::kRecord);
+      bool done = false;
       {
         const WallClock clock(t.after);
-        if (stage.after && stage.after(n, next.measure)) return ended(n, true);
+        done = stage.after && stage.after(n, next.measure);
       }
+      if (done) return ended(n, true);  // the last step's work after it counted
       if (!plan || !stage.checkpoint) continue;
       if (plan->due(sim.step_count())) {
         const WallClock clock(t.checkpoints);
