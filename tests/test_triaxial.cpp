@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -13,6 +14,7 @@
 
 #include "host/cli/job.hpp"
 #include "host/engine/stress.hpp"
+#include "host/triax/micro_record.hpp"
 #include "host/triax/micro_report.hpp"
 #include "host/triax/triaxial.hpp"
 #include "host/triax/triaxial_measure.hpp"
@@ -340,4 +342,43 @@ TEST_F(Triaxial, DampingAboutTheFlowClosesThePlatenGap) {
   EXPECT_GT(absolute, 0.0);
   EXPECT_LT(std::fabs(about), 0.5 * absolute);
   EXPECT_LT(std::fabs(mean_net(flow_run)), 0.5 * std::fabs(mean_net(abs_run)));
+}
+
+// A record's micromechanics worked out on a thread of their own while the steps go on ([micro] overlap = "on", as a
+// GPU build does by default) give the records, micro rows, series and written states of the same run working them
+// out at once, bit for bit: the thread works on its own copy of the record's contacts, not on what the steps change,
+// and the series rows go out in their order.
+TEST_F(Triaxial, RecordsWorkedOutBesideTheStepsHaveTheBitsOfRecordsWorkedOutAtOnce) {
+  const auto dir = dem::test::scratch_dir("micro_overlap");
+  Config c = test::tiny_triaxial_config(0.3, 0.02);
+  c.triaxial.axial_strain_end = 0.05;  // states A (0%), B (1%), C = D (5%), and peaks on the way
+  TriaxialResult r[2];
+  for (const char* mode : {"off", "on"}) {
+    c.micro.overlap = mode;
+    ASSERT_EQ(overlaps_records(c.micro), mode == std::string("on"));
+    io::Output out((dir / mode).string());
+    r[mode == std::string("on")] = run_triaxial(c, *specimen_, &out, false);
+  }
+  ASSERT_GT(r[0].records.size(), 5u);
+  ASSERT_EQ(r[1].records.size(), r[0].records.size());
+  ASSERT_EQ(r[1].micro.size(), r[0].micro.size());
+  for (std::size_t k = 0; k < r[0].records.size(); ++k)
+    EXPECT_EQ(std::memcmp(&r[1].records[k], &r[0].records[k], sizeof(TriaxialRecord)), 0) << "record " << k;
+  std::vector<double> micro[2];
+  for (int m : {0, 1})
+    for (const MicroRow& x : r[m].micro) append_micro_state(x, micro[m]);
+  EXPECT_TRUE(micro[0] == micro[1]) << "micro rows";
+  auto text = [](const std::filesystem::path& p) {
+    std::ifstream in(p);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  int files = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir / "off")) {
+    const std::string name = e.path().filename().string(), ext = e.path().extension().string();
+    if (ext != ".csv" && ext != ".vtk") continue;
+    EXPECT_FALSE(text(e.path()).empty()) << name;
+    EXPECT_TRUE(text(e.path()) == text(dir / "on" / name)) << name;
+    ++files;
+  }
+  EXPECT_GE(files, 16) << "series, the states at A, B, C, D and the peak (3 tables and force chains each)";
 }

@@ -220,6 +220,7 @@ void read_micro(const Tables& read, Config& c) {
   TableReader mi = read("micro");
   mi.boolean("enabled", c.micro.enabled);
   mi.number("rve_edge_mm", c.micro.rve_edge, 0, 1e6, 1e-3, true);
+  mi.string("overlap", c.micro.overlap, {"auto", "on", "off"});
   long bins = c.micro.rose_bins;
   mi.integer("rose_bins", bins, 2, 3600);
   c.micro.rose_bins = static_cast<int>(bins);

@@ -109,6 +109,9 @@ struct MicroConfig {
   bool enabled = true;
   Real rve_edge = 20e-3;   ///< m, edge of the central cube (the paper's 20 mm; file: rve_edge_mm)
   int rose_bins = 18;      ///< angle bins of the directional distributions over 0-180 deg
+  /// Whether a record's micromechanics are worked out on a host thread beside the next steps: "on", "off", or
+  /// "auto" (on where the steps run on a device; host/triax/micro_record.hpp).
+  std::string overlap = "auto";
 };
 
 /// The gas phase's clamp over the consolidation's where [periodic] gas_rate_per_s is automatic (see gas_rate).

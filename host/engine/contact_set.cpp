@@ -26,67 +26,93 @@ ContactRecord record(int a, const Vec3& d, const Vec3& fc_on_a, Real fn) {
   return c;
 }
 
+/// The first n values of a one-dimensional device View, in a host vector of their own.
+template <class V>
+std::vector<typename V::non_const_value_type> host_values(const V& v, int n) {
+  const auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), Kokkos::subview(v, std::make_pair(0, n)));
+  return std::vector<typename V::non_const_value_type>(h.data(), h.data() + n);
+}
+/// The first n rows of a 3-vector View (of a triple View, below), likewise.
+std::vector<Vec3> host_rows(const Vec3View& v, int n) {
+  const auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), v);
+  std::vector<Vec3> out(static_cast<std::size_t>(n));
+  for (int k = 0; k < n; ++k) out[k] = load(h, k);
+  return out;
+}
+std::vector<std::array<int, 3>> host_triples(const Index3View& v, int n) {
+  const auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), v);
+  std::vector<std::array<int, 3>> out(static_cast<std::size_t>(n));
+  for (int k = 0; k < n; ++k) out[k] = {h(k, 0), h(k, 1), h(k, 2)};
+  return out;
+}
+ContactCopy::List host_list(const ContactList& l) {
+  return {host_values(l.i, l.n), host_values(l.j, l.n), host_rows(l.fc, l.n), host_values(l.fn, l.n)};
+}
+
 }  // namespace
 
-ContactSet contact_set(Simulation& sim) {
-  Particles& p = sim.particles();
-  ContactSet s;
-  const HostParticles h = to_host_by_gid(p);
-  s.x = h.x;
-  auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), p.gid);
-  auto rad = Kokkos::create_mirror_view_and_copy(HostSpace(), p.radius);
-  s.radius.resize(p.n);
-  for (int i = 0; i < p.n; ++i) s.radius[gid(i)] = rad(i);
-  const Domain& dom = sim.domain();
-
-  const ContactList& bc = sim.ball_contacts();
-  auto ci = Kokkos::create_mirror_view_and_copy(HostSpace(), bc.i);
-  auto cj = Kokkos::create_mirror_view_and_copy(HostSpace(), bc.j);
-  auto fc = Kokkos::create_mirror_view_and_copy(HostSpace(), bc.fc);
-  auto fn = Kokkos::create_mirror_view_and_copy(HostSpace(), bc.fn);
-  for (int k = 0; k < bc.n; ++k) {
-    if (!(fn(k) > 0)) continue;
-    const int a = static_cast<int>(gid(ci(k))), b = static_cast<int>(gid(cj(k)));
-    ContactRecord c = record(a, dom.min_image(s.x[b] - s.x[a]), load(fc, k), fn(k));
-    c.b = b;
-    const Real overlap = s.radius[a] + s.radius[b] - norm(c.branch);
-    c.point = s.x[c.a] + (s.radius[c.a] - overlap / 2) * c.normal;
-    s.contacts.push_back(c);
-  }
-
-  const ContactList& wc = sim.wall_contacts();
-  auto wi = Kokkos::create_mirror_view_and_copy(HostSpace(), wc.i);
-  auto wj = Kokkos::create_mirror_view_and_copy(HostSpace(), wc.j);
-  auto wf = Kokkos::create_mirror_view_and_copy(HostSpace(), wc.fc);
-  auto wn = Kokkos::create_mirror_view_and_copy(HostSpace(), wc.fn);
+ContactCopy copy_contacts(Simulation& sim) {
+  const Particles& p = sim.particles();
+  ContactCopy c;
+  c.x = to_host_by_gid(p).x;
+  const auto gid = host_values(p.gid, p.n);
+  c.gid.assign(gid.begin(), gid.end());
+  const std::vector<Real> rad = host_values(p.radius, p.n);
+  c.radius.resize(p.n);
+  for (int i = 0; i < p.n; ++i) c.radius[c.gid[i]] = rad[i];
+  c.balls = host_list(sim.ball_contacts());
+  c.walls = host_list(sim.wall_contacts());
   const WallSet& walls = sim.walls();
-  auto kind = Kokkos::create_mirror_view_and_copy(HostSpace(), walls.kind);
-  auto wp = Kokkos::create_mirror_view_and_copy(HostSpace(), walls.point);
-  auto wnorm = Kokkos::create_mirror_view_and_copy(HostSpace(), walls.normal);
-  auto wrad = Kokkos::create_mirror_view_and_copy(HostSpace(), walls.radius);
+  c.wall_kind = host_values(walls.kind, walls.n);
+  c.wall_point = host_rows(walls.point, walls.n);
+  c.wall_normal = host_rows(walls.normal, walls.n);
+  c.wall_radius = host_values(walls.radius, walls.n);
   const FacetMesh& mesh = sim.mesh();
-  auto nx = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.node_x);
-  auto tri = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.tri);
-  for (int k = 0; k < wc.n; ++k) {
-    if (!(wn(k) > 0)) continue;
-    const int a = static_cast<int>(gid(wi(k)));
+  c.node_x = host_rows(mesh.node_x, mesh.nnode);
+  c.tri = host_triples(mesh.tri, mesh.ntri);
+  c.domain = sim.domain();
+  return c;
+}
+
+ContactSet contact_set(const ContactCopy& c) {
+  ContactSet s;
+  s.x = c.x;
+  s.radius = c.radius;
+  const ContactCopy::List& bc = c.balls;
+  for (std::size_t k = 0; k < bc.fn.size(); ++k) {
+    if (!(bc.fn[k] > 0)) continue;
+    const int a = c.gid[bc.i[k]], b = c.gid[bc.j[k]];
+    ContactRecord r = record(a, c.domain.min_image(s.x[b] - s.x[a]), bc.fc[k], bc.fn[k]);
+    r.b = b;
+    const Real overlap = s.radius[a] + s.radius[b] - norm(r.branch);
+    r.point = s.x[r.a] + (s.radius[r.a] - overlap / 2) * r.normal;
+    s.contacts.push_back(r);
+  }
+  const ContactCopy::List& wc = c.walls;
+  const int nwalls = static_cast<int>(c.wall_kind.size());
+  for (std::size_t k = 0; k < wc.fn.size(); ++k) {
+    if (!(wc.fn[k] > 0)) continue;
+    const int a = c.gid[wc.i[k]];
     const Vec3& x = s.x[a];
-    const int obj = wj(k);
+    const int obj = wc.j[k];
     Vec3 cp;
-    if (obj < walls.n) {
-      if (!wall_closest_point(kind(obj), load(wp, obj), load(wnorm, obj), wrad(obj), x, cp)) continue;
+    if (obj < nwalls) {
+      if (!wall_closest_point(c.wall_kind[obj], c.wall_point[obj], c.wall_normal[obj], c.wall_radius[obj], x, cp))
+        continue;
     } else {
-      const int t = obj - walls.n;
-      cp = closest_on_triangle(x, load(nx, tri(t, 0)), load(nx, tri(t, 1)), load(nx, tri(t, 2))).cp;
+      const std::array<int, 3>& t = c.tri[obj - nwalls];
+      cp = closest_on_triangle(x, c.node_x[t[0]], c.node_x[t[1]], c.node_x[t[2]]).cp;
     }
     if (!(norm(cp - x) > 0)) continue;
-    ContactRecord c = record(a, cp - x, load(wf, k), wn(k));
-    c.boundary = obj < walls.n ? Boundary::kPlaten : Boundary::kMembrane;
-    c.point = cp;
-    s.contacts.push_back(c);
+    ContactRecord r = record(a, cp - x, wc.fc[k], wc.fn[k]);
+    r.boundary = obj < nwalls ? Boundary::kPlaten : Boundary::kMembrane;
+    r.point = cp;
+    s.contacts.push_back(r);
   }
   return s;
 }
+
+ContactSet contact_set(Simulation& sim) { return contact_set(copy_contacts(sim)); }
 
 io::ContactTable contact_table(const ContactSet& s) {
   io::ContactTable t;

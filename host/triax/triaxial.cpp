@@ -14,6 +14,7 @@
 #include "host/engine/stage_loop.hpp"
 #include "host/engine/stress.hpp"
 #include "host/data/measured.hpp"
+#include "host/triax/micro_record.hpp"
 #include "host/triax/micro_report.hpp"
 #include "host/util/progress.hpp"
 #include "kernels/motion/wall_servo.hpp"
@@ -154,14 +155,15 @@ void save_blowup(Simulation& sim, const Cell& cell, io::Output& out, const Stage
 class LazyContacts {
  public:
   explicit LazyContacts(Simulation& sim) : sim_(sim) {}
-  const ContactSet& get() {
-    if (!set_) set_ = contact_set(sim_);
-    return *set_;
+  std::shared_ptr<const ContactCopy> copy() {
+    if (!copy_) copy_ = std::make_shared<const ContactCopy>(copy_contacts(sim_));
+    return copy_;
   }
+  ContactSet set() { return contact_set(*copy()); }
 
  private:
   Simulation& sim_;
-  std::optional<ContactSet> set_;
+  std::shared_ptr<const ContactCopy> copy_;
 };
 
 /// What a shear stage's records need besides the step: the test, its state and result, the output, and the
@@ -175,6 +177,7 @@ struct ShearRecorder {
   Real h0, v0, v0_envelope;
   const std::array<Real, kSnapshotStrains>& snaps;  ///< the strains of the paper's points A-D
   Progress& progress;
+  MicroRecords& micro;
   bool verbose;
 };
 
@@ -202,24 +205,25 @@ void take_record(const ShearRecorder& sh, Real eps_a, long k, LazyContacts& cont
   r.kinetic = sim.stats().kinetic;
   measure_stresses(cell, tc, volume, sh.v0 / sh.h0, r);
   sh.res.records.push_back(r);
-  std::vector<double> row = series_row(r, tc.sigma3, sh.st.void_ratio);
-  const int next_snap = sh.st.next_snap;
+  // The series row goes out once its micromechanics are known; a crash keeps the curve so far (flushed every 25).
+  const bool flush = sh.res.records.size() % 25 == 0;
+  auto append = [&res = sh.res, out = sh.out, flush, row = series_row(r, tc.sigma3, sh.st.void_ratio)](
+                    const MicroRow* m, const std::vector<double>& micro) mutable {
+    if (m) res.micro.push_back(*m);
+    row.insert(row.end(), micro.begin(), micro.end());
+    if (out) out->append_series(row);
+    if (out && flush) out->flush_series();
+  };
   if (mc.enabled) {
-    const ContactSet& cs = contacts.get();
-    const ContactSet rve = restrict_to_cube(cs, Vec3(0, 0, top_z / 2), mc.rve_edge);
-    const MicroRow m = micro_row(cs, volume);
-    sh.res.micro.push_back(m);
-    for (const MicroRow& x : {m, micro_row(rve, mc.rve_edge * mc.rve_edge * mc.rve_edge)})
-      for (double v : micro_values(x)) row.push_back(v);
-    const bool snap_due = next_snap < kSnapshotStrains && eps_a >= sh.snaps[next_snap] - 1e-12;
-    if (sh.out && snap_due) write_micro_state(sh.out->folder(), snap_labels[next_snap], cs, rve, mc.rose_bins);
-    if (sh.out && r.q > sh.st.q_max) write_micro_state(sh.out->folder(), "peak", cs, rve, mc.rose_bins);
+    MicroJob job{contacts.copy(), volume, Vec3(0, 0, top_z / 2), {}};
+    const int snap = sh.st.next_snap;
+    if (snap < kSnapshotStrains && eps_a >= sh.snaps[snap] - 1e-12) job.states.push_back(snap_labels[snap]);
+    if (r.q > sh.st.q_max) job.states.push_back("peak");
+    sh.micro.add(std::move(job), [append](const MicroRow& m, const std::vector<double>& v) mutable { append(&m, v); });
+  } else {
+    append(nullptr, {});
   }
   sh.st.q_max = std::max(sh.st.q_max, r.q);
-  if (sh.out) {
-    sh.out->append_series(row);
-    if (sh.res.records.size() % 25 == 0) sh.out->flush_series();  // a crash keeps the curve so far
-  }
   sh.st.next_record += tc.record_every;
   if (sh.verbose) {
     char extra[64];
@@ -240,7 +244,7 @@ void observe_shear(const ShearRecorder& sh, long k, bool last) {
     char label[48];
     std::snprintf(label, sizeof label, "shear eps_a=%.0f%%", 100 * sh.snaps[next_snap]);
     const io::SurfaceSnapshot surface = membrane_surface(sh.cell.membrane);
-    const io::ContactTable table = micro ? contact_table(contacts.get()) : io::ContactTable();
+    const io::ContactTable table = micro ? contact_table(contacts.set()) : io::ContactTable();
     sh.out->write_snapshot(take_snapshot(sim, label), &surface, micro ? &table : nullptr);
     sh.st.next_snap += 1;
   }
@@ -331,12 +335,14 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
   // What both stages do alike: a checkpoint of the test's stage and curve when due; on a blow-up, the state it
   // happened in (balls, membrane, contacts) and the curve so far.
   StageSteps shared;
+  MicroRecords micro(mc, out ? out->folder() : std::string());
   shared.checkpoint = [&](long) {
+    micro.finish();
     if (out) out->flush_series();
     res.wall_seconds = elapsed();
     save_triaxial(plan->path, sim, out, st, res, plan->config);
   };
-  if (out) shared.save_blowup = [&] { save_blowup(sim, cell, *out, st, res, plan); };
+  if (out) shared.save_blowup = [&] { micro.finish(); save_blowup(sim, cell, *out, st, res, plan); };
   if (!st.shear) res.stages.push_back(consolidate(cfg, sp, cell, st, verbose, shared, plan));
   res.consolidation_steps = st.consolidation_steps;
   res.void_ratio_consolidated = st.void_ratio;
@@ -352,7 +358,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
                 tc.axial_strain_end * 100);
   const std::array<Real, kSnapshotStrains> snaps = {0.0, 0.01, 0.05, tc.axial_strain_end};
   Progress shear("shear", steps, st.step);
-  const ShearRecorder recorder{cfg, cell, st, res, out, h0, v0, v0_envelope, snaps, shear, verbose};
+  const ShearRecorder recorder{cfg, cell, st, res, out, h0, v0, v0_envelope, snaps, shear, micro, verbose};
   // Before step k + 1, the state step k left: its record and snapshot where due (the last state's too), then the
   // platen's control. A checkpoint follows each step, before the record of the state it left (a resumed run
   // takes that record).
@@ -378,6 +384,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
   };
   res.stages.push_back(run_stage(sim, shear_stage, plan).timing);
   res.stages.back().name = "shear";
+  micro.finish();
   if (out) out->flush_series();
   finish_result(cell, tc.sigma3, elapsed(), res);
   return res;
