@@ -4,7 +4,6 @@
 #include <stdexcept>
 #include <string>
 
-#include "host/engine/builder.hpp"
 #include "host/io/io_hdf5.hpp"
 #include "host/engine/micro.hpp"
 #include "host/engine/simulation.hpp"
@@ -54,12 +53,16 @@ ContactCopy::List host_list(const ContactList& l) {
 ContactCopy copy_contacts(Simulation& sim) {
   const Particles& p = sim.particles();
   ContactCopy c;
-  c.x = to_host_by_gid(p).x;
   const auto gid = host_values(p.gid, p.n);
   c.gid.assign(gid.begin(), gid.end());
+  const std::vector<Vec3> x = host_rows(p.x, p.n);
   const std::vector<Real> rad = host_values(p.radius, p.n);
+  c.x.resize(p.n);
   c.radius.resize(p.n);
-  for (int i = 0; i < p.n; ++i) c.radius[c.gid[i]] = rad[i];
+  for (int i = 0; i < p.n; ++i) {
+    c.x[c.gid[i]] = x[i];
+    c.radius[c.gid[i]] = rad[i];
+  }
   c.balls = host_list(sim.ball_contacts());
   c.walls = host_list(sim.wall_contacts());
   const WallSet& walls = sim.walls();
