@@ -248,6 +248,13 @@ TEST(CellBatch, PeriodicTestsSideBySideGiveEachItsOwnRunsRecords) {
       }
       EXPECT_EQ(got.result.q_peak, want.q_peak) << "specimen " << s;
       EXPECT_GT(want.q_peak, 0.1 * sigma3[s]) << "specimen " << s;  // a test that sheared
+      // Each stage's host work is split as a single run's is (timings.csv): its control before a step and its
+      // records after one, each measured, so neither is zero.
+      ASSERT_EQ(got.result.stages.size(), want.stages.size()) << "specimen " << s;
+      for (const StageTiming& t : got.result.stages) {
+        EXPECT_GT(t.control, 0.0) << t.name << ", specimen " << s;
+        EXPECT_GT(t.after, 0.0) << t.name << ", specimen " << s;
+      }
     }
   }
 }

@@ -12,19 +12,6 @@ namespace dem {
 
 namespace {
 
-/// Adds the wall seconds of its scope to a sum.
-class WallClock {
- public:
-  explicit WallClock(double& sum) : sum_(sum), t0_(std::chrono::steady_clock::now()) {}
-  ~WallClock() { sum_ += seconds_since(t0_); }
-  WallClock(const WallClock&) = delete;
-  WallClock& operator=(const WallClock&) = delete;
-
- private:
-  double& sum_;
-  std::chrono::steady_clock::time_point t0_;
-};
-
 StageEnd run_steps(Simulation& sim, const StageSteps& stage, CheckpointPlan* plan) {
   long n = stage.first;
   StageTiming t;  // the host's parts; run_stage fills in the rest

@@ -4,15 +4,30 @@
 /// before a step and whether the step measures, what it records after it, and when it is done. The loop does what
 /// they share, in one order: the step, the checkpoint when due and the stop when asked, and on a blow-up the
 /// stage's state saved for inspection before the error goes on.
+#include <chrono>
 #include <functional>
 #include <string>
 #include <vector>
 
 #include "host/engine/checkpoint.hpp"
 #include "host/engine/simulation.hpp"
+#include "host/util/progress.hpp"
 #include "host/util/sync_counts.hpp"
 
 namespace dem {
+
+/// Adds the wall seconds of its scope to a sum (a StageTiming's host parts).
+class WallClock {
+ public:
+  explicit WallClock(double& sum) : sum_(sum), t0_(std::chrono::steady_clock::now()) {}
+  ~WallClock() { sum_ += seconds_since(t0_); }
+  WallClock(const WallClock&) = delete;
+  WallClock& operator=(const WallClock&) = delete;
+
+ private:
+  double& sum_;
+  std::chrono::steady_clock::time_point t0_;
+};
 
 /// What a stage does before a step: whether it is done before taking it (its end was seen in the state the last
 /// step left), and whether the step measures the unbalanced force and kinetic energy (when the stage reads them).

@@ -24,9 +24,14 @@ class Program {
   /// done before its step ends here, and the next one plans the step.
   bool before(char& measure) {
     if (!batch_.running(s_)) return false;
-    StepPlan plan = stage_.before(n_);
+    StepPlan plan;
+    {
+      const WallClock clock(host_.control);
+      plan = stage_.before(n_);
+    }
     while (plan.done && batch_.running(s_)) {
-      end_stage({n_ - 1, true, {}});
+      end_stage({n_ - 1, true, host_});
+      const WallClock clock(host_.control);
       if (batch_.running(s_)) plan = stage_.before(n_);
     }
     measure = plan.measure;
@@ -39,8 +44,13 @@ class Program {
       out_.blowup = batch_.blowup(s_);
       return;
     }
-    if (stage_.after(n_, measured)) end_stage({n_, true, {}});
-    else if (++n_ > stage_.last) end_stage({n_ - 1, false, {}});
+    bool done = false;
+    {
+      const WallClock clock(host_.after);
+      done = stage_.after(n_, measured);
+    }
+    if (done) end_stage({n_, true, host_});
+    else if (++n_ > stage_.last) end_stage({n_ - 1, false, host_});
   }
 
  private:
@@ -56,9 +66,11 @@ class Program {
   StageSteps stage_;
   long n_ = 1;
   long first_step_ = 0;  ///< the specimen's step count at the stage's start
+  StageTiming host_;     ///< the stage's host work so far (control, after), as run_stage splits it
 
   /// The stage ended (run_stage's StageEnd): on to the next stage, or stopped.
   void end_stage(StageEnd e) {
+    host_ = StageTiming();
     e.timing.balls = batch_.balls(s_);
     e.timing.steps = batch_.step_count(s_) - first_step_;
     first_step_ = batch_.step_count(s_);
