@@ -129,7 +129,9 @@ int main(int argc, char** argv) {
   for (const Extension& e : extensions()) csv << "," << e.name << "_bic_gain," << e.name << "_heldout";
   // The recalibrated base parameters: what absorbs a hidden effect the verdict does not name.
   for (const FreeParam& p : free) csv << ",base_" << p.name;
-  csv << "\n";
+  // The best generic discrepancy, every extension's rival (its shape, BIC gain and held-out chi2): what took a name
+  // the data show away, where the verdict gives none.
+  csv << ",rival_shape,rival_gain,rival_heldout\n";
   std::vector<unsigned> seeds = listed;
   for (unsigned s = first; listed.empty() && s <= last; ++s) seeds.push_back(s);
   struct Case {
@@ -170,6 +172,14 @@ int main(int argc, char** argv) {
     }
     t += "\n";
     for (Real v : dg.base.values) put(v);
+    t += "\n";
+    if (const GenericFit* rival = generic_rival(dg.generic)) {
+      std::string shape = rival->shape.name;
+      std::replace(shape.begin(), shape.end(), ' ', '~');  // one token on its line
+      t += shape + " ";
+      put(dg.base_bic - rival->bic);
+      put(rival->heldout);
+    }
     return t + "\n";
   };
   // A case's row and its share of the tables, in case order as the cases end: "none" comes first at every seed, and
@@ -210,6 +220,11 @@ int main(int argc, char** argv) {
     std::istringstream bl(line);
     std::vector<Real> base_values;
     for (std::size_t k = 0; k < free.size(); ++k) base_values.push_back(real(bl));
+    std::getline(in, line);
+    std::istringstream rl(line);
+    std::string rival;
+    rl >> rival;
+    const Real rival_gain = real(rl), rival_heldout = real(rl);
     Real true_heldout = base_heldout;
     bool data_show = false;
     for (const Fit& f : fits)
@@ -246,6 +261,13 @@ int main(int argc, char** argv) {
     }
     for (std::size_t k = 0; k < free.size(); ++k) {
       std::snprintf(row, sizeof row, ",%.4g", free[k].shown * base_values[k]);
+      csv << row;
+    }
+    std::replace(rival.begin(), rival.end(), '~', ' ');
+    if (rival.empty()) {
+      csv << ",,,";
+    } else {
+      std::snprintf(row, sizeof row, ",%s,%.2f,%.2f", rival.c_str(), rival_gain, rival_heldout);
       csv << row;
     }
     csv << "\n" << std::flush;

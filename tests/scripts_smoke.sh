@@ -134,6 +134,9 @@ if [ "$part" != tools ]; then
   grep -q "^none,0,1,none,.*,[0-9]*$" "$work/ident/precise.csv" && grep -q "^- false alarms: \*\*0 of 1\*\*" \
     "$work/identification_table.sh.log" ||
     { cat "$work/identification_table.sh.log"; echo "scripts_smoke: identification_table gave no null row" >&2; exit 1; }
+  # Each row names the best generic discrepancy, every extension's rival, with its BIC gain and held-out chi2.
+  grep -Eq "^none,0,1,.*,[a-z_ ]+,[-0-9.]+,[-0-9.a-z]+,[^,]+,[0-9]+$" "$work/ident/precise.csv" ||
+    { cat "$work/ident/precise.csv"; echo "scripts_smoke: identification_table's row names no rival" >&2; exit 1; }
   env BUILD="$build" OUT="$work/ident" LEVELS=precise HIDDEN_SEEDS= NULL_SEEDS=1 bash "$root/perf/identification_table.sh" \
     > "$work/ident_again.log"
   grep -q " 0 cases left" "$work/ident_again.log" || { echo "scripts_smoke: identification_table ran a case it had" >&2; exit 1; }

@@ -8,7 +8,8 @@ alarm on the null cases, whose own largest gains check the threshold the verdict
 
 Reads the CSVs of perf/hidden_sweep (one row per case). A case (hidden, seed) given in more than one file of a
 level is taken from the last file named, and the table says so. Prints Markdown: per level, the rate with its
-counts, the wrong names, the false alarms and the null statistic (per null case, the largest over the extensions
+counts, the wrong names, the identifiable cases the generic rival took (with its shape and gains where the sweep
+wrote them), the false alarms and the null statistic (per null case, the largest over the extensions
 of the smaller of its BIC gain and held-out gain: what would have to reach the threshold for a false alarm);
 then the detection power per extension and level (the strengths named right, those the data show but were not
 named, and those the data do not show).
@@ -40,6 +41,17 @@ def null_statistic(row):
             continue
         best = max(best, min(float(bic), base_heldout - float(held)))
     return best
+
+
+def rival_text(row):
+    """A case the rival took: the hidden extension's gains against the base model, and the rival's."""
+    h = row["hidden"]
+    text = (f"; {h} {row['strength']} (seed {row['seed']}): BIC gain {float(row[h + '_bic_gain']):.1f}, held-out chi2 "
+            f"{float(row['base_heldout']):.1f} -> {float(row[h + '_heldout']):.1f}")
+    if not row.get("rival_shape"):
+        return text + ", the rival not recorded (a row from before the sweep wrote it)"
+    return text + (f", the rival {row['rival_shape']}: BIC gain {float(row['rival_gain']):.1f}, held-out chi2 "
+                   f"{float(row['rival_heldout']):.1f}")
 
 
 def load_level(paths):
@@ -82,6 +94,9 @@ def summary(name, cases, repeated):
                "".join(f"; seed {r['seed']} named {r['verdict']}" for r in alarms) +
                (f" (with none, the false-alarm rate is below {100 * bound:.0f}% at 95% confidence)" if not alarms and
                 nulls else ""))
+    taken = [r for r in identifiable if first_name(r["verdict"]) == "none"]
+    out.append(f"- identifiable cases the generic rival took (the effect shown against the base model, not against the "
+               f"best generic discrepancy): {len(taken)}" + "".join(rival_text(r) for r in taken))
     if stats:
         out.append(f"- null statistic (largest min(BIC gain, held-out gain) over the extensions): median "
                    f"{quantile(stats, 0.5):.1f}, 90% {quantile(stats, 0.9):.1f}, largest {max(stats):.1f}, against "

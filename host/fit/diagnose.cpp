@@ -234,9 +234,7 @@ void give_verdict(Diagnosis& dg, int n, int d) {
                 "an extension with several parameters needs generic rivals of that many (generic_discrepancy.hpp)");
   static_assert(std::is_same_v<decltype(GenericShape::apply), void (*)(TriaxialTest&, Real)>,
                 "a generic shape of several parameters is no rival of a one-parameter extension");
-  const GenericFit* rival = nullptr;
-  for (const GenericFit& g : dg.generic)
-    if (!rival || g.bic < rival->bic) rival = &g;
+  const GenericFit* rival = generic_rival(dg.generic);
   char line[600];
   for (ExtensionFit& f : dg.fits) weigh(f, dg, rival, n >= d + 2);
   const ExtensionFit* top = nullptr;

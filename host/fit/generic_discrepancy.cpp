@@ -126,4 +126,11 @@ std::vector<GenericFit> fit_generic(const CalibrationResult& base, const Misfit&
   return out;
 }
 
+const GenericFit* generic_rival(const std::vector<GenericFit>& generic) {
+  const GenericFit* rival = nullptr;
+  for (const GenericFit& g : generic)
+    if (!rival || g.bic < rival->bic) rival = &g;
+  return rival;
+}
+
 }  // namespace dem

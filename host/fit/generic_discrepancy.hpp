@@ -43,4 +43,7 @@ struct GenericFit {
 /// scored on it (NaN with one test).
 std::vector<GenericFit> fit_generic(const CalibrationResult& base, const Misfit& misfit);
 
+/// The rival of every extension: the fit of lowest BIC among `generic` (null where it is empty).
+const GenericFit* generic_rival(const std::vector<GenericFit>& generic);
+
 }  // namespace dem
