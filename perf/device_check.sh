@@ -8,7 +8,8 @@
 # BUILD: the build whose binaries run (default build); CPU_BUILD: the one that prepares (default build).
 # TINY=1: a few hundred balls and steps, no membrane specimen and not the suite's tests, for CI on any build.
 # SIZES: the benchmark's cube edges in balls (default "100 38 215"); CAL_LIMIT: seconds for the batched calibration
-# (240; 0 leaves the stage out); CELLS: cells run as processes at once (16; 0 leaves the stage out).
+# (240; 0 leaves the stage out); CELLS: cells run as processes at once (16; 0 leaves the stage out); NCU: Nsight
+# Compute's program for the device's bytes a particle-step (ncu; the stage is skipped where there is none).
 # PARTS: which of the suite's tests run (default "kernels other"; "kernels" when device time is short), each part
 # for at most TEST_LIMIT s (90); FULL_LIMIT: seconds for the full-scale test from nothing (60). BUDGET: seconds for
 # the whole run (660), stages in order of value, what was reached in OUT/reached.txt; TABLE6=LOOP: the full-scale
@@ -210,6 +211,22 @@ for k in $sizes; do
   rm -f "$out/scaling/out_k$k"/*.h5  # the snapshots of 10^7 balls are gigabytes
   done_stage
 done
+# The bytes a particle-step moves on the device (issue 64 item 2's measure there; the CPU counts lines brought into a
+# cache, perf/instruction_count.sh BYTES=1): the step kernels' DRAM reads and writes by Nsight Compute's counters
+# (NCU: its program, default ncu; --clock-control none leaves the clocks alone), on the first benchmark size's
+# packing, a few steps after the lists are built. ncu replays each kernel for its counters: seconds, not minutes.
+ncu="${NCU:-ncu}"; k="${sizes%% *}"; cfg="$out/scaling/k$k.toml"
+if ! command -v "$ncu" > /dev/null; then echo "skipped: the device's bytes a particle-step (no $ncu here)" >> "$out/reached.txt"
+elif [ -f "$cfg" ] && begin "bytes a particle-step on the device at $((k * k * k)) balls (ncu)" 40; then
+  timeout -k 5 "$(limit 120)" "$ncu" --clock-control none --print-units base --csv --kernel-name-base demangled \
+    --kernel-name 'regex:BallForce|Leapfrog' --launch-skip 8 --launch-count 8 \
+    --metrics dram__bytes_read.sum,dram__bytes_write.sum,gpu__time_duration.sum \
+    "$bin" run "$cfg" -n 12 --overwrite > "$out/ncu.log" 2>&1
+  echo "exit status $? (124: stopped at the limit)"
+  "$py" "$root/tools/ncu_bytes.py" "$out/ncu.log" "$((k * k * k))" || { tail -n 5 "$out/ncu.log"; failed+=" bytes"; }
+  rm -f "$out/scaling/out_k$k"/*.h5
+  done_stage
+fi
 if begin "launch overhead (64 balls, $overhead_steps steps)" 15; then
   BUILD="$build" WORK="$out/scaling" K=4 STEPS="$overhead_steps" timeout -k 5 "$(limit 60)" bash "$root/perf/scaling.sh"
   done_stage

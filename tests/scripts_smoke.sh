@@ -75,11 +75,18 @@ if [ "$part" != diagnoses ]; then
     SEEDS=1 NP=1 bash "$root/perf/specimen_settling.sh"
   grep -q "^q_peak kPa " "$work/specimen_settling.sh.log" ||
     { cat "$work/specimen_settling.sh.log"; echo "scripts_smoke: specimen_settling compared nothing" >&2; exit 1; }
+  # Nsight Compute is on GPU machines only: a stand-in prints what ncu printed for two step kernels, so that the
+  # bytes stage and tools/ncu_bytes.py run here.
+  printf '#!/bin/sh\ncat "%s/tests/data/ncu_sample.csv"\n' "$root" > "$work/ncu" && chmod +x "$work/ncu"
   check perf/device_check.sh bash -c "TINY=1 CPU_BUILD='$build' bash '$root/perf/device_check.sh' prepare '$work/dc_ref' &&
     bash '$root/perf/device_check.sh' pack '$build' '$work/dc_pack' &&
-    TINY=1 BUILD='$work/dc_pack/build' bash '$root/perf/device_check.sh' run '$work/dc_ref' '$work/dc'"
+    TINY=1 NCU='$work/ncu' BUILD='$work/dc_pack/build' bash '$root/perf/device_check.sh' run '$work/dc_ref' '$work/dc'"
   grep -q "^ran: a batched calibration" "$work/dc/reached.txt" ||
     { cat "$work/dc/reached.txt"; echo "scripts_smoke: device_check ran no batched calibration" >&2; exit 1; }
+  grep -q "^ran: bytes a particle-step" "$work/dc/reached.txt" &&
+    grep -q "^a particle-step (1 steps of 1000 balls): 691214 bytes read, 344862 written" "$work/device_check.sh.log" ||
+    { cat "$work/dc/reached.txt"; echo "scripts_smoke: device_check's bytes stage read no step" >&2; exit 1; }
+  check tools/ncu_bytes.py "$py" "$root/tools/ncu_bytes.py" "$root/tests/data/ncu_sample.csv" 1000000
   # A window of no time reaches no stage, and says so for each (the budget's bookkeeping, at no cost).
   TINY=1 BUDGET=0 bash "$root/perf/device_check.sh" run "$work/dc_ref" "$work/dc0" > "$work/dc0.log" 2>&1
   [ "$(grep -c '^not reached: ' "$work/dc0/reached.txt")" -ge 6 ] && ! grep -q '^ran: ' "$work/dc0/reached.txt" ||
