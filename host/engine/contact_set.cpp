@@ -1,6 +1,7 @@
 /// The contacts of a state, gathered for the micromechanics (host/engine/micro.hpp): from a running simulation or from
 /// a saved snapshot, and back into a snapshot's contact table.
 #include <algorithm>
+#include <array>
 #include <stdexcept>
 #include <string>
 
@@ -31,18 +32,16 @@ std::vector<typename V::non_const_value_type> host_values(const V& v, int n) {
   const auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), Kokkos::subview(v, std::make_pair(0, n)));
   return std::vector<typename V::non_const_value_type>(h.data(), h.data() + n);
 }
-/// The first n rows of a 3-vector View (of a triple View, below), likewise.
-std::vector<Vec3> host_rows(const Vec3View& v, int n) {
+/// The first n rows of a View of rows (3-vectors, the facets' node triples), each read by `row`, likewise.
+template <class V, class Row>
+auto host_rows(const V& v, int n, Row row) {
   const auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), v);
-  std::vector<Vec3> out(static_cast<std::size_t>(n));
-  for (int k = 0; k < n; ++k) out[k] = load(h, k);
+  std::vector<decltype(row(h, 0))> out(static_cast<std::size_t>(n));
+  for (int k = 0; k < n; ++k) out[k] = row(h, k);
   return out;
 }
-std::vector<std::array<int, 3>> host_triples(const Index3View& v, int n) {
-  const auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), v);
-  std::vector<std::array<int, 3>> out(static_cast<std::size_t>(n));
-  for (int k = 0; k < n; ++k) out[k] = {h(k, 0), h(k, 1), h(k, 2)};
-  return out;
+std::vector<Vec3> host_rows(const Vec3View& v, int n) {
+  return host_rows(v, n, [](const auto& h, int k) { return load(h, k); });
 }
 ContactCopy::List host_list(const ContactList& l) {
   return {host_values(l.i, l.n), host_values(l.j, l.n), host_rows(l.fc, l.n), host_values(l.fn, l.n)};
@@ -72,7 +71,8 @@ ContactCopy copy_contacts(Simulation& sim) {
   c.wall_radius = host_values(walls.radius, walls.n);
   const FacetMesh& mesh = sim.mesh();
   c.node_x = host_rows(mesh.node_x, mesh.nnode);
-  c.tri = host_triples(mesh.tri, mesh.ntri);
+  c.tri = host_rows(mesh.tri, mesh.ntri,
+                    [](const auto& h, int k) { return std::array<int, 3>{h(k, 0), h(k, 1), h(k, 2)}; });
   c.domain = sim.domain();
   return c;
 }
