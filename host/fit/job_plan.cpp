@@ -159,12 +159,30 @@ struct Planner {
     shared = void_ratio ? kStateMatchSpecimens : 0;
   }
 
+  /// A match's packings at the ends of [0, 1] (preparation_reach), in packings of a typical friction: the
+  /// frictionless end's settling takes 2.3 to 3.6 times as many steps.
+  static PackingCost match_ends() {
+    const PackingCost none = packing_cost_at(0), full = packing_cost_at(1);
+    return {none.low + full.low, none.high + full.high};
+  }
+
   /// The state match's packings, where the store does not hold them: `name`'s stage.
   void match_packings_stage(const std::string& name) {
-    add.packings(name, "the data's void_ratio", lab, match_packings * kStateMatchSpecimens,
-                 match_packings * kStateMatchSpecimens, kStateMatchSpecimens,
+    const PackingCost ends = match_ends();
+    const double halvings = match_packings - 2;
+    add.packings(name, "the data's void_ratio", lab, (halvings + ends.low) * kStateMatchSpecimens,
+                 (halvings + ends.high) * kStateMatchSpecimens, kStateMatchSpecimens,
                  "up to " + std::to_string(match_packings) + " packings of " + std::to_string(kStateMatchSpecimens) +
                      " specimens");
+    note_ends();
+  }
+
+  /// Says once that a match's ends are counted at their own cost.
+  void note_ends() {
+    const std::string note = "a state match packs at preparation friction 0, where the balls slide on and settle in " +
+                             fmt("%.1f", packing_cost_at(0).low) + " to " + fmt("%.1f", packing_cost_at(0).high) +
+                             " times a packing's steps: counted so";
+    if (std::find(plan.notes.begin(), plan.notes.end(), note) == plan.notes.end()) plan.notes.push_back(note);
   }
 
   /// The lab's own specimens: the state match and the scatter specimens.
@@ -179,11 +197,12 @@ struct Planner {
                  std::to_string(to_pack) + " packings");
   }
 
-  /// A material's cell's bias check: its own state match (from a bracket around the lab's friction, 4 packings,
-  /// falling back to the whole range, up to 2 + kCellCheckPrepSteps more), its specimens and runs. None where the
-  /// data's specimens have the cell's balls (measure_cell_bias).
+  /// A material's cell's bias check: its own state match (the bracket's two ends around the lab's friction and its
+  /// two halvings where it holds the answer; else its ends, the whole range's and kCellCheckPrepSteps halvings, each
+  /// end at its friction's cost), its specimens and runs. None where the data's specimens have the cell's balls
+  /// (measure_cell_bias).
   void bias_check(const std::string& material, const std::vector<TriaxialTest>& tests) {
-    const int check_low = 4, check_high = 4 + 2 + kCellCheckPrepSteps;
+    const int check_low = 4, check_high = 2 + 2 + kCellCheckPrepSteps;
     const bool checked = std::any_of(tests.begin(), tests.end(), [&](const TriaxialTest& t) {
       return cell_bias_extrapolation(static_cast<Real>(lab.balls), kCellCheckFactor, t.specimen_balls) != 0;
     });
@@ -204,11 +223,17 @@ struct Planner {
                                                                                     kCellCheckSpecimens)
                                            : kCellCheckSpecimens - shared;
     const std::string setting = "the cell's bias check (kCellCheckFactor)";
-    if (void_ratio && !check_stored)
-      add.packings(material + ": cell's bias check, state match", setting, check, check_low * kStateMatchSpecimens,
-                   check_high * kStateMatchSpecimens, kStateMatchSpecimens,
+    const Real around = check_plan.around;
+    const PackingCost lo = packing_cost_at(std::pow(std::max(Real(0), around - kMatchBracket), 2)),
+                      hi = packing_cost_at(std::pow(std::min(Real(1), around + kMatchBracket), 2)), ends = match_ends();
+    if (void_ratio && !check_stored) {
+      add.packings(material + ": cell's bias check, state match", setting, check,
+                   (lo.low + hi.low + 2) * kStateMatchSpecimens,
+                   (lo.high + hi.high + ends.high + kCellCheckPrepSteps) * kStateMatchSpecimens, kStateMatchSpecimens,
                    std::to_string(check_low) + " to " + std::to_string(check_high) + " packings of " +
                        std::to_string(kStateMatchSpecimens) + " specimens");
+      note_ends();
+    }
     add.packings(material + ": cell's bias check, specimens", setting, check, check_to_pack, check_to_pack,
                  kCellCheckSpecimens, std::to_string(check_to_pack) + " packings");
     add.runs(material + ": cell's bias check, runs", setting, check, tests, 1, kCellCheckSpecimens,

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iterator>
 
 #include "host/engine/builder.hpp"
 #include "host/triax/periodic_triaxial.hpp"
@@ -88,6 +89,24 @@ CellCost measure_cell_cost(const Config& cell, double probe_seconds) {
   const Real gas = closing(solid, gas_end, gas_rate) + closing(gas_end, kPackedSolidFraction, rate);
   c.packing_steps = static_cast<long>(kPackingStepsOverGas * gas);
   return c;
+}
+
+PackingCost packing_cost_at(Real prep_mu_s) {
+  // In sqrt(mu), as the state match bisects; linear between the measured points (run_cost.hpp).
+  struct Point {
+    double root, low, high;
+  };
+  static constexpr Point kPoints[] = {{0, 2.3, 3.6},  {0.05, 1.4, 2.1}, {0.1, 1.2, 1.8},
+                                      {0.2, 0.9, 1.3}, {0.55, 0.6, 1.0}, {1, 1.0, 1.5}};
+  const double u = std::sqrt(std::clamp(static_cast<double>(prep_mu_s), 0.0, 1.0));
+  for (std::size_t k = 1; k < std::size(kPoints); ++k) {
+    const Point& a = kPoints[k - 1];
+    const Point& b = kPoints[k];
+    if (u > b.root) continue;
+    const double t = (u - a.root) / (b.root - a.root);
+    return {a.low + t * (b.low - a.low), a.high + t * (b.high - a.high)};
+  }
+  return {kPoints[std::size(kPoints) - 1].low, kPoints[std::size(kPoints) - 1].high};
 }
 
 MembraneCost::MembraneCost(const Config& membrane) : cfg(membrane) {

@@ -14,6 +14,16 @@ constexpr Real kPackedSolidFraction = 0.62;
 /// 200-ball calibration base 17,230 against 13,260; the 1,000-ball walled cross-code base 12,800 against 19,150 (one
 /// seed); an estimate, which the job's last line sets beside what it took.
 constexpr Real kPackingStepsOverGas = 2.0;
+/// A packing's steps at preparation friction mu over those at a typical one (0.03-0.08, the shipped configs' and the
+/// cross-code data's), the range of the cells measured: with little friction the balls slide on and the unbalanced
+/// force settles slowly. Measured (30 November, steps to the preparation's tolerance, each cell at its own friction =
+/// 1): at mu = 0, 3.47 (periodic 1,000 balls), 3.47 and 3.55 (walled 1,000 and 4,000), 2.35 (periodic 200); at 0.0025,
+/// 0.01, 0.04, 0.3 on the walled 1,000: 2.07, 1.74, 1.30, 0.86; at 1: 1.06 (walled 4,000), 1.36 (periodic 1,000), 1.48
+/// (periodic 200). A state match packs both ends of [0, 1] (preparation_reach): the plan counts them so.
+struct PackingCost {
+  double low = 1, high = 1;
+};
+PackingCost packing_cost_at(Real prep_mu_s);
 /// A run's steps beyond its shear, as a share of them: its consolidation to sigma3 (measured 0.04 of the shear on
 /// the walled cross-code base, 0.09 in the small S-1 membrane test) and its set-up and records, which the probe does
 /// not time. With 0.25 the walled case's 24 scatter and 12 check runs came within 20% of the plan (26 s and 1m10s

@@ -147,13 +147,14 @@ std::unique_ptr<Simulation> packing_of(const Config& cfg, std::vector<BallSpec>&
 
 }  // namespace
 
-void prepare_periodic_specimen(const Config& cfg, std::vector<BallSpec>& balls, std::array<Real, 3>& cell,
+long prepare_periodic_specimen(const Config& cfg, std::vector<BallSpec>& balls, std::array<Real, 3>& cell,
                                bool verbose) {
   PeriodicTriaxialParams pp;
   auto sim = packing_of(cfg, balls, cell, pp, verbose);
-  if (!sim) return;
-  consolidate_isotropic(*sim, pp);
+  if (!sim) return 0;
+  const long steps = consolidate_isotropic(*sim, pp).timing.steps;
   balls = extract_balls(*sim, cell);
+  return steps;
 }
 
 std::vector<PreparedCell> prepare_periodic_specimens(const std::vector<Config>& cfgs) {

@@ -143,8 +143,8 @@ void check_periodic_config(const Config& cfg);
 
 /// The specimen of a periodic job: the packing of [particles]/[box], consolidated to [periodic] sigma3_kPa
 /// with the preparation friction (prep_mu_s, prep_mu_r) when that differs from the material's, without the
-/// model extensions. `balls` and `cell` receive it.
-void prepare_periodic_specimen(const Config& cfg, std::vector<BallSpec>& balls, std::array<Real, 3>& cell,
+/// model extensions. `balls` and `cell` receive it; returns the preparation's steps (0 where there was none).
+long prepare_periodic_specimen(const Config& cfg, std::vector<BallSpec>& balls, std::array<Real, 3>& cell,
                                bool verbose);
 
 /// A specimen prepared: its balls in their cell.
