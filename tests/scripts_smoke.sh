@@ -88,7 +88,7 @@ if [ "$part" != diagnoses ]; then
     { cat "$work/dc/reached.txt"; echo "scripts_smoke: device_check's bytes stage read no step" >&2; exit 1; }
   check tools/ncu_bytes.py "$py" "$root/tools/ncu_bytes.py" "$root/tests/data/ncu_sample.csv" 1000000
   # A window of no time reaches no stage, and says so for each (the budget's bookkeeping, at no cost).
-  TINY=1 BUDGET=0 bash "$root/perf/device_check.sh" run "$work/dc_ref" "$work/dc0" > "$work/dc0.log" 2>&1
+  TINY=1 BUDGET=0 BUILD="$build" bash "$root/perf/device_check.sh" run "$work/dc_ref" "$work/dc0" > "$work/dc0.log" 2>&1
   [ "$(grep -c '^not reached: ' "$work/dc0/reached.txt")" -ge 6 ] && ! grep -q '^ran: ' "$work/dc0/reached.txt" ||
     { cat "$work/dc0.log"; echo "scripts_smoke: device_check with no budget ran a stage" >&2; exit 1; }
   # The full-scale Table 6 from the loop's parameters, here the tiny specimen at one pressure; the loop's calibrated.csv

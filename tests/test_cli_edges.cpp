@@ -174,6 +174,30 @@ TEST(CliEdges, TheTriaxialJobTellsItsCostBeforeTheWork) {
   EXPECT_NE(line.find(" on this machine"), std::string::npos) << line;
 }
 
+// The periodic job too says what it will run and about how long before the work: its packing at its preparation
+// friction's cost (a range: packing_cost_at), its consolidation and shear.
+TEST(CliEdges, ThePeriodicJobTellsItsCostBeforeTheWork) {
+  const fs::path dir = dem::test::scratch_dir("cli_periodic_plan");
+  write_edited("tests/data/hidden_effects.toml", "target_axial_strain_pct = 8.0", "target_axial_strain_pct = 0.4",
+               dir / "cell.toml");
+  const Outcome o = triaxdem("periodic " + (dir / "cell.toml").string() + " -o " + (dir / "run").string(), dir);
+  EXPECT_EQ(o.code, 0) << o.output;
+  const std::size_t plan = o.output.find("periodic: plan: "), packing = o.output.find("triaxdem: preparation");
+  ASSERT_NE(plan, std::string::npos) << o.output;
+  EXPECT_LT(plan, packing) << o.output;
+  const std::string line = o.output.substr(plan, o.output.find('\n', plan) - plan);
+  long balls = 0;
+  double low = 0, high = 0;
+  ASSERT_EQ(std::sscanf(line.c_str(),
+                        "periodic: plan: %ld balls, a packing (preparation friction %*f: %lf to %lf steps)", &balls,
+                        &low, &high),
+            3) << line;
+  EXPECT_EQ(balls, 120) << line;
+  EXPECT_GT(low, 0) << line;
+  EXPECT_GT(high, low) << line;
+  EXPECT_NE(line.find(" on this machine"), std::string::npos) << line;
+}
+
 // A specimen whose layer the step cap stopped before it came to rest warned and went on (exit 0): it is refused,
 // naming the keys, unless accepted; the refused specimen is kept, so the rerun that accepts it does not build it
 // again; and a resume reads the run's own copy, so clearing the shared cache costs nothing.

@@ -31,6 +31,25 @@ void print_triaxial_plan(const Config& cfg) {
               cost.steps(sigma3) * static_cast<double>(cost.cell.balls), format_duration(cost.seconds(sigma3)).c_str());
 }
 
+/// The same for a cell's test: its packing (at its preparation friction's cost, packing_cost_at), consolidation and
+/// shear, from a probe of its balls.
+void print_periodic_plan(const Config& cfg) {
+  const CellCost cost = measure_cell_cost(cfg);
+  const Real prep = cfg.periodic.prep_mu_s >= 0 ? cfg.periodic.prep_mu_s : cfg.ball.mu_s;
+  const PackingCost at = packing_cost_at(prep);
+  const Real sigma3 = cfg.periodic.triax.sigma3;
+  const double run = static_cast<double>(cost.run_steps(sigma3)), packing = static_cast<double>(cost.packing_steps);
+  std::printf("%s: plan: %ld balls, a packing (preparation friction %.3g: %.3g to %.3g steps), consolidation to %.0f "
+              "kPa and shear to %.1f%% axial strain (%.3g steps): %.2g to %.2g particle-steps, about %s to %s on this "
+              "machine\n",
+              cfg.periodic.boundary == CellBoundary::walls ? "walls" : "periodic", cost.balls, prep, at.low * packing,
+              at.high * packing, sigma3 / 1e3, 100 * cfg.periodic.triax.target_strain, run,
+              (at.low * packing + run) * static_cast<double>(cost.balls),
+              (at.high * packing + run) * static_cast<double>(cost.balls),
+              format_duration(at.low * cost.packing_seconds() + cost.run_seconds(sigma3)).c_str(),
+              format_duration(at.high * cost.packing_seconds() + cost.run_seconds(sigma3)).c_str());
+}
+
 }  // namespace
 
 int triaxial_job(const Config& cfg, bool resume, long stop_at_step) {
@@ -117,6 +136,7 @@ int triaxial_job(const Config& cfg, bool resume, long stop_at_step) {
 int run_periodic_job(const Config& cfg) {
   std::vector<BallSpec> balls;
   std::array<Real, 3> cell{};
+  print_periodic_plan(cfg);
   prepare_periodic_specimen(cfg, balls, cell, true);
   PeriodicTriaxialParams tp = cfg.periodic.triax;
   tp.name = cfg.run.name;
