@@ -32,8 +32,9 @@ void print_triaxial_plan(const Config& cfg) {
 }
 
 /// The same for a cell's test: its packing (at its preparation friction's cost, packing_cost_at), consolidation and
-/// shear, from a probe of its balls.
+/// shear, from a probe of its balls. A config the cell test refuses is refused first, with its own words.
 void print_periodic_plan(const Config& cfg) {
+  check_periodic_config(cfg);
   const CellCost cost = measure_cell_cost(cfg);
   const Real prep = cfg.periodic.prep_mu_s >= 0 ? cfg.periodic.prep_mu_s : cfg.ball.mu_s;
   const PackingCost at = packing_cost_at(prep);
