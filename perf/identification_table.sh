@@ -20,8 +20,9 @@ sweep="$build/perf/hidden_sweep"
 py=python3; [ -x /usr/bin/python3 ] && py=/usr/bin/python3
 commit="$(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo unknown)"
 git -C "$root" diff --quiet HEAD -- host kernels perf 2>/dev/null || commit="$commit+"  # uncommitted code changes
-# Every extension the sweep knows, from its own --help (the choices of --hidden).
-extensions="$("$sweep" --help | sed -n 's/.*--hidden.*{\(.*\)}.*/\1/p' | tr ',' ' ' | sed 's/\bnone\b//')"
+# Every extension the sweep knows, from its own --help (the choices of --hidden), one space apart (xargs): --hidden
+# then gets no empty entry.
+extensions="$("$sweep" --help | sed -n 's/.*--hidden.*{\(.*\)}.*/\1/p' | tr ',' ' ' | sed 's/\bnone\b//' | xargs)"
 [ -n "$extensions" ] || { echo "identification_table: could not read the extensions from $sweep --help"; exit 1; }
 mkdir -p "$out"
 noise() { [ "$1" = precise ] && echo 0 || echo 1; }
