@@ -223,9 +223,9 @@ struct Planner {
                                                                                     kCellCheckSpecimens)
                                            : kCellCheckSpecimens - shared;
     const std::string setting = "the cell's bias check (kCellCheckFactor)";
-    const Real around = check_plan.around;
-    const PackingCost lo = packing_cost_at(std::pow(std::max(Real(0), around - kMatchBracket), 2)),
-                      hi = packing_cost_at(std::pow(std::min(Real(1), around + kMatchBracket), 2)), ends = match_ends();
+    const auto [root_lo, root_hi] = match_bracket(check_plan.around);
+    const PackingCost lo = packing_cost_at(root_lo * root_lo), hi = packing_cost_at(root_hi * root_hi),
+                      ends = match_ends();
     if (void_ratio && !check_stored) {
       add.packings(material + ": cell's bias check, state match", setting, check,
                    (lo.low + hi.low + 2) * kStateMatchSpecimens,

@@ -99,7 +99,7 @@ Real prep_friction_for(const Config& base, Real target, Real& reached, bool verb
     return low ? lo * lo : hi * hi;
   };
   if (plan.around >= 0) {
-    const Real lo = std::max(Real(0), plan.around - kMatchBracket), hi = std::min(Real(1), plan.around + kMatchBracket);
+    const auto [lo, hi] = match_bracket(plan.around);
     const Real e_lo = at(lo), e_hi = at(hi);
     if (e_lo <= target && target <= e_hi) return bisect(lo, hi, e_lo, e_hi);
   }

@@ -1,6 +1,7 @@
 #pragma once
 /// The measured specimens' state matched: the preparation friction with which the simulator's specimens pack to the
 /// data's void ratio (host/lab/state_match.cpp), for the lab's cell, a grown cell or the cell-bias check's cells.
+#include <algorithm>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -48,6 +49,10 @@ struct NotPacked : std::runtime_error {
 /// 0.005 in void ratio of the smaller one at one friction, 0.02-0.05 in sqrt(prep_mu_s) on the shipped configs.
 /// Its two ends and two halvings reach the 1/32 of five halvings of [0, 1] with four packings instead of seven.
 constexpr Real kMatchBracket = 1.0 / 16;
+/// The bracket's ends in sqrt(prep_mu_s) around `around`, within [0, 1].
+inline std::pair<Real, Real> match_bracket(Real around) {
+  return {std::max(Real(0), around - kMatchBracket), std::min(Real(1), around + kMatchBracket)};
+}
 /// The plan for a lab's specimens: its first seeds ([run] seed on), in the cell it runs ([calibrate] cell_factor,
 /// the config's own where "auto"), 8 halvings, `workers` at once.
 MatchPlan match_plan(const Config& base, int workers);
