@@ -619,6 +619,29 @@ TEST(Stage, ThePartsOfAShortStageFitInItsWallTime) {
   }
 }
 
+// A stage's first kTimedFirst steps are each timed (part_sampling.hpp): a walled shear of 69 steps on a busy machine
+// read a host time below zero, one stalled sample counted 16 times. A stage of 69 steps that starts off the sampling
+// grid must have every step's parts behind fences (the resting ball's step has four laps and the clock's first
+// fence: 5 a step; sampled one in 16 it had about 5 x 5 in all), and its parts then fit in its wall time however
+// noisy the machine. The weights: each of the first kTimedFirst once, each later multiple of kTimedEvery 16 times.
+static_assert(timed_weight(0, 69) == 69, "a short stage counts each of its steps once");
+static_assert(timed_weight(5, 5 + kTimedFirst + 100) == kTimedFirst + 6 * kTimedEvery,
+              "steps 261..360 hold the multiples of 16 from 272 to 352");
+static_assert(timed_weight(7, 7) == 0, "an empty stage");
+TEST(Stage, AStagesFirstStepsAreEachTimed) {
+  Simulation sim = resting_ball();
+  sim.run(3);
+  StageSteps stage;
+  stage.first = sim.step_count() + 1;
+  stage.last = sim.step_count() + 69;
+  stage.before = [](long) { return StepPlan{}; };
+  stage.after = [](long, bool) { return false; };
+  const StageTiming t = run_stage(sim, stage, nullptr).timing;
+  ASSERT_EQ(t.steps, 69);
+  EXPECT_GE(t.syncs[static_cast<int>(SyncPart::kStep)].fences, 4 * t.steps);
+  EXPECT_GE(t.host(), 0) << "parts " << t.parts.loop() << " s in a wall time of " << t.wall;
+}
+
 // The host's work is told apart by where it is spent (timings.csv's host_control_ns, host_after_ns), so that a GPU
 // run's host share says whether the servo or the records hold it. A stage whose work after a step sleeps 2 ms must
 // show at least that there, and its control (nothing) less; sleeping can only last longer than asked, and both

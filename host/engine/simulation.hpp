@@ -87,6 +87,9 @@ class Simulation {
   void step(bool measure = true);
   /// nsteps steps; stats() describe the last one.
   void run(long nsteps) { for (long s = 0; s < nsteps; ++s) step(s + 1 == nsteps); }
+  /// Times each step's parts, counted once, up to the step numbered `end` (part_sampling.hpp: a stage's first
+  /// steps); after it one step in kTimedEvery, counted kTimedEvery times.
+  void time_each_step_until(long end) { timed_until_ = end; }
 
   /// The particles; their f and m are those of the last gather_forces (a step leaves them out).
   Particles& particles() { return p_; }
@@ -280,6 +283,7 @@ class Simulation {
   mutable StageTimes times_;
   Real rmax_ = 0;
   long step_ = 0;
+  long timed_until_ = 0;  ///< time_each_step_until
   Real time_ = 0;
   bool fresh_ = true;
   mutable bool forces_current_ = true;  ///< p_.f and p_.m hold the last step's gathered forces

@@ -70,18 +70,17 @@ StageEnd run_stage(Simulation& sim, const StageSteps& stage, CheckpointPlan* pla
   const StageTimes parts0 = sim.times();
   const long step0 = sim.step_count();
   const SyncTally syncs0 = sync_tally();
+  sim.time_each_step_until(step0 + kTimedFirst);
   StageEnd end = run_steps(sim, stage, plan);
   const SyncTally syncs1 = sync_tally();
   for (int k = 0; k < kSyncParts; ++k) end.timing.syncs[static_cast<std::size_t>(k)] = syncs1[k] - syncs0[k];
   end.timing.balls = sim.particles().n;
   end.timing.steps = sim.step_count() - step0;
   end.timing.wall = seconds_since(t0);
-  // Each sampled step counts for kTimedEvery (Simulation::step): scaled to the steps the stage ran, so that a
-  // stage whose length is no multiple of it does not count its samples for steps it did not run (a short specimen
-  // layer showed host times below zero).
-  const long sampled = sampled_steps_before(sim.step_count()) - sampled_steps_before(step0);
-  const double f =
-      sampled > 0 ? static_cast<double>(end.timing.steps) / static_cast<double>(sampled * kTimedEvery) : 0;
+  // The timed steps' weights (part_sampling.hpp) scaled to the steps the stage ran, so that a stage whose length is
+  // no multiple of kTimedEvery does not count its samples for steps it did not run.
+  const long weight = timed_weight(step0, sim.step_count());
+  const double f = weight > 0 ? static_cast<double>(end.timing.steps) / static_cast<double>(weight) : 0;
   StageTimes& t = end.timing.parts;
   t = sim.times().since(parts0);
   for (double* x : {&t.forces, &t.integrate, &t.boundaries, &t.membrane, &t.walls}) *x *= f;  // the rebuild: every time
