@@ -187,6 +187,13 @@ std::string generic_difference(const Diagnosis& dg, const GenericFit* rival) {
          fmt("%.1f", rival->heldout) + ".";
 }
 
+/// "lowers the held-out chi2 from a to b", or "raises" where it rises: a rival or extension that fits the data
+/// better can predict a held-out pressure worse (YADE's linear data: q offset, 51.0 -> 59.6).
+std::string heldout_change(double from, double to) {
+  return std::string(to <= from ? "lowers" : "raises") + " the held-out chi2 from " + fmt("%.1f", from) + " to " +
+         fmt("%.1f", to);
+}
+
 /// The explanation of a verdict "none" with enough data to test: candidates (accepted against the base, not against
 /// the rival) or no extension accepted at all; either way the generic difference found.
 std::string explain_none(const Diagnosis& dg, int n, const std::string& candidates, const ExtensionFit* best_bic,
@@ -196,24 +203,26 @@ std::string explain_none(const Diagnosis& dg, int n, const std::string& candidat
   if (!candidates.empty()) {
     std::snprintf(line, sizeof line,
                   "%s (chi2 %.1f on %d data, 99%% limit %.1f), and extensions fit it better (%s), but none more "
-                  "specifically than the generic discrepancy %s (%s, c = %.3g), which lowers the chi2 to %.1f, the "
-                  "BIC by %.1f and the held-out chi2 from %.1f to %.1f: a difference no extension explains "
-                  "specifically. The extensions that fit it are candidates, not causes.",
+                  "specifically than the generic discrepancy %s (%s, c = %.3g), which lowers the chi2 to %.1f and "
+                  "the BIC by %.1f, and %s: a difference no extension explains specifically. The extensions that "
+                  "fit it are candidates, not causes.",
                   fits ? "The base model fits within the noise" : "The base model misses the data", dg.base.best.chi2,
                   n, dg.chi2_limit, candidates.c_str(), rival->shape.name.c_str(), rival->shape.formula.c_str(),
-                  rival->c, rival->chi2, dg.base_bic - rival->bic, dg.base_heldout, rival->heldout);
+                  rival->c, rival->chi2, dg.base_bic - rival->bic,
+                  heldout_change(dg.base_heldout, rival->heldout).c_str());
     return line;
   }
   std::snprintf(line, sizeof line,
                 fits ? "The calibrated base model fits within the data's noise (chi2 %.1f on %d data, below the "
                        "99%% limit %.1f) and no extension passes both tests (the lowest BIC, %s, lowers it by %.1f "
-                       "and the held-out chi2 from %.1f to %.1f; a drop of 6 needed for each): no discrepancy "
-                       "beyond noise, and no extension is called for."
+                       "and %s; a drop of 6 needed for each): no discrepancy beyond noise, and no extension is "
+                       "called for."
                      : "The base model misses the data (chi2 %.1f on %d data, 99%% limit %.1f), but no extension "
-                       "explains it: none passes both tests (the lowest BIC, %s, lowers it by %.1f and the held-out "
-                       "chi2 from %.1f to %.1f; a drop of 6 needed for each).",
+                       "explains it: none passes both tests (the lowest BIC, %s, lowers it by %.1f and %s; a drop "
+                       "of 6 needed for each).",
                 dg.base.best.chi2, n, dg.chi2_limit, best_bic ? best_bic->ext.name.c_str() : "-",
-                best_bic ? dg.base_bic - best_bic->bic : 0.0, dg.base_heldout, best_bic ? best_bic->heldout : 0.0);
+                best_bic ? dg.base_bic - best_bic->bic : 0.0,
+                heldout_change(dg.base_heldout, best_bic ? best_bic->heldout : 0.0).c_str());
   return line + generic_difference(dg, rival);
 }
 
