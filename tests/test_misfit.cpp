@@ -650,6 +650,13 @@ TEST(Diagnosis, AnExtensionIsNamedOnlyWhereItBeatsTheGenericRival) {
   EXPECT_EQ(dg.verdict, "none") << dg.explanation;
   EXPECT_NE(dg.explanation.find("The generic discrepancy that fits best is q scaled"), std::string::npos)
       << dg.explanation;
+  // A BIC that rises is said to rise (YADE's walled data: the lowest BIC, wear, "lowers it by -2.2").
+  dg.fits[0].bic = 110.2;
+  dg.generic[0].bic = 108.4;
+  give_verdict(dg, 60, 2);
+  for (const std::string& said : {std::string("has a BIC higher by 2.2"), std::string("BIC higher by 0.4")})
+    EXPECT_NE(dg.explanation.find(said), std::string::npos) << said << "\n" << dg.explanation;
+  EXPECT_EQ(dg.explanation.find("by -"), std::string::npos) << dg.explanation;
 }
 
 // One member in place of the ensemble's mean moves the whitened residuals by (1 - 1/K) tr(Sigma^-1 Sigma_member) in

@@ -154,14 +154,18 @@ ExtensionFit fit_extension(const Extension& e, const FitContext& cx, Evaluation&
   return f;
 }
 
+/// A drop in BIC in words whichever its sign, "lower by 12.3" or "higher by 2.2" (a model that fits no better
+/// pays for its parameter).
+std::string bic_change(Real gain) { return fmt(gain >= 0 ? "lower by %.1f" : "higher by %.1f", std::fabs(gain)); }
+
 /// One extension on both tests, against the base model (accepted) and the generic rival where there is one
 /// (specific), with its reason in words; `testable`: enough data for an extended model (n >= d + 2).
 void weigh(ExtensionFit& f, const Diagnosis& dg, const GenericFit* rival, bool testable) {
   char line[300];
   const Real gain = dg.base_bic - f.bic, held = dg.base_heldout - f.heldout;
   f.accepted = testable && gain >= kStrongEvidence && held >= kStrongEvidence;
-  std::snprintf(line, sizeof line, "BIC %s by %.1f (%s), held-out chi2 %.1f -> %.1f (%s)",
-                gain >= 0 ? "lower" : "higher", std::fabs(gain), gain >= kStrongEvidence ? "passes" : "6 needed",
+  std::snprintf(line, sizeof line, "BIC %s (%s), held-out chi2 %.1f -> %.1f (%s)", bic_change(gain).c_str(),
+                gain >= kStrongEvidence ? "passes" : "6 needed",
                 dg.base_heldout, f.heldout, held >= kStrongEvidence ? "passes" : "a drop of 6 needed");
   f.reason = std::string(f.accepted ? "accepted: " : "rejected: ") + line;
   if (!rival) {
@@ -170,8 +174,8 @@ void weigh(ExtensionFit& f, const Diagnosis& dg, const GenericFit* rival, bool t
   }
   const Real over = rival->bic - f.bic, over_held = rival->heldout - f.heldout;
   f.specific = f.accepted && over >= kStrongEvidence && over_held >= kStrongEvidence;
-  std::snprintf(line, sizeof line, "; against the generic %s: BIC %s by %.1f, held-out chi2 %.1f -> %.1f (%s)",
-                rival->shape.name.c_str(), over >= 0 ? "lower" : "higher", std::fabs(over), rival->heldout,
+  std::snprintf(line, sizeof line, "; against the generic %s: BIC %s, held-out chi2 %.1f -> %.1f (%s)",
+                rival->shape.name.c_str(), bic_change(over).c_str(), rival->heldout,
                 f.heldout, f.specific ? "specific" : "not specific: a drop of 6 needed in both");
   if (f.accepted) f.reason += line;
 }
@@ -182,8 +186,8 @@ void weigh(ExtensionFit& f, const Diagnosis& dg, const GenericFit* rival, bool t
 std::string generic_difference(const Diagnosis& dg, const GenericFit* rival) {
   if (!rival) return "";
   return " The generic discrepancy that fits best is " + rival->shape.name + " (" + rival->shape.formula +
-         ", c = " + fmt("%.3g", rival->c) + "): chi2 " + fmt("%.1f", rival->chi2) + ", BIC lower by " +
-         fmt("%.1f", dg.base_bic - rival->bic) + ", held-out chi2 " + fmt("%.1f", dg.base_heldout) + " -> " +
+         ", c = " + fmt("%.3g", rival->c) + "): chi2 " + fmt("%.1f", rival->chi2) + ", BIC " +
+         bic_change(dg.base_bic - rival->bic) + ", held-out chi2 " + fmt("%.1f", dg.base_heldout) + " -> " +
          fmt("%.1f", rival->heldout) + ".";
 }
 
@@ -203,25 +207,25 @@ std::string explain_none(const Diagnosis& dg, int n, const std::string& candidat
   if (!candidates.empty()) {
     std::snprintf(line, sizeof line,
                   "%s (chi2 %.1f on %d data, 99%% limit %.1f), and extensions fit it better (%s), but none more "
-                  "specifically than the generic discrepancy %s (%s, c = %.3g), which lowers the chi2 to %.1f and "
-                  "the BIC by %.1f, and %s: a difference no extension explains specifically. The extensions that "
+                  "specifically than the generic discrepancy %s (%s, c = %.3g), which takes the chi2 to %.1f with a "
+                  "BIC %s, and %s: a difference no extension explains specifically. The extensions that "
                   "fit it are candidates, not causes.",
                   fits ? "The base model fits within the noise" : "The base model misses the data", dg.base.best.chi2,
                   n, dg.chi2_limit, candidates.c_str(), rival->shape.name.c_str(), rival->shape.formula.c_str(),
-                  rival->c, rival->chi2, dg.base_bic - rival->bic,
+                  rival->c, rival->chi2, bic_change(dg.base_bic - rival->bic).c_str(),
                   heldout_change(dg.base_heldout, rival->heldout).c_str());
     return line;
   }
   std::snprintf(line, sizeof line,
                 fits ? "The calibrated base model fits within the data's noise (chi2 %.1f on %d data, below the "
-                       "99%% limit %.1f) and no extension passes both tests (the lowest BIC, %s, lowers it by %.1f "
+                       "99%% limit %.1f) and no extension passes both tests (the lowest BIC, %s, has a BIC %s "
                        "and %s; a drop of 6 needed for each): no discrepancy beyond noise, and no extension is "
                        "called for."
                      : "The base model misses the data (chi2 %.1f on %d data, 99%% limit %.1f), but no extension "
-                       "explains it: none passes both tests (the lowest BIC, %s, lowers it by %.1f and %s; a drop "
-                       "of 6 needed for each).",
+                       "explains it: none passes both tests (the lowest BIC, %s, has a BIC %s and %s; a "
+                       "drop of 6 needed for each).",
                 dg.base.best.chi2, n, dg.chi2_limit, best_bic ? best_bic->ext.name.c_str() : "-",
-                best_bic ? dg.base_bic - best_bic->bic : 0.0,
+                bic_change(best_bic ? dg.base_bic - best_bic->bic : 0.0).c_str(),
                 heldout_change(dg.base_heldout, best_bic ? best_bic->heldout : 0.0).c_str());
   return line + generic_difference(dg, rival);
 }
