@@ -183,7 +183,7 @@ class PartClock {
 }  // namespace
 
 void Simulation::step(bool measure) {
-  PartClock clock(step_ < timed_until_ ? 1 : step_ % kTimedEvery == 0 ? kTimedEvery : 0);
+  PartClock clock(step_weight(step_, timed_until_));
   // The servo reads the state the last step left, as a servo on the host does before the step.
   if (servo_on_) {
     servo_step();
