@@ -19,14 +19,30 @@ SCALE = {"byte": 1, "kbyte": 1e3, "mbyte": 1e6, "gbyte": 1e9, "b": 1, "kb": 1e3,
 STEP_KERNEL = "BallForce"
 
 
+def first_argument(text):
+    """The first template argument of the text that follows a '<': up to the first ',' or '>' at its own depth."""
+    depth = 0
+    for i, c in enumerate(text):
+        if c == "<":
+            depth += 1
+        elif c in ",>" and depth == 0:
+            return text[:i]
+        elif c == ">":
+            depth -= 1
+    return text
+
+
 def short_name(kernel):
-    """The triaxdem functor a Kokkos kernel runs: the dem:: types its demangled name holds (namespaces left out), the
-    first with the others as its arguments (the reduction tree's level with the functor it sums: TreeLevel<Leapfrog,
-    EvenBlocks>)."""
-    names = re.findall(r"dem::(?:[a-z_]\w*::|\(anonymous namespace\)::)*([A-Z]\w*)", kernel)
-    if not names:
+    """The triaxdem functor a Kokkos kernel runs, namespaces left out: the first template argument of Kokkos'
+    ParallelFor/Reduce/Scan (inside Kokkos 4's CombinedFunctorReducer where there is one), and of a reduction tree's
+    level the functor it sums and its blocks (TreeLevel<Leapfrog, EvenBlocks>). ncu's demangled names drop some
+    namespaces and write an anonymous one as <unnamed> (seen on an H200 with Kokkos 3.4)."""
+    name = re.sub(r"(?<=<)<?unnamed>::|\(anonymous namespace\)::", "", kernel)
+    m = re.search(r"Parallel(?:For|Reduce|Scan)<(?:[\w:]*CombinedFunctorReducer<)?(.*)", name)
+    if not m:
         return kernel[:60]
-    return names[0] if len(names) == 1 else "%s<%s>" % (names[0], ", ".join(names[1:]))
+    functor = re.sub(r"\b\w+::", "", first_argument(m.group(1)))
+    return re.sub(r"<(\s*\d+\s*,\s*)+", "<", functor)
 
 
 def read(path):
