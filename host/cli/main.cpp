@@ -18,6 +18,7 @@
 #include "host/util/busy_machine.hpp"
 #include "host/util/process_pool.hpp"
 #include "host/util/ranks.hpp"
+#include "kernels/core/types.hpp"
 
 namespace {
 
@@ -98,8 +99,9 @@ int main(int argc, char** argv) {
   std::optional<Kokkos::ScopeGuard> kokkos;
   if (cmd.kokkos) {
     kokkos.emplace(argc, argv);
-    // Steps run here, on this process's threads (a calibration's runs are children of one thread each).
-    const int threads = cmd.parallel_runs ? 1 : Kokkos::DefaultExecutionSpace().concurrency();
+    // Steps run here, on this process's threads (a calibration's runs are children of one thread each); on a GPU
+    // one host thread drives them, and the device's concurrency (270,336 on an H200) shares no host core.
+    const int threads = cmd.parallel_runs || dem::kOnDevice ? 1 : Kokkos::DefaultExecutionSpace().concurrency();
     if (const std::string note = dem::busy_machine_note(threads); !note.empty())
       std::fprintf(stderr, "triaxdem: %s\n", note.c_str());
   }
