@@ -1,5 +1,7 @@
 #include "kernels/contact/contact_force.hpp"
 
+#include <algorithm>
+
 #include "kernels/neighbor/contact_detect.hpp"
 
 namespace dem {
@@ -16,6 +18,35 @@ struct MaxOverlap {
   }
   KOKKOS_INLINE_FUNCTION void init(value_type& a) const { a.ratio = 0; a.contact = -1; }
 };
+
+/// A force kernel K's items, one to a thread of a team: on a GPU the kernels run as teams (launch_forces).
+template <class K>
+struct ItemsInTeams : MaxOverlap {
+  K k;
+  int items;
+  KOKKOS_INLINE_FUNCTION void operator()(const Kokkos::TeamPolicy<ExecSpace>::member_type& m, value_type& worst) const {
+    const int item = m.league_rank() * m.team_size() + m.team_rank();
+    if (item < items) k(item, worst);
+  }
+};
+
+/// Launches force kernel `k` over its `items`, the largest overlap into `worst` on the device. On CUDA Kokkos 3.4
+/// launches a RangePolicy reduction on at most as many blocks as a block has threads: the ball forces ran on 256
+/// blocks of 256 threads for 3.5 million contacts (ncu, fifth device run), at a third of the H200's bandwidth, too
+/// few threads in flight to hide the gathers' latency. As a TeamPolicy reduction (a shuffle reduction: up to 32,768
+/// blocks) each item has a thread of its own. The largest overlap and its tie rule (MaxOverlap::join) are the same
+/// in any order and for any number of contributions, so the result is the RangePolicy's.
+template <class K>
+void launch_forces(const char* label, const K& k, int items, const OverlapResultView& worst) {
+  if constexpr (kOnDevice) {
+    using Teams = Kokkos::TeamPolicy<ExecSpace>;
+    const ItemsInTeams<K> f{{}, k, items};
+    const int size = Teams(1, 1).team_size_recommended(f, Kokkos::ParallelReduceTag());
+    Kokkos::parallel_reduce(label, Teams(std::max(1, (items + size - 1) / size), size), f, worst);
+  } else {
+    Kokkos::parallel_reduce(label, RangePolicy(0, items), k, worst);
+  }
+}
 
 /// One work item per kContactLanes consecutive ball-ball contacts, evaluated side by side as lanes of T. Each
 /// lane's arithmetic is that of a single contact, so the results do not depend on which lane a contact falls in.
@@ -251,7 +282,7 @@ void compute_ball_forces(const Particles& p, ContactList& c, const ParamTableVie
   bind_particles(k, p);
   k.c = c; k.params = params; k.spec = one;
   const int items = (c.n + BallForce::W - 1) / BallForce::W;
-  Kokkos::parallel_reduce("dem::force::balls" TRIAXDEM_DEVICE_RESULT, RangePolicy(0, items), k, worst);
+  launch_forces("dem::force::balls" TRIAXDEM_DEVICE_RESULT, k, items, worst);
 }
 
 void compute_ball_forces(const Particles& p, ContactList& c, const ParamTableView& params,
@@ -260,7 +291,7 @@ void compute_ball_forces(const Particles& p, ContactList& c, const ParamTableVie
   BallForce k;
   bind_particles(k, p);
   k.c = c; k.params = params; k.spec.many = specimens; k.items = items;
-  Kokkos::parallel_reduce("dem::force::balls" TRIAXDEM_DEVICE_RESULT, RangePolicy(0, items.items), k, worst);
+  launch_forces("dem::force::balls" TRIAXDEM_DEVICE_RESULT, k, items.items, worst);
 }
 
 OverlapStat compute_ball_forces(const Particles& p, ContactList& c, const ParamTableView& params, const Domain& dom,
@@ -274,7 +305,7 @@ void compute_wall_forces(const Particles& p, ContactList& c, const Adjacency& ad
   bind_particles(k, p);
   k.c = c; k.adj_off = adj.offset; k.adj_entry = adj.entry; k.walls = walls; k.mesh = mesh;
   k.params = params; k.dt = dt;
-  Kokkos::parallel_reduce("dem::force::walls" TRIAXDEM_DEVICE_RESULT, RangePolicy(0, c.n), k, worst);
+  launch_forces("dem::force::walls" TRIAXDEM_DEVICE_RESULT, k, c.n, worst);
 }
 
 OverlapStat compute_wall_forces(const Particles& p, ContactList& c, const Adjacency& adj, const WallSet& walls,
