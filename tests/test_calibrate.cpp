@@ -400,7 +400,8 @@ TEST(JobPlan, PackingsInTheStoreAreNotCounted) {
   bool said = false;
   for (const std::string& n : after.notes) said = said || n.find("state match: its packings are in the packing store") == 0;
   EXPECT_TRUE(said);
-  EXPECT_LT(after.high(), before.high());
+  // The work, not the time: the times rest on the probe's speed, which a busy machine moves between the two plans.
+  EXPECT_LT(after.particle_steps(), before.particle_steps());
 }
 
 // A diagnosis plans the runs of the extensions it will try, which are its law's: hertz_overlap and roughness extend
@@ -456,6 +457,30 @@ TEST(RunCost, TheShearsStepsAreCountedAsTheStageCountsThem) {
     EXPECT_EQ(c.shear_steps(sigma3), r.stages[1].steps) << "sigma3 " << sigma3;
     EXPECT_GT(c.run_steps(sigma3), c.shear_steps(sigma3));
   }
+}
+
+// A calibration's runs on a GPU go as batches of cells, one launch per kernel for all, and a batch of 48 runs of 200
+// balls took 9 s on an H200 where the plan, pricing them one at a time, said 3m58s (the fifth device run). The plan
+// now prices a batch of k as one run's time times 1 + (k - 1) growth, the growth from probing one lattice and a
+// batch of them; runs not batched are priced side by side as before. The arithmetic is exact here: the plan's
+// stages are sums of these.
+TEST(RunCost, ABatchCostsOneRunsTimeGrownByEachFurtherCell) {
+  CellCost c;
+  EXPECT_DOUBLE_EQ(c.seconds_of(5, 2.0, 2), 6.0) << "one at a time: 3 rounds of 2 side by side";
+  c.batch = 4;
+  c.batch_growth = 0.1;
+  EXPECT_DOUBLE_EQ(c.seconds_of(10, 2.0, 2), 2 * 2.0 * 1.3 + 2.0 * 1.1) << "batches of 4, 4 and 2";
+  EXPECT_DOUBLE_EQ(c.seconds_of(0, 2.0, 1), 0.0);
+  Config cfg = test::tiny_cell_config();
+  cfg.calibrate.batch = 1;
+  EXPECT_EQ(measure_cell_cost(cfg, 0.01).batch, 1);
+  cfg.calibrate.batch = 4;
+  const CellCost batched = measure_cell_cost(cfg, 0.01);
+  EXPECT_EQ(batched.batch, 4);
+  EXPECT_GE(batched.batch_growth, 0);
+  EXPECT_TRUE(std::isfinite(batched.batch_growth));
+  cfg.periodic.boundary = CellBoundary::walls;
+  EXPECT_EQ(batch_in_effect(4, cfg), 1) << "CellBatch takes periodic cells";
 }
 
 // A state match packs both ends of the preparation friction's range, and without friction the balls slide on and

@@ -50,8 +50,6 @@ std::string span(double low, double high) {
   return std::fabs(high - low) < 0.5 ? format_duration(high) : format_duration(low) + " to " + format_duration(high);
 }
 
-/// Wall seconds of `n` pieces of `each` seconds, `at_once` of them side by side.
-double wall(double n, double each, int at_once) { return std::ceil(n / std::max(at_once, 1) - 1e-9) * each; }
 
 /// Mean of a cost over the tests' pressures.
 template <class F>
@@ -72,7 +70,7 @@ struct Stages {
     const int k = std::min(at_once, side);
     plan.stages.push_back({name, what + " of " + std::to_string(c.balls) + " balls", setting,
                            n * static_cast<double>(c.packing_steps) * static_cast<double>(c.balls),
-                           wall(low_n, c.packing_seconds(), k), wall(n, c.packing_seconds(), k)});
+                           c.seconds_of(low_n, c.packing_seconds(), k), c.seconds_of(n, c.packing_seconds(), k)});
   }
   /// Runs of `tests` on `low_k` to `k` specimens per point, `points` points one after another.
   void runs(const std::string& name, const std::string& setting, const CellCost& c,
@@ -82,7 +80,8 @@ struct Stages {
     const double per_point_low = static_cast<double>(tests.size()) * low_k;
     const double per_point = static_cast<double>(tests.size()) * k;
     plan.stages.push_back({name, what, setting, points * per_point * steps * static_cast<double>(c.balls),
-                           points * wall(per_point_low, each, at_once), points * wall(per_point, each, at_once)});
+                           points * c.seconds_of(per_point_low, each, at_once),
+                           points * c.seconds_of(per_point, each, at_once)});
   }
 };
 
@@ -260,7 +259,8 @@ struct Planner {
                              std::to_string(mem.cell.balls) + " balls (" + std::to_string(P) + " specimens x " + T +
                              " pressures, " + std::to_string(side) +
                              " specimens at once; a specimen in .specimens is not built again)";
-    const double each = wall(P, build + tests_one, side), tests_s = wall(P, tests_one, side);
+    const double each = side_by_side_seconds(P, build + tests_one, side);
+    const double tests_s = side_by_side_seconds(P, tests_one, side);
     const bool rounds_run = in.two_fidelity && !in.diagnose;
     if (rounds_run) {
       // 1 to kFidelityRounds rounds (two_fidelity_rounds), the specimens built in the first.
@@ -282,7 +282,7 @@ struct Planner {
     double held = 0;
     for (const TriaxialTest& t : in.held_out) held += t.material == material ? 1 : 0;
     const double with_held = tests_one * (T_n + held) / T_n;
-    const double predict = wall(P, rounds_run ? with_held : build + with_held, side);
+    const double predict = side_by_side_seconds(P, rounds_run ? with_held : build + with_held, side);
     plan.stages.push_back({material + ": prediction", what + (held > 0 ? fmt(", %.0f held out", held) : ""),
                            "[calibrate] predict_specimens", test_steps * (T_n + held + kMembraneSpecimenOverTest),
                            predict, predict});
@@ -326,8 +326,12 @@ struct Planner {
   void notes() {
     plan.notes.push_back(fmt("speed measured here: %.0f ns a particle-step", lab.ns_per_particle_step) +
                          " in the cell of " + n + " balls, " + fmt("%.0f", check.ns_per_particle_step) +
-                         " in the check's of " + std::to_string(check.balls) + "; " + std::to_string(in.at_once) +
-                         (in.at_once > 1 ? " runs at once, one thread each" : " run at a time"));
+                         " in the check's of " + std::to_string(check.balls) + "; " +
+                         (lab.batch > 1
+                              ? "runs in batches of up to " + std::to_string(lab.batch) +
+                                    fmt(", each cell adding %.3g of a run's time to its batch", lab.batch_growth)
+                              : std::to_string(in.at_once) +
+                                    (in.at_once > 1 ? " runs at once, one thread each" : " run at a time")));
     plan.notes.push_back(fmt("a run of %.0f steps", static_cast<double>(lab.run_steps(cell.periodic.triax.sigma3))) +
                          fmt(" at %g kPa", 1e-3 * cell.periodic.triax.sigma3) +
                          fmt(" (%.0f s)", lab.run_seconds(cell.periodic.triax.sigma3)) +

@@ -1,4 +1,5 @@
 #include "host/lab/periodic_lab.hpp"
+#include "host/lab/run_cost.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -52,11 +53,7 @@ PeriodicLab::PeriodicLab(const Config& base, bool verbose, int members, unsigned
   pack(std::max(members_, specimens), verbose);
 }
 
-int PeriodicLab::set_batch(long batch) {
-  if (batch == kAutoBatch) batch = kOnDevice ? 4096 : 1;
-  if (cfg_.periodic.boundary == CellBoundary::walls) batch = 1;  // CellBatch takes periodic cells
-  return batch_ = static_cast<int>(std::max(1L, batch));
-}
+int PeriodicLab::set_batch(long batch) { return batch_ = batch_in_effect(batch, cfg_); }
 
 namespace {
 LabTime time_so_far;

@@ -6,6 +6,7 @@
 #include <iterator>
 
 #include "host/engine/builder.hpp"
+#include "host/engine/cell_batch.hpp"
 #include "host/triax/periodic_triaxial.hpp"
 #include "host/triax/specimen.hpp"
 #include "host/triax/triaxial.hpp"
@@ -50,7 +51,52 @@ std::vector<BallSpec> probe_lattice(const Config& cell, std::array<Real, 3>& box
   return balls;
 }
 
+/// Cells in the probe's batch for a batch's growth: on a GPU many cells share a step's launches, and the time of a
+/// batch grows nearly linearly to hundreds of cells (BM_CellBatch: 64 cells 33 times one alone, 512 cells 85 times,
+/// the fifth device run), so a few tens show the slope at a probe's cost.
+constexpr int kGrowthProbeCells = 16;
+
+/// Seconds a step of `cells` copies of the lattice takes as one batch, stepped for about `seconds` (at least 20
+/// steps, after 10 that build the lists and touch the memory).
+double batch_step_seconds(const Config& cell, const std::vector<BallSpec>& balls, const std::array<Real, 3>& box,
+                          int cells, double seconds) {
+  std::vector<std::unique_ptr<Simulation>> sims;
+  std::vector<const Simulation*> specimens;
+  for (int k = 0; k < cells; ++k) {
+    sims.push_back(make_periodic_simulation(balls, box, cell.ball.base(), cell.solver, CellBoundary::periodic));
+    specimens.push_back(sims.back().get());
+  }
+  CellBatch batch(specimens);
+  for (int k = 0; k < 10; ++k) batch.step();
+  long steps = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  double elapsed = 0;
+  while (steps < 20 || elapsed < seconds) {
+    batch.step();
+    ++steps;
+    elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  return elapsed / static_cast<double>(steps);
+}
+
 }  // namespace
+
+int batch_in_effect(long batch, const Config& cell) {
+  if (batch == kAutoBatch) batch = kOnDevice ? 4096 : 1;
+  if (cell.periodic.boundary == CellBoundary::walls) batch = 1;
+  return static_cast<int>(std::max(1L, batch));
+}
+
+double side_by_side_seconds(double n, double each, int at_once) {
+  return std::ceil(n / std::max(at_once, 1) - 1e-9) * each;
+}
+
+double CellCost::seconds_of(double n, double each, int at_once) const {
+  if (batch <= 1) return side_by_side_seconds(n, each, at_once);
+  const double full = std::floor(n / batch + 1e-9), rest = n - full * batch;
+  const auto one = [&](double k) { return k > 0 ? each * (1 + (k - 1) * batch_growth) : 0.0; };
+  return full * one(batch) + one(rest);
+}
 
 CellCost measure_cell_cost(const Config& cell, double probe_seconds) {
   CellCost c;
@@ -74,6 +120,12 @@ CellCost measure_cell_cost(const Config& cell, double probe_seconds) {
   }
   c.ns_per_particle_step = 1e9 * seconds / (static_cast<double>(steps) * static_cast<double>(balls.size())) *
                            kPairsOverLattice;
+  c.batch = batch_in_effect(cell.calibrate.batch, cell);
+  if (c.batch > 1) {
+    const int k = std::min(c.batch, kGrowthProbeCells);
+    const double one = batch_step_seconds(cell, balls, box, 1, probe_seconds);
+    c.batch_growth = std::max(0.0, (batch_step_seconds(cell, balls, box, k, probe_seconds) / one - 1) / (k - 1));
+  }
   // The gas phase: the cell closes on every axis from the box's solid fraction to a dense packing's, at the gas
   // phase's clamp to gas_solid_fraction and at the consolidation rate's after (resolve_periodic_params' defaults).
   const Real volume = cell.box.size[0] * cell.box.size[1] * cell.box.size[2];

@@ -47,6 +47,15 @@ struct CellCost {
   long run_steps(Real sigma3) const { return static_cast<long>((1 + kConsolidationShare) * shear_steps(sigma3)); }
   double run_seconds(Real sigma3) const { return 1e-9 * ns_per_particle_step * balls * run_steps(sigma3); }
   double packing_seconds() const { return 1e-9 * ns_per_particle_step * balls * packing_steps; }
+  /// Runs (and packings) stepped side by side as one batch (batch_in_effect), and what each further cell of a batch
+  /// adds to its time, as a share of one cell's: a batch steps all its cells in one launch per kernel, so on a GPU
+  /// a cell adds a sliver (the fifth device run: 48 runs of 200 balls in 9 s where the plan, pricing one at a time,
+  /// said 3m58s), on a CPU about a whole cell. The probe measures it where batch > 1.
+  int batch = 1;
+  double batch_growth = 1;
+  /// Wall seconds of n pieces of `each` seconds: at_once side by side (forked runs), or, where batch > 1, in
+  /// batches of at most `batch`, a batch of k taking each (1 + (k - 1) batch_growth).
+  double seconds_of(double n, double each, int at_once) const;
   PeriodicTriaxialParams triax;     ///< the cell's test parameters
 };
 
@@ -66,8 +75,17 @@ struct MembraneCost {
   double seconds(Real sigma3) const;
 };
 
+/// Wall seconds of n pieces of `each` seconds, at_once of them side by side.
+double side_by_side_seconds(double n, double each, int at_once);
+
+/// Runs a lab steps side by side as one batch for `batch` ([calibrate] batch; kAutoBatch: 4096 on a GPU build, 1 on
+/// a CPU): 1 for a cell between walls, which CellBatch does not take (PeriodicLab::set_batch).
+int batch_in_effect(long batch, const Config& cell);
+
 /// The cost of `cell` (a periodic or walled cell config): its time step from a lattice of its balls pressed together
-/// (as the runs' contacts are), the speed from stepping that lattice for about `probe_seconds` (at least 50 steps).
+/// (as the runs' contacts are), the speed from stepping that lattice for about `probe_seconds` (at least 50 steps),
+/// and where the lab batches its runs, a batch's growth from stepping one lattice and kGrowthProbeCells of them as
+/// batches.
 CellCost measure_cell_cost(const Config& cell, double probe_seconds = 0.3);
 
 }  // namespace dem
