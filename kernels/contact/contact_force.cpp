@@ -32,7 +32,7 @@ struct ItemsInTeams : MaxOverlap {
 
 /// Launches force kernel `k` over its `items`, the largest overlap into `worst` on the device. On CUDA Kokkos 3.4
 /// launches a RangePolicy reduction on at most as many blocks as a block has threads: the ball forces ran on 256
-/// blocks of 256 threads for 3.5 million contacts (ncu, fifth device run), at a third of the H200's bandwidth, too
+/// blocks of 256 threads for 3 million contacts (ncu, fifth device run), at a third of the H200's bandwidth, too
 /// few threads in flight to hide the gathers' latency. As a TeamPolicy reduction (a shuffle reduction: up to 32,768
 /// blocks) each item has a thread of its own. The largest overlap and its tie rule (MaxOverlap::join) are the same
 /// in any order and for any number of contributions, so the result is the RangePolicy's.
