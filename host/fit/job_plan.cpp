@@ -50,7 +50,6 @@ std::string span(double low, double high) {
   return std::fabs(high - low) < 0.5 ? format_duration(high) : format_duration(low) + " to " + format_duration(high);
 }
 
-
 /// Mean of a cost over the tests' pressures.
 template <class F>
 double mean_over(const std::vector<TriaxialTest>& tests, F f) {

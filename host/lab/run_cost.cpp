@@ -56,8 +56,24 @@ std::vector<BallSpec> probe_lattice(const Config& cell, std::array<Real, 3>& box
 /// the fifth device run), so a few tens show the slope at a probe's cost.
 constexpr int kGrowthProbeCells = 16;
 
+/// Seconds a step takes, `advance` taking ten: once untimed, as the first steps build the lists and touch the memory,
+/// then timed until at least `min_steps` steps and `seconds`.
+template <class Advance>
+double seconds_per_step(Advance advance, long min_steps, double seconds) {
+  advance();
+  long steps = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  double elapsed = 0;
+  while (steps < min_steps || elapsed < seconds) {
+    advance();
+    steps += 10;
+    elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  return elapsed / static_cast<double>(steps);
+}
+
 /// Seconds a step of `cells` copies of the lattice takes as one batch, stepped for about `seconds` (at least 20
-/// steps, after 10 that build the lists and touch the memory).
+/// steps).
 double batch_step_seconds(const Config& cell, const std::vector<BallSpec>& balls, const std::array<Real, 3>& box,
                           int cells, double seconds) {
   std::vector<std::unique_ptr<Simulation>> sims;
@@ -67,16 +83,7 @@ double batch_step_seconds(const Config& cell, const std::vector<BallSpec>& balls
     specimens.push_back(sims.back().get());
   }
   CellBatch batch(specimens);
-  for (int k = 0; k < 10; ++k) batch.step();
-  long steps = 0;
-  const auto t0 = std::chrono::steady_clock::now();
-  double elapsed = 0;
-  while (steps < 20 || elapsed < seconds) {
-    batch.step();
-    ++steps;
-    elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  }
-  return elapsed / static_cast<double>(steps);
+  return seconds_per_step([&] { for (int k = 0; k < 10; ++k) batch.step(); }, 20, seconds);
 }
 
 }  // namespace
@@ -108,18 +115,8 @@ CellCost measure_cell_cost(const Config& cell, double probe_seconds) {
   c.d = cell.particles.diameter;  // the mean of diameters uniform between the smallest and the largest
   c.rho_eff = cell.particles.density * cell.solver.mass_scale;
   c.triax = cell.periodic.triax;
-  // The probe's first steps build the lists and touch the memory: timed after them.
-  sim->run(10);
-  long steps = 0;
-  const auto t0 = std::chrono::steady_clock::now();
-  double seconds = 0;
-  while (steps < 50 || seconds < probe_seconds) {
-    sim->run(10);
-    steps += 10;
-    seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  }
-  c.ns_per_particle_step = 1e9 * seconds / (static_cast<double>(steps) * static_cast<double>(balls.size())) *
-                           kPairsOverLattice;
+  const double step_s = seconds_per_step([&] { sim->run(10); }, 50, probe_seconds);
+  c.ns_per_particle_step = 1e9 * step_s / static_cast<double>(balls.size()) * kPairsOverLattice;
   c.batch = batch_in_effect(cell.calibrate.batch, cell);
   if (c.batch > 1) {
     const int k = std::min(c.batch, kGrowthProbeCells);

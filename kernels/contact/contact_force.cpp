@@ -41,7 +41,8 @@ void launch_forces(const char* label, const K& k, int items, const OverlapResult
   if constexpr (kOnDevice) {
     using Teams = Kokkos::TeamPolicy<ExecSpace>;
     const ItemsInTeams<K> f{{}, k, items};
-    const int size = Teams(1, 1).team_size_recommended(f, Kokkos::ParallelReduceTag());
+    // The team size depends on the kernel's type alone: found once, not at every step.
+    static const int size = Teams(1, 1).team_size_recommended(f, Kokkos::ParallelReduceTag());
     Kokkos::parallel_reduce(label, Teams(std::max(1, (items + size - 1) / size), size), f, worst);
   } else {
     Kokkos::parallel_reduce(label, RangePolicy(0, items), k, worst);
