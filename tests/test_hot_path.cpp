@@ -356,3 +356,38 @@ TEST(HotPath, AStepLeavesTheForcesToOutputWhichGathersTheLastStepsOnDemand) {
     Kokkos::deep_copy(p.m, 0.0);
   }
 }
+
+// A shear record copies the state into kept host buffers (host/engine/state_copy.hpp: deep copies into buffers of
+// their own, which a CPU build allocates and fills as a GPU build does, where mirrors would be the device's own Views
+// on a CPU and hide their cost): after the first records, one buffer set at once and a second where the records are
+// worked out beside the steps, a record allocates nothing, and what it copies is the same for every record. Counted
+// on the shear's control (where the records are taken) of the tiny membrane test with twice the records: the run
+// with more records may allocate more only where a list outgrows its buffer, by a quarter at a time.
+TEST(HotPath, AShearRecordCopiesTheStateIntoKeptBuffersAndAllocatesNothing) {
+  Config c = test::tiny_triaxial_config(0.3, 0.02);
+  c.solver.stats_every = 16;
+  const Specimen sp = build_specimen(c, false);
+  for (const char* overlap : {"off", "on"}) {
+    SyncCounts control[2];
+    std::size_t records[2];
+    for (int more : {0, 1}) {
+      c.micro.overlap = overlap;
+      c.triaxial.record_every = more ? 0.0025 : 0.005;
+      const TriaxialResult r = run_triaxial(c, sp, nullptr, false);
+      control[more] = part_of(r.stages.back(), SyncPart::kControl);
+      records[more] = r.records.size();
+    }
+    const double extra = double(records[1] - records[0]);
+    ASSERT_GT(extra, 10) << overlap;
+    const double copies = double(control[1].copies - control[0].copies) / extra;
+    const double allocations = double(control[1].allocations - control[0].allocations) / extra;
+    std::printf("[micro] overlap %s: %zu and %zu records; a record: %.2f copies, %.2f allocations (%ld and %ld in "
+                "all)\n", overlap, records[0], records[1], copies, allocations, control[0].allocations,
+                control[1].allocations);
+    // The state's arrays (balls, contact lists, walls, membrane) and the wall loads: some twenty copies, the same
+    // number each record (a kept buffer is filled, never remade).
+    EXPECT_GT(copies, 15) << overlap;
+    EXPECT_LT(copies, 25) << overlap;
+    EXPECT_LE(allocations, 0.05) << overlap;
+  }
+}

@@ -14,7 +14,7 @@
 
 #include "host/cli/job.hpp"
 #include "host/engine/stress.hpp"
-#include "host/triax/micro_record.hpp"
+#include "host/triax/record_work.hpp"
 #include "host/triax/micro_report.hpp"
 #include "host/triax/triaxial.hpp"
 #include "host/triax/triaxial_measure.hpp"

@@ -8,6 +8,7 @@
 #include "host/io/io_hdf5.hpp"
 #include "host/engine/micro.hpp"
 #include "host/engine/simulation.hpp"
+#include "host/engine/state_copy.hpp"
 
 namespace dem {
 
@@ -26,88 +27,42 @@ ContactRecord record(int a, const Vec3& d, const Vec3& fc_on_a, Real fn) {
   return c;
 }
 
-/// The first n values of a one-dimensional device View, in a host vector of their own.
-template <class V>
-std::vector<typename V::non_const_value_type> host_values(const V& v, int n) {
-  const auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), Kokkos::subview(v, std::make_pair(0, n)));
-  return std::vector<typename V::non_const_value_type>(h.data(), h.data() + n);
-}
-/// The first n rows of a View of rows (3-vectors, the facets' node triples), each read by `row`, likewise.
-template <class V, class Row>
-auto host_rows(const V& v, int n, Row row) {
-  const auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), v);
-  std::vector<decltype(row(h, 0))> out(static_cast<std::size_t>(n));
-  for (int k = 0; k < n; ++k) out[k] = row(h, k);
-  return out;
-}
-std::vector<Vec3> host_rows(const Vec3View& v, int n) {
-  return host_rows(v, n, [](const auto& h, int k) { return load(h, k); });
-}
-ContactCopy::List host_list(const ContactList& l) {
-  return {host_values(l.i, l.n), host_values(l.j, l.n), host_rows(l.fc, l.n), host_values(l.fn, l.n)};
-}
-
 }  // namespace
-
-ContactCopy copy_contacts(Simulation& sim) {
-  const Particles& p = sim.particles();
-  ContactCopy c;
-  const auto gid = host_values(p.gid, p.n);
-  c.gid.assign(gid.begin(), gid.end());
-  const std::vector<Vec3> x = host_rows(p.x, p.n);
-  const std::vector<Real> rad = host_values(p.radius, p.n);
-  c.x.resize(p.n);
-  c.radius.resize(p.n);
-  for (int i = 0; i < p.n; ++i) {
-    c.x[c.gid[i]] = x[i];
-    c.radius[c.gid[i]] = rad[i];
-  }
-  c.balls = host_list(sim.ball_contacts());
-  c.walls = host_list(sim.wall_contacts());
-  const WallSet& walls = sim.walls();
-  c.wall_kind = host_values(walls.kind, walls.n);
-  c.wall_point = host_rows(walls.point, walls.n);
-  c.wall_normal = host_rows(walls.normal, walls.n);
-  c.wall_radius = host_values(walls.radius, walls.n);
-  const FacetMesh& mesh = sim.mesh();
-  c.node_x = host_rows(mesh.node_x, mesh.nnode);
-  c.tri = host_rows(mesh.tri, mesh.ntri,
-                    [](const auto& h, int k) { return std::array<int, 3>{h(k, 0), h(k, 1), h(k, 2)}; });
-  c.domain = sim.domain();
-  return c;
-}
 
 ContactSet contact_set(const ContactCopy& c) {
   ContactSet s;
-  s.x = c.x;
-  s.radius = c.radius;
+  s.x = centres_by_gid(c);
+  s.radius.resize(static_cast<std::size_t>(c.n));
+  for (int i = 0; i < c.n; ++i) s.radius[c.gid(i)] = c.radius(i);
   const ContactCopy::List& bc = c.balls;
-  for (std::size_t k = 0; k < bc.fn.size(); ++k) {
-    if (!(bc.fn[k] > 0)) continue;
-    const int a = c.gid[bc.i[k]], b = c.gid[bc.j[k]];
-    ContactRecord r = record(a, c.domain.min_image(s.x[b] - s.x[a]), bc.fc[k], bc.fn[k]);
+  for (int k = 0; k < bc.n; ++k) {
+    if (!(bc.fn(k) > 0)) continue;
+    const int a = static_cast<int>(c.gid(bc.i(k))), b = static_cast<int>(c.gid(bc.j(k)));
+    ContactRecord r = record(a, c.domain.min_image(s.x[b] - s.x[a]), load(bc.fc, k), bc.fn(k));
     r.b = b;
     const Real overlap = s.radius[a] + s.radius[b] - norm(r.branch);
     r.point = s.x[r.a] + (s.radius[r.a] - overlap / 2) * r.normal;
     s.contacts.push_back(r);
   }
   const ContactCopy::List& wc = c.walls;
-  const int nwalls = static_cast<int>(c.wall_kind.size());
-  for (std::size_t k = 0; k < wc.fn.size(); ++k) {
-    if (!(wc.fn[k] > 0)) continue;
-    const int a = c.gid[wc.i[k]];
+  const int nwalls = c.nwalls;
+  for (int k = 0; k < wc.n; ++k) {
+    if (!(wc.fn(k) > 0)) continue;
+    const int a = static_cast<int>(c.gid(wc.i(k)));
     const Vec3& x = s.x[a];
-    const int obj = wc.j[k];
+    const int obj = wc.j(k);
     Vec3 cp;
     if (obj < nwalls) {
-      if (!wall_closest_point(c.wall_kind[obj], c.wall_point[obj], c.wall_normal[obj], c.wall_radius[obj], x, cp))
+      if (!wall_closest_point(c.wall_kind(obj), load(c.wall_point, obj), load(c.wall_normal, obj), c.wall_radius(obj),
+                              x, cp))
         continue;
     } else {
-      const std::array<int, 3>& t = c.tri[obj - nwalls];
-      cp = closest_on_triangle(x, c.node_x[t[0]], c.node_x[t[1]], c.node_x[t[2]]).cp;
+      const int t = obj - nwalls;
+      cp = closest_on_triangle(x, load(c.node_x, c.tri(t, 0)), load(c.node_x, c.tri(t, 1)), load(c.node_x, c.tri(t, 2)))
+               .cp;
     }
     if (!(norm(cp - x) > 0)) continue;
-    ContactRecord r = record(a, cp - x, wc.fc[k], wc.fn[k]);
+    ContactRecord r = record(a, cp - x, load(wc.fc, k), wc.fn(k));
     r.boundary = obj < nwalls ? Boundary::kPlaten : Boundary::kMembrane;
     r.point = cp;
     s.contacts.push_back(r);
@@ -115,7 +70,11 @@ ContactSet contact_set(const ContactCopy& c) {
   return s;
 }
 
-ContactSet contact_set(Simulation& sim) { return contact_set(copy_contacts(sim)); }
+ContactSet contact_set(Simulation& sim) {
+  ContactCopy c;
+  copy_state(sim, true, c);
+  return contact_set(c);
+}
 
 io::ContactTable contact_table(const ContactSet& s) {
   io::ContactTable t;

@@ -40,30 +40,10 @@ struct ContactSet {
   std::vector<char> inside;     ///< balls of the analysed volume (empty: all)
 };
 
-/// A running simulation's contacts as its device holds them, copied into host vectors at one state: all that
-/// contact_set needs from the simulation, so that the rest can be worked out on another thread while it steps on.
-struct ContactCopy {
-  /// A contact list: local ball index, partner (a ball's local index, or a wall object: a wall below the walls'
-  /// count, else a facet), the total force on the ball (N) and the normal force (N, > 0 where touching).
-  struct List {
-    std::vector<int> i, j;
-    std::vector<Vec3> fc;
-    std::vector<Real> fn;
-  };
-  std::vector<Vec3> x;                     ///< ball centres by gid (m)
-  std::vector<Real> radius;                ///< by gid (m)
-  std::vector<int> gid;                    ///< of each local index
-  List balls, walls;
-  std::vector<int> wall_kind;
-  std::vector<Vec3> wall_point, wall_normal;
-  std::vector<Real> wall_radius;
-  std::vector<Vec3> node_x;                ///< the membrane's facet nodes (m)
-  std::vector<std::array<int, 3>> tri;     ///< its facets
-  Domain domain;
-};
-ContactCopy copy_contacts(Simulation& sim);
+struct ContactCopy;  // host/engine/state_copy.hpp
 
-/// Touching contacts of a simulation (or of its copy). Analytic walls count as platens, facets as membrane.
+/// Touching contacts of a simulation (or of a copy of its state, with its contacts). Analytic walls count as
+/// platens, facets as membrane.
 ContactSet contact_set(const ContactCopy& c);
 ContactSet contact_set(Simulation& sim);
 /// The same to and from a snapshot file's /contacts group. contact_set(file) throws std::runtime_error

@@ -59,13 +59,12 @@ SpecimenStress specimen_stress(const Simulation& sim, Real volume) {
   return out;
 }
 
-Real lateral_stress(const Simulation& sim, const Membrane& m, const std::vector<Vec3>& f) {
-  auto nx = Kokkos::create_mirror_view_and_copy(HostSpace(), m.mesh.node_x);
-  auto tri = Kokkos::create_mirror_view_and_copy(HostSpace(), m.mesh.tri);
-  auto fixed = Kokkos::create_mirror_view_and_copy(HostSpace(), m.fixed);
-  const int w0 = sim.num_walls();
+Real lateral_stress(const MembraneCopy& m, int w0, const std::vector<Vec3>& f) {
+  const auto& nx = m.node_x;
+  const auto& tri = m.tri;
+  const auto& fixed = m.fixed;
   Real fn = 0, area = 0;
-  for (int t = 0; t < m.mesh.ntri; ++t) {
+  for (int t = 0; t < m.ntri; ++t) {
     if (fixed(tri(t, 0)) || fixed(tri(t, 1)) || fixed(tri(t, 2))) continue;
     const Vec3 a = load(nx, tri(t, 0)), b = load(nx, tri(t, 1)), d = load(nx, tri(t, 2));
     const Vec3 s = 0.5 * cross(b - a, d - a);  // area vector, outward (counter-clockwise seen from outside)

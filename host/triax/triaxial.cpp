@@ -14,7 +14,7 @@
 #include "host/engine/stage_loop.hpp"
 #include "host/engine/stress.hpp"
 #include "host/data/measured.hpp"
-#include "host/triax/micro_record.hpp"
+#include "host/triax/shear_record.hpp"
 #include "host/triax/micro_report.hpp"
 #include "host/util/progress.hpp"
 #include "kernels/motion/wall_servo.hpp"
@@ -27,43 +27,6 @@
 namespace dem {
 
 namespace {
-
-/// series.csv's columns before the micro ones, and a record's values in them (series_row): one order for both.
-const std::vector<std::string> kSeriesColumns = {
-    "eps_a_pct",        "eps_v_pct",          "q_kPa",            "sigma1_kPa",      "sigma1_bottom_kPa",
-    "sigma3_kPa",       "sigma3_balls_kPa",   "eps_v_envelope_pct", "unbalanced_ratio", "kinetic_energy_J",
-    "q_area_kPa",       "q_parabolic_kPa",    "q_membrane_kPa",   "sigma3_hoop_kPa", "q_lw_kPa",
-    "p_lw_kPa",         "q_boundary_kPa",     "p_boundary_kPa",   "q_net_kPa",       "p_net_kPa",
-    "p_kPa",            "void_ratio",         "phi_mob_deg"};
-
-/// `e0`: the void ratio after consolidation, from which eps_v counts. p and phi_mob are the lab's, of the q the
-/// paper reports (q_kPa) and the cell pressure: p = sigma3 + q / 3, as the periodic series has them.
-std::vector<double> series_row(const TriaxialRecord& r, Real sigma3, Real e0) {
-  return {100 * r.eps_a,         100 * r.eps_v,        r.q / 1e3,           r.sigma1 / 1e3,     r.sigma1_bottom / 1e3,
-          sigma3 / 1e3,          r.sigma3_balls / 1e3, 100 * r.eps_v_envelope, r.unbalanced,     r.kinetic,
-          r.q_area / 1e3,        r.q_parabolic / 1e3,  r.q_membrane / 1e3,  r.sigma3_hoop / 1e3, r.q_lw / 1e3,
-          r.p_lw / 1e3,          r.q_boundary / 1e3,   r.p_boundary / 1e3,  r.q_net / 1e3,      r.p_net / 1e3,
-          (sigma3 + r.q / 3) / 1e3, (1 + e0) * (1 - r.eps_v) - 1, friction_angle_deg(r.q, sigma3)};
-}
-
-/// The record's deviators as labs report them and the specimen's stresses over the enclosed `volume` (its contacts'
-/// on the device, specimen_stress), from the platen force (r.sigma1, r.sigma3_balls and the strains set). `a0`: the
-/// cross-section after consolidation, V0 / h0.
-void measure_stresses(const Cell& c, const TriaxialConfig& tc, Real volume, Real a0, TriaxialRecord& r) {
-  const Real force = r.sigma1 * c.area;
-  r.q_area = force / right_cylinder_area(a0, r.eps_a, r.eps_v) - tc.sigma3;
-  r.q_parabolic = force / parabolic_mid_area(a0, r.eps_a, r.eps_v) - tc.sigma3;
-  r.q_membrane = r.q_area + tc.sigma3 - r.sigma3_balls;
-  r.sigma3_hoop = tc.sigma3 + membrane_hoop_stress(tc.membrane_modulus, tc.membrane_thickness,
-                                                   std::sqrt(4 * a0 / M_PI), r.eps_a, r.eps_v);
-  const SpecimenStress s = specimen_stress(*c.sim, volume);
-  r.q_lw = axial_deviator(s.love_weber);
-  r.p_lw = mean_stress(s.love_weber);
-  r.q_boundary = axial_deviator(s.boundary);
-  r.p_boundary = mean_stress(s.boundary);
-  r.q_net = axial_deviator(s.net_force);
-  r.p_net = mean_stress(s.net_force);
-}
 
 /// Isotropic consolidation from the state in `st` (a resumed run's, or step 0): cell pressure on the membrane, stress
 /// servo on the top platen, until the platen's stress and the unbalanced ratio settle; then `st` moves to shear with
@@ -151,114 +114,6 @@ void save_blowup(Simulation& sim, const Cell& cell, io::Output& out, const Stage
                out.folder().c_str(), blowup_path(out.folder()).c_str());
 }
 
-/// The contacts of the current step, copied to the host at most once a step, for the record and the snapshot alike.
-class LazyContacts {
- public:
-  explicit LazyContacts(Simulation& sim) : sim_(sim) {}
-  std::shared_ptr<const ContactCopy> copy() {
-    if (!copy_) copy_ = std::make_shared<const ContactCopy>(copy_contacts(sim_));
-    return copy_;
-  }
-  ContactSet set() { return contact_set(*copy()); }
-
- private:
-  Simulation& sim_;
-  std::shared_ptr<const ContactCopy> copy_;
-};
-
-/// What a shear stage's records need besides the step: the test, its state and result, the output, and the
-/// consolidated height and volumes the strains are taken from.
-struct ShearRecorder {
-  const Config& cfg;
-  const Cell& cell;
-  Stage& st;
-  TriaxialResult& res;
-  io::Output* out;
-  Real h0, v0, v0_envelope;
-  const std::array<Real, kSnapshotStrains>& snaps;  ///< the strains of the paper's points A-D
-  Progress& progress;
-  MicroRecords& micro;
-  bool verbose;
-};
-
-/// One record of the shear stage at axial strain eps_a, step k: boundary stresses and strains, the stress measures,
-/// micromechanics where enabled (with their states at the snapshot strains and the peak), the series row.
-void take_record(const ShearRecorder& sh, Real eps_a, long k, LazyContacts& contacts) {
-  const TriaxialConfig& tc = sh.cfg.triaxial;
-  const MicroConfig& mc = sh.cfg.micro;
-  const Cell& cell = sh.cell;
-  Simulation& sim = *cell.sim;
-  const char* snap_labels[] = {"A", "B", "C", "D"};  // the paper's points A-D (Figure 8)
-  TriaxialRecord r;
-  const std::vector<Vec3> wall_f = sim.wall_forces();
-  const auto [top, bottom] = platen_stresses(cell, wall_f);
-  const Real top_z = sim.wall_point(kTopPlaten).z, volume = specimen_volume(cell);
-  r.eps_a = eps_a;
-  r.eps_v = (sh.v0 - volume) / sh.v0;
-  r.sigma1 = top;
-  r.sigma1_bottom = bottom;
-  r.q = top - tc.sigma3;
-  r.sigma3_balls = lateral_stress(sim, cell.membrane, wall_f);
-  r.eps_v_envelope =
-      (sh.v0_envelope - envelope_volume(sim, top_z, cell.mean_radius, tc.membrane_segments)) / sh.v0_envelope;
-  r.unbalanced = sim.unbalanced_ratio();
-  r.kinetic = sim.stats().kinetic;
-  measure_stresses(cell, tc, volume, sh.v0 / sh.h0, r);
-  sh.res.records.push_back(r);
-  // The series row goes out once its micromechanics are known; a crash keeps the curve so far (flushed every 25).
-  const bool flush = sh.res.records.size() % 25 == 0;
-  auto append = [&res = sh.res, out = sh.out, flush, row = series_row(r, tc.sigma3, sh.st.void_ratio)](
-                    const MicroRow* m, const std::vector<double>& micro) mutable {
-    if (m) res.micro.push_back(*m);
-    row.insert(row.end(), micro.begin(), micro.end());
-    if (out) out->append_series(row);
-    if (out && flush) out->flush_series();
-  };
-  if (mc.enabled) {
-    MicroJob job{contacts.copy(), volume, Vec3(0, 0, top_z / 2), {}};
-    const int snap = sh.st.next_snap;
-    if (snap < kSnapshotStrains && eps_a >= sh.snaps[snap] - 1e-12) job.states.push_back(snap_labels[snap]);
-    if (r.q > sh.st.q_max) job.states.push_back("peak");
-    sh.micro.add(std::move(job), [append](const MicroRow& m, const std::vector<double>& v) mutable { append(&m, v); });
-  } else {
-    append(nullptr, {});
-  }
-  sh.st.q_max = std::max(sh.st.q_max, r.q);
-  sh.st.next_record += tc.record_every;
-  if (sh.verbose) {
-    char extra[64];
-    std::snprintf(extra, sizeof extra, "eps_a %.2f%%, q %.1f kPa", 100 * eps_a, r.q / 1e3);
-    sh.progress.update(k, extra);
-  }
-}
-
-/// The state step k of the shear left: its record where one is due (or `last`), and a snapshot where one is.
-void observe_shear(const ShearRecorder& sh, long k, bool last) {
-  Simulation& sim = *sh.cell.sim;
-  const bool micro = sh.cfg.micro.enabled;
-  const Real eps_a = (sh.h0 - sim.wall_point(kTopPlaten).z) / sh.h0;
-  LazyContacts contacts{sim};
-  if (eps_a >= sh.st.next_record - 1e-12 || last) take_record(sh, eps_a, k, contacts);
-  const int next_snap = sh.st.next_snap;
-  if (sh.out && next_snap < kSnapshotStrains && eps_a >= sh.snaps[next_snap] - 1e-12) {
-    char label[48];
-    std::snprintf(label, sizeof label, "shear eps_a=%.0f%%", 100 * sh.snaps[next_snap]);
-    const io::SurfaceSnapshot surface = membrane_surface(sh.cell.membrane);
-    const io::ContactTable table = micro ? contact_table(contacts.set()) : io::ContactTable();
-    sh.out->write_snapshot(take_snapshot(sim, label), &surface, micro ? &table : nullptr);
-    sh.st.next_snap += 1;
-  }
-}
-
-/// The series' columns: the boundary's, then the micromechanics' of the specimen and of its central cube where enabled.
-std::vector<std::string> series_columns(const MicroConfig& mc) {
-  std::vector<std::string> columns = kSeriesColumns;
-  if (mc.enabled)
-    for (const std::string& prefix : {std::string(), std::string("rve_")})
-      for (const std::string& c : micro_columns(prefix)) columns.push_back(c);
-  return columns;
-}
-
 /// The result's curve values from its records, its highest record, the balls that left the membrane, and the
 /// run's times and counts.
 void finish_result(const Cell& cell, Real sigma3, double wall_seconds, TriaxialResult& res) {
@@ -335,14 +190,14 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
   // What both stages do alike: a checkpoint of the test's stage and curve when due; on a blow-up, the state it
   // happened in (balls, membrane, contacts) and the curve so far.
   StageSteps shared;
-  MicroRecords micro(mc, out ? out->folder() : std::string());
+  RecordWork work(mc, cell.mean_radius, tc.membrane_segments, out ? out->folder() : std::string());
   shared.checkpoint = [&](long) {
-    micro.finish();
+    work.finish();
     if (out) out->flush_series();
     res.wall_seconds = elapsed();
     save_triaxial(plan->path, sim, out, st, res, plan->config);
   };
-  if (out) shared.save_blowup = [&] { micro.finish(); save_blowup(sim, cell, *out, st, res, plan); };
+  if (out) shared.save_blowup = [&] { work.finish(); save_blowup(sim, cell, *out, st, res, plan); };
   if (!st.shear) res.stages.push_back(consolidate(cfg, sp, cell, st, verbose, shared, plan));
   res.consolidation_steps = st.consolidation_steps;
   res.void_ratio_consolidated = st.void_ratio;
@@ -358,7 +213,8 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
                 tc.axial_strain_end * 100);
   const std::array<Real, kSnapshotStrains> snaps = {0.0, 0.01, 0.05, tc.axial_strain_end};
   Progress shear("shear", steps, st.step);
-  const ShearRecorder recorder{cfg, cell, st, res, out, h0, v0, v0_envelope, snaps, shear, micro, verbose};
+  StateCopies copies;
+  const ShearRecorder recorder{cfg, cell, st, res, out, h0, v0, v0_envelope, snaps, shear, copies, work, verbose};
   // Before step k + 1, the state step k left: its record and snapshot where due (the last state's too), then the
   // platen's control. A checkpoint follows each step, before the record of the state it left (a resumed run
   // takes that record).
@@ -384,7 +240,7 @@ TriaxialResult run_triaxial(const Config& cfg, const Specimen& sp, io::Output* o
   };
   res.stages.push_back(run_stage(sim, shear_stage, plan).timing);
   res.stages.back().name = "shear";
-  micro.finish();
+  work.finish();
   if (out) out->flush_series();
   finish_result(cell, tc.sigma3, elapsed(), res);
   return res;

@@ -83,14 +83,17 @@ io::SurfaceSnapshot membrane_surface(const Membrane& m) {
   return s;
 }
 
-Real envelope_volume(Simulation& sim, Real top, Real mean_radius, int slabs) {
+Real envelope_volume(const std::vector<Vec3>& centres, Real top, Real mean_radius, int slabs) {
   const Real dz = top / slabs;
   std::vector<std::vector<std::pair<Real, Real>>> xy(slabs);
-  const HostParticles h = to_host_by_gid(sim.particles());
-  for (const Vec3& x : h.x) xy[std::clamp(static_cast<int>(x.z / dz), 0, slabs - 1)].emplace_back(x.x, x.y);
+  for (const Vec3& x : centres) xy[std::clamp(static_cast<int>(x.z / dz), 0, slabs - 1)].emplace_back(x.x, x.y);
   Real v = 0;
   for (auto& pts : xy) v += disc_hull_area(std::move(pts), mean_radius) * dz;
   return v;
+}
+
+Real envelope_volume(Simulation& sim, Real top, Real mean_radius, int slabs) {
+  return envelope_volume(to_host_by_gid(sim.particles()).x, top, mean_radius, slabs);
 }
 
 int count_escaped(Simulation& sim, const Membrane& m, Real top) {

@@ -35,7 +35,8 @@ io::SurfaceSnapshot membrane_surface(const Membrane& m);
 /// Volume of the balls' envelope (m^3), measured without the membrane: the specimen between the bottom
 /// platen (z = 0) and `top` cut into `slabs` slabs, each slab's cross-section the convex hull of its balls
 /// (centres within the slab, grown by `mean_radius`). It bounds the granular body as a wrapping membrane
-/// would, except for the dimples a soft membrane makes between the outer balls.
+/// would, except for the dimples a soft membrane makes between the outer balls. `centres`: the balls' in gid order.
+Real envelope_volume(const std::vector<Vec3>& centres, Real top, Real mean_radius, int slabs);
 Real envelope_volume(Simulation& sim, Real top, Real mean_radius, int slabs);
 
 /// Balls whose centre lies outside the membrane tube or beyond the platens (z < 0 or z > top). Inside the

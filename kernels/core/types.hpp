@@ -33,6 +33,17 @@ using Index2View = Kokkos::View<int* [2], Layout, MemSpace>;         ///< pair o
 using Real2View = Kokkos::View<Real* [2], Kokkos::LayoutRight, MemSpace>;  ///< two values per item
 using Index3View = Kokkos::View<int* [3], Layout, MemSpace>;         ///< facet vertex indices
 
+/// Host memory for the copies a record takes of the device's state (host/engine/state_copy.hpp): pinned where a
+/// device steps, so that a copy runs at the link's speed with no staging buffer of the driver's in between.
+#ifdef KOKKOS_ENABLE_CUDA
+using CopySpace = Kokkos::CudaHostPinnedSpace;
+#else
+using CopySpace = HostSpace;
+#endif
+/// A kept host copy of a device View V: its type and layout, in CopySpace.
+template <class V>
+using HostCopyView = Kokkos::View<typename V::non_const_data_type, typename V::array_layout, CopySpace>;
+
 /// Largest overlap / radius of a step's contacts and where it happened (for blow-up detection).
 struct OverlapStat {
   Real ratio = 0;
