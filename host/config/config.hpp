@@ -109,8 +109,8 @@ struct MicroConfig {
   bool enabled = true;
   Real rve_edge = 20e-3;   ///< m, edge of the central cube (the paper's 20 mm; file: rve_edge_mm)
   int rose_bins = 18;      ///< angle bins of the directional distributions over 0-180 deg
-  /// Whether a record's micromechanics are worked out on a host thread beside the next steps: "on", "off", or
-  /// "auto" (on where the steps run on a device; host/triax/record_work.hpp).
+  /// Whether a shear record's host work (micromechanics, envelope) is worked out on a host thread beside the next
+  /// steps: "on", "off", or "auto" (on where the steps run on a device; host/triax/record_work.hpp).
   std::string overlap = "auto";
 };
 

@@ -30,6 +30,7 @@ ContactRecord record(int a, const Vec3& d, const Vec3& fc_on_a, Real fn) {
 }  // namespace
 
 ContactSet contact_set(const ContactCopy& c) {
+  if (!c.contacts) throw std::logic_error("contact_set: a copy of the state taken without its contacts (copy_state)");
   ContactSet s;
   s.x = centres_by_gid(c);
   s.radius.resize(static_cast<std::size_t>(c.n));
