@@ -52,9 +52,9 @@ void measure_stresses(const Cell& c, const TriaxialConfig& tc, Real volume, Real
 }
 
 /// The state of the current step, copied to the host at most once a step, for the record and the snapshot alike.
-class LazyContacts {
+class LazyCopy {
  public:
-  LazyContacts(StateCopies& copies, Simulation& sim, bool contacts) : copies_(copies), sim_(sim), contacts_(contacts) {}
+  LazyCopy(StateCopies& copies, Simulation& sim, bool contacts) : copies_(copies), sim_(sim), contacts_(contacts) {}
   std::shared_ptr<const ContactCopy> copy() {
     if (!copy_) copy_ = copies_.take(sim_, contacts_);
     return copy_;
@@ -87,7 +87,7 @@ RecordWork::Done record_done(const ShearRecorder& sh) {
 /// One record of the shear stage at axial strain eps_a, step k: boundary stresses and strains and the stress measures
 /// here; the envelope and the micromechanics where enabled (with their states at the snapshot strains and the peak)
 /// from the copy of the state, then the series row (record_done).
-void take_record(const ShearRecorder& sh, Real eps_a, long k, LazyContacts& state) {
+void take_record(const ShearRecorder& sh, Real eps_a, long k, LazyCopy& state) {
   const TriaxialConfig& tc = sh.cfg.triaxial;
   const Cell& cell = sh.cell;
   Simulation& sim = *cell.sim;
@@ -129,7 +129,7 @@ void observe_shear(const ShearRecorder& sh, long k, bool last) {
   Simulation& sim = *sh.cell.sim;
   const bool micro = sh.cfg.micro.enabled;
   const Real eps_a = (sh.h0 - sim.wall_point(kTopPlaten).z) / sh.h0;
-  LazyContacts state{sh.copies, sim, micro};
+  LazyCopy state{sh.copies, sim, micro};
   if (eps_a >= sh.st.next_record - 1e-12 || last) take_record(sh, eps_a, k, state);
   const int next_snap = sh.st.next_snap;
   if (sh.out && next_snap < kSnapshotStrains && eps_a >= sh.snaps[next_snap] - 1e-12) {
@@ -150,6 +150,5 @@ std::vector<std::string> series_columns(const MicroConfig& mc) {
       for (const std::string& c : micro_columns(prefix)) columns.push_back(c);
   return columns;
 }
-
 
 }  // namespace dem
