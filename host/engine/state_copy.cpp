@@ -56,8 +56,6 @@ void copy_state(Simulation& sim, bool contacts, ContactCopy& into) {
   copy_rows(into.wall_normal, walls.normal, walls.n);
   copy_rows(into.wall_radius, walls.radius, walls.n);
   const FacetMesh& mesh = sim.mesh();
-  into.nnode = mesh.nnode;
-  into.ntri = mesh.ntri;
   copy_rows(into.node_x, mesh.node_x, mesh.nnode);
   copy_rows(into.tri, mesh.tri, mesh.ntri);
 }

@@ -32,7 +32,7 @@ struct ContactCopy {
   bool contacts = false;             ///< whether what follows was copied (copy_state's `contacts`)
   HostCopyView<ScalarView> radius;   ///< m, by local index
   List balls, walls;
-  int nwalls = 0, nnode = 0, ntri = 0;
+  int nwalls = 0;
   HostCopyView<IndexView> wall_kind;
   HostCopyView<Vec3View> wall_point, wall_normal;
   HostCopyView<ScalarView> wall_radius;
