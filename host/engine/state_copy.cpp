@@ -43,6 +43,12 @@ void copy_state(Simulation& sim, bool contacts, ContactCopy& into) {
   into.n = p.n;
   copy_rows(into.gid, p.gid, p.n);
   copy_rows(into.x, p.x, p.n);
+  const FacetMesh& mesh = sim.mesh();
+  copy_rows(into.node_x, mesh.node_x, mesh.nnode);
+  if (into.ntri != mesh.ntri) {
+    into.ntri = mesh.ntri;
+    copy_rows(into.tri, mesh.tri, mesh.ntri);
+  }
   into.contacts = contacts;
   into.domain = sim.domain();
   if (!contacts) return;
@@ -55,17 +61,6 @@ void copy_state(Simulation& sim, bool contacts, ContactCopy& into) {
   copy_rows(into.wall_point, walls.point, walls.n);
   copy_rows(into.wall_normal, walls.normal, walls.n);
   copy_rows(into.wall_radius, walls.radius, walls.n);
-  const FacetMesh& mesh = sim.mesh();
-  copy_rows(into.node_x, mesh.node_x, mesh.nnode);
-  copy_rows(into.tri, mesh.tri, mesh.ntri);
-}
-
-void copy_membrane(const Membrane& m, MembraneCopy& into) {
-  copy_rows(into.node_x, m.mesh.node_x, m.mesh.nnode);
-  if (into.ntri == m.mesh.ntri) return;
-  into.ntri = m.mesh.ntri;
-  copy_rows(into.tri, m.mesh.tri, m.mesh.ntri);
-  copy_rows(into.fixed, m.fixed, m.mesh.nnode);
 }
 
 std::vector<Vec3> centres_by_gid(const ContactCopy& c) {
@@ -82,9 +77,12 @@ std::shared_ptr<const ContactCopy> StateCopies::take(Simulation& sim, bool conta
   return *free;
 }
 
-const MembraneCopy& StateCopies::membrane(const Membrane& m) {
-  copy_membrane(m, membrane_);
-  return membrane_;
+const HostCopyView<FlagView>& StateCopies::fixed_nodes(const Membrane& m) {
+  if (nfixed_ != m.nnode) {
+    nfixed_ = m.nnode;
+    copy_rows(fixed_, m.fixed, m.nnode);
+  }
+  return fixed_;
 }
 
 }  // namespace dem

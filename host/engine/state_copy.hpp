@@ -29,6 +29,11 @@ struct ContactCopy {
   int n = 0;                         ///< balls
   HostCopyView<GidView> gid;         ///< of each local index
   HostCopyView<Vec3View> x;          ///< ball centres (m), by local index
+  /// The facet walls (the membrane's where there is one): the nodes (m) at each copy; the facets, which a simulation
+  /// never changes, where the buffer has none of the count yet.
+  HostCopyView<Vec3View> node_x;
+  HostCopyView<Index3View> tri;
+  int ntri = 0;
   bool contacts = false;             ///< whether what follows was copied (copy_state's `contacts`)
   HostCopyView<ScalarView> radius;   ///< m, by local index
   List balls, walls;
@@ -36,8 +41,6 @@ struct ContactCopy {
   HostCopyView<IndexView> wall_kind;
   HostCopyView<Vec3View> wall_point, wall_normal;
   HostCopyView<ScalarView> wall_radius;
-  HostCopyView<Vec3View> node_x;     ///< the membrane's facet nodes (m)
-  HostCopyView<Index3View> tri;      ///< its facets
   Domain domain;
 };
 
@@ -48,27 +51,18 @@ void copy_state(Simulation& sim, bool contacts, ContactCopy& into);
 /// The copy's ball centres in gid order (m).
 std::vector<Vec3> centres_by_gid(const ContactCopy& c);
 
-/// The membrane's facets as a record's lateral stress reads them (host/engine/stress.hpp): the nodes copied at each
-/// record, the facets and the fixed nodes, which do not change, at the first.
-struct MembraneCopy {
-  HostCopyView<Vec3View> node_x;
-  HostCopyView<Index3View> tri;
-  HostCopyView<FlagView> fixed;
-  int ntri = 0;
-};
-void copy_membrane(const Membrane& m, MembraneCopy& into);
-
 /// Kept copies for a run's records: a copy is taken into a buffer no record's work still holds, so that after the
 /// first records (two where they are worked out beside the steps) none is allocated.
 class StateCopies {
  public:
   std::shared_ptr<const ContactCopy> take(Simulation& sim, bool contacts);
-  /// The membrane copied now, for the stepping thread.
-  const MembraneCopy& membrane(const Membrane& m);
+  /// The membrane's fixed nodes (1: tied to a platen), which do not change: copied at the first call.
+  const HostCopyView<FlagView>& fixed_nodes(const Membrane& m);
 
  private:
   std::vector<std::shared_ptr<ContactCopy>> kept_;
-  MembraneCopy membrane_;
+  HostCopyView<FlagView> fixed_;
+  int nfixed_ = 0;
 };
 
 }  // namespace dem

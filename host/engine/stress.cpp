@@ -59,12 +59,11 @@ SpecimenStress specimen_stress(const Simulation& sim, Real volume) {
   return out;
 }
 
-Real lateral_stress(const MembraneCopy& m, int w0, const std::vector<Vec3>& f) {
-  const auto& nx = m.node_x;
-  const auto& tri = m.tri;
-  const auto& fixed = m.fixed;
+Real lateral_stress(const ContactCopy& state, const HostCopyView<FlagView>& fixed, int w0, const std::vector<Vec3>& f) {
+  const auto& nx = state.node_x;
+  const auto& tri = state.tri;
   Real fn = 0, area = 0;
-  for (int t = 0; t < m.ntri; ++t) {
+  for (int t = 0; t < state.ntri; ++t) {
     if (fixed(tri(t, 0)) || fixed(tri(t, 1)) || fixed(tri(t, 2))) continue;
     const Vec3 a = load(nx, tri(t, 0)), b = load(nx, tri(t, 1)), d = load(nx, tri(t, 2));
     const Vec3 s = 0.5 * cross(b - a, d - a);  // area vector, outward (counter-clockwise seen from outside)
