@@ -48,6 +48,8 @@ void copy_state(Simulation& sim, bool contacts, ContactCopy& into) {
   if (into.ntri != mesh.ntri) {
     into.ntri = mesh.ntri;
     copy_rows(into.tri, mesh.tri, mesh.ntri);
+    const Membrane& m = sim.membrane();
+    copy_rows(into.fixed, m.fixed, m.nnode);
   }
   into.contacts = contacts;
   into.domain = sim.domain();
@@ -75,14 +77,6 @@ std::shared_ptr<const ContactCopy> StateCopies::take(Simulation& sim, bool conta
   if (free == kept_.end()) free = kept_.insert(kept_.end(), std::make_shared<ContactCopy>());
   copy_state(sim, contacts, **free);
   return *free;
-}
-
-const HostCopyView<FlagView>& StateCopies::fixed_nodes(const Membrane& m) {
-  if (nfixed_ != m.nnode) {
-    nfixed_ = m.nnode;
-    copy_rows(fixed_, m.fixed, m.nnode);
-  }
-  return fixed_;
 }
 
 }  // namespace dem

@@ -10,7 +10,6 @@
 #include "kernels/core/domain.hpp"
 #include "kernels/core/types.hpp"
 #include "kernels/core/vec3.hpp"
-#include "kernels/motion/membrane.hpp"
 
 namespace dem {
 
@@ -29,10 +28,11 @@ struct ContactCopy {
   int n = 0;                         ///< balls
   HostCopyView<GidView> gid;         ///< of each local index
   HostCopyView<Vec3View> x;          ///< ball centres (m), by local index
-  /// The facet walls (the membrane's where there is one): the nodes (m) at each copy; the facets, which a simulation
-  /// never changes, where the buffer has none of the count yet.
+  /// The facet walls (the membrane's where there is one): the nodes (m) at each copy; the facets and the membrane's
+  /// fixed nodes (1: tied to a platen), which a simulation never changes, where the buffer has none of the count yet.
   HostCopyView<Vec3View> node_x;
   HostCopyView<Index3View> tri;
+  HostCopyView<FlagView> fixed;
   int ntri = 0;
   bool contacts = false;             ///< whether what follows was copied (copy_state's `contacts`)
   HostCopyView<ScalarView> radius;   ///< m, by local index
@@ -56,13 +56,9 @@ std::vector<Vec3> centres_by_gid(const ContactCopy& c);
 class StateCopies {
  public:
   std::shared_ptr<const ContactCopy> take(Simulation& sim, bool contacts);
-  /// The membrane's fixed nodes (1: tied to a platen), which do not change: copied at the first call.
-  const HostCopyView<FlagView>& fixed_nodes(const Membrane& m);
 
  private:
   std::vector<std::shared_ptr<ContactCopy>> kept_;
-  HostCopyView<FlagView> fixed_;
-  int nfixed_ = 0;
 };
 
 }  // namespace dem

@@ -59,9 +59,10 @@ SpecimenStress specimen_stress(const Simulation& sim, Real volume) {
   return out;
 }
 
-Real lateral_stress(const ContactCopy& state, const HostCopyView<FlagView>& fixed, int w0, const std::vector<Vec3>& f) {
+Real lateral_stress(const ContactCopy& state, int w0, const std::vector<Vec3>& f) {
   const auto& nx = state.node_x;
   const auto& tri = state.tri;
+  const auto& fixed = state.fixed;
   Real fn = 0, area = 0;
   for (int t = 0; t < state.ntri; ++t) {
     if (fixed(tri(t, 0)) || fixed(tri(t, 1)) || fixed(tri(t, 2))) continue;

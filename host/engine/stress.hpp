@@ -53,11 +53,9 @@ SpecimenStress specimen_stress(const Simulation& sim, Real volume);
 /// area of the facets clear of the end rings. It differs from the cell pressure by what the membrane itself carries
 /// (hoop and axial tension of a deforming membrane, inertia). The end bands are left out: the balls cannot fill the
 /// corner between platen and membrane, so there the tied rings and the platen edge carry part of the pressure, as a
-/// lab's platens do. `state`: copied at this step, its facets the membrane's; `fixed`: the membrane's fixed nodes
-/// (StateCopies::fixed_nodes); `wall_forces`: Simulation::wall_forces() of this step (analytic walls, then the
-/// facets), the facets' from `first_facet` (Simulation::num_walls()).
-Real lateral_stress(const ContactCopy& state, const HostCopyView<FlagView>& fixed, int first_facet,
-                    const std::vector<Vec3>& wall_forces);
+/// lab's platens do. `state`: copied at this step, its facets the membrane's; `wall_forces`: Simulation::wall_forces()
+/// of this step (analytic walls, then the facets), the facets' from `first_facet` (Simulation::num_walls()).
+Real lateral_stress(const ContactCopy& state, int first_facet, const std::vector<Vec3>& wall_forces);
 
 /// A cell between six walls (wall 2d the lower, 2d + 1 the upper along axis d): sigma_dd, the mean of what the balls
 /// push the two walls apart with, over the face between the other two lengths `l`.

@@ -101,7 +101,7 @@ void take_record(const ShearRecorder& sh, Real eps_a, long k, LazyCopy& state) {
   r.sigma1 = top;
   r.sigma1_bottom = bottom;
   r.q = top - tc.sigma3;
-  r.sigma3_balls = lateral_stress(*state.copy(), sh.copies.fixed_nodes(cell.membrane), sim.num_walls(), wall_f);
+  r.sigma3_balls = lateral_stress(*state.copy(), sim.num_walls(), wall_f);
   r.unbalanced = sim.unbalanced_ratio();
   r.kinetic = sim.stats().kinetic;
   measure_stresses(cell, tc, volume, sh.v0 / sh.h0, r);
