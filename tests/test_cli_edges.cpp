@@ -34,9 +34,9 @@ struct Outcome {
 
 /// `triaxdem ARGS` (after `prefix`: the environment, or a command that runs it), its exit code and what it
 /// printed (stdout and stderr). A child still running after 5 minutes is stopped (exit code 124): the longest of
-/// these tests takes about 20 s, and a job that should have been refused and runs instead (hours: a plan that the
-/// machine's speed brought under its bound once did, and held CI until its time ran out) fails its test with what
-/// it printed. ctest's TIMEOUT ends the test's process only; the job would run on beside the next tests.
+/// these tests takes about 20 s, and a job that should have been refused and runs instead (for hours) fails its
+/// test with what it printed. ctest's TIMEOUT ends the test's process only; the job would run on beside the next
+/// tests. The line runs in `sh -c '...'`, its own single quotes escaped, so a prefix may hold shell syntax.
 Outcome triaxdem(const std::string& args, const fs::path& dir, const std::string& prefix = "OMP_NUM_THREADS=1") {
   const fs::path log = dir / "log.txt";
   std::string line = prefix + " " + dem::test::triaxdem_binary() + " " + args;
@@ -681,7 +681,8 @@ TEST(CliEdges, ATwoFidelityTemplateOfAnotherSizeIsRefusedBeforeAnyWork) {
 // A plan beyond the bound (four hours here) is refused before any packing unless --yes is given, naming its costliest
 // stage and the setting that sizes it; 64 scatter specimens of 32,000 balls with an "auto" ensemble are such a job:
 // its plan takes up to 15 to 27 hours at 152 to 265 ns a particle-step (this machine idle and busy), so a machine
-// four times faster is still refused. With 8,000 balls it took up to 3h52m on this machine idle: the job ran.
+// four times faster is still refused. The plan's times follow the speed measured on the machine at hand: a job
+// sized near the bound is refused on a busy machine and runs on an idle one.
 TEST(CliEdges, AJobBeyondItsBoundAsksForYes) {
   const fs::path dir = dem::test::scratch_dir("cli_plan_bound");
   write_four_point_curve(dir / "d.csv");
