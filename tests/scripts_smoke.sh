@@ -157,6 +157,24 @@ if [ "$part" != tools ]; then
     bash "$root/perf/table6_loop.sh"
   [ "$(grep -c '^| S-1 | .* | not run |' "$work/table6_loop.sh.log")" = 2 ] ||
     { cat "$work/table6_loop.sh.log"; echo "scripts_smoke: table6_loop gave no row per case" >&2; exit 1; }
+  # The coverage study on one tiny case (the tiny base, data of the cell's size), then again: the case is not run twice;
+  # its row holds the truth, the intervals, the region's rise and the truth's own run.
+  check perf/coverage.sh env BUILD="$build" BASE="$base" OUT="$work/coverage" WORK="$work/coverage_runs" CASES=1 SIZES=1 \
+    JOBS=1 METHOD=tiny bash "$root/perf/coverage.sh"
+  grep -Eq "^tiny,[0-9a-f+]+,1,1,0\.[0-9]+,0\.[0-9]+(,[-0-9.e]+){6},[0-9.e]+,[0-9.]+,[0-9]+,[0-9.]+,[0-9]+,[0-9]+,[01],[01]$" \
+    "$work/coverage/tiny.csv" && grep -q "^| tiny | 1x the cell's balls | 1 | " "$work/coverage.sh.log" ||
+    { cat "$work/coverage/tiny.csv" "$work/coverage.sh.log"; echo "scripts_smoke: coverage wrote no case row" >&2; exit 1; }
+  env BUILD="$build" BASE="$base" OUT="$work/coverage" WORK="$work/coverage_runs" CASES=1 SIZES=1 METHOD=tiny \
+    bash "$root/perf/coverage.sh" > "$work/coverage_again.log"
+  grep -q ": 0 to run," "$work/coverage_again.log" && [ "$(wc -l < "$work/coverage/tiny.csv")" = 2 ] ||
+    { cat "$work/coverage_again.log"; echo "scripts_smoke: coverage ran a case it had" >&2; exit 1; }
+  ran+=(tools/coverage_table.py)
+  # A folder the script did not make is never removed: refused, its file kept.
+  mkdir -p "$work/coverage_user/tiny_1x/case2" && touch "$work/coverage_user/tiny_1x/case2/keep"
+  ! env BUILD="$build" BASE="$base" OUT="$work/coverage" WORK="$work/coverage_user" FIRST=2 CASES=1 SIZES=1 METHOD=tiny \
+    bash "$root/perf/coverage.sh" > "$work/coverage_user.log" 2>&1 && [ -f "$work/coverage_user/tiny_1x/case2/keep" ] &&
+    grep -q "was not made by this script" "$work/coverage_user.log" ||
+    { cat "$work/coverage_user.log"; echo "scripts_smoke: coverage removed a folder it did not make" >&2; exit 1; }
   check perf/inertial_scan "$build/perf/inertial_scan" --config "$base" --specimens 2 --pressures 100 \
     --inertial 1e-3,4e-3 -j 1 -o "$work/inertial.csv"
   exists "$work/inertial.csv"

@@ -15,6 +15,7 @@
 #include "host/study/calibration_jobs.hpp"
 #include "host/config/config.hpp"
 #include "host/config/model_keys.hpp"
+#include "host/fit/diagnose.hpp"
 #include "host/cli/job.hpp"
 #include "host/study/study.hpp"
 #include "host/util/ranks.hpp"
@@ -180,6 +181,9 @@ void synth_options(CLI::App* cmd, Args& a) {
   cmd->add_option("--seed", a.syn.seed, "noise and strength seed");
   cmd->add_option("--specimen-seed", a.syn.specimen_seed, "packing seed of the specimen (default: the config's "
                   "[run] seed + 100000, a specimen no calibration ensemble of that config uses)");
+  cmd->add_option("--cell-factor", a.syn.cell_factor, "the data's specimens have this many times the config's balls "
+                  "(default " + std::to_string(dem::kGeneratorCellFactor) + ": data of a larger specimen than the "
+                  "calibration's cell; 1: of the cell's own size)")->check(CLI::Range(1, 64));
   cmd->add_option("--pressures", a.syn_kpa, "confining pressures, kPa (default 100 200 300)")->check(pressure_kpa());
   cmd->add_option("--material", a.syn.material, "material name in the file");
 }

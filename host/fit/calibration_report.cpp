@@ -73,6 +73,25 @@ std::string uncertainty_text(const CalibrationResult& r, const std::string& mate
   return o.str();
 }
 
+std::string reference_text(const CalibrationResult& r, const std::vector<Real>& reference, Real run_chi2,
+                           const std::string& material, const std::string& job) {
+  std::vector<Real> si;
+  std::string at;
+  for (std::size_t k = 0; k < r.free.size(); ++k) {
+    si.push_back(reference[k] / r.free[k].shown);
+    at += (k ? ", " : "") + r.free[k].name + fmt(" %.4g", reference[k]);
+  }
+  const Real rise = r.region_rise(si);
+  std::string o = job + ": " + material + ": the reference point (" + at + ") ";
+  o += std::isfinite(rise) ? fmt("lies at %.2f of the joint 95%% region's rise: ", rise) +
+                                 (rise <= 1 ? "inside the region" : "outside the region")
+                           : std::string("lies outside the searched ranges");
+  if (std::isfinite(run_chi2))
+    o += fmt("; run: chi2 %.1f", run_chi2) + fmt(" against the best's %.1f", r.best.chi2) +
+         fmt(" (the region's rise: %.1f)", chi2_95(static_cast<int>(r.free.size())) * r.scale);
+  return o + "\n";
+}
+
 /// The noise used, per test and quantity: the median over the test's features of each part.
 std::string noise_table(const Misfit& mf, const std::vector<TriaxialTest>& tests) {
   std::ostringstream md;

@@ -16,6 +16,11 @@ std::string errors_csv(const std::vector<TriaxialTest>& meas, const std::vector<
 void print_errors(const std::vector<TriaxialTest>& meas, const std::vector<TriaxialTest>& sim);
 /// The calibrated values with their 95% intervals and correlations, in lines prefixed "<job>: <material>: ".
 std::string uncertainty_text(const CalibrationResult& r, const std::string& material, const std::string& job);
+/// Where a reference gives every free parameter (`reference`, in the keys' units): the reference point's place against
+/// the joint 95% region, in a line prefixed "<job>: <material>: ": the surrogate chi2's rise there as a share of the
+/// region's (at most 1 inside), and, where the point was run (`run_chi2` finite), its chi2 beside the best's.
+std::string reference_text(const CalibrationResult& r, const std::vector<Real>& reference, Real run_chi2,
+                           const std::string& material, const std::string& job);
 /// The noise used, per test and quantity (markdown).
 std::string noise_table(const Misfit& mf, const std::vector<TriaxialTest>& tests);
 /// The gain of an extension over the base by pressure, strain range and quantity, then every datum (markdown).

@@ -304,6 +304,9 @@ struct Planner {
     add.runs(material + (in.diagnose ? ": diagnosis" : ": search"),
              auto_ensemble ? "[calibrate] ensemble (auto)" : "[calibrate] ensemble", lab, tests,
              static_cast<double>(points), K_low, K, search_what);
+    if (std::find(in.reference_runs.begin(), in.reference_runs.end(), material) != in.reference_runs.end())
+      add.runs(material + ": the reference point", "--reference", lab, tests, 1, K_low, K,
+               "1 point x " + T + " tests x " + k + " specimens of " + n + " balls");
     if (in.membrane) {
       membrane(material, tests, points, search_what);
     } else if (in.walls) {

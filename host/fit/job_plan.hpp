@@ -48,6 +48,7 @@ struct PlanInput {
   bool walls = false;                ///< the prediction is the cell between six walls
   int at_once = 1;                   ///< simulator runs at once
   std::vector<TriaxialTest> held_out;  ///< tests left out of the fit and predicted (--hold-out)
+  std::vector<std::string> reference_runs;  ///< materials whose reference point (--reference) is run after the fit
 };
 
 /// The plan of a job; measures the engine's speed on the cells it will run (about a second).

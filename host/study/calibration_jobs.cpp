@@ -1,5 +1,6 @@
 #include "host/study/calibration_jobs.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -116,7 +117,7 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
   if (o.plan_only) return JobInputs(base, o).announce_plan(base, o, "calibrate"), 0;
   Session ss(base, o, "calibrate");
   std::ostringstream table;
-  table << "material,parameter,value,low95,high95,reference,chi2,data,runs\n";
+  table << "material,parameter,value,low95,high95,reference,chi2,data,runs,reference_rise,reference_chi2\n";
   std::vector<TriaxialTest> all_meas, all_sim;
   std::map<std::string, Calibrated> models;
   for (const auto& by : by_material(ss.data, o.material)) {
@@ -143,6 +144,29 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
     };
     CalibrationResult r = fit(misfit, "calibrate");
     if (ss.two_fidelity) r = two_fidelity_fit(ss, base, material, tests, misfit, r, fit);
+    // A reference that gives every free parameter is placed against the joint region, and run (runs_reference): is
+    // it consistent with these data?
+    const long fit_runs = ss.lab.runs() - runs0;  // the reference point's runs are not the calibration's
+    const std::vector<Real> reference = ss.reference_point(material);
+    const bool whole_reference = std::all_of(reference.begin(), reference.end(), [](Real v) { return std::isfinite(v); });
+    Real reference_rise = std::nan(""), reference_chi2 = std::nan("");
+    if (whole_reference) {
+      Model at = r.model;
+      std::vector<Real> si;
+      for (std::size_t k = 0; k < ss.free.size(); ++k) {
+        si.push_back(reference[k] / ss.free[k].shown);
+        set_param(at, ss.free[k].name, si.back());
+      }
+      reference_rise = r.region_rise(si);
+      if (ss.runs_reference(material)) {
+        const long start = ss.lab.runs();
+        Progress progress("calibrate " + material + ": the reference point", static_cast<long>(tests.size()) *
+                          ss.lab.members());
+        reference_chi2 = sum_sq(misfit.residuals(ss.lab.run_ensemble(at, tests)));
+        progress.finish(std::to_string(ss.lab.runs() - start) + " runs");
+      }
+      std::printf("%s", reference_text(r, reference, reference_chi2, material, "calibrate").c_str());
+    }
     for (std::size_t k = 0; k < ss.free.size(); ++k) {
       const FreeParam& f = ss.free[k];
       const Real ref = ss.reference(material, f.name);
@@ -150,7 +174,9 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
                   std::isfinite(ref) ? fmt(" (reference %g)", ref).c_str() : "");
       table << material << "," << f.name << "," << fmt("%.6g", f.shown * r.values[k]) << ","
             << fmt("%.6g", f.shown * r.interval[k].first) << "," << fmt("%.6g", f.shown * r.interval[k].second) << ","
-            << (std::isfinite(ref) ? fmt("%g", ref) : "") << "," << fmt("%.3f", r.best.chi2) << "," << r.data << "," << ss.lab.runs() - runs0 << "\n";
+            << (std::isfinite(ref) ? fmt("%g", ref) : "") << "," << fmt("%.3f", r.best.chi2) << "," << r.data << "," << fit_runs << ","
+            << (whole_reference ? fmt("%.4g", reference_rise) : "") << ","
+            << (std::isfinite(reference_chi2) ? fmt("%.3f", reference_chi2) : "") << "\n";
     }
     std::printf("%s", uncertainty_text(r, material, "calibrate").c_str());
     for (const std::string& note : r.widened) std::printf("calibrate: %s: %s\n", material.c_str(), note.c_str());
@@ -158,7 +184,7 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
       std::printf("calibrate: %s: WARNING: %s is at the edge of its range: widen it (the optimum may lie "
                   "outside)\n", material.c_str(), name.c_str());
     std::printf("calibrate: %s: chi2 %.1f on %d data after %ld runs\n", material.c_str(), r.best.chi2, r.data,
-                ss.lab.runs() - runs0);
+                fit_runs);
     all_meas.insert(all_meas.end(), tests.begin(), tests.end());
     all_sim.insert(all_sim.end(), r.best.sim.begin(), r.best.sim.end());
     std::vector<TriaxialTest> held;

@@ -46,6 +46,8 @@ struct SynthOptions {
   bool overwrite = false;                 ///< replace an existing output file (never the config)
   unsigned seed = 1;
   long specimen_seed = -1;                ///< packing seed; < 0: the config's seed + kForeignSeedOffset
+  int cell_factor = 0;                    ///< the data's specimens have this many times the config's balls; 0:
+                                          ///< kGeneratorCellFactor (host/fit/diagnose.hpp)
   std::vector<Real> sigma3{100e3, 200e3, 300e3};  ///< Pa
   std::string material = "synthetic";
 };

@@ -148,6 +148,9 @@ JobPlan JobInputs::announce_plan(const Config& base, const CalibrationOptions& o
   in.walls = walls_prediction;
   in.at_once = runs_at_once(o.workers);
   in.held_out = held_out;
+  if (kind == "calibrate")
+    for (const auto& m : in.materials)
+      if (runs_reference(m.first)) in.reference_runs.push_back(m.first);
   JobPlan plan = plan_job(in);
   for (const std::string& n : data.notes) std::printf("%s: note: %s\n", kind.c_str(), n.c_str());
   std::printf("%s", plan.text(kind).c_str());
@@ -320,6 +323,21 @@ Misfit Session::misfit_of(const Config& base, const std::string& material, const
     std::printf("\n");
   }
   return m;
+}
+
+std::vector<Real> JobInputs::reference_point(const std::string& material) const {
+  std::vector<Real> v;
+  const auto m = ref.values.find(material);
+  for (const FreeParam& f : free) {
+    const bool given = m != ref.values.end() && m->second.count(f.name) > 0;
+    v.push_back(given ? m->second.at(f.name) : std::nan(""));
+  }
+  return v;
+}
+
+bool JobInputs::runs_reference(const std::string& material) const {
+  const std::vector<Real> v = reference_point(material);
+  return !two_fidelity && std::all_of(v.begin(), v.end(), [](Real x) { return std::isfinite(x); });
 }
 
 Real Session::reference(const std::string& material, const std::string& name) const {

@@ -66,6 +66,11 @@ struct JobInputs {
   /// The job's plan (host/fit/job_plan.hpp), printed. A plan above kPlanBoundSeconds without --yes is refused
   /// (ConfigError naming its costliest stage and the setting that sizes it).
   JobPlan announce_plan(const Config& base, const CalibrationOptions& o, const std::string& kind) const;
+  /// The reference's value of each free parameter for `material` (in the keys' units; NaN where it gives none).
+  std::vector<Real> reference_point(const std::string& material) const;
+  /// Whether calibrate runs the reference point of `material` after its fit: the reference gives every free parameter
+  /// and the fit's misfit is the data's (two fidelities fit a corrected one).
+  bool runs_reference(const std::string& material) const;
 };
 
 /// What the job's data are taken to be (host/study/data_scope.cpp). take_walled_size: between walls the specimen's size

@@ -54,11 +54,12 @@ int synth_job(const Config& base, const SynthOptions& o) {
     set_param(truth, e.param, v);
     comment += " (" + e.param + " = " + fmt("%.4g", range.shown * v) + ")";
   }
+  const int factor = o.cell_factor > 0 ? o.cell_factor : kGeneratorCellFactor;
   const unsigned specimen = o.specimen_seed >= 0 ? static_cast<unsigned>(o.specimen_seed)
                                                  : base.run.seed + kForeignSeedOffset;
   comment += ", a specimen per test (packing seeds from " + std::to_string(specimen) + ", " +
-             std::to_string(kGeneratorCellFactor) + " times the config's balls)";
-  const Config cell = larger_cell(base, kGeneratorCellFactor);
+             std::to_string(factor) + " times the config's balls)";
+  const Config cell = larger_cell(base, factor);
   // Said before the packings: a packing and a test per pressure one after another, at the engine's speed a probe
   // measures here.
   const CellCost cost = measure_cell_cost(cell);
