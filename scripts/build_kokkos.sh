@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Builds Kokkos 3.4.01 (OpenMP + Serial, C++17) from Debian bookworm's trilinos source package into a
 # cached prefix outside the repository (CI runs in a fresh clone, so an in-repo cache would always miss).
-# Recipe and timings: ../shared/notes/kokkos_recipe.md. About 20 s on a miss, instant on a hit.
+# Debian ships Kokkos only inside Trilinos (Serial only, C++14): packages/kokkos alone is unpacked from the
+# trilinos orig tarball and built standalone, unpatched. About 20 s on a miss, instant on a hit.
 set -euo pipefail
 PREFIX="${KOKKOS_PREFIX:-/opt/kokkos-3.4.01-omp}"
 CFG_H="$PREFIX/include/KokkosCore_config.h"

@@ -78,12 +78,12 @@ TEST_F(Triaxial, DenseFrictionalSpecimenContractsThenDilatesInsideTheMembrane) {
     EXPECT_NEAR(x.eps_v, x.eps_v_envelope, 0.01) << "at eps_a " << x.eps_a;
 }
 
-// The average-stress theorem on the membrane specimen (shared/notes/triaxial_measures.md, section 3): the
-// stress read off the boundary contacts (platens and membrane: contact point times force, over the enclosed
-// volume) plus (1/V) sum_p x_p (x) F_p, with F_p each ball's net contact force as the integrator gathered it,
-// is the Love-Weber stress of every contact. The two sides come from different places (the contact lists
-// and the per-ball gather), so a contact lost (one carries about p / 2,000 here), a force counted twice or a
-// boundary point misplaced by a radius (about sigma3 r / R = 12 kPa in q) shows. What is left: the contact set
+// The average-stress theorem on the membrane specimen (Newton's law for each ball, summed; docs/running.md,
+// "Which q"): the stress read off the boundary contacts (platens and membrane: contact point times force, over
+// the enclosed volume) plus (1/V) sum_p x_p (x) F_p, with F_p each ball's net contact force as the integrator
+// gathered it, is the Love-Weber stress of every contact. The two sides come from different places (the contact
+// lists and the per-ball gather), so a contact lost (one carries about p / 2,000 here), a force counted twice or
+// a boundary point misplaced by a radius (about sigma3 r / R = 12 kPa in q) shows. What is left: the contact set
 // rebuilds each force from its normal magnitude along the normal of the current positions, one step after
 // the force was computed along the old one; balls move some 1e-4 radii a step, which turns the normals and
 // leaves up to 1e-5 p (seen: 9.8e-6 p); the allowance is 1e-4 p, a fifth of one contact. Then the physics: this specimen is sheared at I = 1e-2 with local damping on
@@ -108,8 +108,8 @@ TEST_F(Triaxial, BoundaryStressIsLoveWebersLessTheBallsNetForces) {
 // The lab's areas against what they stand for, computed here another way: the right cylinder keeps the volume
 // A h; the parabolic barrel's mid-height area makes the volume of the solid of revolution (integrated
 // numerically, 2000 slices: error ~1e-7) equal to that of the right cylinder; at eps_v = 0 the barrel reads
-// 5.1% and 7.8% less q than the right cylinder at 10% and 15% strain (shared/notes/triaxial_measures.md,
-// section 1's table, to its 0.1%). The hoop stress: 2 E t eps_theta / D, zero for a shrinking specimen.
+// 5.1% and 7.8% less q than the right cylinder at 10% and 15% strain (the two formulas worked out by hand, to
+// 0.1%). The hoop stress: 2 E t eps_theta / D, zero for a shrinking specimen.
 TEST(TriaxialMeasures, AreasAndHoopStressAsLabsComputeThem) {
   const Real a0 = 2e-3, h0 = 0.1;
   for (const auto& [ea, ev] : {std::pair<Real, Real>{0.05, 0.0}, {0.10, -0.05}, {0.15, -0.08}, {0.02, 0.01}}) {

@@ -1,9 +1,9 @@
 #pragma once
-/// Micromechanics of a granular specimen (Tang et al. 2025, Secs. 4.2-4.4; definitions in
-/// shared/notes/physics_reference.md section 3): coordination, strong and weak networks, fabric and force
-/// anisotropy (Ouadfel & Rothenburg 2001, 3D, vector tangential form), directional distributions, Love-Weber
-/// stress, and the force-chain export. Everything works on a ContactSet, a host copy of the touching
-/// contacts, taken from a running simulation or from a snapshot.
+/// Micromechanics of a granular specimen (Tang et al. 2025, Secs. 4.2-4.4; definitions in docs/running.md,
+/// "Micromechanics"; the networks split at the mean normal force as Radjai et al. 1998, PRL 80:61, do):
+/// coordination, strong and weak networks, fabric and force anisotropy (Ouadfel & Rothenburg 2001, 3D, vector
+/// tangential form), directional distributions, Love-Weber stress, and the force-chain export. Everything works on
+/// a ContactSet, a host copy of the touching contacts, taken from a running simulation or from a snapshot.
 ///
 /// Conventions: SI; stress compression positive; each contact's normal n points from ball a to ball b (or
 /// to the boundary), and the force is the one a exerts on b (or on the boundary): f = fn n + ft.

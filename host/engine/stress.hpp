@@ -1,7 +1,7 @@
 #pragma once
 /// Every stress the program reports, one function each, and every contact term through the one Love-Weber formula
 /// (kernels/contact/contact_sums.hpp: love_weber_term). Pa, compression positive, z the specimen's axis; the
-/// measures and their corrections are in shared/notes/triaxial_measures.md and docs/physics.md.
+/// measures and their corrections are in docs/running.md ("Which q") and docs/physics.md.
 ///
 /// Where each is read:
 /// - the periodic cell's servo and records: Simulation::contact_stress_diagonal (CellBatch::contact_stress_diagonals
@@ -35,8 +35,8 @@ void add_love_weber(Tensor& t, const ContactRecord& c, Real volume);
 Tensor love_weber(const ContactSet& s, Real volume, bool include_boundary);
 /// Boundary stress (1/V) sum f (x) x_c over the boundary contacts (platens, membrane): each contact point with the
 /// force the ball exerts on the boundary, about the origin: the stress a lab would read off its boundaries with the
-/// enclosed volume V. By the average-stress theorem (Newton's law for each ball, summed; triaxial_measures.md
-/// section 3) love_weber(s, V, true) exceeds it by (1/V) sum_p F_p (x) x_p, F_p each ball's net contact force:
+/// enclosed volume V. By the average-stress theorem (Newton's law for each ball, summed over the balls: exact at
+/// every step) love_weber(s, V, true) exceeds it by (1/V) sum_p F_p (x) x_p, F_p each ball's net contact force:
 /// the two agree as far as the balls are at rest.
 Tensor boundary_stress(const ContactSet& s, Real volume);
 

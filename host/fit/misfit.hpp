@@ -7,7 +7,8 @@
 /// straight-line fit over +-min(30%, 0.25% strain) of the strain (curve_value), for measured and simulated
 /// curves alike; a strain is used when both curves reach it. Summary data: the seven quantities of summarise.
 ///
-/// With which noise, per test (the three kinds of scatter of ../shared/notes/discrepancy_methods.md, added):
+/// With which noise, per test (three kinds of scatter kept apart and added: the measurement's, the measured
+/// specimen's from its population, the simulator's mean's; docs/calibration.md, The misfit):
 ///   Sigma = Sigma_data + Sigma_specimen + Sigma_ensemble / K + Sigma_cell
 ///   Sigma_data      the measured curve's own noise: its standard-deviation columns, or, without them, the
 ///                   scatter of its rows about a smooth curve (row_noise, with the lag-1 correlation along

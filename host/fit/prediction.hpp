@@ -16,7 +16,8 @@
 namespace dem {
 
 /// A membrane test must be this many particle diameters across: thinner, the membrane's bands and the walls'
-/// layering make up most of the specimen (shared/notes/triaxial_measures.md, section 4).
+/// layering make up most of the specimen (a packing is layered near a wall; 1 - (1 - 4 d / D)^2 of the
+/// cross-section lies within two diameters of the lateral wall, 75% at 8 diameters across).
 constexpr Real kMinDiametersAcross = 8;
 
 /// The membrane test's config ([specimen] and [triaxial]) checked as a prediction's template: it must describe a

@@ -9,8 +9,9 @@
 /// corrected optimum), so the correction is repeated at each new optimum until the optimum stops moving
 /// (two_fidelity_rounds): a fixed point of "measure the discrepancy here, calibrate to the data less it", where the
 /// membrane test at the optimum reads the data's values within the periodic cell's fit. Kennedy & O'Hagan (2000)
-/// call the idea autoregressive co-kriging; here the correction is a measured offset per feature, not a fitted
-/// process (shared/notes/triaxial_measures.md, section 4).
+/// call the idea autoregressive co-kriging (z_t = rho z_(t-1) + delta_t, a cheap model corrected towards a costly
+/// one); here the correction is a measured offset per feature, not a fitted process (docs/calibration.md, The
+/// reference test).
 #include <functional>
 #include <limits>
 #include <string>

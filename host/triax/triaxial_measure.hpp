@@ -13,7 +13,7 @@ namespace dem {
 class Simulation;
 
 /// The specimen's cross-section as a lab takes it from its strains, for q = F / A (the right-cylinder correction of
-/// ASTM D4767 and D7181; shared/notes/triaxial_measures.md section 1): A0 (1 - eps_v) / (1 - eps_a), with A0
+/// ASTM D4767 and D7181; docs/running.md, "Which q"): A0 (1 - eps_v) / (1 - eps_a), with A0
 /// the cross-section after consolidation and strains compression positive. With A0 = V0 / h0 it is V / h, and
 /// F / A is then the volume-averaged axial stress of a barrelled specimen too.
 Real right_cylinder_area(Real a0, Real eps_a, Real eps_v);

@@ -6,7 +6,7 @@
 /// which ones its parameters use (`slots`), so the kernels load and store only those.
 ///
 /// The default law is PFC's rolling resistance linear model `rrlinear` with the deformability method
-/// (../shared/notes/physics_reference.md sections 1.1-1.2):
+/// (Itasca's PFC manual, the `linear` and `rrlinear` contact models; docs/physics.md):
 ///   kn = pi r^2 E* / L,  r = min(R1, R2), L = R1 + R2 (ball-ball) or L = R1 (ball-facet)
 ///   ks = kn / kappa*,    Fs rotated with the contact plane, |Fs| <= mu_s Fn
 ///   kr = ks Rbar^2,      1/Rbar = 1/R1 + 1/R2 (Rbar = R1 at walls), M <- M - kr dtheta_bend, |M| <= mu_r Rbar Fn
@@ -18,7 +18,8 @@
 ///   ks = 8 G* a = kn 2 (1 - nu) / (2 - nu) (Mindlin's no-slip stiffness, G* = G / (2 (2 - nu))),
 /// and keeps the tangential, rolling and twisting parts (kr = ks Rbar^2 follows the load; YADE's krot is constant).
 ///
-/// Model extensions (physics_reference.md section 4), each off by default and set per material pair; with
+/// Model extensions (what a mu_s + mu_r linear law misses, each with its signature in triaxial data:
+/// docs/calibration.md, Diagnosis), each off by default and set per material pair; with
 /// all of them off the arithmetic is the rrlinear model's, bit for bit:
 ///   Hertz-Mindlin stiffness (hertz_overlap = delta_ref / r > 0): Fn = kn delta^(3/2) / delta_ref^(1/2), the
 ///     secant stiffness equals kn at delta = delta_ref; the tangent stiffness kt = dFn/ddelta = 1.5 kn
