@@ -116,7 +116,7 @@ TEST(HotPath, AStepAllocatesNothingAndReadsItsStatisticsEveryKSteps) {
 // Every stage of the tiny membrane test (specimen layers, consolidation, shear) and of the tiny periodic cell, with
 // the statistics read every step and every 16 steps: the same steps bit for bit (the rebuilds decided between reads
 // as a read at every step decides them), and the steps' own waits down to the reads. What remains per step is the
-// membrane specimen's layers' control (the platen's compaction: docs/performance.md); the servos of the membrane's
+// membrane specimen's layers' control (the platen's compaction: docs/engine.md); the servos of the membrane's
 // consolidation and of the periodic cell run on the device.
 TEST(HotPath, StatisticsReadEvery16StepsGiveTheSameStepsWithFewerWaits) {
   const MembraneRun every1 = membrane_run(1), every16 = membrane_run(16);

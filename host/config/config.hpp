@@ -173,7 +173,7 @@ struct CalibrateConfig {
   /// Simulator runs (and specimen preparations) stepped side by side in one process (host/engine/cell_batch.hpp), at
   /// most this many at once: each bit for bit as alone. kAutoBatch (the file's "auto"): every run of a call at once on
   /// a GPU build, where one small cell uses a sliver of the device; 1 on a CPU, whose cores the runs share as child
-  /// processes of one thread each (docs/performance.md measures both).
+  /// processes of one thread each (docs/engine.md, Many cells in one batch, measures both).
   long batch = kAutoBatch;
   /// The membrane test that `calibrate` and `diagnose` end with, at the calibrated parameters and the data's
   /// pressures (host/fit/prediction.hpp): a config with [specimen] and [triaxial], its path as the file gives it
@@ -188,7 +188,7 @@ struct CalibrateConfig {
   /// "whole" (the cell's own void ratio: its interior packs denser than the data's, its looser layer a larger share)
   /// or "interior" (as a specimen of the data's balls would pack, its walls' layer scaled to the data's size,
   /// host/lab/wall_layer.hpp). On YADE's 4,000-ball walled data the 1,000-ball cell fitted far better whole (chi2 61
-  /// against 118 with mu_s free; docs/calibration.md): the data's strength follows the whole void ratio.
+  /// against 118 with mu_s free; docs/history/calibration.md): the data's strength follows the whole void ratio.
   std::string walled_match = "whole";
 };
 

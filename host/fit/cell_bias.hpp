@@ -2,7 +2,7 @@
 /// The simulator's finite-cell bias (Sigma_cell of host/fit/misfit.hpp): a small periodic cell does not respond as the
 /// larger specimen the data come from, on average, and unlike the scatter that difference does not shrink with the
 /// ensemble. A precise ensemble of small cells exposes it, and a free model extension takes it up: data from cells
-/// of 4 and 16 times the simulator's balls were named wear with nothing hidden (docs/calibration.md). It is
+/// of 4 and 16 times the simulator's balls were named wear with nothing hidden (docs/history/calibration.md). It is
 /// measured once per material, at the base model, on a few cells of kCellCheckFactor times the balls, each
 /// prepared as the simulator's are (to the data's void ratio, where the data give one), and counted as noise with
 /// the size the measured difference extrapolates to at the data's specimen.

@@ -15,8 +15,8 @@ namespace dem {
 
 /// Specimens whose mean void ratio the preparation friction is matched on. One specimen of 120 balls scatters by
 /// about 0.011 in void ratio at one friction (perf/specimen_scatter.sh), and a void ratio 0.001 lower adds about
-/// 0.01-0.02 to q/sigma3 (docs/calibration.md): a match on one specimen leaves that scatter as an offset of every
-/// specimen packed with its friction. The mean of two, packed side by side with 2 workers, costs no more time.
+/// 0.01-0.02 to q/sigma3 (docs/history/calibration.md): a match on one specimen leaves that scatter as an offset of
+/// every specimen packed with its friction. The mean of two, packed side by side with 2 workers, costs no more time.
 constexpr int kStateMatchSpecimens = 2;
 
 /// How the preparation friction is looked for: `steps` halvings, each packing the specimens of packing seeds

@@ -125,8 +125,8 @@ INSTANTIATE_TEST_SUITE_P(LongAnotherEnsemble, HiddenEffect, ::testing::Values(Hi
 // A precise simulator must not find an effect in precise data that have none. With the ensemble and cell it chooses
 // itself, the diagnosis measures its mean to within half of a 480-ball data specimen's scatter, and then sees
 // how a cell of 120 balls differs from one of 480 on average. Before that difference was counted (host/fit/cell_bias.hpp)
-// these data were named wear (BIC 11.2 lower, held-out chi2 98.0 -> 78.9; docs/calibration.md). A long case: about
-// 8 minutes on 2 cores (ctest -L long).
+// these data were named wear (BIC 11.2 lower, held-out chi2 98.0 -> 78.9; docs/history/calibration.md). A long
+// case: about 8 minutes on 2 cores (ctest -L long).
 INSTANTIATE_TEST_SUITE_P(LongAutoEnsemble, HiddenEffect, ::testing::Values(HiddenCase{"none", 0, 6, 1, true, 0}),
                          [](const ::testing::TestParamInfo<HiddenCase>& i) { return i.param.extension; });
 
