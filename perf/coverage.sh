@@ -10,20 +10,23 @@
 #   perf/coverage.sh   # CASES=30 FIRST=1 SIZES="1 4" BASE=tests/data/hidden_effects.toml METHOD=ensemble JOBS=2
 #                      # BUDGET=3600 CASE_S=300 BUILD=build OUT=data/sweeps/coverage WORK=runs/coverage PLAN=0
 #                      # MU_S="0.06 0.40" (log-uniform) MU_R="0.005 0.055" (uniform) CAL_ARGS= (more calibrate options)
-# WORK holds each case's data and calibration folder; the script removes only case folders it made (a marker file).
+#                      # STATE=1 (0: the data's void_ratio column dropped, so that the cells keep the base's preparation,
+#                      # the data's own: what matching the cells to one data set's void ratio costs the intervals)
+# WORK holds each case's data and calibration folder; the script removes only case folders it made (a marker file:
+# scripts/script_folders.sh).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+. "$root/scripts/script_folders.sh"
 fail() { echo "coverage: $*" >&2; exit 2; }
 whole() { [[ "$2" =~ ^[0-9]+$ ]] || fail "$1=$2: a whole number"; }
 cases="${CASES:-30}"; first="${FIRST:-1}"; sizes="${SIZES:-1 4}"; jobs="${JOBS:-2}"; budget="${BUDGET:-3600}"
-case_s="${CASE_S:-300}"; plan="${PLAN:-0}"; method="${METHOD:-ensemble}"; cal_args="${CAL_ARGS:-}"
+case_s="${CASE_S:-300}"; plan="${PLAN:-0}"; state="${STATE:-1}"; method="${METHOD:-ensemble}"; cal_args="${CAL_ARGS:-}"
 mu_s_box="${MU_S:-0.06 0.40}"; mu_r_box="${MU_R:-0.005 0.055}"
 for v in cases first jobs budget case_s; do whole "${v^^}" "${!v}"; done
 for s in $sizes; do whole SIZES "$s"; [ "$s" -ge 1 ] && [ "$s" -le 64 ] || fail "SIZES: $s is not in 1..64"; done
+[[ "$state" =~ ^[01]$ ]] || fail "STATE=$state: 1 (the data's void ratio matched) or 0 (dropped)"
 [[ "$method" =~ ^[A-Za-z0-9_-]+$ ]] || fail "METHOD=$method: letters, digits, _ and - only (it names OUT/<METHOD>.csv)"
-build="${BUILD:-$root/build}"
-[ -d "$build" ] || fail "BUILD=$build: no such folder (build triaxdem there first, or name the build folder with BUILD=)"
-build="$(realpath "$build")"; tdem="$build/triaxdem"
+build="$(build_folder coverage)"; tdem="$build/triaxdem"
 [ -x "$tdem" ] || fail "no triaxdem in BUILD=$build (build it first: cmake --build $build --target triaxdem)"
 base="$(realpath "${BASE:-$root/tests/data/hidden_effects.toml}")"
 [ -f "$base" ] || fail "BASE=$base: no such config"
@@ -62,11 +65,7 @@ if [ "$plan" != 1 ]; then
     fi
     read -r mu_s mu_r <<< "$(truth "$c")"
     dir="$work/${method}_${s}x/case$c"
-    if [ -e "$dir" ]; then
-      [ -f "$dir/.coverage_case" ] || fail "$dir exists and was not made by this script: move it aside"
-      rm -rf "$dir"
-    fi
-    mkdir -p "$dir" && touch "$dir/.coverage_case"
+    fresh_folder coverage "$dir"
     left=$(( (${#todo[@]} - done_here) * each ))
     echo "coverage: case $c, data of ${s}x the cell's balls, mu_s $mu_s, mu_r $mu_r ($((done_here + 1)) of" \
          "${#todo[@]}; about $((left / 60)) min left)"
@@ -79,6 +78,18 @@ if [ "$plan" != 1 ]; then
     "$tdem" synth --config "$dir/truth.toml" -o "$dir/data.csv" --extension none --seed "$((1000 + c))" \
       --specimen-seed "$((${seed:-1} + 300000 + 10 * c))" --cell-factor "$s" > "$dir/synth.log" 2>&1 ||
       { tail -5 "$dir/synth.log"; fail "case $c: synth failed ($dir/synth.log)"; }
+    if [ "$state" = 0 ]; then
+      "$py" - "$dir/data.csv" <<'PY'
+import csv, sys
+lines = open(sys.argv[1]).read().splitlines(True)
+head = [l for l in lines if l.startswith("#")]
+rows = list(csv.reader([l for l in lines if not l.startswith("#")]))
+keep = [i for i, c in enumerate(rows[0]) if c != "void_ratio"]
+with open(sys.argv[1], "w", newline="") as f:
+    f.writelines(head)
+    csv.writer(f, lineterminator="\n").writerows([[r[i] for i in keep] for r in rows])
+PY
+    fi
     # shellcheck disable=SC2086
     "$tdem" calibrate "$dir/data.csv" --config "$base" --reference "$dir/truth.csv" --predict none -j "$jobs" \
       -o "$dir/cal" $cal_args > "$dir/calibrate.log" 2>&1 ||

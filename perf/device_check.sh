@@ -17,6 +17,7 @@
 # Each stage has its own time limit, so that a slow stage costs its limit and not the rest.
 set -uo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+. "$root/scripts/script_folders.sh"
 mode="${1:-}"; ref="$(realpath -m "${2:-}")"
 case "$mode" in prepare|pack|run|table6) [ -n "${2:-}" ] ;; *) false ;; esac ||
   { echo "usage: perf/device_check.sh prepare REF | pack BUILD DIR | run REF OUT | table6 LOOP OUT" >&2; exit 2; }
@@ -33,7 +34,7 @@ if [ "$mode" = pack ]; then
   # A GPU machine starts bare: it gets the programs, the shared libraries they link from this machine (all but the C
   # and C++ runtimes, which it has), and in DIR/build wrappers that look like a build folder to the run mode.
   from="$ref"; dir="$(realpath -m "${3:?usage: perf/device_check.sh pack BUILD DIR}")"
-  rm -rf "$dir"; mkdir -p "$dir/bin" "$dir/lib" "$dir/build/tests"
+  fresh_folder device_check "$dir"; mkdir -p "$dir/bin" "$dir/lib" "$dir/build/tests"
   progs=("$from/triaxdem"); for t in "$from"/tests/triaxdem_tests_* "$from/perf/bench_engine"; do [ -x "$t" ] && [ -f "$t" ] && progs+=("$t"); done
   mkdir -p "$dir/build/perf"
   for p in "${progs[@]}"; do
@@ -79,7 +80,7 @@ if [ "$mode" = table6 ]; then
   # started, one cut by the budget is marked, and the table says what was reached. MATERIALS, PRESSURES: which.
   # TINY=1: tests/data/tiny_triaxial.toml at each pressure in place of configs/paper/ (the scripts' check on a CPU).
   loop="$ref"; out="$(realpath -m "${3:?usage: perf/device_check.sh table6 LOOP OUT}")"
-  bin="$(realpath "${BUILD:-$root/build}")/triaxdem"; budget="${BUDGET:-660}"
+  bin="$(build_folder device_check)/triaxdem"; budget="${BUDGET:-660}"
   mkdir -p "$out"; : > "$out/cases.csv"
   for m in ${MATERIALS:-S-1 S-2 S-3}; do
     cal="$(ls "$loop/${m}_all"/calibrate_*/calibrated.csv 2>/dev/null | tail -n 1)"
@@ -161,7 +162,7 @@ PY
 fi
 
 out="$(realpath -m "${3:?usage: perf/device_check.sh run REF OUT}")"
-build="$(realpath "${BUILD:-$root/build}")"; bin="$build/triaxdem"
+build="$(build_folder device_check)"; bin="$build/triaxdem"
 mkdir -p "$out"; : > "$out/reached.txt"
 failed=""
 # The stages in order of value (issue 64): the kernel and reference tests, the million-ball benchmark, the batch

@@ -12,7 +12,8 @@
 # a tiny config). Rows of another commit are kept and counted apart in the plan: the table should be one program's.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build="$(realpath "${BUILD:-$root/build}")"; out="$(realpath -m "${OUT:-$root/data/sweeps/identification}")"
+. "$root/scripts/script_folders.sh"
+build="$(build_folder identification_table)"; out="$(realpath -m "${OUT:-$root/data/sweeps/identification}")"
 levels="${LEVELS:-precise lab}"; hidden_seeds="${HIDDEN_SEEDS-1 2 3 4 5 6}"; null_seeds="${NULL_SEEDS-$(seq -s ' ' 7 30)}"
 jobs="${JOBS:-2}"; budget="${BUDGET:-3600}"; case_s="${CASE_S:-150}"; plan="${PLAN:-0}"
 sweep="$build/perf/hidden_sweep"

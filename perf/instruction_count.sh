@@ -13,8 +13,9 @@
 # Write-backs are not counted: an array written in a step adds its bytes twice to the memory's traffic, once here.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+. "$root/scripts/script_folders.sh"
 n1="${N1:-20}"; n2="${N2:-40}"; peers="${PEERS-liggghts lammps}"; bytes="${BYTES:-0}"; ll_kb="${LL_KB:-4096}"
-build="$(realpath "${BUILD:-$root/build}")"; work="$(realpath -m "${WORK:-$root/runs/peer_benchmark}")"
+build="$(build_folder instruction_count)"; work="$(realpath -m "${WORK:-$root/runs/peer_benchmark}")"
 for f in packing.data $(for code in $peers; do echo "in.$code"; done); do
   [ -f "$work/$f" ] || { echo "instruction_count: $work/$f missing: run perf/peer_benchmark.sh first"; exit 1; }
 done

@@ -14,8 +14,9 @@
 # no cost. Prints particle-steps per second (median of REPS) and triaxdem's ratio to the faster peer.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+. "$root/scripts/script_folders.sh"
 steps="${STEPS:-2000}"; reps="${REPS:-3}"; np="${NP:-$(nproc)}"
-build="$(realpath "${BUILD:-$root/build}")"; work="$(realpath -m "${WORK:-$root/runs/peer_benchmark}")"
+build="$(build_folder peer_benchmark)"; work="$(realpath -m "${WORK:-$root/runs/peer_benchmark}")"
 peers="${PEERS-liggghts lammps}"
 tdem="$build/triaxdem"
 [ -x "$tdem" ] || { echo "peer_benchmark: build triaxdem first ($tdem)"; exit 1; }

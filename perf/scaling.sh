@@ -6,7 +6,8 @@
 #   perf/scaling.sh                 # K="10 22 46 100" (1,000 to 1,000,000 balls) STEPS=300 BUILD=build
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build="$(realpath "${BUILD:-$root/build}")"; work="$(realpath -m "${WORK:-$root/runs/scaling}")"
+. "$root/scripts/script_folders.sh"
+build="$(build_folder scaling)"; work="$(realpath -m "${WORK:-$root/runs/scaling}")"
 steps="${STEPS:-300}"; sizes="${K:-10 22 46 100}"
 mkdir -p "$work"
 export OMP_NUM_THREADS="${OMP_NUM_THREADS:-$(nproc)}" OMP_PROC_BIND=spread OMP_PLACES=threads

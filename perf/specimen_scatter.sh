@@ -9,7 +9,8 @@
 #   bash perf/specimen_scatter.sh              # SEEDS=12 FACTORS="1 4 16" BUILD=build WORK=runs/specimen_scatter SMALL_PREP_MU_S=
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build="$(realpath "${BUILD:-$root/build}")"; work="$(realpath -m "${WORK:-$root/runs/specimen_scatter}")"
+. "$root/scripts/script_folders.sh"
+build="$(build_folder specimen_scatter)"; work="$(realpath -m "${WORK:-$root/runs/specimen_scatter}")"
 seeds="${SEEDS:-12}"; factors="${FACTORS:-1 4 16}"
 mkdir -p "$work"
 for s3 in 100 300; do

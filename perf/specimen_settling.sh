@@ -16,7 +16,8 @@
 # About 4 minutes a seed for the small case on 2 cores; seconds a seed for the calibration's cells.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build="$(realpath "${BUILD:-$root/build}")"; work="$(realpath -m "${WORK:-$root/runs/specimen_settling}")"
+. "$root/scripts/script_folders.sh"
+build="$(build_folder specimen_settling)"; work="$(realpath -m "${WORK:-$root/runs/specimen_settling}")"
 config="$(realpath "${CONFIG:-$root/configs/small/S3_300kPa.toml}")"
 seeds="${SEEDS:-1 2 3}"; np="${NP:-$(nproc)}"
 if grep -q '^\[specimen\]' "$config"; then
@@ -27,7 +28,7 @@ fi
 tdem="$build/triaxdem"
 [ -x "$tdem" ] || { echo "specimen_settling: build triaxdem first ($tdem)"; exit 1; }
 py=python3; [ -x /usr/bin/python3 ] && py=/usr/bin/python3
-rm -rf "$work"; mkdir -p "$work"
+fresh_folder specimen_settling "$work"
 export OMP_NUM_THREADS="$np" OMP_PROC_BIND=spread OMP_PLACES=threads
 for seed in $seeds; do
   for kind in config variant; do

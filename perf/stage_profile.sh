@@ -15,14 +15,15 @@
 # default diagnosis hours: run it in the background with its log in a file.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build="$(realpath "${BUILD:-$root/build}")"; work="$(realpath -m "${WORK:-$root/runs/stage_profile}")"
+. "$root/scripts/script_folders.sh"
+build="$(build_folder stage_profile)"; work="$(realpath -m "${WORK:-$root/runs/stage_profile}")"
 config="$(realpath "${CONFIG:-$root/configs/paper/S1_100kPa.toml}")"
 diag_config="$(realpath "${DIAG_CONFIG:-$root/configs/calibration/base.toml}")"
 np="${NP:-$(nproc)}"; bench_steps="${BENCH_STEPS:-1000}"; skip="${SKIP:-}"; pressures="${PRESSURES:-100 200 300}"
 tdem="$build/triaxdem"
 [ -x "$tdem" ] || { echo "stage_profile: build triaxdem first ($tdem)"; exit 1; }
 py=python3; [ -x /usr/bin/python3 ] && py=/usr/bin/python3
-rm -rf "$work"; mkdir -p "$work"
+fresh_folder stage_profile "$work"
 export OMP_PROC_BIND=spread OMP_PLACES=threads
 
 if [[ " $skip " != *" triaxial "* ]]; then

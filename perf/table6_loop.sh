@@ -11,7 +11,8 @@
 # plan and runs nothing, then the table of what is done (the scripts' check).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build="$(realpath "${BUILD:-$root/build}")"; work="$(realpath -m "${WORK:-$root/runs/table6_loop}")"
+. "$root/scripts/script_folders.sh"
+build="$(build_folder table6_loop)"; work="$(realpath -m "${WORK:-$root/runs/table6_loop}")"
 materials="${MATERIALS:-S-1 S-2 S-3}"; cases="${CASES:-all 100 200 300}"; jobs="${JOBS:-2}"
 ensemble="${ENSEMBLE:-4}"; plan="${PLAN:-0}"
 tdem="$build/triaxdem"

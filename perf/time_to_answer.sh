@@ -14,11 +14,11 @@
 # taken to be of the cell's size); diagnosis_800, the default diagnosis on the cross-code base grown to 800 balls.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build="$(realpath "${BUILD:-$root/build}")"; work="$(realpath -m "${WORK:-$root/runs/time_to_answer}")"
+. "$root/scripts/script_folders.sh"
+build="$(build_folder time_to_answer)"; work="$(realpath -m "${WORK:-$root/runs/time_to_answer}")"
 cases="${CASES:-walled s1_two_fidelity}"; jobs="${JOBS:-2}"; second="${SECOND:-1}"; store="${STORE:-}"
 tdem="$build/triaxdem"
 [ -x "$tdem" ] || { echo "time_to_answer: build triaxdem first ($tdem)"; exit 1; }
-rm -rf "$work"; mkdir -p "$work"
 export OMP_NUM_THREADS=1  # -j runs at once, one thread each
 cd "$root"
 grown() {  # CONFIG BALLS: the config with BALLS balls, its box grown by the cube root of the ratio (the same density)
@@ -56,13 +56,17 @@ args_of() {  # CASE: the job's command line
     diagnosis_800)
       grown tests/data/crosscode/linear_base.toml 800 > "$work/linear_800.toml"
       echo "diagnose tests/data/crosscode/linear_seed1.csv --config $work/linear_800.toml --predict none" ;;
-    *) echo "time_to_answer: no case '$1' (tiny, walled, s1_two_fidelity, diagnosis, walled_4000, diagnosis_800)" >&2
-       return 1 ;;
   esac
 }
 field() {  # LOG PATTERN: the first group of the first line that matches (sed -E)
   sed -nE "s/.*$2.*/\1/p" "$1" | head -1
 }
+# The cases are checked before the folder is touched (a case misspelt once cost the folder its files).
+known="tiny walled s1_two_fidelity diagnosis walled_4000 diagnosis_800"
+for c in $cases; do
+  [[ " $known " == *" $c "* ]] || { echo "time_to_answer: no case '$c' (${known// /, }); nothing was run or removed" >&2; exit 2; }
+done
+fresh_folder time_to_answer "$work"
 echo "| case | plan | job | of it packing | simulator runs | plan beside it |"
 echo "|---|---|---|---|---|---|"
 for c in $cases; do

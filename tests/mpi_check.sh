@@ -16,7 +16,8 @@ tdem="$build/triaxdem"
 py=python3; [ -x /usr/bin/python3 ] && py=/usr/bin/python3
 compare="$py $root/tools/compare_runs.py"
 command -v mpirun > /dev/null || { echo "mpi_check: no mpirun (Debian: openmpi-bin)" >&2; exit 1; }
-rm -rf "$work"; mkdir -p "$work"; cd "$work"
+. "$root/scripts/script_folders.sh"
+fresh_folder mpi_check "$work"; cd "$work"
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMP_PROC_BIND=false OMP_NUM_THREADS=1
 # Seconds without word from a rank before its piece goes elsewhere: short, so that the killed rank is seen at once.
 export TRIAXDEM_RANK_TIMEOUT_S=3

@@ -71,6 +71,19 @@ if [ "$part" != diagnoses ]; then
     bash "$root/perf/time_to_answer.sh"
   [ "$(grep -c '^| tiny (' "$work/time_to_answer.sh.log")" = 2 ] ||
     { cat "$work/time_to_answer.sh.log"; echo "scripts_smoke: time_to_answer gave no row per pass" >&2; exit 1; }
+  # Issue 87: a misspelt case removed WORK's files before it was refused; a WORK the script did not make is refused and
+  # kept; a BUILD that does not exist is named with BUILD=.
+  mkdir -p "$work/user_folder" && touch "$work/user_folder/keep"
+  for cases in foo tiny; do
+    ! env BUILD="$build" WORK="$work/user_folder" CASES=$cases bash "$root/perf/time_to_answer.sh" > "$work/tta_$cases.log" 2>&1 &&
+      [ -f "$work/user_folder/keep" ] ||
+      { cat "$work/tta_$cases.log"; echo "scripts_smoke: time_to_answer removed a folder it did not make" >&2; exit 1; }
+  done
+  grep -q "no case 'foo'" "$work/tta_foo.log" && grep -q "holds files this script did not make" "$work/tta_tiny.log" ||
+    { cat "$work"/tta_*.log; echo "scripts_smoke: time_to_answer's refusals unclear" >&2; exit 1; }
+  ! env BUILD=/nonexistent CASES=tiny bash "$root/perf/time_to_answer.sh" > "$work/tta_build.log" 2>&1 &&
+    grep -q "BUILD=/nonexistent: no such folder" "$work/tta_build.log" ||
+    { cat "$work/tta_build.log"; echo "scripts_smoke: a missing BUILD is not named" >&2; exit 1; }
   check perf/specimen_settling.sh env BUILD="$build" WORK="$work/settling" CONFIG="$root/tests/data/tiny_triaxial.toml" \
     SEEDS=1 NP=1 bash "$root/perf/specimen_settling.sh"
   grep -q "^q_peak kPa " "$work/specimen_settling.sh.log" ||
@@ -173,7 +186,7 @@ if [ "$part" != tools ]; then
   mkdir -p "$work/coverage_user/tiny_1x/case2" && touch "$work/coverage_user/tiny_1x/case2/keep"
   ! env BUILD="$build" BASE="$base" OUT="$work/coverage" WORK="$work/coverage_user" FIRST=2 CASES=1 SIZES=1 METHOD=tiny \
     bash "$root/perf/coverage.sh" > "$work/coverage_user.log" 2>&1 && [ -f "$work/coverage_user/tiny_1x/case2/keep" ] &&
-    grep -q "was not made by this script" "$work/coverage_user.log" ||
+    grep -q "holds files this script did not make" "$work/coverage_user.log" ||
     { cat "$work/coverage_user.log"; echo "scripts_smoke: coverage removed a folder it did not make" >&2; exit 1; }
   check perf/inertial_scan "$build/perf/inertial_scan" --config "$base" --specimens 2 --pressures 100 \
     --inertial 1e-3,4e-3 -j 1 -o "$work/inertial.csv"
