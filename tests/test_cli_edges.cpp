@@ -232,9 +232,13 @@ TEST(CliEdges, AnUnsettledSpecimenIsRefusedUnlessAcceptedAndKeptForTheRerun) {
   EXPECT_NE(o.output.find("specimen: the run's own"), std::string::npos) << o.output;
   EXPECT_EQ(o.output.find("specimen layer"), std::string::npos) << "built again on resume:\n" << o.output;
   // Step 0 comes before any step and was ignored (the test ran to its end, issue 65): refused, naming the option.
-  o = triaxdem("triaxial " + accepted + out + " --overwrite --stop-at-step 0", dir);
-  EXPECT_NE(o.code, 0) << o.output;
-  EXPECT_NE(o.output.find("--stop-at-step"), std::string::npos) << o.output;
+  // Issue 87: 0 was refused as "not in range 0.000000 to 1.8e308", 1.5 as "Could not convert".
+  for (const char* step : {"0", "-1", "1.5"}) {
+    o = triaxdem("triaxial " + accepted + out + " --overwrite --stop-at-step " + step, dir);
+    EXPECT_NE(o.code, 0) << o.output;
+    EXPECT_NE(o.output.find("--stop-at-step"), std::string::npos) << o.output;
+    EXPECT_NE(o.output.find(std::string(step) + " is no step (a whole number, 1 or more"), std::string::npos) << o.output;
+  }
 }
 
 // A SIGTERM (or Ctrl-C) while the specimen was being built was held until the whole build had ended (minutes to
@@ -626,8 +630,8 @@ TEST(CliEdges, AResumeWithOtherInputsIsRefused) {
 }
 
 // --hold-out leaves a pressure out of the fit and predicts it: the plan fits the other two tests and predicts all three;
-// a pressure the data lack, or one that would leave a material nothing to fit, is refused before any work, naming
-// the file, the option and the data's pressures.
+// a pressure the data lack, one that would leave a material nothing to fit, one --material's material lacks, or no
+// pressure at all (nan, inf, negative) is refused before any work, naming the file, the option and the pressures.
 TEST(CliEdges, AHeldOutPressureIsLeftOutOfTheFitAndPredicted) {
   const fs::path dir = dem::test::scratch_dir("cli_hold_out");
   {
@@ -653,8 +657,41 @@ TEST(CliEdges, AHeldOutPressureIsLeftOutOfTheFitAndPredicted) {
   EXPECT_EQ(alone.code, 1) << alone.output;
   EXPECT_NE(alone.output.find("--hold-out 300 kPa: material B has no other test to fit"), std::string::npos)
       << alone.output;
-  for (const Outcome* o : {&missing, &alone})
-    EXPECT_EQ(o->output.find("plan (before any packing)"), std::string::npos) << o->output;
+  // Issue 87: a pressure of another material than --material's held nothing out while saying it did; nan and inf held
+  // nothing out in silence.
+  const Outcome other = triaxdem(job + " --material B --hold-out 100", dir);
+  EXPECT_EQ(other.code, 1) << other.output;
+  EXPECT_NE(other.output.find("d.csv: --hold-out 100 kPa: material B has no test at that pressure (its pressures, kPa: "
+                              "300)"), std::string::npos) << other.output;
+  std::vector<Outcome> outcomes{missing, alone, other};
+  for (const char* v : {"nan", "inf", "-100"}) {
+    outcomes.push_back(triaxdem(job + " --material A --hold-out " + v, dir));
+    EXPECT_NE(outcomes.back().code, 0) << v << "\n" << outcomes.back().output;
+    EXPECT_NE(outcomes.back().output.find(std::string(v) + " is no confining pressure (kPa, a number above 0)"),
+              std::string::npos) << outcomes.back().output;
+  }
+  for (const Outcome& o : outcomes)
+    EXPECT_EQ(o.output.find("plan (before any packing)"), std::string::npos) << o.output;
+}
+
+// Issue 87: data of a specimen smaller than the simulator's cell (10 balls against 120) were accepted, and the cell's
+// bias check extrapolated "to a specimen of 10 balls" (q -45%): refused before any work, naming the file, the test,
+// both sizes and the key; data of the cell's size plan.
+TEST(CliEdges, DataOfASpecimenSmallerThanTheCellAreRefused) {
+  const fs::path dir = dem::test::scratch_dir("cli_small_specimen");
+  for (const char* balls : {"10", "120"}) {
+    std::ofstream(dir / "d.csv") << "material,sigma3_kPa,eps_a_pct,q_kPa,eps_v_pct,specimen_balls\n"
+                                 << "A,100,0,0,0," << balls << "\nA,100,1,60,0.1," << balls << "\nA,100,2,70,-0.1,"
+                                 << balls << "\nA,100,3,65,-0.3," << balls << "\n";
+    const Outcome o = triaxdem("calibrate " + (dir / "d.csv").string() + " --config tests/data/hidden_effects.toml "
+                               "--predict none -j 1 --plan -o " + (dir / "out").string(), dir);
+    const bool refused = std::string(balls) == "10";
+    EXPECT_EQ(o.code, refused ? 1 : 0) << o.output;
+    EXPECT_EQ(o.output.find("d.csv: specimen_balls 10 (A at 100 kPa) is below the 120 balls of the simulator's cell "
+                            "(tests/data/hidden_effects.toml: [particles] count)") != std::string::npos, refused)
+        << o.output;
+    EXPECT_EQ(o.output.find("plan (before any packing)") == std::string::npos, refused) << o.output;
+  }
 }
 
 // Two fidelities correct the cell toward the membrane template's test, so it must be the data's size: data from

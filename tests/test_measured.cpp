@@ -408,6 +408,12 @@ TEST(Measured, ImplausibleValuesAreRefusedWithLineAndColumn) {
   EXPECT_NE(e.find("bad.csv:2:q_1pct_kPa: 100000 kPa is implausible"), std::string::npos) << e;
   e = error_of(summary + "A,100,300,5,200,50,100,0.011e6\n");
   EXPECT_NE(e.find("bad.csv:2:q_3pct_kPa: 11000 kPa is implausible"), std::string::npos) << e;
+  // Issue 87: 480.5 particles were accepted without a word.
+  const std::string sized = "material,sigma3_kPa,q_peak_kPa,specimen_balls\n";
+  e = error_of(sized + "A,100,300,480.5\n");
+  EXPECT_NE(e.find("bad.csv:2:specimen_balls: particles in the specimen: a whole number in [1, 1e12]"),
+            std::string::npos) << e;
+  EXPECT_DOUBLE_EQ(load_measured(write("sized.csv", sized + "A,100,300,480\n")).tests[0].specimen_balls, 480);
 }
 
 // What no drained test shows is refused, naming the file, the test and what is allowed (issue 65): sigma3 in Pa

@@ -78,7 +78,15 @@ const char* const kOverwriteHelp = "replace another run's outputs in the output 
 void add_stop_at(CLI::App* cmd, Args& a) {
   cmd->add_option("--stop-at-step", a.stop_at, "write a checkpoint after this step and stop (exit status 3); "
                   "steps count from 1")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Validator(
+          [](std::string& s) -> std::string {
+            // CLI11's PositiveNumber says "not in range 0 to 1.8e308" of 0 and "Could not convert" of 1.5.
+            char* end = nullptr;
+            const long long v = std::strtoll(s.c_str(), &end, 10);
+            return end != s.c_str() && *end == '\0' && v >= 1 ? "" : s + " is no step (a whole number, 1 or more: steps "
+                                                                           "count from 1)";
+          },
+          "STEP"));
 }
 
 void run_options(CLI::App* cmd, Args& a) {
@@ -164,7 +172,8 @@ void calibration_options(CLI::App* cmd, Args& a) {
 void calibrate_options(CLI::App* cmd, Args& a) {
   calibration_options(cmd, a);
   cmd->add_option("--hold-out", a.cal.hold_out_kPa, "a confining pressure (kPa) of the data whose tests the fit "
-                  "leaves out and the prediction predicts: the transfer to a pressure it never saw");
+                  "leaves out and the prediction predicts: the transfer to a pressure it never saw")
+      ->check(pressure_kpa());
 }
 
 void synth_options(CLI::App* cmd, Args& a) {

@@ -238,8 +238,8 @@ TriaxialTest& test_of(const RowReader& r, MeasuredData& d, TestIndex& tests) {
   std::tie(key.void_ratio, key.void_ratio_sd) = void_ratio_of(r);
   if (r.has("specimen_balls")) {
     key.specimen_balls = r.number("specimen_balls");
-    if (!(key.specimen_balls >= 1 && key.specimen_balls <= 1e12))
-      r.refuse("specimen_balls", "particles in the specimen must be in [1, 1e12]");
+    if (!(key.specimen_balls >= 1 && key.specimen_balls <= 1e12 && std::floor(key.specimen_balls) == key.specimen_balls))
+      r.refuse("specimen_balls", "particles in the specimen: a whole number in [1, 1e12]");
   }
   const auto [it, is_new] = tests.of.emplace(std::make_tuple(key.material, key.sigma3, key.replicate), d.tests.size());
   if (is_new) {

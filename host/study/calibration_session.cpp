@@ -127,6 +127,7 @@ JobInputs::JobInputs(const Config& base, const CalibrationOptions& o)
       walls_prediction(walls_prediction_wanted(base, o)), workers(o.workers),
       two_fidelity(two_fidelity_wanted(base, o.reference_test, predict_template.has_value())),
       cell_q(reference_q_measure(base, o, data)) {
+  check_specimen_sizes(base, o, data);
   take_walled_size(base, o, data);
   if (two_fidelity)
     check_template_size(*predict_template, data.tests, o.predict.empty() ? base.path + ": [calibrate] predict" : "--predict");

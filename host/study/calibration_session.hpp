@@ -81,6 +81,9 @@ struct JobInputs {
 void take_walled_size(const Config& base, const CalibrationOptions& o, MeasuredData& data);
 std::vector<TriaxialTest> hold_out(const CalibrationOptions& o, MeasuredData& data);
 void check_enough_data(const CalibrationOptions& o, const MeasuredData& data, std::size_t free);
+/// DataError where a test's specimen_balls lie below the simulator cell's balls: the cell's bias check extrapolates
+/// toward larger specimens only (a 10-ball specimen against a 120-ball cell was extrapolated to q -45%).
+void check_specimen_sizes(const Config& base, const CalibrationOptions& o, const MeasuredData& data);
 /// The inputs that decide a job's runs (the data's bytes, the config's keys, the options), in the result folder's
 /// job_inputs.txt; a --resume with other inputs is refused before any work, naming what differs.
 void record_job_inputs(const Config& base, const CalibrationOptions& o, const std::string& folder);

@@ -51,6 +51,19 @@ void take_walled_size(const Config& base, const CalibrationOptions& o, MeasuredD
                          "differs");
 }
 
+void check_specimen_sizes(const Config& base, const CalibrationOptions& o, const MeasuredData& data) {
+  const Config cell = reference_cell(base, o.reference_test);
+  const Real balls = static_cast<Real>(cell.particles.count * std::max(cell.calibrate.cell_factor, 1L));
+  for (const TriaxialTest& t : data.tests)
+    if (std::isfinite(t.specimen_balls) && t.specimen_balls < balls)
+      throw DataError(data.path + ": specimen_balls " + fmt("%.0f", t.specimen_balls) + " (" + t.material + " at " +
+                      fmt("%g kPa", 1e-3 * t.sigma3) + ") is below the " + fmt("%.0f", balls) + " balls of the "
+                      "simulator's cell (" + base.path + ": [particles] count" +
+                      (cell.calibrate.cell_factor > 1 ? " times [calibrate] cell_factor" : "") + "): the cell's bias is "
+                      "measured on larger cells and extrapolated toward larger specimens only; give the cell the "
+                      "data's balls or fewer");
+}
+
 /// Takes the tests at --hold-out's pressure out of `data` and returns them. Refused (DataError naming the file, the
 /// option and the data's pressures) where no test has that pressure or a material the job calibrates (--material)
 /// would keep none.
@@ -68,6 +81,18 @@ std::vector<TriaxialTest> hold_out(const CalibrationOptions& o, MeasuredData& da
   if (held.empty())
     throw DataError(data.path + ": --hold-out " + held_kPa + ": no test at that pressure (the data's, kPa:" + pressures +
                     ")");
+  // With --material only that material's tests are fitted and predicted: another material's test at the pressure
+  // would be held out of nothing.
+  if (!o.material.empty() &&
+      std::none_of(held.begin(), held.end(), [&](const TriaxialTest& t) { return t.material == o.material; })) {
+    std::string own;
+    for (const TriaxialTest& t : data.tests)
+      if (t.material == o.material && own.find(fmt(" %g,", 1e-3 * t.sigma3)) == std::string::npos)
+        own += fmt(" %g,", 1e-3 * t.sigma3);
+    if (!own.empty()) own.pop_back();
+    throw DataError(data.path + ": --hold-out " + held_kPa + ": material " + o.material + " has no test at that "
+                    "pressure (its pressures, kPa:" + own + ")");
+  }
   for (const TriaxialTest& h : held)
     if ((o.material.empty() || h.material == o.material) && std::none_of(kept.begin(), kept.end(), [&](const TriaxialTest& t) { return t.material == h.material; }))
       throw DataError(data.path + ": --hold-out " + held_kPa + ": material " + h.material +
