@@ -8,6 +8,7 @@
 #include <random>
 
 #include "host/fit/calibrate.hpp"
+#include "host/fit/misfit.hpp"
 #include "host/util/fnv1a.hpp"
 
 namespace dem {
@@ -81,6 +82,58 @@ TEST(Coverage, IntervalsAndTheJointRegionHoldTheTruthAtTheirLevel) {
   EXPECT_GE(held[0], 90);
   EXPECT_GE(held[1], 90);
   EXPECT_GE(joint, 90);
+}
+
+// rewhiten: a design whitened again by a misfit whose simulator scatter is twice as wide (the specimen and ensemble
+// terms both double; the data's rows lie on a smooth curve and add almost nothing) halves every residual, keeps the
+// best point where it was and widens the intervals about it (the chi2 falls by four, so the same rise lies twice as
+// far where the intervals end inside the box).
+TEST(Coverage, AWiderScatterWidensTheIntervalsAboutTheSameBest) {
+  Model base;
+  base.law.mu_s = 0.15;
+  base.law.mu_r = 0.015;
+  const std::vector<FreeParam> free{free_param("mu_s", base), free_param("mu_r", base)};
+  // q's level follows x, its early stiffness y; the data at (0.4, 0.6); eps_v the same at every point.
+  auto curve_at = [](Real x, Real y, Real scale) {
+    TriaxialTest t;
+    t.material = "A";
+    t.sigma3 = 100e3;
+    for (Real e = 0; e <= 0.1 + 1e-12; e += 1e-3) {
+      t.eps_a.push_back(e);
+      t.q.push_back(scale * (1 + 0.5 * (x - 0.4)) * 1.5e5 * e / (e + 0.004 * (1 + 1.5 * (y - 0.6))));
+      t.eps_v.push_back(-0.3 * e);
+    }
+    summarise(t);
+    return t;
+  };
+  const std::vector<TriaxialTest> measured{curve_at(0.4, 0.6, 1)};
+  auto scatter = [&](Real spread) {
+    Ensemble e{{}};
+    for (int k = 0; k < 8; ++k) e[0].push_back(curve_at(0.4, 0.6, 1 + (k % 2 ? spread : -spread)));
+    return e;
+  };
+  NoiseBudget budget;
+  budget.scatter = scatter(0.05);  // above the lab's 2% floor on the specimen's q, which does not scale
+  budget.members = 2;
+  budget.sim_end = 0.1;
+  const Misfit narrow(measured, NoiseOptions(), budget);
+  const Simulator simulate = [&](const Model& m, Real) {
+    SimulatedPoint s;
+    s.sim = {curve_at(free[0].unit(m.law.mu_s), free[1].unit(m.law.mu_r), 1)};
+    s.r = narrow.residuals(Ensemble{{s.sim[0]}});
+    return s;
+  };
+  CalibrationResult r = calibrate(simulate, base, free, narrow.data(), 4, 0);
+  const CalibrationResult before = r;
+  rewhiten(r, narrow.with_scatter(scatter(0.1)), base);
+  EXPECT_EQ(r.best.u, before.best.u) << "the same best point";
+  EXPECT_NEAR(r.best.chi2, before.best.chi2 / 4, 0.05 * before.best.chi2 + 1e-9) << "every residual halved";
+  for (int j = 0; j < 2; ++j) {
+    const Real w0 = before.interval[j].second - before.interval[j].first, w1 = r.interval[j].second - r.interval[j].first;
+    std::printf("%s: interval [%.4g, %.4g] -> [%.4g, %.4g]\n", free[j].name.c_str(), before.interval[j].first,
+                before.interval[j].second, r.interval[j].first, r.interval[j].second);
+    EXPECT_GT(w1, 1.5 * w0) << free[j].name;
+  }
 }
 
 }  // namespace

@@ -109,6 +109,36 @@ TEST(Misfit, EnsembleScatterIsPooledAndInflated) {
   EXPECT_EQ(m.members(), 4);
 }
 
+// The misfit measured again at another model's scatter (with_scatter): the simulator's terms follow the new scatter
+// (a spread three times as wide, three times the standard deviation), the data's own noise, the ensemble size and the
+// cell's bias stay.
+TEST(Misfit, WithAnotherScatterTheSimulatorsTermsFollowIt) {
+  const TriaxialTest t = smooth_test(100e3);
+  NoiseBudget budget;
+  budget.scatter = Ensemble{members_of(t, 8, 0.01)};
+  budget.members = 2;
+  budget.sim_end = 0.1;
+  budget.cell_bias.sd = {std::vector<Real>(Misfit({t}, NoiseOptions(), budget).features(0).size(), 500.0)};
+  const Misfit m({t}, NoiseOptions(), budget);
+  const Misfit wide = m.with_scatter(Ensemble{members_of(t, 8, 0.03)});
+  ASSERT_EQ(wide.features(0).size(), m.features(0).size());
+  int checked = 0;
+  for (std::size_t i = 0; i < m.features(0).size(); ++i) {
+    const Feature &a = m.features(0)[i], &b = wide.features(0)[i];
+    EXPECT_EQ(b.data_sd, a.data_sd) << a.name;
+    EXPECT_EQ(b.cell_sd, a.cell_sd) << a.name;
+    if (a.quantity != 0 || a.ensemble_sd < 1e-9) continue;
+    EXPECT_NEAR(b.ensemble_sd, 3 * a.ensemble_sd, 1e-6 * b.ensemble_sd) << a.name;
+    ++checked;
+  }
+  EXPECT_GT(checked, 5);
+  EXPECT_EQ(wide.members(), 2);
+  Misfit corrected = m;
+  corrected.add_discrepancy({std::vector<Real>(m.features(0).size(), 0.0)},
+                            {std::vector<Real>(m.features(0).size(), 1.0)}, "none");
+  EXPECT_THROW(corrected.with_scatter(budget.scatter), std::logic_error) << "a discrepancy would be lost";
+}
+
 // A data specimen of 16 times the simulator's balls counts as one simulator specimen's scatter over sqrt(16), as the
 // specimens of perf/specimen_scatter.sh scatter (host/fit/misfit.hpp). A member scatter of 20% keeps the lab floor (2%
 // of q) out of the way: 20% / 4 is 5%.

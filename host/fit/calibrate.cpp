@@ -310,16 +310,37 @@ std::vector<std::string> CalibrationResult::inseparable() const {
   return out;
 }
 
-void adopt_best(CalibrationResult& r, const Evaluation& better, const Model& base) {
-  r.design.push_back(better);
-  r.best = better;
+namespace {
+
+/// Makes `best` the reported point: its values, the model (`base` with them) and the uncertainty at it.
+void report_at(CalibrationResult& r, const Evaluation& best, const Model& base) {
+  r.best = best;
   r.model = base;
   r.values.clear();
   for (std::size_t k = 0; k < r.free.size(); ++k) {
-    r.values.push_back(r.free[k].value(better.u[k]));
+    r.values.push_back(r.free[k].value(best.u[k]));
     set_param(r.model, r.free[k].name, r.values.back());
   }
   add_uncertainty(r);
+}
+
+}  // namespace
+
+void adopt_best(CalibrationResult& r, const Evaluation& better, const Model& base) {
+  r.design.push_back(better);
+  report_at(r, better, base);
+}
+
+void rewhiten(CalibrationResult& r, const Misfit& misfit, const Model& base) {
+  const Evaluation* best = nullptr;
+  for (Evaluation& e : r.design) {
+    Ensemble one;
+    for (const TriaxialTest& t : e.sim) one.push_back({t});
+    e.r = misfit.residuals(one);
+    e.chi2 = sum_sq(e.r);
+    if (!e.screened && (!best || e.chi2 < best->chi2)) best = &e;
+  }
+  if (best) report_at(r, Evaluation(*best), base);
 }
 
 long planned_points(int d, int rounds) {

@@ -304,6 +304,10 @@ struct Planner {
     add.runs(material + (in.diagnose ? ": diagnosis" : ": search"),
              auto_ensemble ? "[calibrate] ensemble (auto)" : "[calibrate] ensemble", lab, tests,
              static_cast<double>(points), K_low, K, search_what);
+    if (!in.diagnose && !in.two_fidelity)
+      add.runs(material + ": scatter at the calibrated point", "[calibrate] scatter_specimens", lab, tests, 1, S, S,
+               std::to_string(S * static_cast<int>(tests.size())) + " runs of " + n + " balls (" + std::to_string(S) +
+                   " specimens x " + T + " tests)");
     if (std::find(in.reference_runs.begin(), in.reference_runs.end(), material) != in.reference_runs.end())
       add.runs(material + ": the reference point", "--reference", lab, tests, 1, K_low, K,
                "1 point x " + T + " tests x " + k + " specimens of " + n + " balls");

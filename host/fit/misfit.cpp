@@ -115,6 +115,17 @@ std::vector<Real> Misfit::values(std::size_t k, const TriaxialTest& t) const {
 Misfit::Misfit(const std::vector<TriaxialTest>& measured, const NoiseOptions& noise, const NoiseBudget& budget)
     : Misfit(measured, noise, budget.scatter, budget.members, budget.sim_end, budget.sim_balls) {
   if (!budget.cell_bias.sd.empty()) add_cell_bias(budget.cell_bias);
+  measured_ = measured;
+  noise_ = noise;
+  budget_ = budget;
+  from_budget_ = true;
+}
+
+Misfit Misfit::with_scatter(const Ensemble& scatter) const {
+  if (!from_budget_) throw std::logic_error("misfit: with_scatter needs a misfit of a noise budget, without a discrepancy");
+  NoiseBudget b = budget_;
+  b.scatter = scatter;
+  return Misfit(measured_, noise_, b);
 }
 
 Misfit::Misfit(const std::vector<TriaxialTest>& measured, const NoiseOptions& noise, const Ensemble& reference,

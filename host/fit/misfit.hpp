@@ -180,8 +180,17 @@ class Misfit {
                        const std::string& note);
   /// The scatter specimens' mean void ratio at the start of shear of test k, at the base model.
   Real reached_void_ratio(std::size_t k) const { return void_ratio_[k]; }
+  /// The same misfit with the simulator's scatter measured on `scatter` ([test][specimen]: the scatter specimens run at
+  /// another model, the calibrated one): the specimen and ensemble terms follow it, the data's noise, the ensemble and
+  /// the cell's bias stay. Only for a misfit built from a noise budget, before any discrepancy is added.
+  Misfit with_scatter(const Ensemble& scatter) const;
 
  private:
+  /// What built it, for with_scatter: set by the budget's constructor, cleared by add_discrepancy.
+  std::vector<TriaxialTest> measured_;
+  NoiseOptions noise_;
+  NoiseBudget budget_;
+  bool from_budget_ = false;
   std::vector<Real> void_ratio_;
   std::string cell_finding_;
   /// Sigma_cell: adds the simulator's finite-cell bias (host/fit/cell_bias.hpp), each test's correlated along

@@ -273,6 +273,7 @@ void Misfit::add_discrepancy(const std::vector<std::vector<Real>>& delta, const 
   for (std::size_t k = 0; k < features_.size(); ++k)
     if (delta[k].size() != features_[k].size()) throw std::logic_error("misfit: a discrepancy for other data");
   add_correlated(sd, &Feature::discrepancy_sd, "discrepancy");
+  from_budget_ = false;  // with_scatter would rebuild it without the discrepancy
   for (std::size_t k = 0; k < features_.size(); ++k)
     for (std::size_t i = 0; i < delta[k].size(); ++i) features_[k][i].measured -= delta[k][i];
   notes_.push_back(note);
