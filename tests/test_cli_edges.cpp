@@ -537,7 +537,10 @@ TEST(CliEdges, AFolderThatCannotBeWrittenIsRefusedBeforeAnyWork) {
       {"calibrate" + job + "-o " + (dir / "a_file").string(), "a_file is a file, not a folder"},
       {"calibrate" + job + "-o " + (dir / "a_file" / "below").string(), "a_file is a file, not a folder"},
       {"diagnose" + job + "--resume " + (dir / "calibrate_20260101-000000").string(),
-       "not a diagnose_<date> folder of an earlier diagnose"}};
+       "not a diagnose_<date> folder of an earlier diagnose"},
+      // Issue 87: /proc passes access() as root, and the folder failed after the plan ("filesystem error"); as root
+      // it is "a folder cannot be made there", as another user "/proc cannot be written".
+      {"calibrate" + job + "-o /proc/triaxdem_out", "-o /proc/triaxdem_out: "}};
   for (const auto& [args, said] : cases) {
     const Outcome o = triaxdem(args, dir);
     EXPECT_EQ(o.code, 1) << args << "\n" << o.output;
@@ -715,6 +718,29 @@ TEST(CliEdges, ATwoFidelityTemplateOfAnotherSizeIsRefusedBeforeAnyWork) {
   }
 }
 
+// Issue 87: a hertz_mindlin template beside an rrlinear base ran the two fidelities' loop to a "fixed point" without a
+// note: refused before any work, naming the key, the template and both laws.
+TEST(CliEdges, ATwoFidelityTemplateOfAnotherLawIsRefused) {
+  const fs::path dir = dem::test::scratch_dir("cli_template_law");
+  write_four_point_curve(dir / "d.csv");
+  {
+    std::ifstream in(std::string(TRIAXDEM_SOURCE_DIR) + "/configs/small/S1_100kPa.toml");
+    std::ofstream out(dir / "hm.toml");
+    for (std::string line; std::getline(in, line);) {
+      if (line.rfind("emod_Pa", 0) == 0 || line.rfind("kratio", 0) == 0) continue;
+      out << line << "\n";
+      if (line.rfind("[material]", 0) == 0) out << "law = \"hertz_mindlin\"\nshear_modulus_Pa = 1.5e9\npoisson = 0.3\n";
+    }
+  }
+  const Outcome o = triaxdem("calibrate " + (dir / "d.csv").string() + " --config configs/calibration/base.toml "
+                             "--reference-test two_fidelity --predict " + (dir / "hm.toml").string() +
+                             " -j 1 --plan -o " + (dir / "out").string(), dir);
+  EXPECT_EQ(o.code, 1) << o.output;
+  EXPECT_NE(o.output.find("hm.toml, whose contact law is hertz_mindlin where the base's (configs/calibration/base.toml) "
+                          "is rrlinear"), std::string::npos) << o.output;
+  EXPECT_EQ(o.output.find("plan (before any packing)"), std::string::npos) << o.output;
+}
+
 // A plan beyond the bound (four hours here) is refused before any packing unless --yes is given, naming its costliest
 // stage and the setting that sizes it; 64 scatter specimens of 32,000 balls with an "auto" ensemble are such a job:
 // its plan takes up to 15 to 27 hours at 152 to 265 ns a particle-step (this machine idle and busy), so a machine
@@ -741,9 +767,24 @@ TEST(CliEdges, AJobBeyondItsBoundAsksForYes) {
   EXPECT_NE(o.output.find("run it with --yes, or make it smaller; its costliest stage is A: search"),
             std::string::npos) << o.output;
   EXPECT_NE(o.output.find("sized by [calibrate] ensemble (auto)"), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("; a run of "), std::string::npos) << "a run's length is said beside the stage\n" << o.output;
   EXPECT_EQ(o.output.find("triaxdem: packing"), std::string::npos) << o.output;
   EXPECT_EQ(o.output.find("matching the void ratio"), std::string::npos) << o.output;
   EXPECT_FALSE(fs::exists(dir / "out") && !fs::is_empty(dir / "out"));
+  // Issue 87: --yes started a job planned at 1,454 hours. The same job at a hundredth of the inertial number (a hundred
+  // times the steps: 1,500 to 2,700 hours) is refused with --yes too, beyond a week.
+  {
+    std::ifstream in(dir / "big.toml");
+    std::ofstream out(dir / "slow.toml");
+    std::string line;
+    while (std::getline(in, line)) out << (line.rfind("target_inertial = ", 0) == 0 ? "target_inertial = 3e-5" : line) << "\n";
+  }
+  const Outcome slow = triaxdem("calibrate " + (dir / "d.csv").string() + " --config " + (dir / "slow.toml").string() +
+                                " --predict none -j 1 --yes -o " + (dir / "out").string(), dir);
+  EXPECT_EQ(slow.code, 1) << slow.output;
+  EXPECT_NE(slow.output.find("beyond what --yes starts: make it smaller, or spread it over ranks"), std::string::npos)
+      << slow.output;
+  EXPECT_EQ(slow.output.find("triaxdem: packing"), std::string::npos) << slow.output;
 }
 
 // A prediction of the walled cell beside a walled reference would compare the cell with itself: refused before any

@@ -373,6 +373,10 @@ TEST(Measured, TestLabelsTellReplicatesApart) {
   e = error_of("material,sigma3_kPa,test,eps_a_pct,q_kPa\nA,100,r1,0,0\nA,100,r2,0,0\nA,100,r1,0,10\n");
   EXPECT_NE(e.find("bad.csv:4:eps_a_pct: axial strain must increase within a test (A at 100 kPa, test r1)"),
             std::string::npos) << e;
+  // Issue 87: a whole curve given twice was refused as a strain that does not increase, at its first row again.
+  e = error_of("material,sigma3_kPa,eps_a_pct,q_kPa\nA,100,0,0\nA,100,1,100\nA,100,2,120\nA,100,0,0\nA,100,1,100\n");
+  EXPECT_NE(e.find("bad.csv:5:eps_a_pct: 0% starts the curve of A at 100 kPa again (its first row: 0%): a test given "
+                   "twice; replicates need a test column, a label each"), std::string::npos) << e;
 }
 
 // Implausible values are refused: a deviator beyond 100 sigma3 (q = -3e9 kPa was once accepted), a strain

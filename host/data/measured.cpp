@@ -255,6 +255,11 @@ TriaxialTest& test_of(const RowReader& r, MeasuredData& d, TestIndex& tests) {
 void read_curve_row(const RowReader& r, TriaxialTest& t) {
   const Real ea = strain(r, "eps_a");
   if (ea < 0) r.refuse("eps_a", str(100 * ea) + "%: axial strain is >= 0 (compression positive, from the start of shear)");
+  // A curve that starts again from its first strain is a test given twice (or replicates without labels), not a typo.
+  if (t.eps_a.size() >= 3 && ea <= t.eps_a.front())
+    r.refuse("eps_a", str(100 * ea) + "% starts the curve of " + describe_test(t) + " again (its first row: " +
+                          str(100 * t.eps_a.front()) + "%): a test given twice; replicates need a test column, a label "
+                          "each");
   if (!t.eps_a.empty() && !(ea > t.eps_a.back()))
     r.refuse("eps_a", "axial strain must increase within a test (" + describe_test(t) + ")");
   t.eps_a.push_back(ea);

@@ -220,7 +220,8 @@ struct Planner {
     const int check_to_pack = check_stored ? kCellCheckSpecimens - stored_specimens(check_cell, check_plan.first_seed,
                                                                                     kCellCheckSpecimens)
                                            : kCellCheckSpecimens - shared;
-    const std::string setting = "the cell's bias check (kCellCheckFactor)";
+    const std::string setting = "[particles] count (the bias check runs cells of " + std::to_string(kCellCheckFactor) +
+                                " times it where the data's specimen_balls exceed the cell's)";
     const auto [root_lo, root_hi] = match_bracket(check_plan.around);
     const PackingCost lo = packing_cost_at(root_lo * root_lo), hi = packing_cost_at(root_hi * root_hi),
                       ends = match_ends();

@@ -15,6 +15,8 @@ namespace dem {
 
 /// A job whose plan's upper time is above this many seconds asks for --yes (or a smaller setting) before it starts.
 constexpr double kPlanBoundSeconds = 4 * 3600;
+/// A plan above this is refused even with --yes (a job planned at 1,454 hours once started on --yes alone): a week.
+constexpr double kPlanCeilingSeconds = 7 * 24 * 3600;
 
 struct PlanStage {
   std::string name;           ///< "scatter runs"

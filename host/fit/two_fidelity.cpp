@@ -48,6 +48,14 @@ bool two_fidelity_wanted(const Config& base, const std::string& cli, bool membra
   return true;
 }
 
+void check_template_law(const Config& base, const Config& membrane, const std::string& key) {
+  const int a = static_cast<int>(base.ball.law), b = static_cast<int>(membrane.ball.law);
+  if (a != b)
+    throw ConfigError(key + ": two fidelities correct the cell toward the membrane test of " + membrane.path +
+                      ", whose contact law is " + kContactLawNames[b] + " where the base's (" + base.path + ") is " +
+                      kContactLawNames[a] + ": give the template the base's [material] law");
+}
+
 void check_template_size(const Config& membrane, const std::vector<TriaxialTest>& tests, const std::string& key) {
   const Real balls = static_cast<Real>(specimen_ball_count(membrane));
   for (const TriaxialTest& t : tests)

@@ -46,6 +46,10 @@ bool two_fidelity_wanted(const Config& base, const std::string& cli, bool membra
 /// test gives specimen_balls, the template's specimen must have them within kTemplateSizeTolerance. ConfigError
 /// names `key` (where the template came from), both sizes and the ways out, before any run.
 void check_template_size(const Config& membrane, const std::vector<TriaxialTest>& tests, const std::string& key);
+/// Refuses (ConfigError naming `key`, both files and both laws) a membrane template whose ball-ball contact law is not
+/// the base's: two fidelities correct the cell by the template's test at the cell's parameters, which another law reads
+/// otherwise (a hertz_mindlin template beside an rrlinear base ran its loop to a "fixed point" of two models).
+void check_template_law(const Config& base, const Config& membrane, const std::string& key);
 /// A quarter: the boundary's share goes as N^-1/3, so a specimen 25% larger or smaller changes it by under 8%.
 inline constexpr Real kTemplateSizeTolerance = 0.25;
 

@@ -38,6 +38,14 @@ void check_folders(const CalibrationOptions& o, const std::string& kind) {
                                 "to write in)");
   if (::access(p.c_str(), W_OK) != 0)
     throw std::invalid_argument("-o " + o.output + ": " + p.string() + " cannot be written (allowed: a folder to write in)");
+  // Some folders pass access() and still refuse a new folder (/proc, as root): made once here, and what was made
+  // removed again, so that a plan leaves nothing behind and a job learns it before any work.
+  const fs::path want = fs::absolute(o.output, ec);
+  if (fs::exists(want, ec)) return;
+  if (!fs::create_directories(want, ec) || ec)
+    throw std::invalid_argument("-o " + o.output + ": a folder cannot be made there (" + ec.message() +
+                                "; allowed: a folder to write in)");
+  for (fs::path q = want; q != p && !q.empty(); q = q.parent_path()) fs::remove(q, ec);
 }
 
 /// The reference test's cell, sheared as far as the data need, its packings kept in (and read from) the output
@@ -129,8 +137,11 @@ JobInputs::JobInputs(const Config& base, const CalibrationOptions& o)
       cell_q(reference_q_measure(base, o, data)) {
   check_specimen_sizes(base, o, data);
   take_walled_size(base, o, data);
-  if (two_fidelity)
-    check_template_size(*predict_template, data.tests, o.predict.empty() ? base.path + ": [calibrate] predict" : "--predict");
+  if (two_fidelity) {
+    const std::string key = o.predict.empty() ? base.path + ": [calibrate] predict" : "--predict";
+    check_template_size(*predict_template, data.tests, key);
+    check_template_law(base, *predict_template, key);
+  }
   held_out = hold_out(o, data);
   check_enough_data(o, data, free.size());
 }
@@ -155,12 +166,23 @@ JobPlan JobInputs::announce_plan(const Config& base, const CalibrationOptions& o
   JobPlan plan = plan_job(in);
   for (const std::string& n : data.notes) std::printf("%s: note: %s\n", kind.c_str(), n.c_str());
   std::printf("%s", plan.text(kind).c_str());
-  if (plan.high() > kPlanBoundSeconds && !o.yes && !o.plan_only) {
+  const bool above_bound = plan.high() > kPlanBoundSeconds, above_ceiling = plan.high() > kPlanCeilingSeconds;
+  if ((above_ceiling || (above_bound && !o.yes)) && !o.plan_only) {
+    // The cause a user can change: the costliest stage's work and a run's length, beside the setting that sizes it.
     const PlanStage& top = plan.costliest();
+    std::string run_steps;
+    for (const std::string& n : plan.notes)
+      if (n.rfind("a run of ", 0) == 0) run_steps = "; " + n.substr(0, n.find(','));
+    const std::string cause = "its costliest stage is " + top.name + " (up to " + format_duration(top.high) + ": " +
+                              top.work + run_steps + "), sized by " + top.setting +
+                              " (docs/calibration.md, What a job costs)";
+    if (above_ceiling)
+      throw ConfigError(kind + ": the plan takes up to " + format_duration(plan.high()) + " on this machine, more than " +
+                        format_duration(kPlanCeilingSeconds) + ", beyond what --yes starts: make it smaller, or spread "
+                        "it over ranks (docs/cluster.md); " + cause);
     throw ConfigError(kind + ": the plan takes up to " + format_duration(plan.high()) + " on this machine, above the " +
                       format_duration(kPlanBoundSeconds) + " a job runs without asking: run it with --yes, or make it "
-                      "smaller; its costliest stage is " + top.name + " (up to " + format_duration(top.high) +
-                      "), sized by " + top.setting + " (docs/calibration.md, What a job costs)");
+                      "smaller; " + cause);
   }
   return plan;
 }
