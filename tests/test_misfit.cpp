@@ -109,9 +109,9 @@ TEST(Misfit, EnsembleScatterIsPooledAndInflated) {
   EXPECT_EQ(m.members(), 4);
 }
 
-// The misfit measured again at another model's scatter (with_scatter): the simulator's terms follow the new scatter
-// (a spread three times as wide, three times the standard deviation), the data's own noise, the ensemble size and the
-// cell's bias stay.
+// The misfit measured again at another model's scatter (with_scatter): the simulator's terms follow a wider scatter
+// (a spread three times as wide, three times the standard deviation) and keep theirs against a narrower one; the
+// data's own noise, the ensemble size and the cell's bias stay.
 TEST(Misfit, WithAnotherScatterTheSimulatorsTermsFollowIt) {
   const TriaxialTest t = smooth_test(100e3);
   NoiseBudget budget;
@@ -133,6 +133,11 @@ TEST(Misfit, WithAnotherScatterTheSimulatorsTermsFollowIt) {
   }
   EXPECT_GT(checked, 5);
   EXPECT_EQ(wide.members(), 2);
+  // A narrower scatter at the other model keeps the base's: each datum takes the larger of the two.
+  const Misfit narrow = m.with_scatter(Ensemble{members_of(t, 8, 0.005)});
+  for (std::size_t i = 0; i < m.features(0).size(); ++i)
+    EXPECT_NEAR(narrow.features(0)[i].ensemble_sd, m.features(0)[i].ensemble_sd, 1e-9 * m.features(0)[i].ensemble_sd + 1e-12)
+        << m.features(0)[i].name;
   Misfit corrected = m;
   corrected.add_discrepancy({std::vector<Real>(m.features(0).size(), 0.0)},
                             {std::vector<Real>(m.features(0).size(), 1.0)}, "none");

@@ -192,12 +192,14 @@ CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vect
 /// computed again at it, so that the intervals and correlation belong to the reported point.
 void adopt_best(CalibrationResult& r, const Evaluation& better, const Model& base);
 
-/// The misfit measured again at the calibrated point: every point of the design whitened again by `misfit` from its
+/// The misfit measured again at the calibrated point (Misfit::with_scatter): every point of the design whitened again by
+/// `misfit` from its
 /// simulated curves (its ensemble's mean; a screened point's one member), the best point chosen again among those run
 /// whole, and the values, model and uncertainty computed at it. The simulator's scatter grows with the friction (the
 /// hidden-effect cell at mu_s 0.37, mu_r 0.05: q's standard deviation 1.5-3 times the base model's 0.15, 0.015 from
 /// 0.5% strain): measured at the base model alone it understated the noise at a calibrated point far from it, and the
-/// intervals missed the parameters that made synthetic data (docs/calibration.md, Coverage).
+/// intervals missed the parameters that made synthetic data; at the calibrated point alone it understated it where
+/// the truth lies back toward the base (docs/calibration.md, Coverage).
 void rewhiten(CalibrationResult& r, const Misfit& misfit, const Model& base);
 
 /// Parameter points a calibration of d free parameters runs at most before any widening: the design, the

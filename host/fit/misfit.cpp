@@ -113,7 +113,7 @@ std::vector<Real> Misfit::values(std::size_t k, const TriaxialTest& t) const {
 }
 
 Misfit::Misfit(const std::vector<TriaxialTest>& measured, const NoiseOptions& noise, const NoiseBudget& budget)
-    : Misfit(measured, noise, budget.scatter, budget.members, budget.sim_end, budget.sim_balls) {
+    : Misfit(measured, noise, budget.scatter, budget.members, budget.sim_end, budget.sim_balls, budget.scatter_floor) {
   if (!budget.cell_bias.sd.empty()) add_cell_bias(budget.cell_bias);
   measured_ = measured;
   noise_ = noise;
@@ -124,12 +124,15 @@ Misfit::Misfit(const std::vector<TriaxialTest>& measured, const NoiseOptions& no
 Misfit Misfit::with_scatter(const Ensemble& scatter) const {
   if (!from_budget_) throw std::logic_error("misfit: with_scatter needs a misfit of a noise budget, without a discrepancy");
   NoiseBudget b = budget_;
+  if (b.scatter_floor.empty()) b.scatter_floor = b.scatter;
   b.scatter = scatter;
   return Misfit(measured_, noise_, b);
 }
 
 Misfit::Misfit(const std::vector<TriaxialTest>& measured, const NoiseOptions& noise, const Ensemble& reference,
-               int members, Real sim_end, Real sim_balls) {
+               int members, Real sim_end, Real sim_balls, const Ensemble& floor) {
+  if (!floor.empty() && floor.size() != reference.size())
+    throw std::logic_error("misfit: the scatter's floor has other tests");
   if (measured.empty()) throw std::invalid_argument("misfit: no measured tests");
   if (noise.mode != "data" && noise.mode != "lab")
     throw std::invalid_argument("noise '" + noise.mode + "' (allowed: data, lab)");
@@ -168,9 +171,9 @@ Misfit::Misfit(const std::vector<TriaxialTest>& measured, const NoiseOptions& no
     features_.push_back(fs);
   }
   if (curves_)
-    build_curve_noise(measured, noise, reference, sim_balls);
+    build_curve_noise(measured, noise, reference, sim_balls, floor);
   else
-    build_summary_noise(measured, noise, reference);
+    build_summary_noise(measured, noise, reference, floor);
 }
 
 int Misfit::data() const {
@@ -180,7 +183,7 @@ int Misfit::data() const {
 }
 
 void Misfit::build_summary_noise(const std::vector<TriaxialTest>& measured, const NoiseOptions& noise,
-                                 const Ensemble& ref) {
+                                 const Ensemble& ref, const Ensemble& floor) {
   const bool given = std::any_of(measured.begin(), measured.end(), [](const TriaxialTest& t) {
     return !t.summary_sd.empty();
   });
@@ -203,14 +206,17 @@ void Misfit::build_summary_noise(const std::vector<TriaxialTest>& measured, cons
         }
       }
       fs[i].data_sd = std::sqrt(cov(i, i));
-      // The ensemble's scatter of this quantity (sample variance over the members).
-      Real s = 0, s2 = 0;
-      int m = 0;
-      for (const TriaxialTest& t : ref[k]) {
-        const Real v = quantities(t)[fs[i].quantity];
-        if (std::isfinite(v)) s += v, s2 += v * v, ++m;
-      }
-      fs[i].ensemble_sd = m > 1 ? std::sqrt(std::max(Real(0), (s2 - s * s / m) / (m - 1))) : 0;
+      // The ensemble's scatter of this quantity (sample variance over the members), at least the floor's.
+      auto sd_of = [&](const std::vector<TriaxialTest>& runs) {
+        Real s = 0, s2 = 0;
+        int m = 0;
+        for (const TriaxialTest& t : runs) {
+          const Real v = quantities(t)[fs[i].quantity];
+          if (std::isfinite(v)) s += v, s2 += v * v, ++m;
+        }
+        return m > 1 ? std::sqrt(std::max(Real(0), (s2 - s * s / m) / (m - 1))) : Real(0);
+      };
+      fs[i].ensemble_sd = std::max(sd_of(ref[k]), floor.empty() ? Real(0) : sd_of(floor[k]));
       cov(i, i) += fs[i].ensemble_sd * fs[i].ensemble_sd / members_;
     }
     cov_.emplace_back(cov.data(), cov.data() + n * n);

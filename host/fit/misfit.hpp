@@ -121,6 +121,9 @@ struct CellBias {
 /// bias. The misfit is built from it and the report prints it; neither runs the simulator.
 struct NoiseBudget {
   Ensemble scatter;      ///< the scatter specimens at the base model on the final cell, [test][specimen]
+  /// Empty, or the same specimens at another model: each feature's simulator variance is then the larger of the two
+  /// (Misfit::with_scatter keeps the base model's as this floor).
+  Ensemble scatter_floor;
   int members = 1;       ///< the ensemble whose mean is compared
   int cell_factor = 1;   ///< the cell's balls as a multiple of the config's
   Real sim_balls = 0;    ///< particles in a simulator specimen (0: not given)
@@ -138,8 +141,9 @@ class Misfit {
   /// simulator's last axial strain.
   /// `sim_balls`: particles in a simulator specimen, against which a test's specimen_balls scales its specimen
   /// term.
+  /// `floor`: empty, or another scatter of the same specimens whose variance each feature keeps at least.
   Misfit(const std::vector<TriaxialTest>& measured, const NoiseOptions& noise, const Ensemble& reference,
-         int members, Real sim_end, Real sim_balls = 0);
+         int members, Real sim_end, Real sim_balls = 0, const Ensemble& floor = {});
   std::size_t tests() const { return features_.size(); }
   int data() const;                               ///< compared data in all tests
   int data(std::size_t test) const { return static_cast<int>(features_[test].size()); }
@@ -180,9 +184,10 @@ class Misfit {
                        const std::string& note);
   /// The scatter specimens' mean void ratio at the start of shear of test k, at the base model.
   Real reached_void_ratio(std::size_t k) const { return void_ratio_[k]; }
-  /// The same misfit with the simulator's scatter measured on `scatter` ([test][specimen]: the scatter specimens run at
-  /// another model, the calibrated one): the specimen and ensemble terms follow it, the data's noise, the ensemble and
-  /// the cell's bias stay. Only for a misfit built from a noise budget, before any discrepancy is added.
+  /// The same misfit with the simulator's scatter measured also on `scatter` ([test][specimen]: the scatter specimens
+  /// run at another model, the calibrated one): each feature's specimen and ensemble terms take the larger of the two
+  /// scatters; the data's noise, the ensemble and the cell's bias stay. Only for a misfit built from a noise budget,
+  /// before any discrepancy is added.
   Misfit with_scatter(const Ensemble& scatter) const;
 
  private:
@@ -198,8 +203,9 @@ class Misfit {
   void add_cell_bias(const CellBias& bias);
   std::vector<Real> values(std::size_t k, const TriaxialTest& t) const;
   void build_curve_noise(const std::vector<TriaxialTest>& measured, const NoiseOptions& noise, const Ensemble& ref,
-                         Real sim_balls);
-  void build_summary_noise(const std::vector<TriaxialTest>& measured, const NoiseOptions& noise, const Ensemble& ref);
+                         Real sim_balls, const Ensemble& floor);
+  void build_summary_noise(const std::vector<TriaxialTest>& measured, const NoiseOptions& noise, const Ensemble& ref,
+                           const Ensemble& floor);
   /// Sets each feature's `field` to sd[test][feature] and adds it to Sigma, correlated along strain.
   void add_correlated(const std::vector<std::vector<Real>>& sd, Real Feature::*field, const std::string& what);
   std::vector<std::vector<Feature>> features_;

@@ -168,14 +168,21 @@ bool data_noise(const TriaxialTest& t, const std::vector<Feature>& fs, bool have
 }  // namespace
 
 void Misfit::build_curve_noise(const std::vector<TriaxialTest>& measured, const NoiseOptions& noise,
-                               const Ensemble& ref, Real sim_balls) {
+                               const Ensemble& ref, Real sim_balls, const Ensemble& floor) {
   std::vector<std::vector<std::vector<Real>>> z(measured.size());  // [test][member][feature], scaled deviations
   PooledVariance ens, rep = replicate_scatter(features_, measured);
-  {
+  auto pooled = [&](const Ensemble& runs, std::vector<std::vector<std::vector<Real>>>& deviations) {
     std::vector<std::vector<std::vector<Real>>> v(measured.size());
     for (std::size_t k = 0; k < measured.size(); ++k)
-      for (const TriaxialTest& t : ref[k]) v[k].push_back(values(k, t));
-    ens = ensemble_scatter(features_, measured, v, z);
+      for (const TriaxialTest& t : runs[k]) v[k].push_back(values(k, t));
+    return ensemble_scatter(features_, measured, v, deviations);
+  };
+  ens = pooled(ref, z);
+  if (!floor.empty()) {  // each feature's variance at least the floor's (its correlation length stays ref's)
+    std::vector<std::vector<std::vector<Real>>> unused(measured.size());
+    const PooledVariance low = pooled(floor, unused);
+    for (auto& [key, var] : ens.var)
+      if (const auto f = low.var.find(key); f != low.var.end()) var = std::max(var, f->second);
   }
   length_ = ref.front().size() > 2 ? fitted_length(features_, z, noise.lab.length) : noise.lab.length;
   const bool lab = noise.mode == "lab";

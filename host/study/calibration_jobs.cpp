@@ -111,8 +111,8 @@ CalibrationResult two_fidelity_fit(Session& ss, const Config& base, const std::s
   return rounds.last();
 }
 
-/// The misfit with the simulator's scatter measured at the calibrated point r.model (the scatter specimens run there),
-/// and r whitened again by it; the change of the simulator's scatter is said.
+/// The misfit with the simulator's scatter measured at the calibrated point r.model too (the scatter specimens run
+/// there; each datum takes the larger), and r whitened again by it; the change of the simulator's scatter is said.
 Misfit rescattered(Session& ss, const std::string& material, const std::vector<TriaxialTest>& tests,
                    const Misfit& misfit, CalibrationResult& r, const Model& base) {
   const long start = ss.lab.runs();
@@ -128,8 +128,9 @@ Misfit rescattered(Session& ss, const std::string& material, const std::vector<T
   std::sort(ratio.begin(), ratio.end());
   const Real before = r.best.chi2;
   rewhiten(r, there, base);
-  std::printf("calibrate: %s: the simulator's scatter at the calibrated point is %s of the base model's (median over "
-              "the data; %s to %s); the design whitened by it: best chi2 %.1f (was %.1f)\n", material.c_str(),
+  std::printf("calibrate: %s: the simulator's scatter measured at the calibrated point too, each datum's the larger of "
+              "the two: %s of the base model's (median over the data; %s to %s); the design whitened by it: best chi2 "
+              "%.1f (was %.1f)\n", material.c_str(),
               ratio.empty() ? "-" : fmt("%.2f", ratio[ratio.size() / 2]).c_str(),
               ratio.empty() ? "-" : fmt("%.2f", ratio.front()).c_str(),
               ratio.empty() ? "-" : fmt("%.2f", ratio.back()).c_str(), r.best.chi2, before);
