@@ -65,6 +65,15 @@ if [ "$part" != diagnoses ]; then
   grep -q "identifiable cases named right: \*\*14 of 14\*\*" "$work/sweep_table.py.log" ||
     { cat "$work/sweep_table.py.log"; echo "scripts_smoke: sweep_table miscounted the shipped lab-like sweep" >&2; exit 1; }
 
+  # The results page from its artifacts, then from a copy of them with one figure changed: the check must fail.
+  check tools/results_page.py "$py" "$root/tools/results_page.py" --check
+  mkdir -p "$work/results/data/sweeps" "$work/results/docs"
+  cp -r "$root/data/runs" "$work/results/data/" && cp -r "$root/data/sweeps/identification" "$root/data/sweeps/coverage" \
+    "$work/results/data/sweeps/" && cp "$root/docs/results.md" "$work/results/docs/"
+  sed -i "s/,31.348,/,41.348,/" "$work/results/data/runs/S1_table6_periodic/prediction.csv"  # the error at 100 kPa
+  ! "$py" "$root/tools/results_page.py" --root "$work/results" --check > "$work/results_changed.log" 2>&1 &&
+    grep -q "is not what its artifacts give" "$work/results_changed.log" ||
+    { cat "$work/results_changed.log"; echo "scripts_smoke: the results page passed with a changed artifact" >&2; exit 1; }
   check perf/scaling.sh env BUILD="$build" WORK="$work/scaling" K=4 STEPS=20 bash "$root/perf/scaling.sh"
   # The tiny calibration above, again from its packing store: the plan, a first and a second job, one row each.
   check perf/time_to_answer.sh env BUILD="$build" WORK="$work/answer" CASES=tiny JOBS=1 STORE="$work/cal" \
