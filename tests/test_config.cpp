@@ -217,6 +217,26 @@ TEST(Config, TriaxialInputsOutOfReachRefused) {
   EXPECT_NE(error_of("[periodic]\nsigma3 = 100.0\n").find("unknown key"), std::string::npos);
 }
 
+// Issue 87: `check` said OK to balls of 2 um in the cell's 14.5 mm box (a gas that never packs) and to emod_Pa = 0.1
+// under 100 kPa (the run planned "a run of 1 steps" and stopped at a negative box). Both are refused naming the key,
+// the value and what is allowed; the hidden-effect base (a solid fraction near 0.05, emod 1000 sigma3) loads.
+TEST(Config, ACellThatCannotPackOrCarryItsPressureIsRefused) {
+  std::ifstream in(std::string(TRIAXDEM_SOURCE_DIR) + "/tests/data/hidden_effects.toml");
+  const std::string cell((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NO_THROW(dem::load_config(write_config("cell.toml", cell)));
+  auto edited = [&](const std::string& from, const std::string& to) {
+    std::string t = cell;
+    t.replace(t.find(from), from.size(), to);
+    return t;
+  };
+  std::string e = error_of(edited("diameter_mm = 2.0", "diameter_mm = 0.002"));
+  EXPECT_NE(e.find("[box] size_mm: 120 balls of 0.002 mm fill 1.6e-10 of the box; a cell packs from at least 0.001"),
+            std::string::npos) << e;
+  e = error_of(edited("emod_Pa = 1.0e8", "emod_Pa = 0.1"));
+  EXPECT_NE(e.find("[material] emod_Pa: 0.1 Pa under sigma3 = 100 kPa overlaps the contacts by about 1e+06 of a "
+                   "diameter (allowed: emod_Pa at least 10 x sigma3, 1e+06 Pa)"), std::string::npos) << e;
+}
+
 TEST(Config, PaperCountGivesTheLabVoidRatio) {
   // The paper's 53,704 beads of 2 mm in 61.8 mm x 120 mm: e = 0.600 (Sec. 2.3), not Table 4's 0.61.
   const dem::Config c = dem::load_config(std::string(TRIAXDEM_SOURCE_DIR) + "/configs/paper/S1_100kPa.toml");

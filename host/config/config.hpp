@@ -234,6 +234,12 @@ struct Config {
 /// The smallest time step a run takes, as a fraction of the critical step: quasi-static DEM runs at 0.1-0.3 of it,
 /// and a step a thousand times smaller only multiplies the cost (dt_s = 1e-300 ran, and would never end).
 constexpr Real kMinDtFraction = 1e-3;
+/// A periodic cell's balls must fill at least this share of its box: it packs from a gas, and a box much emptier
+/// never closes (a 120-ball cell starts near 0.05).
+constexpr Real kMinSolidFraction = 1e-3;
+/// The linear law's emod_Pa must be at least this many times the cell pressure: a contact loaded by sigma3 d^2
+/// overlaps by about sigma3 / emod of a diameter, a tenth at this bound (glass beads: 1e8 Pa at 100 kPa, 1e-3).
+constexpr Real kMinStiffnessOverPressure = 10;
 
 /// The time step of a run: [solver] dt_s when set, else dt_safety x `critical` (s). Throws ConfigError naming
 /// `path`, the key and the allowed range when dt_s is above the critical step or below kMinDtFraction of it.

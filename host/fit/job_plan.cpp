@@ -331,9 +331,13 @@ struct Planner {
 
   /// What the counts rest on: the speed measured, a run's and a packing's steps, and the choices made on the way.
   void notes() {
+    const auto probed = [](const CellCost& c) {
+      return c.probed_balls < c.balls ? " (probed on a lattice of " + std::to_string(c.probed_balls) + ")" : std::string();
+    };
     plan.notes.push_back(fmt("speed measured here: %.0f ns a particle-step", lab.ns_per_particle_step) +
-                         " in the cell of " + n + " balls, " + fmt("%.0f", check.ns_per_particle_step) +
-                         " in the check's of " + std::to_string(check.balls) + "; " +
+                         " in the cell of " + n + " balls" + probed(lab) + ", " +
+                         fmt("%.0f", check.ns_per_particle_step) + " in the check's of " +
+                         std::to_string(check.balls) + probed(check) + "; " +
                          (lab.batch > 1
                               ? "runs in batches of up to " + std::to_string(lab.batch) +
                                     fmt(", each cell adding %.3g of a run's time to its batch", lab.batch_growth)

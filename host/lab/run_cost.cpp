@@ -33,14 +33,16 @@ Real mean_cube_diameter(const ParticleConfig& pc) {
   return (std::pow(dmax, 4) - std::pow(dmin, 4)) / (4 * (dmax - dmin));
 }
 
-/// A cubic lattice of the cell's balls, each pressed into its six neighbours by 0.1% of its diameter: a probe with
-/// the contacts of a loaded packing (the gas phase of a random insertion would time a cheaper step).
+/// A cubic lattice of the cell's balls (at most kMaxProbeBalls), each pressed into its six neighbours by 0.1% of its
+/// diameter: a probe with the contacts of a loaded packing (the gas phase of a random insertion would time a cheaper
+/// step).
 std::vector<BallSpec> probe_lattice(const Config& cell, std::array<Real, 3>& box) {
   const ParticleConfig& pc = cell.particles;
-  const long n = static_cast<long>(std::ceil(std::cbrt(static_cast<Real>(pc.count))));
+  const long count = std::min(pc.count, kMaxProbeBalls);
+  const long n = static_cast<long>(std::ceil(std::cbrt(static_cast<Real>(count))));
   const Real pitch = 0.999 * pc.diameter;
   std::vector<BallSpec> balls;
-  for (long k = 0; k < n * n * n && static_cast<long>(balls.size()) < pc.count; ++k) {
+  for (long k = 0; k < n * n * n && static_cast<long>(balls.size()) < count; ++k) {
     BallSpec b;
     b.x = Vec3((k % n + 0.5) * pitch, ((k / n) % n + 0.5) * pitch, (k / (n * n) + 0.5) * pitch);
     b.radius = pc.diameter / 2;
@@ -110,6 +112,7 @@ CellCost measure_cell_cost(const Config& cell, double probe_seconds) {
   c.balls = cell.particles.count;
   std::array<Real, 3> box{};
   const std::vector<BallSpec> balls = probe_lattice(cell, box);
+  c.probed_balls = static_cast<long>(balls.size());
   auto sim = make_periodic_simulation(balls, box, cell.ball.base(), cell.solver, CellBoundary::periodic);
   c.dt = sim->params().integ.dt;
   c.d = cell.particles.diameter;  // the mean of diameters uniform between the smallest and the largest

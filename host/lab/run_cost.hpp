@@ -34,8 +34,13 @@ constexpr Real kConsolidationShare = 0.25;
 constexpr Real kPairsOverLattice = 1.5;
 
 /// The cost of one cell's work on this machine: its balls, its time step, the engine's speed on it.
+/// The largest lattice the speed probe steps: a particle-step costs about the same from 10^3 to 10^6 balls (within
+/// 18%, perf/scaling.sh), while building a lattice of a million balls took the plan 65-80 s in silence.
+constexpr long kMaxProbeBalls = 32768;
+
 struct CellCost {
   long balls = 0;
+  long probed_balls = 0;            ///< the lattice the speed was measured on (at most kMaxProbeBalls)
   Real dt = 0;                      ///< s, the runs' time step
   Real d = 0, rho_eff = 0;          ///< m, kg/m^3: the inertial number's scales
   double ns_per_particle_step = 0;  ///< this process's threads, as a run of the cell takes them
