@@ -49,6 +49,15 @@ std::vector<TriaxialTest> members_of(const TriaxialTest& t, int n, Real spread) 
   return out;
 }
 
+/// A noise budget of 8 specimens around `t` (members_of, q scaled by +-spread), an ensemble of `members`, to 10% strain.
+NoiseBudget budget_of(const TriaxialTest& t, Real spread, int members) {
+  NoiseBudget b;
+  b.scatter = Ensemble{members_of(t, 8, spread)};
+  b.members = members;
+  b.sim_end = 0.1;
+  return b;
+}
+
 Real chi2(const std::vector<Real>& r) {
   Real s = 0;
   for (Real x : r) s += x * x;
@@ -114,10 +123,7 @@ TEST(Misfit, EnsembleScatterIsPooledAndInflated) {
 // data's own noise, the ensemble size and the cell's bias stay.
 TEST(Misfit, WithAnotherScatterTheSimulatorsTermsFollowIt) {
   const TriaxialTest t = smooth_test(100e3);
-  NoiseBudget budget;
-  budget.scatter = Ensemble{members_of(t, 8, 0.01)};
-  budget.members = 2;
-  budget.sim_end = 0.1;
+  NoiseBudget budget = budget_of(t, 0.01, 2);
   budget.cell_bias.sd = {std::vector<Real>(Misfit({t}, NoiseOptions(), budget).features(0).size(), 500.0)};
   const Misfit m({t}, NoiseOptions(), budget);
   const Misfit wide = m.with_scatter(Ensemble{members_of(t, 8, 0.03)});
@@ -316,10 +322,7 @@ TEST(CellBias, CountsOnlyTheDifferenceBeyondItsOwnScatter) {
 TEST(CellBias, ABiasBeyondTheNoiseIsAFindingWithItsQuantityAndCause) {
   TriaxialTest data = smooth_test(100e3);
   data.specimen_balls = 1000;
-  NoiseBudget budget;
-  budget.scatter = Ensemble{members_of(data, 8, 0.01)};
-  budget.members = 8;
-  budget.sim_end = 0.1;
+  NoiseBudget budget = budget_of(data, 0.01, 8);
   const Misfit m({data}, NoiseOptions(), budget);
   auto scaled = [&](Real f) {
     TriaxialTest t = data;
@@ -348,10 +351,7 @@ TEST(CellBias, ABiasBeyondTheNoiseIsAFindingWithItsQuantityAndCause) {
 // bias does not cover, is still seen in full.
 TEST(CellBias, ACountedBiasTakesUpTheShiftItMeasuredAndNothingElse) {
   const TriaxialTest data = smooth_test(100e3);
-  NoiseBudget budget;
-  budget.scatter = Ensemble{members_of(data, 8, 0.01)};
-  budget.members = 8;
-  budget.sim_end = 0.1;
+  NoiseBudget budget = budget_of(data, 0.01, 8);
   const Misfit before_bias({data}, NoiseOptions(), budget);
   TriaxialTest shifted = data;
   for (Real& q : shifted.q) q *= 1.1;

@@ -28,38 +28,38 @@ def fmt(v, digits=3):
     return f"{float(v):.{digits}g}"
 
 
-def table6_periodic(root):
-    """The periodic cell's S-1 calibration predicting the membrane test (Table 6's S-1)."""
-    folder = os.path.join(root, "data/runs/S1_table6_periodic")
+def prediction_section(folder, periodic_column):
+    """A calibration's prediction beside its data (prediction.csv) and its calibrated values (calibrated.csv)."""
     rows = read_rows(os.path.join(folder, "prediction.csv"))
     cal = read_rows(os.path.join(folder, "calibrated.csv"))
     out = io.StringIO()
-    out.write("| sigma3 kPa | lab q_peak kPa | predicted kPa | error |\n|---|---|---|---|\n")
+    extra = " periodic cell kPa |" if periodic_column else ""
+    out.write(f"| sigma3 kPa | measured q_peak kPa | predicted kPa | error |{extra}\n|---|---|---|---|"
+              f"{'---|' if periodic_column else ''}\n")
     for r in rows:
         out.write(f"| {r['sigma3_kPa']} | {fmt(r['measured_q_peak_kPa'], 4)} | {fmt(r['predicted_q_peak_kPa'], 4)} | "
-                  f"{float(r['error_pct']):+.1f}% |\n")
+                  f"{float(r['error_pct']):+.1f}% |" + (f" {fmt(r['periodic_q_peak_kPa'], 4)} |" if periodic_column else "")
+                  + "\n")
     mean = statistics.fmean(abs(float(r["error_pct"])) for r in rows)
     values = "; ".join(f"{c['parameter']} {fmt(c['value'])} [{fmt(c['low95'])}, {fmt(c['high95'])}]" for c in cal)
-    out.write(f"\nMean |error| **{mean:.1f}%**, at {values}.\n")
-    return out.getvalue(), [folder], ("triaxdem calibrate data/tang2025_table6_peak.csv --config "
-                                      "data/runs/S1_table6_periodic/base.toml --material S-1 -j 2")
+    out.write(f"\nMean |error| **{mean:.1f}%**, at {values} (chi2 {fmt(cal[0]['chi2'])} on {cal[0]['data']} data, "
+              f"{cal[0]['runs']} runs).\n")
+    return out.getvalue()
+
+
+def table6_periodic(root):
+    """The periodic cell's S-1 calibration predicting the membrane test (Table 6's S-1)."""
+    folder = os.path.join(root, "data/runs/S1_table6_periodic")
+    return prediction_section(folder, False), [folder], ("triaxdem calibrate data/tang2025_table6_peak.csv --config "
+                                                         "data/runs/S1_table6_periodic/base.toml --material S-1 -j 2")
 
 
 def walled_on_periodic(root):
     """Another code's walled data (YADE, 4,000 balls) calibrated on the periodic cell, predicted by the walled cell."""
     folder = os.path.join(root, "data/runs/walled_periodic_predict_walls")
-    rows = read_rows(os.path.join(folder, "prediction.csv"))
-    cal = read_rows(os.path.join(folder, "calibrated.csv"))
-    out = io.StringIO()
-    out.write("| sigma3 kPa | data q_peak kPa | walled cell kPa | error | periodic cell kPa |\n|---|---|---|---|---|\n")
-    for r in rows:
-        out.write(f"| {r['sigma3_kPa']} | {fmt(r['measured_q_peak_kPa'], 4)} | {fmt(r['predicted_q_peak_kPa'], 4)} | "
-                  f"{float(r['error_pct']):+.1f}% | {fmt(r['periodic_q_peak_kPa'], 4)} |\n")
-    values = "; ".join(f"{c['parameter']} {fmt(c['value'])} [{fmt(c['low95'])}, {fmt(c['high95'])}]" for c in cal)
-    out.write(f"\nAt {values} (chi2 {fmt(cal[0]['chi2'])} on {cal[0]['data']} data, {cal[0]['runs']} runs).\n")
-    return out.getvalue(), [folder], ("triaxdem calibrate tests/data/crosscode/walled_seed1.csv --config "
-                                      "data/runs/walled_periodic_predict_walls/base.toml --reference-test periodic "
-                                      "--predict walls -j 2")
+    return prediction_section(folder, True), [folder], ("triaxdem calibrate tests/data/crosscode/walled_seed1.csv "
+                                                        "--config data/runs/walled_periodic_predict_walls/base.toml "
+                                                        "--reference-test periodic --predict walls -j 2")
 
 
 def identification(root):
