@@ -367,7 +367,9 @@ TEST(CliEdges, SynthNeverWritesOverItsConfigNorOutOfRange) {
     o = triaxdem("synth --config " + config.string() + " -o " + (dir / "new.csv").string() +
                      " --extension wear --strength " + strength, dir);
     EXPECT_EQ(o.code, 1) << strength;
-    EXPECT_NE(o.output.find("out of the range of wear (allowed: [0, 0.9])"), std::string::npos) << o.output;
+    // The key's own range (issue 87: the search's [0, 0.9] was said where docs/config.md gives [0, 0.99]).
+    EXPECT_NE(o.output.find("out of the range of wear (allowed: [0, 0.99], as [material] wear takes it)"),
+              std::string::npos) << o.output;
     EXPECT_FALSE(fs::exists(dir / "new.csv"));
   }
   // Taken silently before (issue 65): a NaN strength (replaced by a drawn one), a strength with no extension (dropped),

@@ -7,6 +7,7 @@
 #include <limits>
 #include <random>
 
+#include "host/fit/calibration_report.hpp"
 #include "host/fit/cell_bias.hpp"
 #include "host/fit/diagnose.hpp"
 #include "host/fit/generic_discrepancy.hpp"
@@ -116,6 +117,19 @@ TEST(Misfit, EnsembleScatterIsPooledAndInflated) {
     EXPECT_EQ(f.specimen_sd, f.ensemble_sd) << "no replicates: the measured specimen counts as one of the simulator's";
   }
   EXPECT_EQ(m.members(), 4);
+}
+
+// Issue 87: the errors table wrote "-nan" or "inf" % where the measured value is 0 (a test without dilatancy): its
+// error cell is empty, the values beside it stay.
+TEST(Misfit, AnErrorAgainstAMeasuredZeroIsLeftEmpty) {
+  TriaxialTest meas = smooth_test(100e3), sim = meas;
+  meas.max_dilatancy = 0;
+  sim.max_dilatancy = 0.1;
+  const std::string csv = errors_csv({meas}, {sim});
+  EXPECT_EQ(csv.find("nan"), std::string::npos) << csv;
+  EXPECT_EQ(csv.find("inf"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",max_dilatancy,-,0,0.1,\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",q_peak,kPa,"), std::string::npos) << csv;
 }
 
 // The misfit measured again at another model's scatter (with_scatter): the simulator's terms follow a wider scatter

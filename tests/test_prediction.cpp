@@ -195,4 +195,8 @@ TEST(Prediction, TheWalledPredictionIsTheWalledCellsRunsAtTheCalibratedPoint) {
   EXPECT_NE(md.find("| 33% |"), std::string::npos) << md;
   EXPECT_NE(md.find("The boundary's share of the predicted q_peak is 20 to 33%"), std::string::npos) << md;
   EXPECT_NE(walled_cell_text(walls).find("between six walls (100 balls"), std::string::npos);
+  // Issue 87: one share said as a range of one ("83 to 83%").
+  p[1].periodic_q_peak = 0.8 * p[1].q_peak_mean;
+  const std::string same = prediction_markdown(p, QMeasure::kFixedArea);
+  EXPECT_NE(same.find("The boundary's share of the predicted q_peak is 20%:"), std::string::npos) << same;
 }

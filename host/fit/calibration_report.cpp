@@ -25,7 +25,9 @@ std::vector<std::array<std::string, 7>> error_rows(const std::vector<TriaxialTes
       if (!std::isfinite(m[i])) continue;
       rows.push_back({meas[k].material, fmt("%g", 1e-3 * meas[k].sigma3), quantity_name(i),
                       in_table_unit(i, m[i]).second, fmt("%.5g", in_table_unit(i, m[i]).first),
-                      fmt("%.5g", in_table_unit(i, q[i]).first), fmt("%.2f", 100 * (q[i] - m[i]) / std::fabs(m[i]))});
+                      fmt("%.5g", in_table_unit(i, q[i]).first),
+                      // No relative error of a measured 0 (a test without dilatancy): empty, not -nan or inf.
+                      m[i] != 0 && std::isfinite(q[i]) ? fmt("%.2f", 100 * (q[i] - m[i]) / std::fabs(m[i])) : ""});
     }
   }
   return rows;

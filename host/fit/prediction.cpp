@@ -203,8 +203,10 @@ std::string prediction_markdown(const std::vector<Prediction>& p, QMeasure measu
   for (const Prediction& x : p)
     if (std::isfinite(x.periodic_q_peak)) low = std::min(low, boundary_share(x)), high = std::max(high, boundary_share(x));
   if (low <= high)
-    md += " The boundary's share of the predicted q_peak is " + fmt("%.0f", 100 * low) + " to " +
-          fmt("%.0f%%", 100 * high) + ": what the test's boundary adds to what the grains carry, which a calibration "
+    md += " The boundary's share of the predicted q_peak is " +
+          (fmt("%.0f", 100 * low) == fmt("%.0f", 100 * high) ? fmt("%.0f%%", 100 * high)
+                                                              : fmt("%.0f", 100 * low) + " to " + fmt("%.0f%%", 100 * high)) +
+          ": what the test's boundary adds to what the grains carry, which a calibration "
           "on the periodic cell against such data puts into the contact parameters.";
   return md + "\n";
 }

@@ -333,8 +333,9 @@ FolderLock claim_output_folder(const std::string& folder, bool resume, bool over
   if (!overwrite) {
     std::sort(outputs.begin(), outputs.end());
     throw std::runtime_error("output folder '" + folder + "' holds another run's outputs (" +
-                             outputs.front().filename().string() + " and " + std::to_string(outputs.size() - 1) +
-                             " more): continue that run with --resume, replace it with --overwrite, or choose "
+                             outputs.front().filename().string() +
+                             (outputs.size() > 1 ? " and " + std::to_string(outputs.size() - 1) + " more" : "") +
+                             "): continue that run with --resume, replace it with --overwrite, or choose "
                              "another folder with -o");
   }
   for (const fs::path& p : outputs) fs::remove(p);

@@ -45,10 +45,13 @@ int synth_job(const Config& base, const SynthOptions& o) {
   if (o.extension != "none") {
     const Extension& e = extension(o.extension);
     const FreeParam range = free_param(e.param, truth);  // an extension of another law than the base's is refused
-    if (!std::isnan(o.strength) && !(o.strength >= range.shown * range.lo && o.strength <= range.shown * range.hi))
+    // A given strength may be any the config key takes (docs/config.md), not only what a diagnosis searches.
+    const ModelKey& key = model_key(e.param);
+    if (!std::isnan(o.strength) &&
+        !((key.open_lo ? o.strength > key.lo : o.strength >= key.lo) && o.strength <= key.hi))
       throw std::invalid_argument("synth --strength " + fmt("%g", o.strength) + ": out of the range of " + e.param +
-                                  " (allowed: [" + fmt("%g", range.shown * range.lo) + ", " +
-                                  fmt("%g", range.shown * range.hi) + "])");
+                                  " (allowed: " + (key.open_lo ? "(" : "[") + fmt("%g", key.lo) + ", " +
+                                  fmt("%g", key.hi) + "], as [material] " + e.param + " takes it)");
     const Real v = !std::isnan(o.strength) ? o.strength / range.shown  // given in the key's unit
                                            : draw_strength(e, o.seed);
     set_param(truth, e.param, v);
