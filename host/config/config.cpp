@@ -1,6 +1,5 @@
 #include "host/config/config.hpp"
 #include "host/config/config_checks.hpp"
-#include "host/util/text_format.hpp"
 #include "host/config/model_keys.hpp"
 #include "host/util/fnv1a.hpp"
 #include "host/config/noise_model.hpp"
@@ -46,31 +45,6 @@ void read_contact(TableReader& r, ContactParams& c, const ContactParams* from = 
   r.finish();
 }
 
-
-/// What a run of the periodic cell could not survive, refused where `check` would otherwise say OK (issue 87): balls
-/// so few for the box that it is nearly empty (2 um balls in a 14.5 mm box: a gas that never packs), and a linear
-/// law so soft that the cell pressure overlaps its contacts by more than a tenth of a diameter (the overlap of a
-/// contact loaded by sigma3 d^2 is about sigma3 / emod of a diameter; emod_Pa = 0.1 under 100 kPa planned "a run of
-/// 1 steps" and stopped at a negative box).
-void check_cell_physics(const Config& c) {
-  if (!c.has_periodic) return;
-  const Real volume = c.box.size[0] * c.box.size[1] * c.box.size[2];
-  const Real d = c.particles.diameter;
-  const Real solid = static_cast<Real>(c.particles.count) * M_PI / 6 * d * d * d / volume;
-  if (solid < kMinSolidFraction)
-    throw ConfigError(c.path + ": [box] size_mm: " + std::to_string(c.particles.count) + " balls of " +
-                      fmt("%g mm", 1e3 * d) + " fill " + fmt("%.2g", solid) + " of the box; a cell packs from at " +
-                      fmt("least %g", kMinSolidFraction) + " (allowed: a box of at most " +
-                      fmt("%.4g mm a side", 1e3 * std::cbrt(static_cast<Real>(c.particles.count) * M_PI / 6 * d * d * d /
-                                                               kMinSolidFraction)) +
-                      " for these balls, or more or larger balls: [particles] count, diameter_mm)");
-  if (static_cast<int>(c.ball.law) == kRRLinear && c.ball.emod < kMinStiffnessOverPressure * c.periodic.triax.sigma3)
-    throw ConfigError(c.path + ": [material] emod_Pa: " + fmt("%g Pa", c.ball.emod) + " under sigma3 = " +
-                      fmt("%g kPa", 1e-3 * c.periodic.triax.sigma3) + " overlaps the contacts by about " +
-                      fmt("%.3g", c.periodic.triax.sigma3 / c.ball.emod) + " of a diameter (allowed: emod_Pa at least " +
-                      fmt("%g", kMinStiffnessOverPressure) + " x sigma3, " +
-                      fmt("%g Pa", kMinStiffnessOverPressure * c.periodic.triax.sigma3) + ")");
-}
 
 /// Refuses a ball count whose run cannot fit in memory, before anything is allocated.
 void check_memory(TableReader& t, const std::string& key, long balls) {

@@ -251,6 +251,9 @@ Real time_step(const SolverConfig& solver, Real critical, const std::string& pat
 constexpr double kBytesPerBall = 2 * 667;
 /// Upper bound of a membrane node's memory, its triangles and facet contacts included (the config check).
 constexpr double kBytesPerMembraneNode = 1000;
+/// Refuses (ConfigError naming the key, the value and what is allowed) a periodic cell its balls cannot pack or its
+/// linear law cannot carry at sigma3 (kMinSolidFraction, kMinStiffnessOverPressure).
+void check_cell_physics(const Config& c);
 double run_memory_bytes(long balls);
 
 /// Reads and validates a config file. Throws ConfigError.
