@@ -137,6 +137,31 @@ Misfit rescattered(Session& ss, const std::string& material, const std::vector<T
   return there;
 }
 
+/// Where the reference gives every free parameter: its rise over the joint 95% region of r, and its chi2 run on the
+/// ensemble against `misfit` where the job runs it (runs_reference); NaN where not, and the line said.
+std::pair<Real, Real> place_reference(Session& ss, const std::string& material, const std::vector<TriaxialTest>& tests,
+                                      const Misfit& misfit, const CalibrationResult& r) {
+  const std::vector<Real> reference = ss.reference_point(material);
+  Real rise = std::nan(""), chi2 = std::nan("");
+  if (!std::all_of(reference.begin(), reference.end(), [](Real v) { return std::isfinite(v); })) return {rise, chi2};
+  Model at = r.model;
+  std::vector<Real> si;
+  for (std::size_t k = 0; k < ss.free.size(); ++k) {
+    si.push_back(reference[k] / ss.free[k].shown);
+    set_param(at, ss.free[k].name, si.back());
+  }
+  rise = r.region_rise(si);
+  if (ss.runs_reference(material)) {
+    const long start = ss.lab.runs();
+    Progress progress("calibrate " + material + ": the reference point", static_cast<long>(tests.size()) *
+                      ss.lab.members());
+    chi2 = sum_sq(misfit.residuals(ss.lab.run_ensemble(at, tests)));
+    progress.finish(std::to_string(ss.lab.runs() - start) + " runs");
+  }
+  std::printf("%s", reference_text(r, reference, chi2, material, "calibrate").c_str());
+  return {rise, chi2};
+}
+
 }  // namespace
 
 int calibrate_job(const Config& base, const CalibrationOptions& o) {
@@ -176,26 +201,8 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
     // A reference that gives every free parameter is placed against the joint region, and run (runs_reference): is
     // it consistent with these data?
     const long fit_runs = ss.lab.runs() - runs0;  // the reference point's runs are not the calibration's
-    const std::vector<Real> reference = ss.reference_point(material);
-    const bool whole_reference = std::all_of(reference.begin(), reference.end(), [](Real v) { return std::isfinite(v); });
-    Real reference_rise = std::nan(""), reference_chi2 = std::nan("");
-    if (whole_reference) {
-      Model at = r.model;
-      std::vector<Real> si;
-      for (std::size_t k = 0; k < ss.free.size(); ++k) {
-        si.push_back(reference[k] / ss.free[k].shown);
-        set_param(at, ss.free[k].name, si.back());
-      }
-      reference_rise = r.region_rise(si);
-      if (ss.runs_reference(material)) {
-        const long start = ss.lab.runs();
-        Progress progress("calibrate " + material + ": the reference point", static_cast<long>(tests.size()) *
-                          ss.lab.members());
-        reference_chi2 = sum_sq(there.residuals(ss.lab.run_ensemble(at, tests)));
-        progress.finish(std::to_string(ss.lab.runs() - start) + " runs");
-      }
-      std::printf("%s", reference_text(r, reference, reference_chi2, material, "calibrate").c_str());
-    }
+    const auto [reference_rise, reference_chi2] = place_reference(ss, material, tests, there, r);
+    const bool whole_reference = !std::isnan(reference_rise);  // inf: outside the searched ranges
     for (std::size_t k = 0; k < ss.free.size(); ++k) {
       const FreeParam& f = ss.free[k];
       const Real ref = ss.reference(material, f.name);
