@@ -124,9 +124,25 @@ struct CalibrationResult {
   /// rises by 3.84 x scale), the correlation of the free parameters (Gauss-Newton, (J^T J)^-1), and the joint
   /// 95% region (a rise of the chi2 quantile with d degrees of freedom). scale = chi2 / (n - d) where that
   /// exceeds 1: a misfit beyond the noise widens the region by its root, as the noise was understated.
+  ///
+  /// Measured on the specimens (where `spreads` holds the scatter specimens' departures, Misfit::specimen_spreads):
+  /// the answer's covariance is the sandwich G (I - M + M_s) G^T, G = (J^T J)^-1 J^T the Gauss-Newton map from
+  /// whitened residuals to unit coordinates, M the misfit's modelled specimen and ensemble terms, M_s the specimens'
+  /// sample covariance of the same terms (times nu / (nu - 2), nu = S - 1, as the misfit counts an estimated
+  /// variance): the data specimen's term within each test (a specimen a test), the ensemble mean's across tests too
+  /// (its members are the same packings at every pressure). Each profile's rise is then 3.84 x scale x rise_factor[j], rise_factor[j] the sandwich's variance of
+  /// parameter j over (J^T J)^-1's; the joint region's chi2_95(d) x scale x region_factor, region_factor the 95%
+  /// quantile of sum lambda_i z_i^2 (lambda the eigenvalues of J^T J times the sandwich; Satterthwaite's scaled
+  /// chi2) over chi2's with d degrees of freedom. With several spreads (the base model's specimens and the
+  /// calibrated point's) each factor is the larger. On the program's synthetic data one 120-ball specimen's
+  /// departure crosses q and eps_v and turns along strain as the modelled terms do not: the truth's run lay 20-40
+  /// above the best chi2 where the modelled region's rise was 6 (docs/calibration.md, Coverage).
   std::vector<std::pair<Real, Real>> interval;     ///< SI, per free parameter
   std::vector<std::vector<Real>> correlation;      ///< d x d
   Real scale = 1;
+  std::vector<SpecimenSpread> spreads;             ///< empty: the misfit's model alone
+  std::vector<Real> rise_factor;                   ///< per free parameter; 1 without spreads
+  Real region_factor = 1;
   /// The surrogate chi2 at unit coordinates u.
   Real surrogate_chi2(const std::vector<Real>& u) const;
   /// How far parameter values (SI, in free order) lie from the best, as the surrogate chi2's rise over the
@@ -200,6 +216,11 @@ void adopt_best(CalibrationResult& r, const Evaluation& better, const Model& bas
 /// 0.5% strain): measured at the base model alone it understated the noise at a calibrated point far from it, and the
 /// intervals missed the parameters that made synthetic data; at the calibrated point alone it understated it where
 /// the truth lies back toward the base (docs/calibration.md, Coverage).
+/// The intervals and region of r measured on `spreads` (CalibrationResult; empty: the misfit's model alone), at its
+/// best point.
+void measure_on_specimens(CalibrationResult& r, std::vector<SpecimenSpread> spreads);
+/// The spreads of `misfit` (Misfit::specimen_spreads) are kept in r, so that its intervals and region are measured
+/// on the specimens.
 void rewhiten(CalibrationResult& r, const Misfit& misfit, const Model& base);
 
 /// Parameter points a calibration of d free parameters runs at most before any widening: the design, the

@@ -65,6 +65,13 @@ std::string uncertainty_text(const CalibrationResult& r, const std::string& mate
         << fmt("%+.2f", r.correlation[a][b]) << "\n";
   for (const std::string& p : r.inseparable())
     o << at << "these data cannot separate " << p << ": they trade against each other (in strength, for friction)\n";
+  if (!r.spreads.empty()) {
+    o << at << "the intervals measured on the scatter specimens (their departures in place of the modelled specimen "
+      << "and ensemble noise): the rise of";
+    for (std::size_t k = 0; k < r.free.size() && k < r.rise_factor.size(); ++k)
+      o << " " << r.free[k].name << fmt(" x%.2f,", r.rise_factor[k]);
+    o << " of the joint region" << fmt(" x%.2f", r.region_factor) << " the misfit's own\n";
+  }
   if (r.scale > 1)
     o << at << "the misfit exceeds the noise (chi2 / dof " << fmt("%.2f", r.scale)
       << "): the intervals are widened by its square root\n";
@@ -90,7 +97,7 @@ std::string reference_text(const CalibrationResult& r, const std::vector<Real>& 
                            : std::string("lies outside the searched ranges");
   if (std::isfinite(run_chi2))
     o += fmt("; run: chi2 %.1f", run_chi2) + fmt(" against the best's %.1f", r.best.chi2) +
-         fmt(" (the region's rise: %.1f)", chi2_95(static_cast<int>(r.free.size())) * r.scale);
+         fmt(" (the region's rise: %.1f)", chi2_95(static_cast<int>(r.free.size())) * r.scale * r.region_factor);
   return o + "\n";
 }
 

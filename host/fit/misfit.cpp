@@ -223,6 +223,8 @@ void Misfit::build_summary_noise(const std::vector<TriaxialTest>& measured, cons
     std::vector<Real> member(static_cast<std::size_t>(n) * n, 0);
     for (int i = 0; i < n; ++i) member[static_cast<std::size_t>(i) * n + i] = fs[i].ensemble_sd * fs[i].ensemble_sd;
     member_cov_.push_back(member);
+    for (Real& m : member) m /= members_;  // the data's noise is the lab's or the data's: the ensemble's term alone
+    spread_cov_.push_back(member);
   }
 }
 
@@ -315,6 +317,60 @@ Real Misfit::member_spread() const {
   }
   // One member less the mean of K that include it: its deviation's variance is (1 - 1/K) of one member's.
   return (1 - 1 / static_cast<Real>(members_)) * spread;
+}
+
+SpecimenSpread Misfit::specimen_spread(const Ensemble& scatter) const {
+  SpecimenSpread out;
+  std::size_t specimens = scatter.front().size();
+  for (const auto& runs : scatter) specimens = std::min(specimens, runs.size());
+  out.specimen.assign(specimens, {});
+  out.ensemble.assign(specimens, {});
+  const int all = data();
+  out.modelled.assign(static_cast<std::size_t>(all) * all, 0);
+  int at = 0;  // the first datum of test k
+  for (std::size_t k = 0; k < features_.size(); ++k) {
+    out.tests.push_back(at);
+    const std::vector<Feature>& fs = features_[k];
+    const int n = static_cast<int>(fs.size());
+    const Eigen::Map<const Eigen::MatrixXd> cov(cov_[k].data(), n, n), spread(spread_cov_[k].data(), n, n);
+    const Eigen::MatrixXd L = Eigen::LLT<Eigen::MatrixXd>(cov).matrixL();
+    const auto lower = L.triangularView<Eigen::Lower>();
+    // L^-1 C L^-T: the modelled terms in whitened units.
+    const Eigen::MatrixXd half = lower.solve(Eigen::MatrixXd(spread));
+    const Eigen::MatrixXd w = lower.solve(Eigen::MatrixXd(half.transpose()));
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) out.modelled[static_cast<std::size_t>(at + i) * all + at + j] = w(i, j);
+    // The specimen term's scale over one member's: what spread_cov_ holds beside the ensemble's 1/K.
+    Eigen::VectorXd scale = Eigen::VectorXd::Zero(n);
+    for (int i = 0; i < n; ++i)
+      if (fs[i].ensemble_sd > 0) {
+        const Real e2 = fs[i].ensemble_sd * fs[i].ensemble_sd;
+        scale(i) = std::sqrt(std::max(Real(0), spread(i, i) - e2 / members_) / e2);
+      }
+    const std::vector<Real> mean = mean_values(k, scatter[k]);
+    for (std::size_t s = 0; s < specimens; ++s) {
+      const std::vector<Real> v = values(k, scatter[k][s]);
+      Eigen::VectorXd d(n);
+      for (int i = 0; i < n; ++i) d(i) = std::isfinite(v[i]) && std::isfinite(mean[i]) ? v[i] - mean[i] : 0;
+      const Eigen::VectorXd sp = lower.solve(Eigen::VectorXd(scale.cwiseProduct(d)));
+      const Eigen::VectorXd en = lower.solve(Eigen::VectorXd(d / std::sqrt(static_cast<Real>(members_))));
+      out.specimen[s].insert(out.specimen[s].end(), sp.data(), sp.data() + n);
+      out.ensemble[s].insert(out.ensemble[s].end(), en.data(), en.data() + n);
+    }
+    at += n;
+  }
+  out.tests.push_back(at);
+  return out;
+}
+
+std::vector<SpecimenSpread> Misfit::specimen_spreads() const {
+  std::vector<SpecimenSpread> out;
+  if (!from_budget_) return out;
+  for (const Ensemble* e : {&budget_.scatter, &budget_.scatter_floor})
+    if (e->size() == features_.size() && !e->empty() &&
+        static_cast<int>(e->front().size()) >= kMinSpreadSpecimens)
+      out.push_back(specimen_spread(*e));
+  return out;
 }
 
 std::vector<Real> Misfit::residuals(const Ensemble& sim) const {

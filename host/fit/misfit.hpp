@@ -132,6 +132,24 @@ struct NoiseBudget {
   CellBias cell_bias;    ///< empty: not measured
 };
 
+/// The scatter specimens' word on the noise a calibration's answer carries (host/fit/calibrate.hpp, the intervals
+/// measured on the specimens): the modelled Sigma's specimen and ensemble terms assume a shape (q and eps_v apart,
+/// each correlated along strain by one kernel) that one specimen's departure need not have; these are that departure
+/// as the specimens show it, in the misfit's whitened units.
+struct SpecimenSpread {
+  /// Per scatter specimen, its departure from the specimens' mean (all tests, whitened as the residuals are), scaled
+  /// to the data specimen's term (the specimen's scale over one member's, as the misfit scales it; zero where that
+  /// term is a lab's or the replicates'). A data specimen is one specimen a test: only the blocks of each test count.
+  std::vector<std::vector<Real>> specimen;
+  /// The same departures scaled to the ensemble mean's term (1 / sqrt(K)): the ensemble's members are the same
+  /// packings at every pressure, so their departures count across tests too.
+  std::vector<std::vector<Real>> ensemble;
+  /// The first datum of each test, and the number of data after the last.
+  std::vector<int> tests;
+  /// Both terms as the misfit models them, whitened: data() x data(), row-major, zero between tests.
+  std::vector<Real> modelled;
+};
+
 class Misfit {
  public:
   /// The misfit of a decided noise budget: its scatter, ensemble and cell bias.
@@ -189,6 +207,10 @@ class Misfit {
   /// scatters; the data's noise, the ensemble and the cell's bias stay. Only for a misfit built from a noise budget,
   /// before any discrepancy is added.
   Misfit with_scatter(const Ensemble& scatter) const;
+  /// The specimen spreads of the scatter this misfit was built from (a noise budget's): its scatter specimens' and,
+  /// after with_scatter, those of the scatter it keeps as a floor. Empty for a misfit not built from a budget, or
+  /// whose scatter has fewer than kMinSpreadSpecimens specimens.
+  std::vector<SpecimenSpread> specimen_spreads() const;
 
  private:
   /// What built it, for with_scatter: set by the budget's constructor, cleared by add_discrepancy.
@@ -211,6 +233,10 @@ class Misfit {
   std::vector<std::vector<Feature>> features_;
   std::vector<std::vector<Real>> cov_;   ///< per test, Sigma (n x n, row-major)
   std::vector<std::vector<Real>> member_cov_;  ///< per test, one member's scatter (n x n): Sigma holds it / K
+  /// Per test, the terms of Sigma that the simulator's scatter stands for (n x n): the specimen's where it is the
+  /// simulator's (not a lab's or the replicates'), and the ensemble mean's.
+  std::vector<std::vector<Real>> spread_cov_;
+  SpecimenSpread specimen_spread(const Ensemble& scatter) const;
   std::vector<std::string> notes_;
   std::string source_;
   Real length_ = 1;
@@ -232,6 +258,10 @@ NoiseBudget decide_noise_budget(PeriodicLab& lab, const Model& base, const std::
 /// The misfit of the budget decide_noise_budget decides.
 Misfit measure_misfit(PeriodicLab& lab, const Model& base, const std::vector<TriaxialTest>& measured,
                       const NoiseOptions& noise, bool cell_bias = true, const StateMatch& state = {});
+
+/// Fewer scatter specimens leave the covariance of their departures too uncertain to weigh (its Student's t factor
+/// nu / (nu - 2) needs nu = S - 1 above 2).
+constexpr int kMinSpreadSpecimens = 4;
 
 /// The chi2 of whitened residuals: the sum of their squares, of r[from, to) where given.
 Real sum_sq(const std::vector<Real>& r, std::size_t from, std::size_t to);

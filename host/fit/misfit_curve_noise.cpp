@@ -203,6 +203,7 @@ void Misfit::build_curve_noise(const std::vector<TriaxialTest>& measured, const 
     std::vector<Real> data_var(n, 0);
     const bool use_lab = lab || !data_noise(t, fs, !rep.var.empty(), where, data_var, notes_);
     Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(n, n);
+    std::vector<char> sim_specimen(n, 0);  // the specimen term is the simulator's scatter, scaled
     for (int i = 0; i < n; ++i) {
       Feature& f = fs[i];
       const Real scale = pooled_scale(f, t.sigma3);
@@ -222,13 +223,17 @@ void Misfit::build_curve_noise(const std::vector<TriaxialTest>& measured, const 
         const Real floor = f.quantity == 0 ? noise.lab.q_shared * std::fabs(f.measured) : noise.lab.ev_abs;
         const Real size = sized ? std::pow(sim_balls / t.specimen_balls, kSpecimenScatterExponent) : 1;
         f.specimen_sd = std::max(f.ensemble_sd * size, floor);
+        sim_specimen[i] = 1;
       }
       f.data_sd = std::sqrt(data_var[i]);
     }
-    std::vector<Real> member(static_cast<std::size_t>(n) * n);
+    std::vector<Real> member(static_cast<std::size_t>(n) * n), spread(member.size());
     for_each_pair(fs, use_lab ? noise.lab.length : length_, true, [&](int i, int j, Real rho) {
       const Feature &a = fs[i], &b = fs[j];
       member[static_cast<std::size_t>(i) * n + j] = rho * a.ensemble_sd * b.ensemble_sd;
+      spread[static_cast<std::size_t>(i) * n + j] =
+          rho * ((sim_specimen[i] && sim_specimen[j] ? a.specimen_sd * b.specimen_sd : 0) +
+                 a.ensemble_sd * b.ensemble_sd / members_);
       Real c = rho * (a.specimen_sd * b.specimen_sd + a.ensemble_sd * b.ensemble_sd / members_);
       if (use_lab && a.quantity == 0 && b.quantity == 0) {
         // The lab's specimen factor moves the whole q curve together: rank one, beside the correlated rest.
@@ -248,6 +253,7 @@ void Misfit::build_curve_noise(const std::vector<TriaxialTest>& measured, const 
     }
     cov_.emplace_back(cov.data(), cov.data() + n * n);
     member_cov_.push_back(member);
+    spread_cov_.push_back(spread);
   }
   if (lab)
     notes_.push_back("noise: " + noise.lab_name + fmt(" (q %.3g%%", 100 * noise.lab.q_rel) +

@@ -39,9 +39,11 @@ void check_folders(const CalibrationOptions& o, const std::string& kind) {
   if (::access(p.c_str(), W_OK) != 0)
     throw std::invalid_argument("-o " + o.output + ": " + p.string() + " cannot be written (allowed: a folder to write in)");
   // Some folders pass access() and still refuse a new folder (/proc, as root): made once here, and what was made
-  // removed again, so that a plan leaves nothing behind and a job learns it before any work.
+  // removed again, so that a plan leaves nothing behind and a job learns it before any work. Only the leader
+  // writes: shadows making and removing the same folder at once refused each other's (check_shared_folder later
+  // tells whether every rank sees the leader's folder).
   const fs::path want = fs::absolute(o.output, ec);
-  if (fs::exists(want, ec)) return;
+  if (!ranks::leader() || fs::exists(want, ec)) return;
   if (!fs::create_directories(want, ec) || ec)
     throw std::invalid_argument("-o " + o.output + ": a folder cannot be made there (" + ec.message() +
                                 "; allowed: a folder to write in)");
