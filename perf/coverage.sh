@@ -42,7 +42,14 @@ mkdir -p "$out" "$work"
 export OMP_NUM_THREADS=1  # -j runs at once, one thread each
 
 have() { awk -F, -v c="$1" -v s="$2" 'NR > 1 && $3 == c && $4 == s' "$csv" | grep -q .; }
-mean_case() { awk -F, -v d="$case_s" 'NR > 1 && $18 > 0 { s += $18; n++ } END { printf "%d", n ? s / n : d }' "$csv"; }
+# SIZE: a case's seconds, the mean of this method's rows of that size, else of every method's in OUT (the same cells
+# and searches), else CASE_S.
+mean_case() {
+  awk -F, -v d="$case_s" -v z="$1" -v m="$method" 'FNR > 1 && $4 == z && $18 > 0 {
+      if ($1 == m) { s += $18; n++ } else { o += $18; k++ } }
+    END { printf "%d", n ? s / n : k ? o / k : d }' "$out"/*.csv
+}
+plan_s() { local t=0 i; for i in "$@"; do t=$((t + $(mean_case "${i##*:}"))); done; echo "$t"; }
 truth() {  # CASE: "mu_s mu_r", drawn from the case number (the same on every machine)
   "$py" -c 'import math, random, sys
 r = random.Random(int(sys.argv[1])); a, b = map(float, sys.argv[2].split()); c, d = map(float, sys.argv[3].split())
@@ -51,22 +58,22 @@ print("%.4g %.4g" % (math.exp(math.log(a) + r.random() * math.log(b / a)), c + r
 }
 todo=()
 for ((c = first; c < first + cases; c++)); do for s in $sizes; do have "$c" "$s" || todo+=("$c:$s"); done; done
-each="$(mean_case)"
+total="$(plan_s "${todo[@]}")"
 echo "coverage: $method, cases $first..$((first + cases - 1)), data sizes ${sizes// /x, }x the cell's: ${#todo[@]} to run," \
-     "about $each s each on this machine (-j $jobs): $(( ${#todo[@]} * each / 60 )) min in all; this sitting's budget" \
+     "about $(( total / 60 )) min in all on this machine (-j $jobs; each case as the rows of its size took); this sitting's budget" \
      "$budget s"
 if [ "$plan" != 1 ]; then
   start=$SECONDS; done_here=0
   for item in "${todo[@]}"; do
     c="${item%%:*}"; s="${item##*:}"
-    elapsed=$((SECONDS - start)); each="$(mean_case)"
+    elapsed=$((SECONDS - start)); each="$(mean_case "$s")"
     if [ $((elapsed + each)) -gt "$budget" ]; then
       echo "coverage: budget reached after $done_here cases ($elapsed s); run again to go on"; break
     fi
     read -r mu_s mu_r <<< "$(truth "$c")"
     dir="$work/${method}_${s}x/case$c"
     fresh_folder coverage "$dir"
-    left=$(( (${#todo[@]} - done_here) * each ))
+    left="$(plan_s "${todo[@]:done_here}")"
     echo "coverage: case $c, data of ${s}x the cell's balls, mu_s $mu_s, mu_r $mu_r ($((done_here + 1)) of" \
          "${#todo[@]}; about $((left / 60)) min left)"
     sed -e "s/^mu_s = .*/mu_s = $mu_s/" -e "s/^mu_r = .*/mu_r = $mu_r/" "$base" > "$dir/truth.toml"
