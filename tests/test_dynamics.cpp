@@ -642,6 +642,30 @@ TEST(Stage, AStagesFirstStepsAreEachTimed) {
   EXPECT_GE(t.host(), 0) << "parts " << t.parts.loop() << " s in a wall time of " << t.wall;
 }
 
+// fit_sampled_parts: sampled parts that add up beyond the wall time the measured host work and rebuilds leave are
+// scaled down to it in proportion (host() then equals the measured host work, never below zero); parts within it are
+// kept as they are.
+TEST(Stage, SampledPartsNeverExceedTheWallTimeTheMeasuredPartsLeave) {
+  StageTiming t;
+  t.wall = 1.0;
+  t.control = 0.1, t.after = 0.05, t.checkpoints = 0.05;
+  t.parts.rebuild = 0.2;
+  t.parts.forces = 0.9, t.parts.integrate = 0.3;  // 1.2 sampled where 0.6 is left: a stalled sample
+  fit_sampled_parts(t);
+  EXPECT_NEAR(t.parts.forces + t.parts.integrate, 0.6, 1e-12);
+  EXPECT_NEAR(t.parts.forces / t.parts.integrate, 3.0, 1e-12) << "in proportion";
+  EXPECT_NEAR(t.host(), 0.2, 1e-12) << "the host's measured work";
+  const StageTiming within = [] {
+    StageTiming w;
+    w.wall = 1.0;
+    w.parts.forces = 0.5;
+    return w;
+  }();
+  StageTiming kept = within;
+  fit_sampled_parts(kept);
+  EXPECT_EQ(kept.parts.forces, within.parts.forces);
+}
+
 // The host's work is told apart by where it is spent (timings.csv's host_control_ns, host_after_ns), so that a GPU
 // run's host share says whether the servo or the records hold it. A stage whose work after a step sleeps 2 ms must
 // show at least that there, and its control (nothing) less; sleeping can only last longer than asked, and both

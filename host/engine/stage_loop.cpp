@@ -65,6 +65,14 @@ std::array<double, 10> ns_per_part(const StageTiming& t) {
 
 }  // namespace
 
+void fit_sampled_parts(StageTiming& timing) {
+  StageTimes& t = timing.parts;
+  const double room = timing.wall - timing.control - timing.after - timing.checkpoints - t.rebuild;
+  const double sampled = t.forces + t.integrate + t.boundaries + t.membrane + t.walls;
+  if (sampled <= room || sampled <= 0) return;
+  for (double* x : {&t.forces, &t.integrate, &t.boundaries, &t.membrane, &t.walls}) *x *= std::max(0.0, room) / sampled;
+}
+
 StageEnd run_stage(Simulation& sim, const StageSteps& stage, CheckpointPlan* plan) {
   const auto t0 = std::chrono::steady_clock::now();
   const StageTimes parts0 = sim.times();
@@ -84,6 +92,7 @@ StageEnd run_stage(Simulation& sim, const StageSteps& stage, CheckpointPlan* pla
   StageTimes& t = end.timing.parts;
   t = sim.times().since(parts0);
   for (double* x : {&t.forces, &t.integrate, &t.boundaries, &t.membrane, &t.walls}) *x *= f;  // the rebuild: every time
+  fit_sampled_parts(end.timing);
   const double n = std::max(1, sim.particles().n);
   end.timing.ball_pairs = sim.ball_contacts().n / n;
   end.timing.wall_pairs = sim.wall_contacts().n / n;

@@ -75,6 +75,13 @@ struct StageTiming {
   double rate() const { return wall > 0 ? static_cast<double>(balls) * static_cast<double>(steps) / wall : 0; }
 };
 
+/// The sampled parts of a stage's loop (forces, integration, boundaries, membrane, walls: timed one step in
+/// kTimedEvery and scaled to the stage) are an estimate, and one stalled sample counts kTimedEvery times (a Hertz
+/// consolidation on a busy machine read a host time of -63 ns a particle-step). The host's work and the rebuilds are
+/// timed whole: the sampled parts are scaled down, in proportion, to the wall time those leave, so that host() is
+/// never below the host's measured work.
+void fit_sampled_parts(StageTiming& timing);
+
 /// How a stage ended: the number of its last step, whether it was done (else it reached its cap), and its cost.
 struct StageEnd {
   long step = 0;
