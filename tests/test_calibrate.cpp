@@ -483,6 +483,22 @@ TEST(RunCost, ABatchCostsOneRunsTimeGrownByEachFurtherCell) {
   EXPECT_EQ(batch_in_effect(4, cfg), 1) << "CellBatch takes periodic cells";
 }
 
+// A preparation friction that equals the material's still packs the specimen (a state match reads its void ratio):
+// a frictionless material matched at preparation friction 0 read the generated cloud's void ratio, 5.07, and called
+// the data's void ratio beyond the cell's reach. A consolidated packing of equal spheres has a solid fraction near
+// 0.64 without friction (random close packing); below 0.5 it was not consolidated (the cloud's is about 0.16).
+TEST(RunCost, APreparationFrictionEqualToTheMaterialsStillPacks) {
+  Config cfg = test::tiny_cell_config();
+  cfg.ball.mu_s = cfg.ball.mu_r = 0;
+  cfg.periodic.prep_mu_s = cfg.periodic.prep_mu_r = 0;
+  std::vector<BallSpec> balls;
+  std::array<Real, 3> cell{};
+  EXPECT_GT(prepare_periodic_specimen(cfg, balls, cell, false), 0) << "a preparation stage ran";
+  Real solid = 0;
+  for (const BallSpec& b : balls) solid += 4.0 / 3.0 * M_PI * b.radius * b.radius * b.radius;
+  EXPECT_GT(solid / (cell[0] * cell[1] * cell[2]), 0.5);
+}
+
 // A state match packs both ends of the preparation friction's range, and without friction the balls slide on and
 // the unbalanced force settles several times slower than at a config's own friction (a 4,000-ball walled match ran
 // 2.4 times its plan, 28 November). The plan counts each end by packing_cost_at, a range measured on other cells

@@ -200,7 +200,8 @@ struct PeriodicConfig {
   PeriodicTriaxialParams triax;
   CellBoundary boundary = CellBoundary::periodic;
   /// Friction during a preparatory consolidation (YADE's compaction friction): below the test's mu_s
-  /// gives a denser specimen. < 0: the material's value (no preparatory stage).
+  /// gives a denser specimen. < 0: the material's value; both < 0: no preparatory stage (the test's own
+  /// consolidation packs the specimen).
   Real prep_mu_s = -1, prep_mu_r = -1;
   /// Unbalanced-force ratio that ends the preparatory consolidation (the test's own consolidation then
   /// brings it to unbalanced_tolerance with the test's friction; frictionless packings creep for long).

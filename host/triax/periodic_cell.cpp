@@ -132,7 +132,10 @@ std::unique_ptr<Simulation> packing_of(const Config& cfg, std::vector<BallSpec>&
   ContactParams prep = cfg.ball.base();
   if (pc.prep_mu_s >= 0) prep.mu_s = pc.prep_mu_s;
   if (pc.prep_mu_r >= 0) prep.mu_r = pc.prep_mu_r;
-  if (prep.mu_s == cfg.ball.mu_s && prep.mu_r == cfg.ball.mu_r) return nullptr;
+  // Without a preparation friction the test's own consolidation packs the specimen. One that is set packs it here
+  // even where it equals the material's: a state match reads the packing's void ratio (a frictionless material's
+  // match at preparation friction 0 read the generated cloud's 5.07 and blamed the data).
+  if (pc.prep_mu_s < 0 && pc.prep_mu_r < 0) return nullptr;
   auto sim = make_periodic_simulation(balls, cell, prep, cfg.solver, pc.boundary);
   if (verbose)
     std::printf("triaxdem: preparation: %zu balls in %s %.2f x %.2f x %.2f mm, consolidated with "
