@@ -84,7 +84,8 @@ def coverage(root):
     out = io.StringIO()
     coverage_table.table(rows, out)
     return out.getvalue(), [folder], ('perf/coverage.sh (METHOD=ensemble with the binary of its commit; '
-                                      'METHOD=rescatter_max at 9827c3e), tools/coverage_table.py data/sweeps/coverage')
+                                      'METHOD=rescatter_max at 9827c3e; METHOD=specimens at 82f074b), '
+                                      'tools/coverage_table.py data/sweeps/coverage')
 
 
 SECTIONS = [

@@ -24,7 +24,7 @@ namespace dem {
 /// balls against a plane wall order into layers whose density oscillates and settles to the interior's within 2-3
 /// diameters, most of the deficit lying in the first; 2 keeps 60% of a 1,000-ball cell's side (10 diameters) in
 /// each slab. The cut's place along the layers' oscillation moves D: on cells of 500 balls, margins of 1 to 3
-/// diameters gave D 0.024-0.038, 2 the largest (docs/calibration.md, The walls' layer).
+/// diameters gave D 0.024-0.038, 2 the largest (docs/prediction.md, The walls' layer).
 inline constexpr Real kWallLayerDiameters = 2;
 
 /// Whether a specimen of `data_balls` is larger than a cell of `cell_balls` (false for NaN): within a percent (a data
