@@ -586,6 +586,7 @@ TEST(Calibrate, StateIsMatchedOnTheMeanOfTheLabsFirstSpecimens) {
   const Config matched = matched_state(cfg, data, m, true, plan);
   const std::string shown = testing::internal::GetCapturedStdout();
   EXPECT_NE(shown.find("matching the void ratio 6/6 (100%)"), std::string::npos) << shown;
+  EXPECT_NE(shown.find("matching the void ratio 0/6"), std::string::npos) << "said before the first packing: " << shown;
   EXPECT_EQ(m.tests, 2);
   EXPECT_NEAR(m.target, target, 1e-12);
   EXPECT_EQ(m.specimens, kStateMatchSpecimens);
@@ -834,6 +835,34 @@ TEST(Calibrate, EdgeRangeIsRecentredWithinHardLimits) {
   r.lo = 0;
   r.hi = 0.06;
   EXPECT_FALSE(recentre(r, 0.0)) << "mu_r = 0 is a hard limit";
+}
+
+// A search whose best lies beyond its range widens it, and the answer's uncertainty is computed over every range
+// searched and every point run: from the last range alone a mu_r interval read [0.06, 0.12] where the first held the
+// truth (coverage case 5, four times the balls). Residuals linear in mu_r, 10 of them, each (mu_r - 0.1) / 0.08: the
+// 95% interval is 0.1 -+ 0.08 sqrt(3.84 / 10) = [0.0504, 0.1496], the search's ranges [0, 0.06], then [0.03, 0.09],
+// then [0.06, 0.12]; the interval must reach below 0.06 into the earlier ranges, and every run must be in the design.
+TEST(Calibrate, AWidenedSearchsUncertaintyCoversEveryRangeSearched) {
+  Model base;
+  base.law.mu_s = 0.15;
+  base.law.mu_r = 0.015;
+  const std::vector<FreeParam> free{free_param("mu_r", base)};  // [0, 0.06]
+  long runs = 0;
+  const Simulator simulate = [&](const Model& m, Real) {
+    ++runs;
+    SimulatedPoint s;
+    s.r.assign(10, (m.law.mu_r - 0.1) / 0.08);
+    return s;
+  };
+  const CalibrationResult r = calibrate(simulate, base, free, 10);
+  EXPECT_NEAR(r.values[0], 0.1, 0.005);
+  EXPECT_NEAR(r.free[0].lo, 0.0, 1e-12) << "the union of the ranges searched";
+  EXPECT_NEAR(r.free[0].hi, 0.12, 1e-9);
+  EXPECT_EQ(static_cast<long>(r.design.size()), runs) << "every point run";
+  EXPECT_NEAR(r.interval[0].first, 0.0504, 0.002);
+  EXPECT_NEAR(r.interval[0].second, 0.12, 1e-9) << "the last range's edge: nothing was searched beyond";
+  EXPECT_LE(r.region_rise({0.06}), 1) << "the first range's edge lies inside the region";
+  EXPECT_LE(r.region_rise({0.055}), 1) << "so does a point only the earlier ranges searched";
 }
 
 // The base fit must find its own optimum: on another code's linear data, a base calibration stopped at the edge

@@ -168,6 +168,28 @@ Real best_inside(const CalibrationResult& r, std::size_t k) {
   return best;
 }
 
+/// `into` over the union of its ranges and `other`'s, holding both searches' points (other's first where
+/// `other_first`, so that the design keeps the order the points ran in): every point's unit coordinates
+/// (and the best's) mapped from its own search's ranges to the union's. The uncertainty is then computed over every
+/// point run and every range searched: from the last widened range alone, a mu_r interval read [0.06, 0.12] where the
+/// first range held the truth, 0.042, and the region could not reach it (coverage case 5, four times the balls).
+void merge_searches(CalibrationResult& into, const CalibrationResult& other, bool other_first) {
+  std::vector<FreeParam> all = into.free;
+  for (std::size_t k = 0; k < all.size(); ++k) {
+    all[k].lo = std::min(all[k].lo, other.free[k].lo);
+    all[k].hi = std::max(all[k].hi, other.free[k].hi);
+  }
+  auto remap = [&](Evaluation& e, const std::vector<FreeParam>& from) {
+    for (std::size_t k = 0; k < all.size(); ++k) e.u[k] = std::clamp(all[k].unit(from[k].value(e.u[k])), Real(0), Real(1));
+  };
+  for (Evaluation& e : into.design) remap(e, into.free);
+  remap(into.best, into.free);
+  std::vector<Evaluation> more = other.design;
+  for (Evaluation& e : more) remap(e, other.free);
+  into.design.insert(other_first ? into.design.begin() : into.design.end(), more.begin(), more.end());
+  into.free = all;
+}
+
 CalibrationResult search(const Simulator& simulate, const Model& base, const std::vector<FreeParam>& free, int data,
                          int rounds, int widen, Real known_best = std::numeric_limits<Real>::infinity()) {
   const int d = static_cast<int>(free.size());
@@ -213,6 +235,7 @@ CalibrationResult search(const Simulator& simulate, const Model& base, const std
       if (moved[k].lo != free[k].lo || moved[k].hi != free[k].hi) res.searched_beyond.push_back(free[k].name);
   }
   CalibrationResult& out = again.best.chi2 < res.best.chi2 ? again : res;
+  merge_searches(out, &out == &again ? res : again, &out == &again);  // the first search's points first
   out.widened.insert(out.widened.begin(), notes.begin(), notes.end());
   return out;
 }

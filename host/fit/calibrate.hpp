@@ -104,10 +104,12 @@ struct Evaluation {
 
 struct CalibrationResult {
   Model model;                        ///< base model with the calibrated values
+  /// The ranges searched: after a widened search, their union (every point's u is in it), so that the intervals and
+  /// the region reach over every range a search ran.
   std::vector<FreeParam> free;
   std::vector<Real> values;
   Evaluation best;                    ///< the best point run
-  std::vector<Evaluation> design;     ///< every point run, in order
+  std::vector<Evaluation> design;     ///< every point run, in order (a widened search's after its first search's)
   int data = 0;                       ///< number of data in the misfit
   /// Names of the parameters whose best value lies on an edge of its range (within 1% of it): the true
   /// optimum may lie outside, and a misfit found there may be the range's and not the model's. A lower edge

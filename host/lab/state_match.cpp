@@ -76,7 +76,11 @@ Real prep_friction_for(const Config& base, Real target, Real& reached, bool verb
   // Each packing of the plan's specimens takes seconds to minutes: the match reports them (the ends, then the
   // bisection's steps; it may stop early at an end).
   std::optional<Progress> progress;
-  if (verbose) progress.emplace("triaxdem: matching the void ratio", 2L + plan.steps);
+  if (verbose) {
+    // Said before the first packing, which takes the longest (a Hertz-Mindlin base's larger cells: 32 s in silence).
+    progress.emplace("triaxdem: matching the void ratio", 2L + plan.steps);
+    progress->update(0, "packings");
+  }
   long packings = 0;
   auto packed = [&](long count) {
     packings += count;
