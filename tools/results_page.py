@@ -84,7 +84,7 @@ def coverage(root):
     out = io.StringIO()
     coverage_table.table(rows, out)
     return out.getvalue(), [folder], ('perf/coverage.sh (METHOD=ensemble with the binary of its commit; '
-                                      'METHOD=rescatter_max at 9827c3e; METHOD=specimens at 82f074b, cases 17-24 of 1x at ac9b891), '
+                                      'METHOD=rescatter_max at 9827c3e; METHOD=specimens at 82f074b, cases 17-30 of 1x at ac9b891 and fb5505c, the same code as b79c38d), '
                                       'tools/coverage_table.py data/sweeps/coverage')
 
 
