@@ -225,6 +225,10 @@ void measure_on_specimens(CalibrationResult& r, std::vector<SpecimenSpread> spre
 /// on the specimens.
 void rewhiten(CalibrationResult& r, const Misfit& misfit, const Model& base);
 
+/// r's intervals, correlation, region and surfaces at its best point, measured on r.spreads where given
+/// (calibration_uncertainty.cpp).
+void add_uncertainty(CalibrationResult& r);
+
 /// Parameter points a calibration of d free parameters runs at most before any widening: the design, the
 /// surrogate rounds and the compass stage (for a progress bar's plan).
 long planned_points(int d, int rounds = 4);

@@ -228,6 +228,12 @@ class Misfit {
                          Real sim_balls, const Ensemble& floor);
   void build_summary_noise(const std::vector<TriaxialTest>& measured, const NoiseOptions& noise, const Ensemble& ref,
                            const Ensemble& floor);
+  /// Test k's Sigma, one member's scatter and the terms the simulator's scatter stands for (cov_, member_cov_,
+  /// spread_cov_), from its features' standard deviations correlated along strain over `length`; `lab` where the
+  /// test takes the lab's noise (its specimen factor moves the whole q curve), `sim_specimen` where a feature's
+  /// specimen term is the simulator's scatter scaled, `data_var` the data's own noise.
+  void add_test_covariance(const std::vector<Feature>& fs, Real length, const LabCurveNoise* lab,
+                           const std::vector<char>& sim_specimen, const std::vector<Real>& data_var, Real sigma3);
   /// Sets each feature's `field` to sd[test][feature] and adds it to Sigma, correlated along strain.
   void add_correlated(const std::vector<std::vector<Real>>& sd, Real Feature::*field, const std::string& what);
   std::vector<std::vector<Feature>> features_;

@@ -202,7 +202,6 @@ void Misfit::build_curve_noise(const std::vector<TriaxialTest>& measured, const 
     // The data's own noise of each feature (variance), and whether this test falls back to the lab model.
     std::vector<Real> data_var(n, 0);
     const bool use_lab = lab || !data_noise(t, fs, !rep.var.empty(), where, data_var, notes_);
-    Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(n, n);
     std::vector<char> sim_specimen(n, 0);  // the specimen term is the simulator's scatter, scaled
     for (int i = 0; i < n; ++i) {
       Feature& f = fs[i];
@@ -227,38 +226,47 @@ void Misfit::build_curve_noise(const std::vector<TriaxialTest>& measured, const 
       }
       f.data_sd = std::sqrt(data_var[i]);
     }
-    std::vector<Real> member(static_cast<std::size_t>(n) * n), spread(member.size());
-    for_each_pair(fs, use_lab ? noise.lab.length : length_, true, [&](int i, int j, Real rho) {
-      const Feature &a = fs[i], &b = fs[j];
-      member[static_cast<std::size_t>(i) * n + j] = rho * a.ensemble_sd * b.ensemble_sd;
-      spread[static_cast<std::size_t>(i) * n + j] =
-          rho * ((sim_specimen[i] && sim_specimen[j] ? a.specimen_sd * b.specimen_sd : 0) +
-                 a.ensemble_sd * b.ensemble_sd / members_);
-      Real c = rho * (a.specimen_sd * b.specimen_sd + a.ensemble_sd * b.ensemble_sd / members_);
-      if (use_lab && a.quantity == 0 && b.quantity == 0) {
-        // The lab's specimen factor moves the whole q curve together: rank one, beside the correlated rest.
-        const Real sh = noise.lab.q_shared;
-        const Real rest = rho * (a.specimen_sd * b.specimen_sd - sh * sh * std::fabs(a.measured * b.measured));
-        c = sh * sh * a.measured * b.measured + std::max(Real(0), rest) +
-            rho * a.ensemble_sd * b.ensemble_sd / members_;
-      }
-      cov(i, j) = c;
-    });
-    for (int i = 0; i < n; ++i) {
-      cov(i, i) += data_var[i];
-      // A floor of 1e-3 of the feature's own scale keeps Sigma invertible where every part is zero (a curve and an
-      // ensemble without noise): 0.1% of sigma3 on q, 1e-6 on eps_v.
-      const Real floor = fs[i].quantity == 0 ? 1e-3 * t.sigma3 : 1e-6;
-      cov(i, i) += floor * floor;
-    }
-    cov_.emplace_back(cov.data(), cov.data() + n * n);
-    member_cov_.push_back(member);
-    spread_cov_.push_back(spread);
+    add_test_covariance(fs, use_lab ? noise.lab.length : length_, use_lab ? &noise.lab : nullptr, sim_specimen,
+                        data_var, t.sigma3);
   }
   if (lab)
     notes_.push_back("noise: " + noise.lab_name + fmt(" (q %.3g%%", 100 * noise.lab.q_rel) +
                      fmt(" with a %.3g%% specimen factor", 100 * noise.lab.q_shared) +
                      fmt(", eps_v %.3g%%", 100 * noise.lab.ev_rel) + fmt(" or %.3g%%)", 100 * noise.lab.ev_abs));
+}
+
+void Misfit::add_test_covariance(const std::vector<Feature>& fs, Real length, const LabCurveNoise* lab,
+                                 const std::vector<char>& sim_specimen, const std::vector<Real>& data_var,
+                                 Real sigma3) {
+  const int n = static_cast<int>(fs.size());
+  Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(n, n);
+  std::vector<Real> member(static_cast<std::size_t>(n) * n), spread(member.size());
+  for_each_pair(fs, length, true, [&](int i, int j, Real rho) {
+    const Feature &a = fs[i], &b = fs[j];
+    member[static_cast<std::size_t>(i) * n + j] = rho * a.ensemble_sd * b.ensemble_sd;
+    spread[static_cast<std::size_t>(i) * n + j] =
+        rho * ((sim_specimen[i] && sim_specimen[j] ? a.specimen_sd * b.specimen_sd : 0) +
+               a.ensemble_sd * b.ensemble_sd / members_);
+    Real c = rho * (a.specimen_sd * b.specimen_sd + a.ensemble_sd * b.ensemble_sd / members_);
+    if (lab && a.quantity == 0 && b.quantity == 0) {
+      // The lab's specimen factor moves the whole q curve together: rank one, beside the correlated rest.
+      const Real sh = lab->q_shared;
+      const Real rest = rho * (a.specimen_sd * b.specimen_sd - sh * sh * std::fabs(a.measured * b.measured));
+      c = sh * sh * a.measured * b.measured + std::max(Real(0), rest) +
+          rho * a.ensemble_sd * b.ensemble_sd / members_;
+    }
+    cov(i, j) = c;
+  });
+  for (int i = 0; i < n; ++i) {
+    cov(i, i) += data_var[i];
+    // A floor of 1e-3 of the feature's own scale keeps Sigma invertible where every part is zero (a curve and an
+    // ensemble without noise): 0.1% of sigma3 on q, 1e-6 on eps_v.
+    const Real floor = fs[i].quantity == 0 ? 1e-3 * sigma3 : 1e-6;
+    cov(i, i) += floor * floor;
+  }
+  cov_.emplace_back(cov.data(), cov.data() + n * n);
+  member_cov_.push_back(member);
+  spread_cov_.push_back(spread);
 }
 
 void Misfit::add_correlated(const std::vector<std::vector<Real>>& sd, Real Feature::*field, const std::string& what) {
