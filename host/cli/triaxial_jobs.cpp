@@ -39,15 +39,17 @@ void print_periodic_plan(const Config& cfg) {
   const Real prep = cfg.periodic.prep_mu_s >= 0 ? cfg.periodic.prep_mu_s : cfg.ball.mu_s;
   const PackingCost at = packing_cost_at(prep);
   const Real sigma3 = cfg.periodic.triax.sigma3;
-  const double run = static_cast<double>(cost.run_steps(sigma3)), packing = static_cast<double>(cost.packing_steps);
+  const double run_low = static_cast<double>(cost.run_steps(sigma3, false)),
+               run = static_cast<double>(cost.run_steps(sigma3)), packing = static_cast<double>(cost.packing_steps);
   std::printf("%s: plan: %ld balls, a packing (preparation friction %.3g: %.3g to %.3g steps), consolidation to %.0f "
-              "kPa and shear to %.1f%% axial strain (%.3g steps): %.2g to %.2g particle-steps, about %s to %s on this "
-              "machine\n",
+              "kPa and shear to %.1f%% axial strain (%.3g to %.3g steps%s): %.2g to %.2g particle-steps, about %s to "
+              "%s on this machine\n",
               cfg.periodic.boundary == CellBoundary::walls ? "walls" : "periodic", cost.balls, prep, at.low * packing,
-              at.high * packing, sigma3 / 1e3, 100 * cfg.periodic.triax.target_strain, run,
-              (at.low * packing + run) * static_cast<double>(cost.balls),
+              at.high * packing, sigma3 / 1e3, 100 * cfg.periodic.triax.target_strain, run_low, run,
+              cost.resettles() ? ", the balls sliding on without friction: the consolidation settles them again" : "",
+              (at.low * packing + run_low) * static_cast<double>(cost.balls),
               (at.high * packing + run) * static_cast<double>(cost.balls),
-              format_duration(at.low * cost.packing_seconds() + cost.run_seconds(sigma3)).c_str(),
+              format_duration(at.low * cost.packing_seconds() + cost.run_seconds(sigma3, false)).c_str(),
               format_duration(at.high * cost.packing_seconds() + cost.run_seconds(sigma3)).c_str());
 }
 

@@ -74,12 +74,13 @@ struct Stages {
   /// Runs of `tests` on `low_k` to `k` specimens per point, `points` points one after another.
   void runs(const std::string& name, const std::string& setting, const CellCost& c,
             const std::vector<TriaxialTest>& tests, double points, int low_k, int k, const std::string& what) {
+    const double each_low = mean_over(tests, [&](Real s) { return c.run_seconds(s, false); });
     const double each = mean_over(tests, [&](Real s) { return c.run_seconds(s); });
     const double steps = mean_over(tests, [&](Real s) { return static_cast<double>(c.run_steps(s)); });
     const double per_point_low = static_cast<double>(tests.size()) * low_k;
     const double per_point = static_cast<double>(tests.size()) * k;
     plan.stages.push_back({name, what, setting, points * per_point * steps * static_cast<double>(c.balls),
-                           points * c.seconds_of(per_point_low, each, at_once),
+                           points * c.seconds_of(per_point_low, each_low, at_once),
                            points * c.seconds_of(per_point, each, at_once)});
   }
 };
@@ -125,6 +126,9 @@ struct Planner {
   Config cell;  ///< the lab's cell as the job grows it, with a preparation friction where matched
   bool void_ratio = false;  ///< the data give void ratios: the specimens are matched to them
   CellCost lab, check;
+  /// The lab's cost at the searched points: where mu_s is free, at its range's centre, not the base's friction (a
+  /// frictionless base's own runs settle their packings again, the searched ones need not).
+  CellCost searched;
   int S = 0, K = 0, K_low = 0;  ///< scatter specimens, ensemble (auto: 1 to S)
   bool auto_ensemble = false;
   std::string n;  ///< the lab's balls
@@ -143,6 +147,9 @@ struct Planner {
     if (void_ratio && cell.periodic.prep_mu_s < 0) cell.periodic.prep_mu_s = 0.5 * cell.ball.mu_s;
     lab = measure_cell_cost(cell);
     check = measure_cell_cost(larger_cell(cell, kCellCheckFactor));
+    searched = lab;
+    if (std::find(in.free.begin(), in.free.end(), "mu_s") != in.free.end())
+      searched.mu_s = free_param("mu_s", model_of(in.cell)).value(0.5);
     S = static_cast<int>(cc.scatter_specimens);
     auto_ensemble = cc.ensemble == kAutoEnsemble;
     K = auto_ensemble ? S : static_cast<int>(cc.ensemble);
@@ -271,10 +278,10 @@ struct Planner {
       plan.stages.push_back({material + ": two fidelities, membrane tests",
                              what + rounds + ", once more where they do not converge", "[calibrate] predict_specimens",
                              test_steps * ((R + 1) * T_n + kMembraneSpecimenOverTest), each, each + R * tests_s});
-      add.runs(material + ": two fidelities, periodic runs", "[calibrate] scatter_specimens", lab, tests, 1, S, S,
+      add.runs(material + ": two fidelities, periodic runs", "[calibrate] scatter_specimens", searched, tests, 1, S, S,
                std::to_string(S * static_cast<int>(tests.size())) + " runs of " + n + " balls" + rounds);
       upto_rounds(plan.stages.back());
-      add.runs(material + ": search (corrected)", "[calibrate] ensemble", lab, tests, static_cast<double>(points),
+      add.runs(material + ": search (corrected)", "[calibrate] ensemble", searched, tests, static_cast<double>(points),
                K_low, K, search_what + rounds);
       upto_rounds(plan.stages.back());
     }
@@ -296,27 +303,27 @@ struct Planner {
                  " specimens x " + T + " tests)");
     bias_check(material, tests);
     const long tried = in.diagnose ? static_cast<long>(extensions_of(model_of(in.cell)).size()) : 0;
-    const long points = planned_points(in.free) + tried * 6;
+    const long points = planned_points(static_cast<int>(in.free.size())) + tried * 6;
     const std::string k = auto_ensemble ? "1 to " + std::to_string(K) : std::to_string(K);
     const std::string search_what = std::to_string(points) + " points x " + T + " tests x " + k + " specimens of " + n +
                                     " balls" + (in.diagnose ? " (the base model, then " +
                                                                   std::to_string(tried) + " extensions)"
                                                             : "");
     add.runs(material + (in.diagnose ? ": diagnosis" : ": search"),
-             auto_ensemble ? "[calibrate] ensemble (auto)" : "[calibrate] ensemble", lab, tests,
+             auto_ensemble ? "[calibrate] ensemble (auto)" : "[calibrate] ensemble", searched, tests,
              static_cast<double>(points), K_low, K, search_what);
     if (!in.diagnose && !in.two_fidelity)
-      add.runs(material + ": scatter at the calibrated point", "[calibrate] scatter_specimens", lab, tests, 1, S, S,
+      add.runs(material + ": scatter at the calibrated point", "[calibrate] scatter_specimens", searched, tests, 1, S, S,
                std::to_string(S * static_cast<int>(tests.size())) + " runs of " + n + " balls (" + std::to_string(S) +
                    " specimens x " + T + " tests)");
     if (std::find(in.reference_runs.begin(), in.reference_runs.end(), material) != in.reference_runs.end())
-      add.runs(material + ": the reference point", "--reference", lab, tests, 1, K_low, K,
+      add.runs(material + ": the reference point", "--reference", searched, tests, 1, K_low, K,
                "1 point x " + T + " tests x " + k + " specimens of " + n + " balls");
     if (in.membrane) {
       membrane(material, tests, points, search_what);
     } else if (in.walls) {
       const int P = static_cast<int>(cc.predict_specimens);
-      add.runs(material + ": prediction (walls)", "[calibrate] predict_specimens", lab, tests, 1, P, P,
+      add.runs(material + ": prediction (walls)", "[calibrate] predict_specimens", searched, tests, 1, P, P,
                std::to_string(P * static_cast<int>(tests.size())) + " runs of the walled cell of " + n + " balls");
     }
   }
@@ -348,6 +355,11 @@ struct Planner {
                          fmt(" (%.0f s)", lab.run_seconds(cell.periodic.triax.sigma3)) +
                          fmt(", a packing of %.0f steps", static_cast<double>(lab.packing_steps)) +
                          fmt(" (%.0f s)", lab.packing_seconds()) + ": estimates (host/lab/run_cost.hpp)");
+    if (lab.resettles())
+      plan.notes.push_back(fmt("the base's sliding friction %g", static_cast<double>(lab.mu_s)) +
+                           " lets the balls slide on at sigma3: a run's consolidation settles its packing again, "
+                           "counted as " + fmt("%g", static_cast<double>(ResettleCost::low)) +
+                           fmt(" to %g packings' steps (measured 0.56 to 18.5: a frictionless packing is marginally rigid)", static_cast<double>(ResettleCost::high)));
     plan.notes.push_back("a search counts its planned points on the whole ensemble: one whose optimum lies on the "
                          "edge of a range searches again beyond it and runs more, and points far above the best run "
                          "one specimen only (Table 6's S-1 once ran 636 runs where 264 were planned, now 200)");

@@ -43,7 +43,7 @@ struct PlanInput {
   Config cell;  ///< the reference test's cell as the config gives it ([calibrate] cell_factor not yet applied), its store set
   std::map<std::string, std::vector<TriaxialTest>> materials;  ///< the data's tests by material
   std::vector<TriaxialTest> state_tests;  ///< the tests whose void ratio the lab's specimens are matched to (all)
-  int free = 0;                      ///< free parameters
+  std::vector<std::string> free;     ///< the free parameters
   bool diagnose = false;
   bool two_fidelity = false;
   const Config* membrane = nullptr;  ///< the membrane test that predicts (and corrects two fidelities), or none

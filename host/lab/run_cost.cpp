@@ -24,6 +24,12 @@ long CellCost::shear_steps(Real sigma3) const {
   return shear_step_count(triax.target_strain, axial_rate(triax, d, rho_eff, sigma3), dt);
 }
 
+long CellCost::consolidation_steps(Real sigma3, bool high) const {
+  const Real share = kConsolidationShare * static_cast<Real>(shear_steps(sigma3));
+  const Real settle = resettles() ? (high ? ResettleCost::high : ResettleCost::low) * packing_steps : 0;
+  return static_cast<long>(share + settle);
+}
+
 namespace {
 
 /// Mean of d^3 over diameters uniform between the config's smallest and largest (packing.cpp's draw).
@@ -118,6 +124,7 @@ CellCost measure_cell_cost(const Config& cell, double probe_seconds) {
   c.d = cell.particles.diameter;  // the mean of diameters uniform between the smallest and the largest
   c.rho_eff = cell.particles.density * cell.solver.mass_scale;
   c.triax = cell.periodic.triax;
+  c.mu_s = cell.ball.mu_s;
   const double step_s = seconds_per_step([&] { sim->run(10); }, 50, probe_seconds);
   c.ns_per_particle_step = 1e9 * step_s / static_cast<double>(balls.size()) * kPairsOverLattice;
   c.batch = batch_in_effect(cell.calibrate.batch, cell);

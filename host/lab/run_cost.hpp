@@ -29,6 +29,19 @@ PackingCost packing_cost_at(Real prep_mu_s);
 /// not time. With 0.25 the walled case's 24 scatter and 12 check runs came within 20% of the plan (26 s and 1m10s
 /// against 31 s and 1m06s).
 constexpr Real kConsolidationShare = 0.25;
+/// Below this sliding friction a run's consolidation settles its packing again: the balls slide on at sigma3 until
+/// the unbalanced force falls to the run's tolerance (tighter than the preparation's). Measured (2 December, the
+/// periodic cells' consolidation after a preparation at 0.03): the 120-ball hidden-effect cell 11,900 steps at 0.005
+/// against 1,400 at 0.01 and 200 at 0.05; every cell 100-200 steps at 0.15.
+constexpr Real kSlidingFriction = 0.0075;
+/// Such a consolidation's steps as a multiple of the cell's packing's (packing_steps), the range measured at mu_s = 0
+/// (2 December, 100 and 300 kPa, after a preparation at 0.03): the 120-ball hidden-effect cell 0.8 to 1.45 (0.56
+/// after a frictionless preparation), the 200-ball calibration base 2.4 and 3.2, the 1,000-ball S-1 cell 3.5 at 300
+/// kPa and 17.7 and 18.5 (two seeds) at 100 kPa: a frictionless packing is marginally rigid, and its unbalanced force
+/// lingers near the tolerance for longer the larger the cell. The plan counts the whole range and says why it is wide.
+struct ResettleCost {
+  static constexpr Real low = 0.5, high = 20.0;
+};
 /// Contact pairs a ball of a random packing has (4.5, docs/performance.md) over the probe lattice's 3: the probe's
 /// speed is scaled by it.
 constexpr Real kPairsOverLattice = 1.5;
@@ -45,12 +58,20 @@ struct CellCost {
   Real d = 0, rho_eff = 0;          ///< m, kg/m^3: the inertial number's scales
   double ns_per_particle_step = 0;  ///< this process's threads, as a run of the cell takes them
   long packing_steps = 0;           ///< one specimen's packing and preparation, estimated
+  Real mu_s = 0;                    ///< the runs' sliding friction (the config's material)
   /// Steps of one run's shear at sigma3 (Pa): the config's end strain at its axial rate (given, or from its
   /// inertial number at p = sigma3, as resolve_periodic_params sets it).
   long shear_steps(Real sigma3) const;
+  /// Steps of one run's consolidation at sigma3 (Pa), at the lower or the upper end of its range: a share of its
+  /// shear, and below kSlidingFriction a packing's settling again.
+  long consolidation_steps(Real sigma3, bool high = true) const;
   /// Steps of one run at sigma3 (Pa): its shear and its consolidation.
-  long run_steps(Real sigma3) const { return static_cast<long>((1 + kConsolidationShare) * shear_steps(sigma3)); }
-  double run_seconds(Real sigma3) const { return 1e-9 * ns_per_particle_step * balls * run_steps(sigma3); }
+  long run_steps(Real sigma3, bool high = true) const { return shear_steps(sigma3) + consolidation_steps(sigma3, high); }
+  double run_seconds(Real sigma3, bool high = true) const {
+    return 1e-9 * ns_per_particle_step * balls * run_steps(sigma3, high);
+  }
+  /// Whether a run's consolidation settles its packing again (mu_s below kSlidingFriction): its steps are a range.
+  bool resettles() const { return mu_s < kSlidingFriction; }
   double packing_seconds() const { return 1e-9 * ns_per_particle_step * balls * packing_steps; }
   /// Runs (and packings) stepped side by side as one batch (batch_in_effect), and what each further cell of a batch
   /// adds to its time, as a share of one cell's: a batch steps all its cells in one launch per kernel, so on a GPU

@@ -155,7 +155,7 @@ JobPlan JobInputs::announce_plan(const Config& base, const CalibrationOptions& o
   in.cell = stored_cell(base, o, data);
   in.materials = by_material(data, o.material);
   in.state_tests = data.tests;
-  in.free = static_cast<int>(free.size());
+  for (const FreeParam& f : free) in.free.push_back(f.name);
   in.diagnose = kind == "diagnose";
   in.two_fidelity = two_fidelity;
   in.membrane = predict_template ? &*predict_template : nullptr;
