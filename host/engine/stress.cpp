@@ -20,9 +20,13 @@ void add_love_weber(Tensor& t, const ContactRecord& c, Real volume) {
   add_term(t, c.fn * c.normal + c.ft, c.branch, volume);
 }
 
-Real axial_deviator(const Tensor& t) { return t[8] - (t[0] + t[4]) / 2; }
+Real axial_deviator(const std::array<Real, 3>& s) { return s[2] - (s[0] + s[1]) / 2; }
 
-Real mean_stress(const Tensor& t) { return (t[0] + t[4] + t[8]) / 3; }
+Real axial_deviator(const Tensor& t) { return axial_deviator(std::array<Real, 3>{t[0], t[4], t[8]}); }
+
+Real mean_stress(const std::array<Real, 3>& s) { return (s[0] + s[1] + s[2]) / 3; }
+
+Real mean_stress(const Tensor& t) { return mean_stress(std::array<Real, 3>{t[0], t[4], t[8]}); }
 
 Real stress_ratio(const Tensor& s) {
   const Real p = mean_stress(s);

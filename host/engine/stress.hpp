@@ -23,8 +23,12 @@ class Simulation;
 
 /// Axial deviator t_zz - (t_xx + t_yy)/2 of a tensor: q of a stress.
 Real axial_deviator(const Tensor& t);
+/// The same of the normal stresses (xx, yy, zz) of a cell.
+Real axial_deviator(const std::array<Real, 3>& s);
 /// Mean of the diagonal, tr / 3: p of a stress.
 Real mean_stress(const Tensor& t);
+/// The same of the normal stresses (xx, yy, zz) of a cell.
+Real mean_stress(const std::array<Real, 3>& s);
 /// Triaxial stress ratio q/p of a stress tensor (p = tr/3); zero when p <= 0.
 Real stress_ratio(const Tensor& s);
 

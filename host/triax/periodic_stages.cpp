@@ -16,20 +16,6 @@ namespace {
 
 constexpr Real kPi = 3.14159265358979323846;
 
-/// The servo of stage (a): every axis to sigma3, its rates clamped to consolidation_rate, or to gas_rate while the
-/// cell holds a gas.
-CellServoSpec consolidation_servo(const PeriodicTriaxialParams& prm) {
-  CellServoSpec s;
-  for (bool& on : s.servo) on = true;
-  s.sigma3 = prm.sigma3;
-  s.alpha = prm.servo_alpha;
-  s.max_rate = prm.consolidation_rate;
-  s.gas_rate = prm.gas_rate;
-  s.gas_volume = prm.gas_volume;
-  s.stiffness_every = prm.stiffness_every;
-  return s;
-}
-
 /// The servo of stage (b): the lateral axes to sigma3 plus the membrane's confinement from their strains since L0,
 /// clamped to max_lateral_rate; the axial axis shortened at axial_rate.
 CellServoSpec shear_servo(const PeriodicTriaxialParams& prm, const std::array<Real, 3>& L0) {
@@ -142,6 +128,18 @@ void announce(const PeriodicTriaxialParams& prm, Real inertial, Real dt) {
 
 }  // namespace
 
+CellServoSpec consolidation_servo(const PeriodicTriaxialParams& prm) {
+  CellServoSpec s;
+  for (bool& on : s.servo) on = true;
+  s.sigma3 = prm.sigma3;
+  s.alpha = prm.servo_alpha;
+  s.max_rate = prm.consolidation_rate;
+  s.gas_rate = prm.gas_rate;
+  s.gas_volume = prm.gas_volume;
+  s.stiffness_every = prm.stiffness_every;
+  return s;
+}
+
 GrainScales grain_scales(Simulation& sim) {
   Particles& p = sim.particles();
   auto r = Kokkos::create_mirror_view_and_copy(HostSpace(), p.radius);
@@ -191,8 +189,12 @@ void CellServo::update(CellControl& cell) {
 }
 
 Consolidation::Consolidation(CellControl& cell, const PeriodicTriaxialParams& prm)
-    : cell_(cell), prm_(prm), servo_(consolidation_servo(prm)),
-      progress_(prm.name + " consolidation (ETA to the step cap)", prm.max_consolidation_steps) {}
+    : Consolidation(cell, prm, consolidation_servo(prm), "consolidation") {}
+
+Consolidation::Consolidation(CellControl& cell, const PeriodicTriaxialParams& prm, const CellServoSpec& spec,
+                             const std::string& what)
+    : cell_(cell), prm_(prm), spec_(spec), what_(what), servo_(spec),
+      progress_(prm.name + " " + what + " (ETA to the step cap)", prm.max_consolidation_steps) {}
 
 StageSteps Consolidation::steps() {
   StageSteps stage;
@@ -205,7 +207,8 @@ StageSteps Consolidation::steps() {
     if (!measured) return false;
     s_ = cell_.stress();
     err_ = 0;
-    for (int d = 0; d < 3; ++d) err_ = std::max(err_, std::fabs(s_[d] - prm_.sigma3) / prm_.sigma3);
+    for (int d = 0; d < 3; ++d)
+      if (spec_.servo[d]) err_ = std::max(err_, std::fabs(s_[d] - spec_.sigma3) / spec_.sigma3);
     ratio_ = cell_.unbalanced_ratio();
     if (prm_.verbose) {
       char extra[128];
@@ -222,12 +225,11 @@ std::string Consolidation::end(StageEnd& e) {
   cell_.set_rates(Vec3());
   if (e.done) {
     if (prm_.verbose) progress_.finish("(converged after " + std::to_string(e.step) + " steps)");
-    e.timing.name = "consolidation";
+    e.timing.name = what_;
     return "";
   }
   std::ostringstream msg;
-  msg << "periodic triaxial: isotropic consolidation to sigma3 = " << 1e-3 * prm_.sigma3
-      << " kPa did not converge in " << prm_.max_consolidation_steps << " steps: stresses (xx, yy, zz) = ("
+  msg << prm_.name << ": " << what_ << " (target " << 1e-3 * spec_.sigma3 << " kPa on the servoed axes) did not converge in " << prm_.max_consolidation_steps << " steps: stresses (xx, yy, zz) = ("
       << 1e-3 * s_[0] << ", " << 1e-3 * s_[1] << ", " << 1e-3 * s_[2] << ") kPa, largest error " << err_
       << " (tolerance " << prm_.stress_tolerance << "), unbalanced-force ratio " << ratio_ << " (tolerance "
       << prm_.unbalanced_tolerance << "). Raise max_consolidation_steps, or loosen unbalanced_tolerance if the "

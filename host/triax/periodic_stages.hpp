@@ -39,10 +39,19 @@ class CellServo {
   std::array<Real, 3> k_{};
 };
 
-/// Stage (a), isotropic consolidation, on a cell: its servo, its progress line, and the state it reached.
+/// The servo of stage (a): every axis to sigma3, its rates clamped to consolidation_rate, or to gas_rate while the
+/// cell holds a gas.
+CellServoSpec consolidation_servo(const PeriodicTriaxialParams& prm);
+
+/// A hold at stress on a cell: the servoed axes of its spec to the spec's sigma3, the others at their fixed rates,
+/// until each servoed stress is within stress_tolerance of its target and the unbalanced ratio below its tolerance.
+/// Stage (a), isotropic consolidation, and each increment of a compression test (host/triax/compression_test.hpp).
 class Consolidation {
  public:
   Consolidation(CellControl& cell, const PeriodicTriaxialParams& prm);
+  /// A hold of `spec`, named `what` ("oedometer to 200 kPa") in its progress line and failure.
+  Consolidation(CellControl& cell, const PeriodicTriaxialParams& prm, const CellServoSpec& spec,
+                const std::string& what);
 
   StageSteps steps();
   /// After the stage: the cell's rates zeroed; "" where it converged, else why not (the error's message).
@@ -51,6 +60,8 @@ class Consolidation {
  private:
   CellControl& cell_;
   PeriodicTriaxialParams prm_;
+  CellServoSpec spec_;
+  std::string what_;
   CellServo servo_;
   Progress progress_;
   Real err_ = 0, ratio_ = 1;
