@@ -203,6 +203,31 @@ TEST(CliEdges, ThePeriodicJobTellsItsCostBeforeTheWork) {
   EXPECT_NE(line.find(" on this machine"), std::string::npos) << line;
 }
 
+// The compression command (issue 88): the cell's oedometer says what it will run before the packing, writes a row per
+// increment (the seating state first) with K0 = sigma_h / sigma_v, and refuses a test it does not know, naming the
+// ones it does.
+TEST(CliEdges, TheCompressionJobWritesARowPerIncrement) {
+  const fs::path dir = dem::test::scratch_dir("cli_compression");
+  const std::string cell = (dir / "cell.toml").string();
+  write_edited("tests/data/hidden_effects.toml", "target_axial_strain_pct = 8.0", "target_axial_strain_pct = 8.0",
+               cell);
+  const Outcome o = triaxdem("compression " + cell + " --stresses 200,400 -o " + (dir / "run").string(), dir);
+  EXPECT_EQ(o.code, 0) << o.output;
+  const std::size_t plan = o.output.find("compression: plan: 120 balls"), packing = o.output.find("preparation");
+  ASSERT_NE(plan, std::string::npos) << o.output;
+  EXPECT_LT(plan, packing) << o.output;
+  std::ifstream series(dir / "run" / "series.csv");
+  std::string header, line;
+  std::getline(series, header);
+  EXPECT_NE(header.find("K0"), std::string::npos) << header;
+  int rows = 0;
+  while (std::getline(series, line)) ++rows;
+  EXPECT_EQ(rows, 3) << "the seating state and two increments";
+  const Outcome bad = triaxdem("compression " + cell + " --test triaxial -o " + (dir / "bad").string(), dir);
+  EXPECT_NE(bad.code, 0);
+  EXPECT_NE(bad.output.find("oedometer"), std::string::npos) << bad.output;
+}
+
 // A specimen whose layer the step cap stopped before it came to rest warned and went on (exit 0): it is refused,
 // naming the keys, unless accepted; the refused specimen is kept, so the rerun that accepts it does not build it
 // again; and a resume reads the run's own copy, so clearing the shared cache costs nothing.

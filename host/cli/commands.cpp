@@ -110,6 +110,18 @@ void one_config_options(CLI::App* cmd, Args& a) {
   cmd->add_flag("--overwrite", a.overwrite, kOverwriteHelp);
 }
 
+void compression_options(CLI::App* cmd, Args& a) {
+  one_config_options(cmd, a);
+  cmd->add_option("--test", a.compression_path, "oedometer (lateral strain zero, K0 recorded) or isotropic (every axis "
+                  "to the mean stress); default oedometer")
+      ->check(CLI::IsMember({"oedometer", "isotropic"}));
+  cmd->add_option("--stresses", a.compression_kpa, "the increments' targets in kPa, loading and unloading in order: "
+                  "the axial stress (oedometer) or the mean stress (isotropic); default 2, 4, 8, 4, 2 times [periodic] "
+                  "sigma3_kPa")
+      ->delimiter(',')
+      ->check(CLI::PositiveNumber);
+}
+
 void study_options(CLI::App* cmd, Args& a) {
   cmd->add_option("configs", a.study_inputs, "config folders (every *.toml) or files")->required();
   cmd->add_option("-o,--output", a.study.output, "output folder: summary, figure, one subfolder per case");
@@ -285,6 +297,11 @@ const std::vector<Command>& command_table() {
      }},
     {"periodic", "periodic-cell drained triaxial test (no platens, no membrane)", one_config_options,
      [](Args& a) { return in_own_folder(a, dem::run_periodic_job); }},
+    {"compression", "oedometer or isotropic compression of a cell, loaded in increments", compression_options,
+     [](Args& a) {
+       return in_own_folder(
+           a, [&](const dem::Config& c) { return dem::compression_job(c, a.compression_path, a.compression_kpa); });
+     }},
     {"study", "run a set of triaxial cases and write one summary table and figure", study_options, study, true, false,
      false},
     {"micro", "micromechanics of a saved state (a run folder and a strain, or a snapshot)", micro_options, micro},

@@ -29,6 +29,8 @@ struct Args {
   std::string free_list;
   dem::SynthOptions syn;
   std::vector<double> syn_kpa;
+  std::string compression_path = "oedometer";
+  std::vector<double> compression_kpa;
 };
 
 

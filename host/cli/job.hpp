@@ -39,6 +39,12 @@ int triaxial_job(const Config& cfg, bool resume = false, long stop_at_step = -1)
 /// Returns 0, or 2 on a blow-up (state saved).
 int run_periodic_job(const Config& cfg);
 
+/// The `compression` job: the cell of a periodic job's config (fully periodic or [periodic] boundary = "walls"),
+/// consolidated to [periodic] sigma3, then loaded in increments to `targets_kpa` (kPa; empty: 2, 4, 8, 4 and 2 times
+/// sigma3) along `path` ("oedometer" or "isotropic", host/triax/compression_test.hpp), a row per increment in
+/// series.csv. Returns 0, or 2 on a blow-up (state saved).
+int compression_job(const Config& cfg, const std::string& path, const std::vector<double>& targets_kpa);
+
 /// `triaxdem micro`: the micromechanics of one saved state. `source` is a run folder (then `at_pct` picks
 /// the snapshot taken at that axial strain) or a snapshot file. Writes micro_<label>.csv (one row of the
 /// micro columns for the specimen and the cube), the distributions and the force chains into `output`
