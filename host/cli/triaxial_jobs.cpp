@@ -4,9 +4,9 @@
 #include <filesystem>
 
 #include "host/cli/job.hpp"
-#include "host/config/provenance.hpp"
 #include "host/engine/checkpoint.hpp"
 #include "host/engine/setup.hpp"
+#include "host/engine/stress.hpp"
 #include "host/io/io_hdf5.hpp"
 #include "host/lab/run_cost.hpp"
 #include "host/triax/cell_boundary.hpp"
@@ -91,7 +91,7 @@ int triaxial_job(const Config& cfg, bool resume, long stop_at_step) {
       std::printf("at the highest record (micro_*_peak.csv): q/p %.3f at the boundary, %.3f from the contacts "
                   "(Love-Weber), %.3f from the stress-force-fabric relation, with a_c %.3f, a_n %.3f, a_t %.3f; "
                   "Z %.2f\n",
-                  r.records[k].q / (cfg.triaxial.sigma3 + r.records[k].q / 3), m.q_over_p, m.q_over_p_sff, m.all.a_c,
+                  r.records[k].q / triaxial_mean_stress(cfg.triaxial.sigma3, r.records[k].q), m.q_over_p, m.q_over_p_sff, m.all.a_c,
                   m.all.a_n, m.all.a_t, m.z.z);
     }
     std::printf("time loop (consolidation and shear): %s; measurements and output %.1f s\n",
@@ -99,29 +99,7 @@ int triaxial_job(const Config& cfg, bool resume, long stop_at_step) {
     std::vector<StageTiming> stages = sp.stages;
     stages.insert(stages.end(), r.stages.begin(), r.stages.end());
     report_timings(out.folder(), stages);
-    TestSummary s;
-    s.kind = "membrane";
-    s.sigma3 = cfg.triaxial.sigma3;
-    s.mu_s = cfg.ball.mu_s;
-    s.mu_r = cfg.ball.mu_r;
-    s.balls = static_cast<long>(sp.balls.size());
-    s.void_ratio0 = r.void_ratio_consolidated;
-    s.q_peak = r.q_peak;
-    if (!r.records.empty()) {
-      s.q_peak_area = curves_of(r, q_field(QMeasure::kAreaCorrected), s.sigma3).q_peak;
-      s.q_peak_parabolic = curves_of(r, q_field(QMeasure::kParabolic), s.sigma3).q_peak;
-      s.q_peak_membrane = curves_of(r, q_field(QMeasure::kMembraneCorrected), s.sigma3).q_peak;
-      s.q_peak_lw = curves_of(r, &TriaxialRecord::q_lw, s.sigma3).q_peak;
-    }
-    s.phi_peak_deg = r.phi_peak_deg;
-    s.eps_a_peak = r.eps_a_peak;
-    s.q_end = r.q_end;
-    s.eps_a_end = r.records.empty() ? 0 : r.records.back().eps_a;
-    s.max_dilatancy = r.max_dilatancy;
-    s.inertial_number = r.inertial_number;
-    s.wall_seconds = r.wall_seconds;
-    s.provenance = provenance_of(cfg);
-    write_summary(out.folder(), s);
+    write_summary(out.folder(), summary_of(cfg, r, static_cast<long>(sp.balls.size())));
     std::printf("output: %s/series.csv, summary.csv, snapshots.xdmf (ParaView: balls and membrane)\n",
                 out.folder().c_str());
     run_plot_script("plot_triaxial.py", {out.folder(), "--title", cfg.run.name});
@@ -160,25 +138,7 @@ int run_periodic_job(const Config& cfg) {
     announce("test");
     const PeriodicTriaxialResult r = run_periodic_triaxial(*sim, tp, &out);
     timings = r.stages;
-    TestSummary su;
-    su.kind = cfg.periodic.boundary == CellBoundary::walls ? "walls" : "periodic";
-    su.sigma3 = r.params.sigma3;
-    su.mu_s = cfg.ball.mu_s;
-    su.mu_r = cfg.ball.mu_r;
-    su.balls = static_cast<long>(balls.size());
-    su.void_ratio0 = r.void_ratio0;
-    su.q_peak = r.q_peak;
-    // The cell has one q: the periodic cell's from its contacts, the walled cell's from its walls.
-    su.q_peak_area = su.q_peak_parabolic = su.q_peak_membrane = su.q_peak_lw = r.q_peak;
-    su.phi_peak_deg = r.phi_peak_deg;
-    su.eps_a_peak = r.eps_a_peak;
-    su.q_end = r.q_end;
-    su.eps_a_end = r.series.back().eps_a;
-    su.max_dilatancy = r.max_dilatancy;
-    su.inertial_number = r.inertial;
-    su.wall_seconds = r.wall_seconds;
-    su.provenance = provenance_of(cfg);
-    write_summary(out.folder(), su);
+    write_summary(out.folder(), summary_of(cfg, r, static_cast<long>(balls.size())));
   } catch (const BlowUp& e) {
     out.flush_series();
     if (sim) {

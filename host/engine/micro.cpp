@@ -24,7 +24,7 @@ Tensor outer(const Vec3& a, const Vec3& b) {
 
 Tensor deviator(const Tensor& t) {
   Tensor d = t;
-  const Real m = (t[0] + t[4] + t[8]) / 3;
+  const Real m = mean_stress(t);
   for (int i = 0; i < 3; ++i) d[4 * i] -= m;
   return d;
 }

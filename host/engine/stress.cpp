@@ -28,6 +28,8 @@ Real mean_stress(const std::array<Real, 3>& s) { return (s[0] + s[1] + s[2]) / 3
 
 Real mean_stress(const Tensor& t) { return mean_stress(std::array<Real, 3>{t[0], t[4], t[8]}); }
 
+Real triaxial_mean_stress(Real sigma3, Real q) { return sigma3 + q / 3; }
+
 Real stress_ratio(const Tensor& s) {
   const Real p = mean_stress(s);
   return p > 0 ? axial_deviator(s) / p : 0;

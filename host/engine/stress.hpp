@@ -29,6 +29,8 @@ Real axial_deviator(const std::array<Real, 3>& s);
 Real mean_stress(const Tensor& t);
 /// The same of the normal stresses (xx, yy, zz) of a cell.
 Real mean_stress(const std::array<Real, 3>& s);
+/// p of a triaxial test from its lateral stress sigma3 and deviator q (Pa), as labs report it: sigma3 + q / 3.
+Real triaxial_mean_stress(Real sigma3, Real q);
 /// Triaxial stress ratio q/p of a stress tensor (p = tr/3); zero when p <= 0.
 Real stress_ratio(const Tensor& s);
 

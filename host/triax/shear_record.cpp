@@ -29,7 +29,7 @@ std::vector<double> series_row(const TriaxialRecord& r, Real sigma3, Real e0) {
           sigma3 / 1e3,          r.sigma3_balls / 1e3, 100 * r.eps_v_envelope, r.unbalanced,     r.kinetic,
           r.q_area / 1e3,        r.q_parabolic / 1e3,  r.q_membrane / 1e3,  r.sigma3_hoop / 1e3, r.q_lw / 1e3,
           r.p_lw / 1e3,          r.q_boundary / 1e3,   r.p_boundary / 1e3,  r.q_net / 1e3,      r.p_net / 1e3,
-          (sigma3 + r.q / 3) / 1e3, (1 + e0) * (1 - r.eps_v) - 1, friction_angle_deg(r.q, sigma3)};
+          triaxial_mean_stress(sigma3, r.q) / 1e3, (1 + e0) * (1 - r.eps_v) - 1, friction_angle_deg(r.q, sigma3)};
 }
 
 /// The record's deviators as labs report them and the specimen's stresses over the enclosed `volume` (its contacts'

@@ -30,6 +30,16 @@ struct TestSummary {
   Provenance provenance;        ///< empty in a summary written before it was recorded
 };
 
+struct Config;
+struct TriaxialResult;
+struct PeriodicTriaxialResult;
+
+/// The summary of a membrane test of `balls` balls run from `cfg` (kind "membrane", each q measure's peak).
+TestSummary summary_of(const Config& cfg, const TriaxialResult& r, long balls);
+/// The summary of a cell's test of `balls` balls run from `cfg` (kind "periodic" or "walls"): the cell has one q,
+/// the periodic cell's from its contacts, the walled cell's from its walls, so every measure's peak is q_peak.
+TestSummary summary_of(const Config& cfg, const PeriodicTriaxialResult& r, long balls);
+
 /// The peak of the q a lab reports as `m`, so that a measured peak is compared like with like; a periodic
 /// cell's q_peak whatever m is.
 Real q_peak_as(const TestSummary& s, QMeasure m);
