@@ -162,29 +162,64 @@ std::pair<Real, Real> place_reference(Session& ss, const std::string& material, 
   return {rise, chi2};
 }
 
-}  // namespace
+/// What a job does with each material's tests: the calibration's fit, or the diagnosis. The loop over the
+/// materials, the account of the runs, the prediction and the pools are the job's (run_materials), one for both.
+class MaterialWork {
+ public:
+  virtual ~MaterialWork() = default;
+  /// Fits `tests` of `material` against `misfit`: the calibrated model and its curves, for the prediction.
+  virtual Calibrated fit(const std::string& material, const std::vector<TriaxialTest>& tests,
+                         const Misfit& misfit) = 0;
+  /// After every material: the job's lines and files; returns where its results are, for the closing line.
+  virtual std::string close(const std::vector<TriaxialTest>& meas, const std::vector<TriaxialTest>& sim) = 0;
+  /// The prediction's text (not empty), once the membrane tests or the walled runs have ended.
+  virtual void predicted(const std::string& prediction) = 0;
+  /// What the curves of fit are, in the job's closing lines.
+  virtual const char* fitted() const = 0;
+};
 
-int calibrate_job(const Config& base, const CalibrationOptions& o) {
-  if (o.plan_only) return JobInputs(base, o).announce_plan(base, o, "calibrate"), 0;
-  Session ss(base, o, "calibrate");
-  std::ostringstream table;
-  table << "material,parameter,value,low95,high95,reference,chi2,data,runs,reference_rise,reference_chi2\n";
+int run_materials(const Config& base, const CalibrationOptions& o, Session& ss, const std::string& kind,
+                  MaterialWork& work) {
   std::vector<TriaxialTest> all_meas, all_sim;
   std::map<std::string, Calibrated> models;
-  for (const auto& by : by_material(ss.data, o.material)) {
-    // Named, not structured, bindings: a lambda below captures them (C++17 cannot capture a structured binding).
-    const std::string& material = by.first;
-    const std::vector<TriaxialTest>& tests = by.second;
-    std::printf("calibrate: %s, %zu tests, free %zu parameters, %zu balls in %s\n", material.c_str(), tests.size(),
-                ss.free.size(), ss.lab.balls(), ss.cell_text().c_str());
-    const long runs0 = ss.lab.runs();
+  for (const auto& [material, tests] : by_material(ss.data, o.material)) {
+    std::printf("%s: %s, %zu tests, free %zu parameters, %zu balls in %s\n", kind.c_str(), material.c_str(),
+                tests.size(), ss.free.size(), ss.lab.balls(), ss.cell_text().c_str());
     const Misfit misfit = ss.misfit_of(base, material, tests);  // sets the ensemble ("auto": from the scatter)
+    Calibrated c = work.fit(material, tests, misfit);
+    all_meas.insert(all_meas.end(), tests.begin(), tests.end());
+    all_sim.insert(all_sim.end(), c.sim.begin(), c.sim.end());
+    models[material] = std::move(c);
+  }
+  const std::string where = work.close(all_meas, all_sim);
+  std::printf("%s: %s in %s; %s\n", kind.c_str(), ss.runs_text().c_str(), format_duration(ss.lab.seconds()).c_str(),
+              where.c_str());
+  if (const std::string w = ss.workers_text(); !w.empty()) std::printf("%s: %s\n", kind.c_str(), w.c_str());
+  ss.finish(all_meas, all_sim, work.fitted());
+  const std::string prediction = ss.predict_boundary(base, models);
+  if (!prediction.empty()) work.predicted(prediction);
+  ss.write_pools();
+  std::printf("%s: %s\n", kind.c_str(), ss.plan_text().c_str());
+  return 0;
+}
+
+/// The calibration of each material: the fit (two fidelities where asked), the scatter at the answer, the reference
+/// placed, the values with their intervals in calibrated.csv.
+class CalibrationWork : public MaterialWork {
+ public:
+  CalibrationWork(Session& ss, const Config& base) : ss_(ss), base_(base) {
+    table_ << "material,parameter,value,low95,high95,reference,chi2,data,runs,reference_rise,reference_chi2\n";
+  }
+
+  Calibrated fit(const std::string& material, const std::vector<TriaxialTest>& tests, const Misfit& misfit) override {
+    Session& ss = ss_;
+    const long runs0 = ss.lab.runs();
     auto fit = [&](const Misfit& m, const std::string& what) {
       const long start = ss.lab.runs();
       const long planned = planned_points(static_cast<int>(ss.free.size())) * static_cast<long>(tests.size()) *
                            ss.lab.members();
       Progress progress(what + " " + material, planned);
-      CalibrationResult r = calibrate(ss.lab, model_of(base), ss.free, tests, m, 4, [&](long done, long, Real chi2) {
+      CalibrationResult r = calibrate(ss.lab, model_of(base_), ss.free, tests, m, 4, [&](long done, long, Real chi2) {
         char extra[64];
         std::snprintf(extra, sizeof extra, "runs, best chi2 %.1f", chi2);
         progress.update(done - start, extra);
@@ -194,10 +229,10 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
       return r;
     };
     CalibrationResult r = fit(misfit, "calibrate");
-    if (ss.two_fidelity) r = two_fidelity_fit(ss, base, material, tests, misfit, r, fit);
+    if (ss.two_fidelity) r = two_fidelity_fit(ss, base_, material, tests, misfit, r, fit);
     // The noise at the answer: the scatter specimens run again at the calibrated point, and the design whitened by it
     // (rewhiten). Two fidelities fit a misfit corrected by the membrane test, which is measured at its own points.
-    const Misfit there = ss.two_fidelity ? misfit : rescattered(ss, material, tests, misfit, r, model_of(base));
+    const Misfit there = ss.two_fidelity ? misfit : rescattered(ss, material, tests, misfit, r, model_of(base_));
     // A reference that gives every free parameter is placed against the joint region, and run (runs_reference): is
     // it consistent with these data?
     const long fit_runs = ss.lab.runs() - runs0;  // the reference point's runs are not the calibration's
@@ -208,11 +243,11 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
       const Real ref = ss.reference(material, f.name);
       std::printf("calibrate: %s: %s = %.4g%s\n", material.c_str(), f.name.c_str(), f.shown * r.values[k],
                   std::isfinite(ref) ? fmt(" (reference %g)", ref).c_str() : "");
-      table << material << "," << f.name << "," << fmt("%.6g", f.shown * r.values[k]) << ","
-            << fmt("%.6g", f.shown * r.interval[k].first) << "," << fmt("%.6g", f.shown * r.interval[k].second) << ","
-            << (std::isfinite(ref) ? fmt("%g", ref) : "") << "," << fmt("%.3f", r.best.chi2) << "," << r.data << "," << fit_runs << ","
-            << (whole_reference ? fmt("%.4g", reference_rise) : "") << ","
-            << (std::isfinite(reference_chi2) ? fmt("%.3f", reference_chi2) : "") << "\n";
+      table_ << material << "," << f.name << "," << fmt("%.6g", f.shown * r.values[k]) << ","
+             << fmt("%.6g", f.shown * r.interval[k].first) << "," << fmt("%.6g", f.shown * r.interval[k].second)
+             << "," << (std::isfinite(ref) ? fmt("%g", ref) : "") << "," << fmt("%.3f", r.best.chi2) << ","
+             << r.data << "," << fit_runs << "," << (whole_reference ? fmt("%.4g", reference_rise) : "") << ","
+             << (std::isfinite(reference_chi2) ? fmt("%.3f", reference_chi2) : "") << "\n";
     }
     std::printf("%s", uncertainty_text(r, material, "calibrate").c_str());
     for (const std::string& note : r.widened) std::printf("calibrate: %s: %s\n", material.c_str(), note.c_str());
@@ -221,28 +256,85 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
                   "outside)\n", material.c_str(), name.c_str());
     std::printf("calibrate: %s: chi2 %.1f on %d data after %ld runs\n", material.c_str(), r.best.chi2, r.data,
                 fit_runs);
-    all_meas.insert(all_meas.end(), tests.begin(), tests.end());
-    all_sim.insert(all_sim.end(), r.best.sim.begin(), r.best.sim.end());
     std::vector<TriaxialTest> held;
     for (const TriaxialTest& t : ss.held_out)
       if (t.material == material) held.push_back(t);
-    models[material] = Calibrated{tests, r.model, r.best.sim, held};
+    return Calibrated{tests, r.model, r.best.sim, held};
   }
-  if (ss.two_fidelity)
-    std::printf("calibrate: two fidelities: the table sets the periodic cell against the data as measured; it was "
-                "fitted to them less the boundary's discrepancy, and the membrane prediction below is the test "
-                "that compares with the lab\n");
-  print_errors(all_meas, all_sim);
-  io::write_text_atomic(ss.folder + "/calibrated.csv", table.str());
-  std::printf("calibrate: %s in %s; results in %s (calibrated.csv, errors.csv, simulated_curves.csv)\n",
-              ss.runs_text().c_str(), format_duration(ss.lab.seconds()).c_str(), ss.folder.c_str());
-  if (const std::string w = ss.workers_text(); !w.empty()) std::printf("calibrate: %s\n", w.c_str());
-  ss.finish(all_meas, all_sim, "the calibrated parameters");
-  const std::string prediction = ss.predict_boundary(base, models);
-  if (!prediction.empty()) io::write_text_atomic(ss.folder + "/prediction.md", prediction);
-  ss.write_pools();
-  std::printf("calibrate: %s\n", ss.plan_text().c_str());
-  return 0;
+
+  std::string close(const std::vector<TriaxialTest>& meas, const std::vector<TriaxialTest>& sim) override {
+    if (ss_.two_fidelity)
+      std::printf("calibrate: two fidelities: the table sets the periodic cell against the data as measured; it was "
+                  "fitted to them less the boundary's discrepancy, and the membrane prediction below is the test "
+                  "that compares with the lab\n");
+    print_errors(meas, sim);
+    io::write_text_atomic(ss_.folder + "/calibrated.csv", table_.str());
+    return "results in " + ss_.folder + " (calibrated.csv, errors.csv, simulated_curves.csv)";
+  }
+
+  void predicted(const std::string& prediction) override {
+    io::write_text_atomic(ss_.folder + "/prediction.md", prediction);
+  }
+
+  const char* fitted() const override { return "the calibrated parameters"; }
+
+ private:
+  Session& ss_;
+  const Config& base_;
+  std::ostringstream table_;
+};
+
+/// The diagnosis of each material: the base model's fit, each extension's, the verdict; diagnosis.md.
+class DiagnosisWork : public MaterialWork {
+ public:
+  DiagnosisWork(Session& ss, const Config& base, const CalibrationOptions& o)
+      : ss_(ss), base_(base), report_(ss, base, o) {}
+
+  Calibrated fit(const std::string& material, const std::vector<TriaxialTest>& tests, const Misfit& misfit) override {
+    const Diagnosis dg = diagnose(ss_.lab, model_of(base_), ss_.free, tests, misfit, true);
+    require_a_result(dg.base, "diagnose " + material + " (the base model's search)", ss_);
+    std::printf("diagnose: %s: verdict: %s\n  %s\n", material.c_str(), dg.verdict.c_str(), dg.explanation.c_str());
+    std::printf("%s", uncertainty_text(dg.base, material, "diagnose").c_str());
+    for (const std::string& note : dg.base.widened) std::printf("diagnose: %s: %s\n", material.c_str(), note.c_str());
+    if (const std::string edge = edge_names(dg.base); !edge.empty())
+      std::printf("diagnose: %s: WARNING: %s at the edge of the search range\n", material.c_str(), edge.c_str());
+    if (const ExtensionFit* top = report_.add_material(material, tests, misfit, dg)) {
+      extended_.insert(extended_.end(), top->best.sim.begin(), top->best.sim.end());
+      std::printf("diagnose: %s: gain of %s: chi2 %.1f -> %.1f, held-out chi2 %.1f -> %.1f (diagnosis.md has it by "
+                  "pressure, strain range and quantity)\n", material.c_str(), top->ext.name.c_str(),
+                  dg.base.best.chi2, top->best.chi2, dg.base_heldout, top->heldout);
+    }
+    return Calibrated{tests, dg.base.model, dg.base.best.sim, {}};
+  }
+
+  std::string close(const std::vector<TriaxialTest>& meas, const std::vector<TriaxialTest>&) override {
+    report_.close();
+    if (extended_.size() == meas.size())
+      write_measured_curves(ss_.folder + "/extended_curves.csv", extended_,
+                            "simulated by the extended model of each material");
+    report_.write();
+    return "report in " + ss_.folder + "/diagnosis.md";
+  }
+
+  // The report stands before the membrane tests run; their section is added when they end.
+  void predicted(const std::string& prediction) override { report_.write(prediction); }
+
+  const char* fitted() const override { return "the calibrated base model"; }
+
+ private:
+  Session& ss_;
+  const Config& base_;
+  DiagnosisReport report_;
+  std::vector<TriaxialTest> extended_;  ///< the best extension's curves, where a material has one
+};
+
+}  // namespace
+
+int calibrate_job(const Config& base, const CalibrationOptions& o) {
+  if (o.plan_only) return JobInputs(base, o).announce_plan(base, o, "calibrate"), 0;
+  Session ss(base, o, "calibrate");
+  CalibrationWork work(ss, base);
+  return run_materials(base, o, ss, "calibrate", work);
 }
 
 int diagnose_job(const Config& base, const CalibrationOptions& o) {
@@ -251,44 +343,8 @@ int diagnose_job(const Config& base, const CalibrationOptions& o) {
   if (ss.two_fidelity)
     std::printf("diagnose: note: the diagnosis fits the periodic cell; two fidelities apply to calibrate (the "
                 "membrane prediction at the end shows what the boundary adds)\n");
-  DiagnosisReport report(ss, base, o);
-  std::vector<TriaxialTest> all_meas, all_sim, all_ext;
-  std::map<std::string, Calibrated> models;
-  for (const auto& [material, tests] : by_material(ss.data, o.material)) {
-    std::printf("diagnose: %s, %zu tests, %zu balls in %s\n", material.c_str(), tests.size(), ss.lab.balls(),
-                ss.cell_text().c_str());
-    const Misfit misfit = ss.misfit_of(base, material, tests);
-    const Diagnosis dg = diagnose(ss.lab, model_of(base), ss.free, tests, misfit, true);
-    require_a_result(dg.base, "diagnose " + material + " (the base model's search)", ss);
-    std::printf("diagnose: %s: verdict: %s\n  %s\n", material.c_str(), dg.verdict.c_str(), dg.explanation.c_str());
-    std::printf("%s", uncertainty_text(dg.base, material, "diagnose").c_str());
-    for (const std::string& note : dg.base.widened) std::printf("diagnose: %s: %s\n", material.c_str(), note.c_str());
-    if (const std::string edge = edge_names(dg.base); !edge.empty())
-      std::printf("diagnose: %s: WARNING: %s at the edge of the search range\n", material.c_str(), edge.c_str());
-    if (const ExtensionFit* top = report.add_material(material, tests, misfit, dg)) {
-      all_ext.insert(all_ext.end(), top->best.sim.begin(), top->best.sim.end());
-      std::printf("diagnose: %s: gain of %s: chi2 %.1f -> %.1f, held-out chi2 %.1f -> %.1f (diagnosis.md has it by "
-                  "pressure, strain range and quantity)\n", material.c_str(), top->ext.name.c_str(),
-                  dg.base.best.chi2, top->best.chi2, dg.base_heldout, top->heldout);
-    }
-    all_meas.insert(all_meas.end(), tests.begin(), tests.end());
-    all_sim.insert(all_sim.end(), dg.base.best.sim.begin(), dg.base.best.sim.end());
-    models[material] = Calibrated{tests, dg.base.model, dg.base.best.sim, {}};
-  }
-  report.close();
-  if (all_ext.size() == all_meas.size())
-    write_measured_curves(ss.folder + "/extended_curves.csv", all_ext, "simulated by the extended model of each material");
-  report.write();
-  std::printf("diagnose: %s in %s; report in %s/diagnosis.md\n", ss.runs_text().c_str(),
-              format_duration(ss.lab.seconds()).c_str(), ss.folder.c_str());
-  if (const std::string w = ss.workers_text(); !w.empty()) std::printf("diagnose: %s\n", w.c_str());
-  ss.finish(all_meas, all_sim, "the calibrated base model");
-  // The report stands before the membrane tests run; their section is added when they end.
-  const std::string prediction = ss.predict_boundary(base, models);
-  if (!prediction.empty()) report.write(prediction);
-  ss.write_pools();
-  std::printf("diagnose: %s\n", ss.plan_text().c_str());
-  return 0;
+  DiagnosisWork work(ss, base, o);
+  return run_materials(base, o, ss, "diagnose", work);
 }
 
 }  // namespace dem
