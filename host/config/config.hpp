@@ -30,11 +30,23 @@ struct RunConfig {
   Real checkpoint_minutes = 10;  ///< wall-clock minutes between checkpoints (0 = by steps only)
 };
 
+/// How the balls' diameters are distributed (host/config/size_distribution.hpp draws them): uniform by number
+/// between the smallest and the largest, lognormal by mass, or a sieve table (percent passing by mass), the last two
+/// as labs measure a material.
+enum class SizeLaw { uniform, lognormal, sieve };
+
 struct ParticleConfig {
   long count = 2000;
-  Real diameter = 2e-3;          ///< m (file: diameter_mm)
-  Real diameter_ratio = 1.0;     ///< largest / smallest diameter, uniform in between
+  /// m (file: diameter_mm): the mean diameter by number; of a lognormal or sieve distribution, worked out from it
+  /// (the file then gives none).
+  Real diameter = 2e-3;
+  Real diameter_ratio = 1.0;     ///< uniform: largest / smallest diameter, uniform in between
   Real density = 2500;           ///< kg/m^3
+  SizeLaw psd = SizeLaw::uniform;  ///< file: psd = "uniform", "lognormal" or "sieve"
+  Real median = 0;               ///< m, lognormal: the median diameter by mass, D50 (file: median_mm)
+  Real log_sd = 0;               ///< lognormal: the standard deviation of ln(d) by mass
+  std::vector<Real> sieve;       ///< m, sieve: the sieve sizes, increasing (file: sieve_mm)
+  std::vector<Real> passing;     ///< sieve: the fraction by mass finer than each sieve, 0 to 1 (file: passing_pct)
 };
 
 /// Box holding the particles at the start; its non-periodic faces carry plane walls when `walls`.

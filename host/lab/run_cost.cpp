@@ -5,6 +5,7 @@
 #include <cmath>
 #include <iterator>
 
+#include "host/config/size_distribution.hpp"
 #include "host/engine/builder.hpp"
 #include "host/engine/cell_batch.hpp"
 #include "host/triax/periodic_triaxial.hpp"
@@ -31,13 +32,6 @@ long CellCost::consolidation_steps(Real sigma3, bool high) const {
 }
 
 namespace {
-
-/// Mean of d^3 over diameters uniform between the config's smallest and largest (packing.cpp's draw).
-Real mean_cube_diameter(const ParticleConfig& pc) {
-  const Real r = pc.diameter_ratio, dmin = 2 * pc.diameter / (1 + r), dmax = r * dmin;
-  if (dmax - dmin < 1e-12 * dmax) return pc.diameter * pc.diameter * pc.diameter;
-  return (std::pow(dmax, 4) - std::pow(dmin, 4)) / (4 * (dmax - dmin));
-}
 
 /// A cubic lattice of the cell's balls (at most kMaxProbeBalls), each pressed into its six neighbours by 0.1% of its
 /// diameter: a probe with the contacts of a loaded packing (the gas phase of a random insertion would time a cheaper
@@ -136,7 +130,7 @@ CellCost measure_cell_cost(const Config& cell, double probe_seconds) {
   // The gas phase: the cell closes on every axis from the box's solid fraction to a dense packing's, at the gas
   // phase's clamp to gas_solid_fraction and at the consolidation rate's after (resolve_periodic_params' defaults).
   const Real volume = cell.box.size[0] * cell.box.size[1] * cell.box.size[2];
-  const Real solid = static_cast<Real>(c.balls) * M_PI / 6 * mean_cube_diameter(cell.particles) / volume;
+  const Real solid = static_cast<Real>(c.balls) * M_PI / 6 * SizeDistribution(cell.particles).mean_cube() / volume;
   const Real axial = axial_rate(c.triax, c.d, c.rho_eff, c.triax.sigma3);
   const Real rate = c.triax.consolidation_rate > 0
                         ? c.triax.consolidation_rate

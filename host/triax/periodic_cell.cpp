@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "host/config/size_distribution.hpp"
 #include "host/triax/cell_boundary.hpp"
 #include "host/engine/checkpoint.hpp"
 #include "host/engine/setup.hpp"
@@ -101,10 +102,10 @@ void check_periodic_config(const Config& cfg) {
   // contact cut-offs, or the minimum image becomes ambiguous and the run stops part way. 5% more for the
   // overlaps under load (a 64-ball cell at 1.03 times the limit by this estimate ended 0.1% short of it).
   const ParticleConfig& pc = cfg.particles;
-  const Real d = pc.diameter, dmax = 2 * d * pc.diameter_ratio / (1 + pc.diameter_ratio);
-  const Real cutoff = dmax + cfg.solver.skin * d;
+  const SizeDistribution sizes(pc);
+  const Real cutoff = sizes.largest() + cfg.solver.skin * pc.diameter;
   const Real box = cfg.box.size[0] * cfg.box.size[1] * cfg.box.size[2];
-  const Real dense = std::cbrt(static_cast<Real>(pc.count) * M_PI / 6 * d * d * d / 0.64 / box);
+  const Real dense = std::cbrt(static_cast<Real>(pc.count) * M_PI / 6 * sizes.mean_cube() / 0.64 / box);
   const Real shortest = dense * std::min({cfg.box.size[0], cfg.box.size[1], cfg.box.size[2]}) *
                         (1 - cfg.periodic.triax.target_strain);
   if (shortest < 1.05 * 3 * cutoff) {

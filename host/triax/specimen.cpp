@@ -1,3 +1,4 @@
+#include "host/config/size_distribution.hpp"
 #include "host/triax/specimen.hpp"
 
 #include <algorithm>
@@ -26,8 +27,6 @@ namespace dem {
 namespace {
 
 constexpr int kProfileBins = 24;
-
-Real ball_volume(Real d) { return M_PI / 6 * d * d * d; }
 
 /// Volume of a spherical cap of height h (0 <= h <= 2r).
 Real cap_volume(Real r, Real h) { return M_PI * h * h * (3 * r - h) / 3; }
@@ -130,7 +129,7 @@ long specimen_ball_count(const Config& cfg) {
   const SpecimenConfig& sc = cfg.specimen;
   if (sc.ball_count > 0) return sc.ball_count;
   const Real v = M_PI * sc.diameter * sc.diameter / 4 * sc.height;
-  return std::lround(v / ((1 + sc.void_ratio) * ball_volume(cfg.particles.diameter)));
+  return std::lround(v / ((1 + sc.void_ratio) * M_PI / 6 * SizeDistribution(cfg.particles).mean_cube()));
 }
 
 Specimen build_specimen(const Config& cfg, bool verbose) {
@@ -216,7 +215,7 @@ std::string specimen_key(const Config& cfg) {
   const SolverConfig& sv = cfg.solver;
   std::ostringstream k;
   k.precision(17);
-  k << "v2 d " << pc.diameter << " ratio " << pc.diameter_ratio << " rho " << pc.density << " D " << sc.diameter
+  k << "v2 d " << pc.diameter << " ratio " << pc.diameter_ratio << size_key(pc) << " rho " << pc.density << " D " << sc.diameter
     << " H " << sc.height << " n " << specimen_ball_count(cfg) << " layers " << sc.layers << " mu " << sc.compaction_mu_s
     << " settle " << sc.settle_mu_s
     << " v " << sc.platen_speed << " stop " << sc.stop_ratio << " max " << sc.max_steps_per_layer << " seed "
