@@ -70,6 +70,8 @@ struct Diagnosis {
   std::vector<GenericFit> generic;  ///< the generic discrepancies, in the order of generic_shapes()
   std::string verdict;              ///< name of the extension found, "none", or several joined by " or "
   std::string explanation;          ///< plain words
+  /// What the held-out check predicted from what (heldout_parts), or why it could make none.
+  std::string heldout_basis;
   std::vector<std::string> notes;   ///< what the search did beyond the plan (a better base run found late)
 };
 

@@ -66,15 +66,21 @@ class ShapedPoint {
     for (std::size_t i = 0; i < r.size(); ++i) r[i] += shaped[i] - plain_[k][i];
     return r;
   }
-  /// chi2 over the tests but `skip` (none: all), at c.
-  Real chi2(Real c, std::size_t skip) const {
+  /// chi2 over the data but the held-out part `skip` (none: all), at c.
+  Real chi2(Real c, const HeldOutPart* skip) const {
     Real s = 0;
-    for (std::size_t k = 0; k < run_.size(); ++k)
-      if (k != skip) s += sum_sq(residuals(k, c));
+    for (std::size_t k = 0; k < run_.size(); ++k) {
+      const bool held = skip && skip->test == k;
+      if (held && skip->local.size() == run_[k].size()) continue;  // a whole test held out
+      const std::vector<Real> r = residuals(k, c);
+      s += held ? sum_sq(r) - sum_sq(r, skip->local) : sum_sq(r);
+    }
     return s;
   }
+  /// chi2 of the held-out part alone, at c.
+  Real held_chi2(Real c, const HeldOutPart& part) const { return sum_sq(residuals(part.test, c), part.local); }
   /// The c that minimises chi2(c, skip) within the shape's range.
-  Real best_c(std::size_t skip) const {
+  Real best_c(const HeldOutPart* skip) const {
     const Real lo = shape_.lo, hi = shape_.hi;
     const std::vector<Real> u =
         minimise_unit_box([&](const std::vector<Real>& x) { return chi2(lo + x[0] * (hi - lo), skip); }, 1);
@@ -93,7 +99,7 @@ class ShapedPoint {
 
 std::vector<GenericFit> fit_generic(const CalibrationResult& base, const Misfit& misfit) {
   const int d = static_cast<int>(base.free.size()), n = base.data;
-  constexpr std::size_t kAll = std::numeric_limits<std::size_t>::max();
+  const HeldOutParts held_out = heldout_parts(misfit);
   std::vector<GenericFit> out;
   for (const GenericShape& shape : generic_shapes()) {
     std::vector<ShapedPoint> points;
@@ -103,7 +109,7 @@ std::vector<GenericFit> fit_generic(const CalibrationResult& base, const Misfit&
     f.shape = shape;
     f.chi2 = std::numeric_limits<Real>::infinity();
     for (const ShapedPoint& p : points) {
-      const Real c = p.best_c(kAll), chi2 = p.chi2(c, kAll);
+      const Real c = p.best_c(nullptr), chi2 = p.chi2(c, nullptr);
       if (chi2 < f.chi2) {
         f.chi2 = chi2;
         f.c = c;
@@ -112,12 +118,14 @@ std::vector<GenericFit> fit_generic(const CalibrationResult& base, const Misfit&
       }
     }
     f.bic = f.chi2 + (d + 1) * std::log(static_cast<Real>(n));
-    f.heldout = misfit.tests() < 2 ? std::numeric_limits<Real>::quiet_NaN() : 0;
-    for (std::size_t k = 0; k < misfit.tests() && misfit.tests() >= 2; ++k) {
+    // Each held-out part predicted by the shape and point fitted to the rest (heldout_parts, as the extensions'
+    // check holds them out).
+    f.heldout = held_out.parts.empty() ? std::numeric_limits<Real>::quiet_NaN() : 0;
+    for (const HeldOutPart& part : held_out.parts) {
       Real best = std::numeric_limits<Real>::infinity(), held = 0;
       for (const ShapedPoint& p : points) {
-        const Real c = p.best_c(k), others = p.chi2(c, k);
-        if (others < best) best = others, held = sum_sq(p.residuals(k, c));
+        const Real c = p.best_c(&part), others = p.chi2(c, &part);
+        if (others < best) best = others, held = p.held_chi2(c, part);
       }
       f.heldout += held;
     }

@@ -251,6 +251,22 @@ class Misfit {
   bool curves_ = true;
 };
 
+/// A part of the data the held-out check (host/fit/diagnose.hpp) predicts from the rest: residuals `local` of test
+/// `test` (indices into its own residuals), at `global` in the whole residual vector.
+struct HeldOutPart {
+  std::size_t test = 0;
+  std::vector<std::size_t> local, global;
+};
+/// The held-out parts of a misfit's data, and what they are in words (`basis`): each test from the others where the
+/// data hold two or more; where they hold one test with a curve, its two halves by strain, each from the other (the
+/// curve beyond the median strain from the curve before it, and back); none where one test has no curve to halve,
+/// `basis` then saying why no held-out check can be made.
+struct HeldOutParts {
+  std::vector<HeldOutPart> parts;
+  std::string basis;
+};
+HeldOutParts heldout_parts(const Misfit& misfit);
+
 /// The noise budget decided: `lab`'s scatter specimens run at `base` on every measured test. With an "auto" ensemble
 /// ([calibrate] ensemble), the lab's ensemble becomes the fewest specimens (at most all the scatter specimens) whose
 /// mean's standard error is below kEnsembleRatioGoal of the data's noise. Where all of them fall short and the cell
@@ -272,6 +288,8 @@ constexpr int kMinSpreadSpecimens = 4;
 /// The chi2 of whitened residuals: the sum of their squares, of r[from, to) where given.
 Real sum_sq(const std::vector<Real>& r, std::size_t from, std::size_t to);
 Real sum_sq(const std::vector<Real>& r);
+/// The sum of squares of r at the indices `at`, in their order.
+Real sum_sq(const std::vector<Real>& r, const std::vector<std::size_t>& at);
 /// The quantile of chi2 with nu degrees of freedom at the standard normal score z (Wilson-Hilferty: within 3% of
 /// the exact quantile at nu = 1, 95%, and closer as nu grows).
 Real chi2_quantile(Real nu, Real z);

@@ -130,6 +130,20 @@ std::unique_ptr<Simulation> packing_of(const Config& cfg, std::vector<BallSpec>&
   if (pc.boundary == CellBoundary::walls) inside.box.periodic = {false, false, false};
   balls = make_packing(inside);
   cell = cfg.box.size;
+  if (verbose && cfg.particles.psd != SizeLaw::uniform) {
+    // What was drawn, beside the table: a lab compares its sieve curve with the specimen's.
+    const SizeDistribution sizes(cfg.particles);
+    Real mean = 0, lo = balls.empty() ? 0 : 2 * balls[0].radius, hi = lo;
+    for (const BallSpec& b : balls) {
+      mean += 2 * b.radius;
+      lo = std::min(lo, 2 * b.radius);
+      hi = std::max(hi, 2 * b.radius);
+    }
+    std::printf("triaxdem: sizes: %s distribution, %.4g to %.4g mm, mean %.4g mm by number; drawn: %.4g to %.4g mm, "
+                "mean %.4g mm\n", cfg.particles.psd == SizeLaw::sieve ? "sieve" : "lognormal",
+                1e3 * sizes.smallest(), 1e3 * sizes.largest(), 1e3 * sizes.mean(), 1e3 * lo, 1e3 * hi,
+                1e3 * mean / std::max<std::size_t>(balls.size(), 1));
+  }
   ContactParams prep = cfg.ball.base();
   if (pc.prep_mu_s >= 0) prep.mu_s = pc.prep_mu_s;
   if (pc.prep_mu_r >= 0) prep.mu_r = pc.prep_mu_r;
