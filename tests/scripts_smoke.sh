@@ -69,7 +69,7 @@ if [ "$part" != diagnoses ]; then
   check tools/results_page.py "$py" "$root/tools/results_page.py" --check
   mkdir -p "$work/results/data/sweeps" "$work/results/docs"
   cp -r "$root/data/runs" "$work/results/data/" && cp -r "$root/data/sweeps/identification" "$root/data/sweeps/coverage" \
-    "$work/results/data/sweeps/" && cp "$root/docs/results.md" "$work/results/docs/"
+    "$root/data/sweeps/plan" "$root/data/sweeps/compression" "$root/data/sweeps/psd" "$work/results/data/sweeps/" && cp "$root/docs/results.md" "$work/results/docs/"
   sed -i "s/,31.348,/,41.348,/" "$work/results/data/runs/S1_table6_periodic/prediction.csv"  # the error at 100 kPa
   ! "$py" "$root/tools/results_page.py" --root "$work/results" --check > "$work/results_changed.log" 2>&1 &&
     grep -q "is not what its artifacts give" "$work/results_changed.log" ||
@@ -197,6 +197,10 @@ if [ "$part" != tools ]; then
     bash "$root/perf/coverage.sh" > "$work/coverage_user.log" 2>&1 && [ -f "$work/coverage_user/tiny_1x/case2/keep" ] &&
     grep -q "holds files this script did not make" "$work/coverage_user.log" ||
     { cat "$work/coverage_user.log"; echo "scripts_smoke: coverage removed a folder it did not make" >&2; exit 1; }
+  # The tutorial's commands (docs/tutorial.md) on their tiny cell: a calibration and a diagnosis, each with its report.
+  check scripts/tutorial.sh env BUILD="$build" JOBS=1 TINY=1 bash "$root/scripts/tutorial.sh" "$work/tutorial"
+  exists "$(ls -d "$work"/tutorial/calibrate/calibrate_*)/calibrated.csv" \
+    "$(ls -d "$work"/tutorial/diagnose/diagnose_*)/diagnosis.md"
   check perf/inertial_scan "$build/perf/inertial_scan" --config "$base" --specimens 2 --pressures 100 \
     --inertial 1e-3,4e-3 -j 1 -o "$work/inertial.csv"
   exists "$work/inertial.csv"

@@ -88,11 +88,72 @@ def coverage(root):
                                       'tools/coverage_table.py data/sweeps/coverage')
 
 
+def frictionless_plan(root):
+    """A frictionless base's runs against the plan (issue 87): the consolidation after a preparation, by the runs'
+    sliding friction, over the plan's packing estimate; below mu_s 0.0075 the plan counts 0.5 to 20 such packings
+    (host/lab/run_cost.hpp, ResettleCost), above it a share of the shear."""
+    path = os.path.join(root, "data/sweeps/plan/frictionless_consolidation.csv")
+    rows = read_rows(path)
+    out = io.StringIO()
+    out.write("| cell | balls | seed | sigma3 kPa | preparation mu_s | mu_s | consolidation steps | over the packing "
+              "estimate | within the plan |\n|---|---|---|---|---|---|---|---|---|\n")
+    for r in rows:
+        ratio = float(r["consolidation_steps"]) / float(r["packing_steps_est"])
+        counted = "0.5-20 packings" if float(r["mu_s"]) < 0.0075 else "a share of the shear"
+        inside = (0.5 <= ratio <= 20) if float(r["mu_s"]) < 0.0075 else ratio < 0.5
+        out.write(f"| {r['cell']} | {r['balls']} | {r['seed']} | {r['sigma3_kPa']} | {r['prep_mu_s']} | {r['mu_s']} | "
+                  f"{r['consolidation_steps']} | {ratio:.3g} | {'yes' if inside else 'NO'} ({counted}) |\n")
+    return out.getvalue(), [path], ("triaxdem periodic CONFIG on each cell's config with mu_s, sigma3_kPa and [run] "
+                                    "seed set, read from its 'consolidated in N steps' line")
+
+
+def k0_jaky(root):
+    """An oedometer's K0 on loading (1,600 kPa, after seating at 100 kPa) against Jaky's 1 - sin(phi), phi the peak
+    friction angle of the same cell's periodic triaxial test at 400 kPa: 120-ball cells, mu_s 0.3, three seeds at each
+    contact stiffness."""
+    folder = os.path.join(root, "data/sweeps/compression")
+    rows = read_rows(os.path.join(folder, "k0_jaky.csv"))
+    out = io.StringIO()
+    out.write("| emod Pa | K0 (each seed) | peak phi deg | K0 - Jaky with the peak angle | mean | K0 - Jaky with the end-of-test "
+              "angle, mean |\n|---|---|---|---|---|---|\n")
+    for emod in dict.fromkeys(r["emod_Pa"] for r in rows):
+        sel = [r for r in rows if r["emod_Pa"] == emod]
+        d_peak = [float(r["K0_at_1600kPa"]) - float(r["jaky_peak"]) for r in sel]
+        d_end = [float(r["K0_at_1600kPa"]) - float(r["jaky_end"]) for r in sel]
+        out.write(f"| {emod} | {', '.join(fmt(r['K0_at_1600kPa']) for r in sel)} | "
+                  f"{', '.join(fmt(r['phi_peak_deg_400kPa']) for r in sel)} | {', '.join(f'{v:+.3f}' for v in d_peak)} | "
+                  f"**{statistics.fmean(d_peak):+.3f}** | {statistics.fmean(d_end):+.3f} |\n")
+    return out.getvalue(), [folder], "BUILD=build SRC=. bash data/sweeps/compression/run.sh (from a scratch folder)"
+
+
+def psd_width(root):
+    """What a wider size distribution does to the calibration cell (S-1's friction, 600 balls) at 100 kPa: lognormal
+    sizes by mass about D50 2 mm, every cell inserted at the same solid fraction, three seeds each."""
+    folder = os.path.join(root, "data/sweeps/psd")
+    rows = read_rows(os.path.join(folder, "psd_width.csv"))
+    out = io.StringIO()
+    out.write("| log_sd | sizes drawn mm | void ratio after consolidation (mean, seeds) | q_peak kPa (mean, seeds) | "
+              "peak phi deg (mean) |\n|---|---|---|---|---|\n")
+    for s in dict.fromkeys(r["log_sd"] for r in rows):
+        sel = [r for r in rows if r["log_sd"] == s]
+        e = [float(r["void_ratio0"]) for r in sel]
+        q = [float(r["q_peak_kPa"]) for r in sel]
+        phi = [float(r["phi_peak_deg"]) for r in sel]
+        lo = min(float(r["smallest_mm"]) for r in sel)
+        hi = max(float(r["largest_mm"]) for r in sel)
+        out.write(f"| {s} | {lo:.3g}-{hi:.3g} | **{statistics.fmean(e):.4f}** ({', '.join(f'{v:.4f}' for v in e)}) | "
+                  f"**{statistics.fmean(q):.1f}** ({', '.join(f'{v:.1f}' for v in q)}) | {statistics.fmean(phi):.2f} |\n")
+    return out.getvalue(), [folder], "BUILD=build SRC=. bash data/sweeps/psd/run.sh (from a scratch folder)"
+
+
 SECTIONS = [
     ("Table 6, S-1, calibrated on the periodic cell and predicted by the membrane test", table6_periodic),
     ("Another code's walled data, calibrated on the periodic cell and predicted between walls", walled_on_periodic),
     ("The diagnosis: hidden effects named, and false alarms", identification),
     ("Coverage of the 95% intervals", coverage),
+    ("A frictionless base's consolidation against the plan", frictionless_plan),
+    ("An oedometer's K0 against Jaky's", k0_jaky),
+    ("What a wider size distribution does", psd_width),
 ]
 
 
@@ -105,7 +166,8 @@ def page(root):
     for title, make in SECTIONS:
         text, folders, command = make(root)
         where = ", ".join("`" + os.path.relpath(f, root) + "`" for f in folders)
-        out.write(f"\n## {title}\n\n{(make.__doc__ or '').strip()} From {where}; made by `{command}`.\n\n{text}")
+        about = " ".join((make.__doc__ or "").split())  # a docstring's lines as one paragraph
+        out.write(f"\n## {title}\n\n{about} From {where}; made by `{command}`.\n\n{text}")
     return out.getvalue()
 
 
