@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The tutorial's commands (docs/tutorial.md), in its order: a lab's peak strengths (Table 6's S-1) calibrated on the
-# shipped calibration cell, then curves with an effect hidden in them diagnosed on the cheap cell of the hidden-effect
-# tests. About 15-30 minutes on 2 cores (each job prints its plan first). TINY=1 runs every step on a cell cut to
-# seconds, on synthetic data in place of the lab's: the scripts' smoke test runs it so, so that the page cannot rot.
+# shipped quick calibration cell, then curves with an effect hidden in them diagnosed on the cheap cell of the
+# hidden-effect tests. About 13 minutes on 2 cores (each job prints its plan first). TINY=1 runs every step on a cell
+# cut to seconds, on synthetic data in place of the lab's: the scripts' smoke test runs it so, so that the page
+# cannot rot.
 #   bash scripts/tutorial.sh [OUT]                 # default out/tutorial; BUILD=path/to/build, JOBS=2
 #   TINY=1 bash scripts/tutorial.sh OUT
 set -euo pipefail
@@ -24,7 +25,7 @@ if [ "${TINY:-0}" = 1 ]; then
   "$tdem" synth --config "$calib" -o "$lab" --overwrite --extension none --seed 1 --pressures 100 200 --material S-1
   pressures=(100 200)
 else
-  calib="$root/configs/calibration/base.toml"
+  calib="$root/configs/calibration/quick.toml"
   diag="$root/tests/data/hidden_effects.toml"
   lab="$root/data/tang2025_table6_peak.csv"
   pressures=(100 200 300)
