@@ -1,3 +1,4 @@
+#include "host/config/size_distribution.hpp"
 #include "host/cli/job.hpp"
 
 #include <algorithm>
@@ -121,8 +122,8 @@ void report_timings(const std::string& folder, const std::vector<StageTiming>& s
 int specimen_job(const Config& cfg) {
   if (!cfg.has_specimen) throw ConfigError(cfg.path + ": [specimen]: table missing (the specimen job needs it)");
   io::Output out(cfg.run.output);
-  std::printf("specimen: %ld balls of %.2f mm for e = %.3f in a %.1f x %.1f mm cylinder, %ld layers\n",
-              specimen_ball_count(cfg), cfg.particles.diameter * 1e3, cfg.specimen.void_ratio,
+  std::printf("specimen: %ld balls of %s for e = %.3f in a %.1f x %.1f mm cylinder, %ld layers\n",
+              specimen_ball_count(cfg), size_text(cfg.particles).c_str(), cfg.specimen.void_ratio,
               cfg.specimen.diameter * 1e3, cfg.specimen.height * 1e3, cfg.specimen.layers);
   Specimen sp;
   StopSignals signals;
@@ -225,13 +226,13 @@ int check_job(const Config& cfg) {
   } else if (cfg.has_periodic) {
     const PeriodicTriaxialParams& p = cfg.periodic.triax;
     std::printf("%s (triaxdem periodic):\n"
-                "  cell: %d balls of %.3g mm in %.4g x %.4g x %.4g mm, %s\n"
+                "  cell: %d balls of %s in %.4g x %.4g x %.4g mm, %s\n"
                 "  consolidation at %.4g kPa, then shear to %.3g%% at inertial number %.1e, a record every %.3g%%\n"
                 "  time step: %s\n  speed: %s\n",
                 cfg.periodic.boundary == CellBoundary::walls
                     ? "a cell triaxial test between six servo-controlled walls, measured at the walls"
                     : "a periodic-cell triaxial test",
-                box->particles().n, cfg.particles.diameter * 1e3, cfg.box.size[0] * 1e3, cfg.box.size[1] * 1e3,
+                box->particles().n, size_text(cfg.particles).c_str(), cfg.box.size[0] * 1e3, cfg.box.size[1] * 1e3,
                 cfg.box.size[2] * 1e3, cfg.box.fill.c_str(), p.sigma3 / 1e3, 100 * p.target_strain,
                 p.target_inertial, 100 * p.record_strain, dt_text.c_str(), speed.c_str());
   } else {

@@ -158,6 +158,27 @@ Real SizeDistribution::number_passing(Real d) const {
   return 0;
 }
 
+std::string size_text(const ParticleConfig& pc) {
+  const SizeDistribution sizes(pc);
+  std::ostringstream t;
+  t.precision(3);
+  const Real lo = 1e3 * sizes.smallest(), hi = 1e3 * sizes.largest(), mean = 1e3 * sizes.mean();
+  switch (pc.psd) {
+    case SizeLaw::uniform:
+      if (hi - lo < 1e-9 * hi) t << mean << " mm";
+      else t << lo << " to " << hi << " mm (uniform)";
+      break;
+    case SizeLaw::lognormal:
+      t << "lognormal by mass, D50 " << 1e3 * pc.median << " mm, log_sd " << pc.log_sd << ": " << lo << " to " << hi
+        << " mm, mean " << mean << " mm";
+      break;
+    case SizeLaw::sieve:
+      t << "a sieve table by mass: " << lo << " to " << hi << " mm, mean " << mean << " mm";
+      break;
+  }
+  return t.str();
+}
+
 std::string size_key(const ParticleConfig& pc) {
   if (pc.psd == SizeLaw::uniform) return "";
   std::ostringstream k;

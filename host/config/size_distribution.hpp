@@ -8,6 +8,7 @@
 ///              density between sieves a and b falls as d^-3.
 /// Labs give a distribution by mass (a sieve curve); a specimen is drawn ball by ball, by number: one uniform number
 /// a ball, through the quantile of the number distribution.
+#include <string>
 #include <vector>
 
 #include "host/config/config.hpp"
@@ -36,6 +37,10 @@ class SizeDistribution {
   Real median_n_ = 0, sd_ = 0, zlo_ = 0, zhi_ = 0;  // lognormal by number: ln(d / median_n) / sd in [zlo, zhi]
   std::vector<Real> sieve_, passing_, count_;       // sieve: count_[i] the number fraction finer than sieve_[i]
 };
+
+/// The balls' sizes in words for a job's description: "2 mm", "1.6 to 2.4 mm (uniform)", or the law with its range
+/// and mean ("lognormal by mass, D50 2 mm, log_sd 0.1: 1.48 to 2.7 mm, mean 1.95 mm").
+std::string size_text(const ParticleConfig& pc);
 
 /// The text of a non-uniform distribution for keys (the specimen cache's), with a leading space: its law and
 /// parameters; "" for uniform, so that the keys of earlier specimens hold.
