@@ -2,8 +2,6 @@
 #include <cstdio>
 
 #include "host/cli/job.hpp"
-#include "host/engine/checkpoint.hpp"
-#include "host/engine/setup.hpp"
 #include "host/io/io_hdf5.hpp"
 #include "host/triax/compression_test.hpp"
 #include "host/triax/periodic_triaxial.hpp"
@@ -39,14 +37,7 @@ int compression_job(const Config& cfg, const std::string& path_name_in, const st
                   1e-3 * x.sigma_h, 1e-3 * x.p, x.k0, 100 * x.eps_a, 100 * x.eps_v, x.void_ratio);
     report_timings(out.folder(), r.stages);
   } catch (const BlowUp& e) {
-    out.flush_series();
-    if (sim) {
-      out.write_snapshot(take_snapshot(*sim, "blow-up"));
-      write_checkpoint(blowup_path(out.folder()), checkpoint_of("compression", *sim, &out, cfg.fingerprint));
-    }
-    std::fprintf(stderr, "\ntriaxdem: %s\n  state at the blow-up saved in %s (snapshot and %s)\n", e.what(),
-                 out.folder().c_str(), blowup_path(out.folder()).c_str());
-    return 2;
+    return cell_blowup(out, sim.get(), "compression", cfg, e);
   }
   std::printf("time loop: %s\noutput: %s/series.csv (a row per increment), timings.csv\n",
               describe(sim->times(), sim->particles().n, sim->step_count()).c_str(), out.folder().c_str());

@@ -39,6 +39,16 @@ int triaxial_job(const Config& cfg, bool resume = false, long stop_at_step = -1)
 /// Returns 0, or 2 on a blow-up (state saved).
 int run_periodic_job(const Config& cfg);
 
+class Simulation;
+struct BlowUp;
+namespace io {
+class Output;
+}
+
+/// A cell job's blow-up: the series so far written, the state saved in the output folder as a snapshot and a
+/// checkpoint of `kind`, and the error with where it was saved on stderr. Returns 2, the jobs' status for it.
+int cell_blowup(io::Output& out, Simulation* sim, const std::string& kind, const Config& cfg, const BlowUp& e);
+
 /// The `compression` job: the cell of a periodic job's config (fully periodic or [periodic] boundary = "walls"),
 /// consolidated to [periodic] sigma3, then loaded in increments to `targets_kpa` (kPa; empty: 2, 4, 8, 4 and 2 times
 /// sigma3) along `path` ("oedometer" or "isotropic", host/triax/compression_test.hpp), a row per increment in

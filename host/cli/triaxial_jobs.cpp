@@ -114,6 +114,17 @@ int triaxial_job(const Config& cfg, bool resume, long stop_at_step) {
   return 0;
 }
 
+int cell_blowup(io::Output& out, Simulation* sim, const std::string& kind, const Config& cfg, const BlowUp& e) {
+  out.flush_series();
+  if (sim) {
+    out.write_snapshot(take_snapshot(*sim, "blow-up"));
+    write_checkpoint(blowup_path(out.folder()), checkpoint_of(kind, *sim, &out, cfg.fingerprint));
+  }
+  std::fprintf(stderr, "\ntriaxdem: %s\n  state at the blow-up saved in %s (snapshot and %s)\n", e.what(),
+               out.folder().c_str(), blowup_path(out.folder()).c_str());
+  return 2;
+}
+
 int run_periodic_job(const Config& cfg) {
   std::vector<BallSpec> balls;
   std::array<Real, 3> cell{};
@@ -140,14 +151,7 @@ int run_periodic_job(const Config& cfg) {
     timings = r.stages;
     write_summary(out.folder(), summary_of(cfg, r, static_cast<long>(balls.size())));
   } catch (const BlowUp& e) {
-    out.flush_series();
-    if (sim) {
-      out.write_snapshot(take_snapshot(*sim, "blow-up"));
-      write_checkpoint(blowup_path(out.folder()), checkpoint_of("periodic", *sim, &out, cfg.fingerprint));
-    }
-    std::fprintf(stderr, "\ntriaxdem: %s\n  state at the blow-up saved in %s (snapshot and %s)\n", e.what(),
-                 out.folder().c_str(), blowup_path(out.folder()).c_str());
-    return 2;
+    return cell_blowup(out, sim.get(), "periodic", cfg, e);
   }
   std::printf("time loop (test): %s\n", describe(sim->times(), sim->particles().n, sim->step_count()).c_str());
   report_timings(out.folder(), timings);

@@ -98,50 +98,50 @@ void write_summary(const std::string& folder, const TestSummary& s) {
   io::write_text_atomic(folder + "/summary.csv", summary_header() + "\n" + summary_values(s) + "\n");
 }
 
-TestSummary summary_of(const Config& cfg, const TriaxialResult& r, long balls) {
+namespace {
+
+/// What every test's summary takes alike from its config and its result's curve values (take_curve_values).
+template <class Result>
+TestSummary curve_summary(const Config& cfg, const Result& r, long balls, const char* kind) {
   TestSummary s;
-  s.kind = "membrane";
-  s.sigma3 = cfg.triaxial.sigma3;
+  s.kind = kind;
   s.mu_s = cfg.ball.mu_s;
   s.mu_r = cfg.ball.mu_r;
   s.balls = balls;
-  s.void_ratio0 = r.void_ratio_consolidated;
   s.q_peak = r.q_peak;
+  s.phi_peak_deg = r.phi_peak_deg;
+  s.eps_a_peak = r.eps_a_peak;
+  s.q_end = r.q_end;
+  s.max_dilatancy = r.max_dilatancy;
+  s.wall_seconds = r.wall_seconds;
+  s.provenance = provenance_of(cfg);
+  return s;
+}
+
+}  // namespace
+
+TestSummary summary_of(const Config& cfg, const TriaxialResult& r, long balls) {
+  TestSummary s = curve_summary(cfg, r, balls, "membrane");
+  s.sigma3 = cfg.triaxial.sigma3;
+  s.void_ratio0 = r.void_ratio_consolidated;
   if (!r.records.empty()) {
     s.q_peak_area = curves_of(r, q_field(QMeasure::kAreaCorrected), s.sigma3).q_peak;
     s.q_peak_parabolic = curves_of(r, q_field(QMeasure::kParabolic), s.sigma3).q_peak;
     s.q_peak_membrane = curves_of(r, q_field(QMeasure::kMembraneCorrected), s.sigma3).q_peak;
     s.q_peak_lw = curves_of(r, &TriaxialRecord::q_lw, s.sigma3).q_peak;
   }
-  s.phi_peak_deg = r.phi_peak_deg;
-  s.eps_a_peak = r.eps_a_peak;
-  s.q_end = r.q_end;
   s.eps_a_end = r.records.empty() ? 0 : r.records.back().eps_a;
-  s.max_dilatancy = r.max_dilatancy;
   s.inertial_number = r.inertial_number;
-  s.wall_seconds = r.wall_seconds;
-  s.provenance = provenance_of(cfg);
   return s;
 }
 
 TestSummary summary_of(const Config& cfg, const PeriodicTriaxialResult& r, long balls) {
-  TestSummary s;
-  s.kind = cfg.periodic.boundary == CellBoundary::walls ? "walls" : "periodic";
+  TestSummary s = curve_summary(cfg, r, balls, cfg.periodic.boundary == CellBoundary::walls ? "walls" : "periodic");
   s.sigma3 = r.params.sigma3;
-  s.mu_s = cfg.ball.mu_s;
-  s.mu_r = cfg.ball.mu_r;
-  s.balls = balls;
   s.void_ratio0 = r.void_ratio0;
-  s.q_peak = r.q_peak;
   s.q_peak_area = s.q_peak_parabolic = s.q_peak_membrane = s.q_peak_lw = r.q_peak;
-  s.phi_peak_deg = r.phi_peak_deg;
-  s.eps_a_peak = r.eps_a_peak;
-  s.q_end = r.q_end;
   s.eps_a_end = r.series.empty() ? 0 : r.series.back().eps_a;
-  s.max_dilatancy = r.max_dilatancy;
   s.inertial_number = r.inertial;
-  s.wall_seconds = r.wall_seconds;
-  s.provenance = provenance_of(cfg);
   return s;
 }
 
