@@ -565,6 +565,34 @@ TEST(RunCost, AFrictionlessRunsConsolidationSettlesInThePlansRange) {
   EXPECT_GT(settle, 5 * held) << "the settling is what the plan adds";
 }
 
+// A diagnosis's extension fits are priced on a cell with each extension at its middle strength (issue 87): the Hertz
+// extension's stiffer contacts take a smaller step, so its points cost more steps than the base law's. Priced at the
+// base law's, the Hertz-Mindlin data's diagnosis took 1.5 times its plan (data/sweeps/plan/crosscode_diagnoses.txt).
+// Particle-steps, not seconds: the steps follow from the probes' time steps alone.
+TEST(JobPlan, ADiagnosisPricesEachExtensionOnItsOwnStep) {
+  Config cfg = test::tiny_cell_config();
+  TriaxialTest t;
+  t.material = "A";
+  t.sigma3 = 100e3;
+  t.specimen_balls = 100;
+  PlanInput in;
+  in.cell = cfg;
+  in.materials["A"] = {t};
+  in.free = {"mu_s", "mu_r"};
+  in.diagnose = true;
+  double diagnosis = 0;
+  for (const PlanStage& s : plan_job(in).stages)
+    if (s.name == "A: diagnosis") diagnosis = s.particle_steps;
+  const CellCost base = measure_cell_cost(cfg, 0.01);
+  const long points = planned_points(2) + 6 * static_cast<long>(extensions().size());
+  const int K = static_cast<int>(cfg.calibrate.scatter_specimens);  // "auto": up to all of them
+  const double at_base = static_cast<double>(points) * K * static_cast<double>(base.run_steps(t.sigma3)) * base.balls;
+  EXPECT_GT(diagnosis, 1.02 * at_base) << "the Hertz extension's points cost more steps than the base law's";
+  Config hertz = cfg;
+  hertz.ball.hertz_overlap = extension("hertz").levels[1];
+  EXPECT_LT(measure_cell_cost(hertz, 0.01).dt, base.dt) << "its contacts take a smaller step";
+}
+
 // A run stopped by a blow-up gives no test (every quantity missing) and is counted with its pressure, so that the
 // calibration can say why data went missing (a walled diagnosis once lost most of its 300 kPa runs to the default
 // overlap guard, silently). Contacts 10^5 times softer than the specimen was packed with overlap by far more than

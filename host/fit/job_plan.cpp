@@ -248,6 +248,31 @@ struct Planner {
                  std::to_string(check.balls) + " balls");
   }
 
+  /// A diagnosis's extension fits (6 points each) added to its stage, each priced on a cell with the extension at its
+  /// middle strength: the Hertz extension's stiffer contacts take a smaller step, and priced at the base law's, the
+  /// Hertz-Mindlin data's diagnosis took 1.5 times its plan (data/sweeps/plan/crosscode_diagnoses.txt).
+  void extension_points(const std::vector<TriaxialTest>& tests) {
+    const Model base = model_of(cell);
+    PlanStage whole = plan.stages.back();
+    for (const Extension& e : extensions_of(base)) {
+      Model m = base;
+      set_param(m, e.param, e.levels[std::min<std::size_t>(1, e.levels.size() - 1)]);
+      CellCost c = searched;
+      if (!same_model({m.law, 0}, {base.law, 0})) {  // a contact law of its own: its step and speed probed
+        Config extended = cell;
+        extended.ball = m.law;
+        c = measure_cell_cost(extended);
+        c.mu_s = searched.mu_s;
+      }
+      add.runs("", "", c, tests, 6, K_low, K, "");
+      whole.particle_steps += plan.stages.back().particle_steps;
+      whole.low += plan.stages.back().low;
+      whole.high += plan.stages.back().high;
+      plan.stages.pop_back();
+    }
+    plan.stages.back() = whole;
+  }
+
   /// A material's membrane tests: two fidelities' rounds (with the periodic runs and the corrected search they
   /// repeat) where the job fits them, then the prediction, held-out pressures included.
   void membrane(const std::string& material, const std::vector<TriaxialTest>& tests, long points,
@@ -311,7 +336,8 @@ struct Planner {
                                                             : "");
     add.runs(material + (in.diagnose ? ": diagnosis" : ": search"),
              auto_ensemble ? "[calibrate] ensemble (auto)" : "[calibrate] ensemble", searched, tests,
-             static_cast<double>(points), K_low, K, search_what);
+             static_cast<double>(points - tried * 6), K_low, K, search_what);
+    if (in.diagnose) extension_points(tests);
     if (!in.diagnose && !in.two_fidelity)
       add.runs(material + ": scatter at the calibrated point", "[calibrate] scatter_specimens", searched, tests, 1, S, S,
                std::to_string(S * static_cast<int>(tests.size())) + " runs of " + n + " balls (" + std::to_string(S) +

@@ -81,7 +81,7 @@ double batch_step_seconds(const Config& cell, const std::vector<BallSpec>& balls
   std::vector<std::unique_ptr<Simulation>> sims;
   std::vector<const Simulation*> specimens;
   for (int k = 0; k < cells; ++k) {
-    sims.push_back(make_periodic_simulation(balls, box, cell.ball.base(), cell.solver, CellBoundary::periodic));
+    sims.push_back(make_periodic_simulation(balls, box, cell.ball, cell.solver, CellBoundary::periodic));
     specimens.push_back(sims.back().get());
   }
   CellBatch batch(specimens);
@@ -113,7 +113,7 @@ CellCost measure_cell_cost(const Config& cell, double probe_seconds) {
   std::array<Real, 3> box{};
   const std::vector<BallSpec> balls = probe_lattice(cell, box);
   c.probed_balls = static_cast<long>(balls.size());
-  auto sim = make_periodic_simulation(balls, box, cell.ball.base(), cell.solver, CellBoundary::periodic);
+  auto sim = make_periodic_simulation(balls, box, cell.ball, cell.solver, CellBoundary::periodic);
   c.dt = sim->params().integ.dt;
   c.d = cell.particles.diameter;  // the mean of diameters uniform between the smallest and the largest
   c.rho_eff = cell.particles.density * cell.solver.mass_scale;
