@@ -90,42 +90,6 @@ void read_run(const Tables& read, Config& c) {
   run.finish();
 }
 
-/// [particles] psd and the keys of its distribution (host/config/size_distribution.hpp); the mean diameter of a
-/// lognormal or sieve distribution worked out from it.
-void read_size_distribution(TableReader& pt, ParticleConfig& pc) {
-  std::string psd = "uniform";
-  pt.string("psd", psd, {"uniform", "lognormal", "sieve"});
-  pc.psd = psd == "lognormal" ? SizeLaw::lognormal : psd == "sieve" ? SizeLaw::sieve : SizeLaw::uniform;
-  pt.number("median_mm", pc.median, 1e-6, 1e6, 1e-3, true);
-  pt.number("log_sd", pc.log_sd, 0, 1, 1, true);
-  pt.numbers("sieve_mm", pc.sieve, 1e-6, 1e6, 1e-3);
-  pt.numbers("passing_pct", pc.passing, 0, 100, 0.01);
-  const std::vector<std::pair<const char*, SizeLaw>> own = {
-      {"diameter_mm", SizeLaw::uniform}, {"diameter_ratio", SizeLaw::uniform}, {"median_mm", SizeLaw::lognormal},
-      {"log_sd", SizeLaw::lognormal},    {"sieve_mm", SizeLaw::sieve},         {"passing_pct", SizeLaw::sieve}};
-  for (const auto& [key, law] : own) {
-    if (pt.has(key) && law != pc.psd)
-      pt.fail(key, "not with psd = \"" + psd + "\" (it belongs to psd = \"" +
-                       (law == SizeLaw::uniform ? "uniform" : law == SizeLaw::lognormal ? "lognormal" : "sieve") +
-                       "\")");
-    if (!pt.has(key) && law == pc.psd && law != SizeLaw::uniform)
-      pt.fail(key, "missing: psd = \"" + psd + "\" needs it");
-  }
-  if (pc.psd == SizeLaw::sieve) {
-    if (pc.sieve.size() < 2) pt.fail("sieve_mm", "at least two sieves");
-    if (pc.passing.size() != pc.sieve.size())
-      pt.fail("passing_pct", "one value a sieve (" + std::to_string(pc.sieve.size()) + " sieves, " +
-                                 std::to_string(pc.passing.size()) + " values)");
-    for (std::size_t i = 1; i < pc.sieve.size(); ++i) {
-      if (!(pc.sieve[i] > pc.sieve[i - 1])) pt.fail("sieve_mm", "the sizes must increase");
-      if (pc.passing[i] < pc.passing[i - 1]) pt.fail("passing_pct", "the percentages must not decrease");
-    }
-    if (pc.passing.front() != 0 || pc.passing.back() != 1)
-      pt.fail("passing_pct", "must run from 0 (the smallest sieve holds everything) to 100 (the largest passes all)");
-  }
-  if (pc.psd != SizeLaw::uniform) pc.diameter = SizeDistribution(pc).mean();
-}
-
 /// [particles], with the memory the count needs.
 void read_particles(const Tables& read, Config& c) {
   TableReader pt = read("particles");

@@ -1,5 +1,7 @@
 #include "host/config/size_distribution.hpp"
 
+#include "host/config/toml_reader.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -44,6 +46,8 @@ SizeDistribution::SizeDistribution(const ParticleConfig& pc) : law_(pc.psd) {
       zhi_ = kLognormalCut + 3 * sd_;
       dmin_ = pc.median * std::exp(-kLognormalCut * sd_);
       dmax_ = pc.median * std::exp(kLognormalCut * sd_);
+      plo_ = phi(zlo_);
+      pspan_ = phi(zhi_) - plo_;
       // Means of the truncated number distribution: by the midpoint rule on 4,000 quantiles, to 1e-7.
       constexpr int kPoints = 4000;
       Real s1 = 0, s3 = 0;
@@ -97,8 +101,7 @@ Real SizeDistribution::diameter(Real u) const {
     case SizeLaw::uniform:
       return dmin_ + (dmax_ - dmin_) * u;
     case SizeLaw::lognormal: {
-      const Real plo = phi(zlo_), phi_hi = phi(zhi_);
-      return median_n_ * std::exp(sd_ * phi_inverse(plo + u * (phi_hi - plo), zlo_, zhi_));
+      return median_n_ * std::exp(sd_ * phi_inverse(plo_ + u * pspan_, zlo_, zhi_));
     }
     case SizeLaw::sieve: {
       std::size_t i = 1;
@@ -143,7 +146,7 @@ Real SizeDistribution::number_passing(Real d) const {
       return dmax_ > dmin_ ? std::clamp((d - dmin_) / (dmax_ - dmin_), Real(0), Real(1)) : (d >= dmin_ ? 1 : 0);
     case SizeLaw::lognormal: {
       const Real z = std::clamp(std::log(d / median_n_) / sd_, zlo_, zhi_);
-      return (phi(z) - phi(zlo_)) / (phi(zhi_) - phi(zlo_));
+      return (phi(z) - plo_) / pspan_;
     }
     case SizeLaw::sieve: {
       if (d <= sieve_.front()) return 0;
@@ -156,6 +159,40 @@ Real SizeDistribution::number_passing(Real d) const {
     }
   }
   return 0;
+}
+
+void read_size_distribution(TableReader& pt, ParticleConfig& pc) {
+  std::string psd = "uniform";
+  pt.string("psd", psd, {"uniform", "lognormal", "sieve"});
+  pc.psd = psd == "lognormal" ? SizeLaw::lognormal : psd == "sieve" ? SizeLaw::sieve : SizeLaw::uniform;
+  pt.number("median_mm", pc.median, 1e-6, 1e6, 1e-3, true);
+  pt.number("log_sd", pc.log_sd, 0, 1, 1, true);
+  pt.numbers("sieve_mm", pc.sieve, 1e-6, 1e6, 1e-3);
+  pt.numbers("passing_pct", pc.passing, 0, 100, 0.01);
+  const std::vector<std::pair<const char*, SizeLaw>> own = {
+      {"diameter_mm", SizeLaw::uniform}, {"diameter_ratio", SizeLaw::uniform}, {"median_mm", SizeLaw::lognormal},
+      {"log_sd", SizeLaw::lognormal},    {"sieve_mm", SizeLaw::sieve},         {"passing_pct", SizeLaw::sieve}};
+  for (const auto& [key, law] : own) {
+    if (pt.has(key) && law != pc.psd)
+      pt.fail(key, "not with psd = \"" + psd + "\" (it belongs to psd = \"" +
+                       (law == SizeLaw::uniform ? "uniform" : law == SizeLaw::lognormal ? "lognormal" : "sieve") +
+                       "\")");
+    if (!pt.has(key) && law == pc.psd && law != SizeLaw::uniform)
+      pt.fail(key, "missing: psd = \"" + psd + "\" needs it");
+  }
+  if (pc.psd == SizeLaw::sieve) {
+    if (pc.sieve.size() < 2) pt.fail("sieve_mm", "at least two sieves");
+    if (pc.passing.size() != pc.sieve.size())
+      pt.fail("passing_pct", "one value a sieve (" + std::to_string(pc.sieve.size()) + " sieves, " +
+                                 std::to_string(pc.passing.size()) + " values)");
+    for (std::size_t i = 1; i < pc.sieve.size(); ++i) {
+      if (!(pc.sieve[i] > pc.sieve[i - 1])) pt.fail("sieve_mm", "the sizes must increase");
+      if (pc.passing[i] < pc.passing[i - 1]) pt.fail("passing_pct", "the percentages must not decrease");
+    }
+    if (pc.passing.front() != 0 || pc.passing.back() != 1)
+      pt.fail("passing_pct", "must run from 0 (the smallest sieve holds everything) to 100 (the largest passes all)");
+  }
+  if (pc.psd != SizeLaw::uniform) pc.diameter = SizeDistribution(pc).mean();
 }
 
 std::string size_text(const ParticleConfig& pc) {

@@ -15,6 +15,12 @@
 
 namespace dem {
 
+class TableReader;
+
+/// Reads [particles] psd and the keys of its distribution from `pt` into `pc`, refusing by key a table that is no
+/// distribution or keys of another law; the mean diameter of a lognormal or sieve distribution worked out from it.
+void read_size_distribution(TableReader& pt, ParticleConfig& pc);
+
 class SizeDistribution {
  public:
   /// Throws std::invalid_argument on a table that is no distribution (the config's checks name the keys first).
@@ -35,6 +41,7 @@ class SizeDistribution {
   SizeLaw law_;
   Real dmin_ = 0, dmax_ = 0, mean_ = 0, mean_cube_ = 0;
   Real median_n_ = 0, sd_ = 0, zlo_ = 0, zhi_ = 0;  // lognormal by number: ln(d / median_n) / sd in [zlo, zhi]
+  Real plo_ = 0, pspan_ = 1;                        // Phi(zlo) and Phi(zhi) - Phi(zlo): the cut's quantiles
   std::vector<Real> sieve_, passing_, count_;       // sieve: count_[i] the number fraction finer than sieve_[i]
 };
 
