@@ -12,6 +12,8 @@
 #                      # MU_S="0.06 0.40" (log-uniform) MU_R="0.005 0.055" (uniform) CAL_ARGS= (more calibrate options)
 #                      # STATE=1 (0: the data's void_ratio column dropped, so that the cells keep the base's preparation,
 #                      # the data's own: what matching the cells to one data set's void ratio costs the intervals)
+#                      # SEARCH=ensemble ([calibrate] method of the calibrations: ensemble or one_specimen; BASE's copy
+#                      # in WORK carries it)
 # WORK holds each case's data and calibration folder; the script removes only case folders it made (a marker file:
 # scripts/script_folders.sh).
 set -euo pipefail
@@ -21,11 +23,13 @@ fail() { echo "coverage: $*" >&2; exit 2; }
 whole() { [[ "$2" =~ ^[0-9]+$ ]] || fail "$1=$2: a whole number"; }
 cases="${CASES:-30}"; first="${FIRST:-1}"; sizes="${SIZES:-1 4}"; jobs="${JOBS:-2}"; budget="${BUDGET:-3600}"
 case_s="${CASE_S:-300}"; plan="${PLAN:-0}"; state="${STATE:-1}"; method="${METHOD:-ensemble}"; cal_args="${CAL_ARGS:-}"
+search="${SEARCH:-ensemble}"
 mu_s_box="${MU_S:-0.06 0.40}"; mu_r_box="${MU_R:-0.005 0.055}"
 for v in cases first jobs budget case_s; do whole "${v^^}" "${!v}"; done
 for s in $sizes; do whole SIZES "$s"; [ "$s" -ge 1 ] && [ "$s" -le 64 ] || fail "SIZES: $s is not in 1..64"; done
 [[ "$state" =~ ^[01]$ ]] || fail "STATE=$state: 1 (the data's void ratio matched) or 0 (dropped)"
 [[ "$method" =~ ^[A-Za-z0-9_-]+$ ]] || fail "METHOD=$method: letters, digits, _ and - only (it names OUT/<METHOD>.csv)"
+[[ "$search" =~ ^(ensemble|one_specimen)$ ]] || fail "SEARCH=$search: ensemble or one_specimen"
 build="$(build_folder coverage)"; tdem="$build/triaxdem"
 [ -x "$tdem" ] || fail "no triaxdem in BUILD=$build (build it first: cmake --build $build --target triaxdem)"
 base="$(realpath "${BASE:-$root/tests/data/hidden_effects.toml}")"
@@ -37,6 +41,12 @@ git -C "$root" diff --quiet HEAD -- host kernels perf 2>/dev/null || commit="$co
 csv="$out/$method.csv"
 header="method,commit,case,size,mu_s_true,mu_r_true,mu_s,mu_s_lo,mu_s_hi,mu_r,mu_r_lo,mu_r_hi,region_rise,chi2,data,truth_chi2,runs,seconds,finding,edge"
 mkdir -p "$out" "$work"
+if [ "$search" != ensemble ]; then  # the calibrations' base: BASE with [calibrate] method set
+  grep -q '^\[calibrate\]' "$base" || fail "BASE=$base: no [calibrate] table to set method in"
+  ! grep -q '^method *=' "$base" || fail "BASE=$base: sets method itself; SEARCH would be ignored"
+  sed "s/^\[calibrate\]/[calibrate]\nmethod = \"$search\"/" "$base" > "$work/base_$search.toml"
+  base="$work/base_$search.toml"
+fi
 [ -f "$csv" ] || echo "$header" > "$csv"
 [ "$(head -1 "$csv")" = "$header" ] || fail "$csv has other columns than this script writes: move it aside"
 export OMP_NUM_THREADS=1  # -j runs at once, one thread each

@@ -288,7 +288,11 @@ void read_calibrate(const Tables& read, Config& c) {
   cal.integer("predict_specimens", c.calibrate.predict_specimens, 1, 16);
   cal.string("reference_test", c.calibrate.reference_test, {"periodic", "walls", "two_fidelity"});
   cal.string("walled_match", c.calibrate.walled_match, {"interior", "whole"});
+  cal.string("method", c.calibrate.method, {"ensemble", "one_specimen"});
   cal.finish();
+  if (c.calibrate.method == "one_specimen" && c.calibrate.reference_test == "two_fidelity")
+    throw ConfigError(read.path + ": [calibrate] method: \"one_specimen\" fits one cell; with reference_test = "
+                      "\"two_fidelity\" the allowed value is \"ensemble\"");
 }
 
 }  // namespace

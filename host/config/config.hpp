@@ -202,6 +202,10 @@ struct CalibrateConfig {
   /// host/lab/wall_layer.hpp). On YADE's 4,000-ball walled data the 1,000-ball cell fitted far better whole (chi2 61
   /// against 118 with mu_s free; docs/history/calibration.md): the data's strength follows the whole void ratio.
   std::string walled_match = "whole";
+  /// How the search spends its runs (host/fit/calibrate.hpp): "ensemble" (every point the mean of the ensemble's
+  /// specimens) or "one_specimen" (every point one specimen, in turn from the scatter specimens, and the response
+  /// surfaces carry their scatter: OneSpecimenSearch). `diagnose` and two fidelities search with the ensemble.
+  std::string method = "ensemble";
 };
 
 /// The [periodic] table: the periodic-cell triaxial test (host/triax/periodic_triaxial.hpp).

@@ -35,10 +35,14 @@ namespace {
 class Search {
  public:
   /// `known_best`: the best chi2 of an earlier search (a widened one's), the screening's bound until one is run here.
-  Search(const Simulator& simulate, const Model& base, const std::vector<FreeParam>& free, int data, Real known_best)
-      : simulate_(simulate), base_(base), free_(free), d_(static_cast<int>(free.size())), known_best_(known_best) {
+  /// `one`: one specimen a point (OneSpecimenSearch), or null for the ensemble's search.
+  Search(const Simulator& simulate, const Model& base, const std::vector<FreeParam>& free, int data, Real known_best,
+         const OneSpecimenSearch* one = nullptr)
+      : simulate_(simulate), base_(base), free_(free), d_(static_cast<int>(free.size())), known_best_(known_best),
+        one_(one) {
     res.free = free;
     res.data = data;
+    res.surrogate_answer = one != nullptr;
   }
   Model model_at(const std::vector<Real>& u) const {
     Model m = base_;
@@ -59,6 +63,10 @@ class Search {
       long c = p;
       for (int k = 0; k < d_; ++k, c /= 3) u[k] = 0.5 * static_cast<Real>(c % 3);
       us.push_back(u);
+    }
+    if (one_) {
+      one_specimen_design(us);
+      return;
     }
     std::vector<char> whole(us.size(), 0);
     for (std::size_t i = 0; i < us.size(); ++i) {
@@ -108,9 +116,67 @@ class Search {
     }
     if (moved) surrogate_step();
   }
+  /// One specimen a point: rounds that run the surfaces' minimum on the next specimen until it and the joint region's
+  /// half-widths move by less than a tenth of those half-widths, then the answer at the surfaces' minimum.
+  void one_specimen_rounds() {
+    if (d_ == 0) return;
+    std::vector<Real> centre(d_, 0.5), was_at, was_wide;
+    for (int round = 0;; ++round) {
+      const std::vector<QuadraticSurface> s = response_surfaces(res.design, centre);
+      auto chi2 = [&](const std::vector<Real>& x) {
+        Real c = 0;
+        for (const QuadraticSurface& q : s) c += q(x) * q(x);
+        return c;
+      };
+      const std::vector<Real> u = minimise_unit_box(chi2, d_);
+      const Real scale = std::max(Real(1), chi2(u) / std::max(1, res.data - d_));
+      const std::vector<Real> wide = region_half_widths(s, u, chi2_95(d_) * scale);
+      bool settled = !was_at.empty();
+      for (int k = 0; k < d_ && settled; ++k)
+        settled = std::fabs(u[k] - was_at[k]) < 0.1 * was_wide[k] && std::fabs(wide[k] - was_wide[k]) < 0.1 * was_wide[k];
+      centre = u;
+      if (settled || round == one_->rounds) break;
+      evaluate(u);
+      was_at = u;
+      was_wide = wide;
+    }
+    // The answer: the surfaces' minimum, centred on itself; its curves the nearest run's (one specimen's) until the
+    // job runs the scatter specimens there.
+    Evaluation best;
+    best.u = minimise_unit_box([&, s = response_surfaces(res.design, centre)](const std::vector<Real>& x) {
+      Real c = 0;
+      for (const QuadraticSurface& q : s) c += q(x) * q(x);
+      return c;
+    }, d_);
+    Real nearest = std::numeric_limits<Real>::infinity();
+    for (const Evaluation& e : res.design) {
+      Real d2 = 0;
+      for (int k = 0; k < d_; ++k) d2 += (e.u[k] - best.u[k]) * (e.u[k] - best.u[k]);
+      if (d2 < nearest) nearest = d2, best.sim = e.sim;
+    }
+    for (const QuadraticSurface& q : response_surfaces(res.design, best.u)) best.r.push_back(q(best.u));
+    best.chi2 = sum_sq(best.r);
+    res.best = best;
+  }
   CalibrationResult res;
 
  private:
+  /// The scatter runs at the base model (where it lies inside the ranges), then the 3^d design, each point on the next
+  /// specimen (the simulator's turn); a design point at the base is not run again.
+  void one_specimen_design(const std::vector<std::vector<Real>>& us) {
+    std::vector<Real> at(d_);
+    bool inside = true;
+    for (int k = 0; k < d_; ++k) {
+      const Real v = get_param(base_, free_[k].name);
+      inside = inside && v >= free_[k].lo && v <= free_[k].hi;
+      if (inside) at[k] = free_[k].unit(v);
+    }
+    // A widened search has them from the first (merge_searches).
+    if (inside && !std::isfinite(known_best_))
+      for (const SimulatedPoint& p : one_->at_base) record(at, p);
+    for (const std::vector<Real>& u : us)
+      if (!run_before(u)) evaluate(u);
+  }
   bool run_before(const std::vector<Real>& u) const {
     for (const Evaluation& e : res.design) {
       Real d2 = 0;
@@ -133,6 +199,7 @@ class Search {
     e.r = std::move(s.r);
     e.chi2 = sum_sq(e.r);
     e.screened = s.screened;
+    e.specimen = s.specimen;
     res.design.push_back(e);
     if (res.design.size() == 1 || (!e.screened && (res.best.screened || e.chi2 < res.best.chi2))) res.best = e;
     return e.chi2;
@@ -154,6 +221,7 @@ class Search {
   const std::vector<FreeParam>& free_;
   int d_;
   Real known_best_;
+  const OneSpecimenSearch* one_;
   /// The least chi2 of the design's probes: one member's, above the ensemble mean's by the members' spread on
   /// average.
   Real probe_best_ = std::numeric_limits<Real>::infinity();
@@ -190,12 +258,17 @@ void merge_searches(CalibrationResult& into, const CalibrationResult& other, boo
 }
 
 CalibrationResult search(const Simulator& simulate, const Model& base, const std::vector<FreeParam>& free, int data,
-                         int rounds, int widen, Real known_best = std::numeric_limits<Real>::infinity()) {
+                         int rounds, int widen, Real known_best = std::numeric_limits<Real>::infinity(),
+                         const OneSpecimenSearch* one = nullptr) {
   const int d = static_cast<int>(free.size());
-  Search sr(simulate, base, free, data, known_best);
+  Search sr(simulate, base, free, data, known_best, one);
   sr.design();
-  sr.surrogate_rounds(rounds);
-  sr.compass();
+  if (one) {
+    sr.one_specimen_rounds();
+  } else {
+    sr.surrogate_rounds(rounds);
+    sr.compass();
+  }
   CalibrationResult res = std::move(sr.res);
   res.model = sr.model_at(res.best.u);
   for (int k = 0; k < d; ++k) res.values.push_back(free[k].value(res.best.u[k]));
@@ -206,7 +279,9 @@ CalibrationResult search(const Simulator& simulate, const Model& base, const std
   bool any_moved = false;
   for (int k = 0; k < d; ++k) {
     if (res.best.u[k] >= 0.01 && res.best.u[k] <= 0.99) continue;
-    const Real inside = best_inside(res, static_cast<std::size_t>(k));
+    // One specimen a point: a run's chi2 carries its specimen's scatter, and the surfaces' minimum on an edge is the
+    // word; the ensemble's search widens on a significant gain over its best run inside.
+    const Real inside = one ? std::numeric_limits<Real>::infinity() : best_inside(res, static_cast<std::size_t>(k));
     if (res.best.chi2 > inside - significant_gain(inside, data, d)) {
       char line[200];
       std::snprintf(line, sizeof line, "%s: best %.4g on the edge of [%.4g, %.4g], chi2 %.2f against %.2f inside: "
@@ -227,7 +302,7 @@ CalibrationResult search(const Simulator& simulate, const Model& base, const std
     res.widened.insert(res.widened.begin(), notes.begin(), notes.end());
     return res;
   }
-  CalibrationResult again = search(simulate, base, moved, data, rounds, widen - 1, res.best.chi2);
+  CalibrationResult again = search(simulate, base, moved, data, rounds, widen - 1, res.best.chi2, one);
   if (again.best.chi2 >= res.best.chi2) {
     notes.push_back("the wider search found no better point");
     for (int k = 0; k < d; ++k)
@@ -247,9 +322,22 @@ long planned_points(int d, int rounds) {
   return design + rounds + (d > 0 ? 4 * d + 1 : 0);  // the compass: both steps' polls once, and its last round
 }
 
+long planned_one_specimen_points(int d, int rounds) {
+  long design = 1;
+  for (int k = 0; k < d; ++k) design *= 3;
+  return design + (d > 0 ? rounds : 0);
+}
+
 CalibrationResult calibrate(const Simulator& simulate, const Model& base, const std::vector<FreeParam>& free, int data,
                             int rounds, int widen) {
   CalibrationResult r = search(simulate, base, free, data, rounds, widen);
+  add_uncertainty(r);
+  return r;
+}
+
+CalibrationResult calibrate(const Simulator& simulate, const Model& base, const std::vector<FreeParam>& free, int data,
+                            const OneSpecimenSearch& one, int widen) {
+  CalibrationResult r = search(simulate, base, free, data, 0, widen, std::numeric_limits<Real>::infinity(), &one);
   add_uncertainty(r);
   return r;
 }

@@ -100,6 +100,7 @@ struct Evaluation {
   std::vector<Real> r;                ///< normalised residuals (all tests)
   Real chi2 = 0;
   bool screened = false;              ///< run on one member only (sim and r are that member's): clearly worse
+  int specimen = -1;                  ///< one specimen a point: the specimen it ran on; -1: the ensemble's mean
 };
 
 struct CalibrationResult {
@@ -159,6 +160,16 @@ struct CalibrationResult {
   Real flat_share() const;
   std::vector<QuadraticSurface> surfaces;          ///< the residuals' surfaces around the best run
   std::vector<Real> offset;                        ///< best-run residual minus surface value there
+  /// One specimen a point (OneSpecimenSearch): the answer is the surfaces' minimum, its residuals and chi2 the
+  /// surfaces' there (no offset), since every run carries its one specimen's scatter and the surfaces average it over
+  /// the design; the best run means nothing.
+  bool surrogate_answer = false;
+  /// The ensemble the surfaces' value at the answer is worth: 1 / sum over specimens of the square of their share of
+  /// it (the surfaces' weights of each point summed over the points a specimen ran, as one specimen's departure moves
+  /// every run of it alike), or 1 / sum of the points' squared weights where that is larger (departures that change
+  /// from point to point). The misfit whitening the answer counts the simulator's scatter as that of this ensemble's
+  /// mean. At most the number of specimens; 0 where no point ran on one specimen.
+  Real surrogate_members() const;
 };
 
 /// Moves f's range to centre on v, keeping its width (its ratio when logarithmic), inside the registry's range
@@ -173,6 +184,7 @@ struct SimulatedPoint {
   std::vector<TriaxialTest> sim;
   std::vector<Real> r;
   bool screened = false;  ///< run on part of the ensemble, clearly above the bound the search gave
+  int specimen = -1;      ///< one specimen a point: the specimen it ran on
 };
 /// The simulator at a model, given a chi2 bound (`screen_above`) above which the point matters to the search only as
 /// worse than its best: the simulator may then run it on part of its ensemble and return that part's estimate, where
@@ -198,9 +210,35 @@ Real screen_bound(Real best_chi2, int data, int d);
 bool clearly_above(const std::vector<Real>& r, Real spread, Real bound);
 constexpr Real kScreenSigmas = 2.5;
 
+/// One specimen a point (CalibrateConfig::method "one_specimen"): instead of an ensemble's mean at every point, each
+/// point runs every test on one specimen, taken in turn from the scatter specimens (the same list at every point), and
+/// the surfaces carry the specimens' scatter: a quadratic surface fitted to many points averages their specimens'
+/// departures as an ensemble does at one point (stochastic kriging's idea with a quadratic trend). The search:
+///   1. the scatter runs at the base model, one point a specimen, and the 3^d design, each point on the next specimen;
+///   2. rounds: the surfaces' minimum is run on the next specimen, until it and the joint 95% region's half-widths
+///      (Gauss-Newton's) move by less than a tenth of those half-widths between two rounds, or `rounds` are run;
+///   3. the answer is the surfaces' minimum (CalibrationResult::surrogate_answer); a minimum on an edge of a range that
+///      can move searches again beyond it (at most `widen` times), as the ensemble's search does.
+/// The misfit it searches with whitens one run (an ensemble of 1); the job whitens the design again at the answer with
+/// the ensemble the surfaces are worth there (CalibrationResult::surrogate_members, rescattered).
+struct OneSpecimenSearch {
+  std::vector<SimulatedPoint> at_base;  ///< the scatter runs at the base model, one a specimen: design points there
+  int rounds = 6;
+};
+
 /// Calibrates `free` from `base` on a misfit of `data` data; see the top of the file.
 CalibrationResult calibrate(const Simulator& simulate, const Model& base, const std::vector<FreeParam>& free, int data,
                             int rounds = 4, int widen = 2);
+/// One specimen a point (OneSpecimenSearch) on a simulator that runs each point on one specimen.
+CalibrationResult calibrate(const Simulator& simulate, const Model& base, const std::vector<FreeParam>& free, int data,
+                            const OneSpecimenSearch& one, int widen = 2);
+/// The same on `measured`, simulated by the lab: point i (the scatter runs' points at the base first) on specimen
+/// i mod the lab's specimens, whitened by `misfit` (an ensemble of 1: one run's scatter).
+CalibrationResult calibrate_one_specimen(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,
+                                         const std::vector<TriaxialTest>& measured, const Misfit& misfit,
+                                         const CalibrationProgress& progress = {}, int widen = 2);
+/// Points a one-specimen search of d free parameters runs at most before any widening, besides its points at the base.
+long planned_one_specimen_points(int d, int rounds = OneSpecimenSearch{}.rounds);
 /// The same on `measured` (one material, any number of pressures), simulated by the lab's ensemble.
 CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,
                             const std::vector<TriaxialTest>& measured, const Misfit& misfit, int rounds = 4,
@@ -235,6 +273,17 @@ long planned_points(int d, int rounds = 4);
 
 /// One response surface per residual of the evaluations, weighted towards `centre` (unit coordinates).
 std::vector<QuadraticSurface> response_surfaces(const std::vector<Evaluation>& pts, const std::vector<Real>& centre);
+/// The map from the points' values to a surface's coefficients (basis x points, row-major by basis term): the weighted
+/// least squares of response_surfaces centred on `centre`, the same for every residual.
+std::vector<std::vector<Real>> surface_projection(const std::vector<Evaluation>& pts, const std::vector<Real>& centre);
+/// What each point weighs in the surfaces' value at u (response_surfaces centred on `centre`): the row of the
+/// weighted least squares' hat matrix, so that a surface's value at u is sum_i a_i y_i (the a_i sum to 1).
+std::vector<Real> surface_shares(const std::vector<Evaluation>& pts, const std::vector<Real>& centre,
+                                 const std::vector<Real>& u);
+/// The joint 95% region's half-widths in unit coordinates at u, to first order (Gauss-Newton on the surfaces' Jacobian
+/// there, a rise of `rise` in chi2); 1 along a direction the surfaces leave flat.
+std::vector<Real> region_half_widths(const std::vector<QuadraticSurface>& surfaces, const std::vector<Real>& u,
+                                     Real rise);
 
 /// Calls f(u) at every point of the grid of n points per axis over the unit box [0, 1]^d, the first axis fastest.
 void for_each_grid_point(int d, int n, const std::function<void(const std::vector<Real>&)>& f);

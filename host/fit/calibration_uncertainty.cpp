@@ -9,15 +9,72 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <random>
 #include <stdexcept>
 
 namespace dem {
 
 namespace {
 
+/// One specimen a point: the answer's covariance (unit coordinates) from the surfaces' own scatter. Every point's run
+/// departs from the surfaces by its specimen's departure and its chaos; the surfaces' value at the answer carries them
+/// (the whitening counts that, surrogate_members), and so do their slopes and curvature, which move the minimum with
+/// the data's residual as lever. Measured by a wild bootstrap over the specimens: each draw flips the sign of every
+/// departure of a specimen at once (its points share its packing), each point's departure its residual from the
+/// surfaces over sqrt(1 - its own share); the surfaces are fitted again and minimised, and the minima's covariance is
+/// added to the answer's. On a bowl whose noise is known (tests/test_coverage.cpp, 100 data sets) the whitening alone
+/// held the truth in 87 joint regions; with the bootstrap's covariance less its first-order part through the value at
+/// the answer (what the whitening counts) 90; with all of it 95, as a 95% region should: eight specimens' signs
+/// understate the scatter about as much as the value's part counts twice. A fixed seed: the same design gives the same
+/// intervals.
+Eigen::MatrixXd surface_scatter(const CalibrationResult& r, int d) {
+  constexpr int kDraws = 200;
+  const int n = static_cast<int>(r.design.size()), m = static_cast<int>(r.surfaces.size());
+  const std::vector<std::vector<Real>> proj = surface_projection(r.design, r.best.u);
+  const int nb = static_cast<int>(proj.size());
+  Eigen::MatrixXd P(nb, n), basis(n, nb);  // coefficients = values x P^T; values at the points = coefficients x basis^T
+  for (int j = 0; j < nb; ++j) P.row(j) = Eigen::Map<const Eigen::RowVectorXd>(proj[static_cast<std::size_t>(j)].data(), n);
+  Eigen::MatrixXd Y(m, n);
+  std::vector<int> specimen(static_cast<std::size_t>(n));
+  int specimens = 0;
+  for (int i = 0; i < n; ++i) {
+    const Evaluation& e = r.design[static_cast<std::size_t>(i)];
+    const std::vector<Real> b = QuadraticSurface::basis(e.u);
+    basis.row(i) = Eigen::Map<const Eigen::RowVectorXd>(b.data(), nb);
+    Y.col(i) = Eigen::Map<const Eigen::VectorXd>(e.r.data(), m);
+    specimen[static_cast<std::size_t>(i)] = e.specimen + 1;
+    specimens = std::max(specimens, e.specimen + 2);
+  }
+  const Eigen::MatrixXd fitted = Y * P.transpose() * basis.transpose();  // m x n
+  const Eigen::VectorXd own = (basis * P).diagonal();                    // each point's share in its own value
+  Eigen::MatrixXd departure = Y - fitted;
+  for (int i = 0; i < n; ++i) departure.col(i) /= std::sqrt(std::max(Real(0.05), 1 - own(i)));
+  std::mt19937_64 rng(20261202);
+  Eigen::MatrixXd moves(kDraws, d);
+  for (int b = 0; b < kDraws; ++b) {
+    std::vector<Real> sign(static_cast<std::size_t>(specimens));
+    for (Real& v : sign) v = (rng() & 1) ? 1 : -1;
+    Eigen::MatrixXd drawn = fitted;
+    for (int i = 0; i < n; ++i) drawn.col(i) += sign[static_cast<std::size_t>(specimen[static_cast<std::size_t>(i)])] * departure.col(i);
+    const Eigen::MatrixXd C = drawn * P.transpose();  // m x nb: each residual's surface
+    const Eigen::MatrixXd Q = C.transpose() * C;      // the chi2 as a quadratic form of the basis
+    const std::vector<Real> u = minimise_unit_box([&](const std::vector<Real>& x) {
+      const std::vector<Real> bx = QuadraticSurface::basis(x);
+      const Eigen::Map<const Eigen::VectorXd> v(bx.data(), nb);
+      return v.dot(Q * v);
+    }, d);
+    for (int k = 0; k < d; ++k) moves(b, k) = u[static_cast<std::size_t>(k)];
+  }
+  auto covariance = [](Eigen::MatrixXd x) {
+    x.rowwise() -= x.colwise().mean();
+    return Eigen::MatrixXd(x.transpose() * x / (x.rows() - 1));
+  };
+  return covariance(moves);
+}
+
 /// The rise factors of r's spreads (CalibrationResult, measured on the specimens) at the Jacobian J of the whitened
-/// residuals in unit coordinates; 1 where there are none or J^T J is singular (a flat direction: the intervals
-/// already span the range).
+/// residuals in unit coordinates, and of the surfaces' own scatter where the answer is theirs (surface_scatter); 1
+/// where there are neither or J^T J is singular (a flat direction: the intervals already span the range).
 void specimen_factors(CalibrationResult& r, const Eigen::MatrixXd& J) {
   const int d = static_cast<int>(J.cols()), n = static_cast<int>(J.rows());
   r.rise_factor.assign(d, 1);
@@ -28,7 +85,22 @@ void specimen_factors(CalibrationResult& r, const Eigen::MatrixXd& J) {
   const Eigen::MatrixXd model = llt.solve(Eigen::MatrixXd::Identity(d, d));  // (J^T J)^-1
   const Eigen::MatrixXd G = model * J.transpose();
   const Eigen::MatrixXd L = llt.matrixL();
+  // In the model's units: its covariance is scale x (J^T J)^-1.
+  const Eigen::MatrixXd surfaces =
+      r.surrogate_answer ? Eigen::MatrixXd(surface_scatter(r, d) / r.scale) : Eigen::MatrixXd::Zero(d, d);
   bool first = true;
+  auto take = [&](const Eigen::MatrixXd& V) {
+    const Eigen::VectorXd lambda =
+        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(L.transpose() * V * L).eigenvalues().cwiseMax(0);
+    const Real s1 = lambda.sum(), s2 = lambda.squaredNorm();
+    const Real region = s1 > 0 ? (s2 / s1) * chi2_quantile(s1 * s1 / s2, 1.645) / chi2_quantile(d, 1.645) : 1;
+    r.region_factor = first ? region : std::max(r.region_factor, region);
+    for (int j = 0; j < d; ++j) {
+      const Real f = std::max(Real(0), V(j, j)) / model(j, j);
+      r.rise_factor[j] = first ? f : std::max(r.rise_factor[j], f);
+    }
+    first = false;
+  };
   for (const SpecimenSpread& s : r.spreads) {
     const int S = static_cast<int>(s.specimen.size());
     if (S < kMinSpreadSpecimens || s.modelled.size() != static_cast<std::size_t>(n) * n || s.tests.empty() ||
@@ -47,36 +119,67 @@ void specimen_factors(CalibrationResult& r, const Eigen::MatrixXd& J) {
       const Eigen::VectorXd g = G * en;  // the ensemble's members: the same packings in every test
       V += weight * g * g.transpose();
     }
-    const Eigen::VectorXd lambda =
-        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(L.transpose() * V * L).eigenvalues().cwiseMax(0);
-    const Real s1 = lambda.sum(), s2 = lambda.squaredNorm();
-    const Real region = s1 > 0 ? (s2 / s1) * chi2_quantile(s1 * s1 / s2, 1.645) / chi2_quantile(d, 1.645) : 1;
-    r.region_factor = first ? region : std::max(r.region_factor, region);
-    for (int j = 0; j < d; ++j) {
-      const Real f = std::max(Real(0), V(j, j)) / model(j, j);
-      r.rise_factor[j] = first ? f : std::max(r.rise_factor[j], f);
-    }
-    first = false;
+    take(V + surfaces);
   }
+  if (first && r.surrogate_answer) take(model + surfaces);
+}
+
+/// d residuals / du at u: central differences of the surfaces.
+Eigen::MatrixXd surface_jacobian(const std::vector<QuadraticSurface>& surfaces, const std::vector<Real>& u) {
+  const int d = static_cast<int>(u.size());
+  Eigen::MatrixXd J(static_cast<int>(surfaces.size()), d);
+  for (int j = 0; j < d; ++j) {
+    std::vector<Real> up = u, dn = u;
+    up[j] += 1e-3, dn[j] -= 1e-3;
+    for (std::size_t i = 0; i < surfaces.size(); ++i)
+      J(static_cast<int>(i), j) = (surfaces[i](up) - surfaces[i](dn)) / 2e-3;
+  }
+  return J;
 }
 
 }  // namespace
+
+std::vector<Real> region_half_widths(const std::vector<QuadraticSurface>& surfaces, const std::vector<Real>& u,
+                                     Real rise) {
+  const Eigen::MatrixXd J = surface_jacobian(surfaces, u);
+  const Eigen::MatrixXd cov = (J.transpose() * J).completeOrthogonalDecomposition().pseudoInverse();
+  std::vector<Real> w;
+  for (int j = 0; j < cov.rows(); ++j) w.push_back(cov(j, j) > 0 ? std::min(Real(1), std::sqrt(rise * cov(j, j))) : 1);
+  return w;
+}
+
+Real CalibrationResult::surrogate_members() const {
+  if (design.empty() || free.empty()) return 0;
+  const std::vector<Real> a = surface_shares(design, best.u, best.u);
+  std::vector<Real> by_specimen;
+  Real points = 0;
+  for (std::size_t i = 0; i < design.size(); ++i) {
+    if (design[i].specimen < 0) return 0;
+    const std::size_t s = static_cast<std::size_t>(design[i].specimen);
+    if (s >= by_specimen.size()) by_specimen.resize(s + 1, 0);
+    by_specimen[s] += a[i];
+    points += a[i] * a[i];
+  }
+  Real shared = 0;
+  for (Real A : by_specimen) shared += A * A;
+  return 1 / std::max(shared, points);
+}
 
 void add_uncertainty(CalibrationResult& r) {
   const int d = static_cast<int>(r.free.size());
   if (d == 0 || r.design.size() < 2) return;
   r.surfaces = response_surfaces(r.design, r.best.u);
   r.offset.clear();
-  for (std::size_t i = 0; i < r.surfaces.size(); ++i) r.offset.push_back(r.best.r[i] - r.surfaces[i](r.best.u));
-  r.scale = std::max(Real(1), r.best.chi2 / std::max(1, r.data - d));
-  // J = d residuals / du at the best point (central differences of the surfaces).
-  Eigen::MatrixXd J(static_cast<int>(r.surfaces.size()), d);
-  for (int j = 0; j < d; ++j) {
-    std::vector<Real> up = r.best.u, dn = r.best.u;
-    up[j] += 1e-3, dn[j] -= 1e-3;
-    for (std::size_t i = 0; i < r.surfaces.size(); ++i)
-      J(static_cast<int>(i), j) = (r.surfaces[i](up) - r.surfaces[i](dn)) / 2e-3;
+  if (r.surrogate_answer) {
+    r.best.r.clear();
+    for (const QuadraticSurface& q : r.surfaces) r.best.r.push_back(q(r.best.u));
+    r.best.chi2 = sum_sq(r.best.r);
+    r.offset.assign(r.surfaces.size(), 0);
+  } else {
+    for (std::size_t i = 0; i < r.surfaces.size(); ++i) r.offset.push_back(r.best.r[i] - r.surfaces[i](r.best.u));
   }
+  r.scale = std::max(Real(1), r.best.chi2 / std::max(1, r.data - d));
+  const Eigen::MatrixXd J = surface_jacobian(r.surfaces, r.best.u);
   specimen_factors(r, J);
   // Profile intervals: each parameter on a grid of its unit range, the surrogate minimised over the others.
   const Real best = r.surrogate_chi2(r.best.u);
@@ -186,13 +289,13 @@ void measure_on_specimens(CalibrationResult& r, std::vector<SpecimenSpread> spre
 
 void rewhiten(CalibrationResult& r, const Misfit& misfit, const Model& base) {
   r.spreads = misfit.specimen_spreads();
-  const Evaluation* best = nullptr;
+  const Evaluation* best = r.surrogate_answer ? &r.best : nullptr;  // the answer stays where the surfaces put it
   for (Evaluation& e : r.design) {
     Ensemble one;
     for (const TriaxialTest& t : e.sim) one.push_back({t});
     e.r = misfit.residuals(one);
     e.chi2 = sum_sq(e.r);
-    if (!e.screened && (!best || e.chi2 < best->chi2)) best = &e;
+    if (!r.surrogate_answer && !e.screened && (!best || e.chi2 < best->chi2)) best = &e;
   }
   if (best) report_at(r, Evaluation(*best), base);
 }

@@ -328,15 +328,17 @@ struct Planner {
                  " specimens x " + T + " tests)");
     bias_check(material, tests);
     const long tried = in.diagnose ? static_cast<long>(extensions_of(model_of(in.cell)).size()) : 0;
-    const long points = planned_points(static_cast<int>(in.free.size())) + tried * 6;
-    const std::string k = auto_ensemble ? "1 to " + std::to_string(K) : std::to_string(K);
+    const bool one = cc.method == "one_specimen" && !in.diagnose && !in.two_fidelity;
+    const long points = (one ? planned_one_specimen_points(static_cast<int>(in.free.size()))
+                             : planned_points(static_cast<int>(in.free.size()))) + tried * 6;
+    const std::string k = one ? "1" : auto_ensemble ? "1 to " + std::to_string(K) : std::to_string(K);
     const std::string search_what = std::to_string(points) + " points x " + T + " tests x " + k + " specimens of " + n +
                                     " balls" + (in.diagnose ? " (the base model, then " +
                                                                   std::to_string(tried) + " extensions)"
                                                             : "");
     add.runs(material + (in.diagnose ? ": diagnosis" : ": search"),
-             auto_ensemble ? "[calibrate] ensemble (auto)" : "[calibrate] ensemble", searched, tests,
-             static_cast<double>(points - tried * 6), K_low, K, search_what);
+             one ? "[calibrate] method" : auto_ensemble ? "[calibrate] ensemble (auto)" : "[calibrate] ensemble",
+             searched, tests, static_cast<double>(points - tried * 6), one ? 1 : K_low, one ? 1 : K, search_what);
     if (in.diagnose) extension_points(tests);
     if (!in.diagnose && !in.two_fidelity)
       add.runs(material + ": scatter at the calibrated point", "[calibrate] scatter_specimens", searched, tests, 1, S, S,

@@ -121,11 +121,19 @@ Misfit::Misfit(const std::vector<TriaxialTest>& measured, const NoiseOptions& no
   from_budget_ = true;
 }
 
-Misfit Misfit::with_scatter(const Ensemble& scatter) const {
+Misfit Misfit::with_scatter(const Ensemble& scatter, int members) const {
   if (!from_budget_) throw std::logic_error("misfit: with_scatter needs a misfit of a noise budget, without a discrepancy");
   NoiseBudget b = budget_;
   if (b.scatter_floor.empty()) b.scatter_floor = b.scatter;
   b.scatter = scatter;
+  if (members > 0) b.members = members;
+  return Misfit(measured_, noise_, b);
+}
+
+Misfit Misfit::with_members(int members) const {
+  if (!from_budget_) throw std::logic_error("misfit: with_members needs a misfit of a noise budget, without a discrepancy");
+  NoiseBudget b = budget_;
+  b.members = std::max(members, 1);
   return Misfit(measured_, noise_, b);
 }
 

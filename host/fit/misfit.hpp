@@ -206,7 +206,14 @@ class Misfit {
   /// run at another model, the calibrated one): each feature's specimen and ensemble terms take the larger of the two
   /// scatters; the data's noise, the ensemble and the cell's bias stay. Only for a misfit built from a noise budget,
   /// before any discrepancy is added.
-  Misfit with_scatter(const Ensemble& scatter) const;
+  /// `members` > 0: and the simulator's mean counted as that of so many specimens (one specimen a point: the ensemble the
+  /// surfaces are worth at the answer, CalibrationResult::surrogate_members).
+  Misfit with_scatter(const Ensemble& scatter, int members = 0) const;
+  /// The same misfit with the simulator's mean counted as that of `members` specimens (one specimen a point searches
+  /// with 1: each run is one specimen). Only for a misfit built from a noise budget, before any discrepancy.
+  Misfit with_members(int members) const;
+  /// The noise budget it was built from (empty where it was built from a reference ensemble).
+  const NoiseBudget& budget() const { return budget_; }
   /// The specimen spreads of the scatter this misfit was built from (a noise budget's): its scatter specimens' and,
   /// after with_scatter, those of the scatter it keeps as a floor. Empty for a misfit not built from a budget, or
   /// whose scatter has fewer than kMinSpreadSpecimens specimens.

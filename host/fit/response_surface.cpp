@@ -78,17 +78,26 @@ std::vector<Real> minimise_unit_box(const std::function<Real(const std::vector<R
   return best;
 }
 
-/// Weights: a Gaussian of width 0.3 in unit coordinates around `centre`, floor 0.1 (far points still hold
+namespace {
+
+/// The surfaces' weights: a Gaussian of width 0.3 in unit coordinates around `centre`, floor 0.1 (far points still hold
 /// the curvature).
-std::vector<QuadraticSurface> response_surfaces(const std::vector<Evaluation>& pts, const std::vector<Real>& centre) {
-  std::vector<std::vector<Real>> u;
+std::vector<Real> surface_weights(const std::vector<Evaluation>& pts, const std::vector<Real>& centre) {
   std::vector<Real> w;
   for (const Evaluation& e : pts) {
-    u.push_back(e.u);
     Real d2 = 0;
     for (std::size_t k = 0; k < centre.size(); ++k) d2 += (e.u[k] - centre[k]) * (e.u[k] - centre[k]);
     w.push_back(0.1 + std::exp(-d2 / (2 * 0.3 * 0.3)));
   }
+  return w;
+}
+
+}  // namespace
+
+std::vector<QuadraticSurface> response_surfaces(const std::vector<Evaluation>& pts, const std::vector<Real>& centre) {
+  std::vector<std::vector<Real>> u;
+  for (const Evaluation& e : pts) u.push_back(e.u);
+  const std::vector<Real> w = surface_weights(pts, centre);
   std::vector<QuadraticSurface> s;
   for (std::size_t i = 0; i < pts.front().r.size(); ++i) {
     std::vector<Real> y;
@@ -96,6 +105,36 @@ std::vector<QuadraticSurface> response_surfaces(const std::vector<Evaluation>& p
     s.emplace_back(u, y, w);
   }
   return s;
+}
+
+std::vector<std::vector<Real>> surface_projection(const std::vector<Evaluation>& pts, const std::vector<Real>& centre) {
+  const std::vector<Real> w = surface_weights(pts, centre);
+  const int n = static_cast<int>(pts.size()), m = static_cast<int>(QuadraticSurface::basis(pts.front().u).size());
+  Eigen::MatrixXd B(n, m);
+  for (int i = 0; i < n; ++i) {
+    const std::vector<Real> row = QuadraticSurface::basis(pts[static_cast<std::size_t>(i)].u);
+    for (int j = 0; j < m; ++j) B(i, j) = row[static_cast<std::size_t>(j)];
+  }
+  const Eigen::VectorXd W = Eigen::Map<const Eigen::VectorXd>(w.data(), n);
+  const Eigen::MatrixXd P =
+      (B.transpose() * W.asDiagonal() * B).completeOrthogonalDecomposition().pseudoInverse() * B.transpose() *
+      W.asDiagonal();
+  std::vector<std::vector<Real>> out(static_cast<std::size_t>(m));
+  for (int j = 0; j < m; ++j) {
+    const Eigen::RowVectorXd row = P.row(j);  // P is column-major: a row is not contiguous
+    out[static_cast<std::size_t>(j)].assign(row.data(), row.data() + n);
+  }
+  return out;
+}
+
+std::vector<Real> surface_shares(const std::vector<Evaluation>& pts, const std::vector<Real>& centre,
+                                 const std::vector<Real>& u) {
+  const std::vector<std::vector<Real>> P = surface_projection(pts, centre);
+  const std::vector<Real> b = QuadraticSurface::basis(u);
+  std::vector<Real> a(pts.size(), 0);
+  for (std::size_t j = 0; j < b.size(); ++j)
+    for (std::size_t i = 0; i < a.size(); ++i) a[i] += b[j] * P[j][i];
+  return a;
 }
 
 }  // namespace dem

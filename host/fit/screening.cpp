@@ -73,4 +73,37 @@ CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vect
   return calibrate(simulate, base, free, misfit.data(), rounds, widen);
 }
 
+CalibrationResult calibrate_one_specimen(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,
+                                         const std::vector<TriaxialTest>& measured, const Misfit& misfit,
+                                         const CalibrationProgress& progress, int widen) {
+  const std::size_t T = measured.size(), S = static_cast<std::size_t>(lab.specimens());
+  OneSpecimenSearch one;
+  const Ensemble& scatter = misfit.budget().scatter;
+  for (std::size_t s = 0; s < S && !scatter.empty() && s < scatter.front().size(); ++s) {
+    Ensemble run(T);
+    for (std::size_t k = 0; k < T; ++k) run[k].push_back(scatter[k][s]);
+    SimulatedPoint p;
+    for (const auto& member : run) p.sim.push_back(member.front());
+    p.r = misfit.residuals(run);
+    p.specimen = static_cast<int>(s);
+    one.at_base.push_back(std::move(p));
+  }
+  const long planned = planned_one_specimen_points(static_cast<int>(free.size())) * static_cast<long>(T);
+  Real best = std::numeric_limits<Real>::infinity();
+  std::size_t next = one.at_base.size() % S;  // the turn goes on after the scatter runs' specimens
+  auto simulate = [&](const Model& m, Real) {
+    const std::size_t s = next;
+    next = (next + 1) % S;
+    const Ensemble run = lab.run_part(m, measured, S, s * T, (s + 1) * T);
+    SimulatedPoint p;
+    for (const auto& member : run) p.sim.push_back(member.front());
+    p.r = misfit.residuals(run);
+    p.specimen = static_cast<int>(s);
+    best = std::min(best, sum_sq(p.r));
+    if (progress) progress(lab.runs(), planned, best);
+    return p;
+  };
+  return calibrate(simulate, base, free, misfit.data(), one, widen);
+}
+
 }  // namespace dem

@@ -112,14 +112,35 @@ CalibrationResult two_fidelity_fit(Session& ss, const Config& base, const std::s
 }
 
 /// The misfit with the simulator's scatter measured at the calibrated point r.model too (the scatter specimens run
-/// there; each datum takes the larger), and r whitened again by it; the change of the simulator's scatter is said.
+/// there; each datum takes the larger), and r whitened again by it; the change of the simulator's scatter is said. One
+/// specimen a point: those runs join the design at the answer, and the misfit counts the ensemble the surfaces are worth.
 Misfit rescattered(Session& ss, const std::string& material, const std::vector<TriaxialTest>& tests,
                    const Misfit& misfit, CalibrationResult& r, const Model& base) {
   const long start = ss.lab.runs();
   Progress progress("calibrate " + material + ": the scatter at the calibrated point",
                     static_cast<long>(tests.size()) * ss.lab.specimens());
-  const Misfit there = misfit.with_scatter(ss.lab.run_ensemble(r.model, tests, true));
+  const Ensemble scatter = ss.lab.run_ensemble(r.model, tests, true);
   progress.finish(std::to_string(ss.lab.runs() - start) + " runs");
+  int members = 0;  // the ensemble's, as the budget decided
+  if (r.surrogate_answer) {
+    // One specimen a point: the scatter runs are design points at the answer too, its curves their mean, and the
+    // simulator's mean there counts as the ensemble the surfaces are worth (the fewer specimens, the more scatter).
+    Evaluation at = r.best;
+    at.sim.clear();
+    for (const std::vector<TriaxialTest>& runs : scatter) at.sim.push_back(mean_curve(runs));
+    for (std::size_t s = 0; s < scatter.front().size(); ++s) {
+      Evaluation e = r.best;
+      e.sim.clear();
+      for (const std::vector<TriaxialTest>& runs : scatter) e.sim.push_back(runs[s]);
+      e.specimen = static_cast<int>(s);
+      r.design.push_back(std::move(e));
+    }
+    r.best = at;
+    members = std::max(1, static_cast<int>(r.surrogate_members()));
+    std::printf("calibrate: %s: one specimen a point: the surfaces at the answer are worth the mean of %d specimens "
+                "(%.1f)\n", material.c_str(), members, r.surrogate_members());
+  }
+  const Misfit there = misfit.with_scatter(scatter, members);
   std::vector<Real> ratio;
   for (std::size_t k = 0; k < tests.size(); ++k)
     for (std::size_t i = 0; i < there.features(k).size(); ++i)
@@ -207,7 +228,8 @@ int run_materials(const Config& base, const CalibrationOptions& o, Session& ss, 
 /// placed, the values with their intervals in calibrated.csv.
 class CalibrationWork : public MaterialWork {
  public:
-  CalibrationWork(Session& ss, const Config& base) : ss_(ss), base_(base) {
+  CalibrationWork(Session& ss, const Config& base)
+      : ss_(ss), base_(base), one_specimen_(base.calibrate.method == "one_specimen") {
     table_ << "material,parameter,value,low95,high95,reference,chi2,data,runs,reference_rise,reference_chi2\n";
   }
 
@@ -216,14 +238,18 @@ class CalibrationWork : public MaterialWork {
     const long runs0 = ss.lab.runs();
     auto fit = [&](const Misfit& m, const std::string& what) {
       const long start = ss.lab.runs();
-      const long planned = planned_points(static_cast<int>(ss.free.size())) * static_cast<long>(tests.size()) *
-                           ss.lab.members();
+      const int d = static_cast<int>(ss.free.size());
+      const long planned = static_cast<long>(tests.size()) *
+                           (one_specimen_ ? planned_one_specimen_points(d) : planned_points(d) * ss.lab.members());
       Progress progress(what + " " + material, planned);
-      CalibrationResult r = calibrate(ss.lab, model_of(base_), ss.free, tests, m, 4, [&](long done, long, Real chi2) {
+      const CalibrationProgress report = [&](long done, long, Real chi2) {
         char extra[64];
         std::snprintf(extra, sizeof extra, "runs, best chi2 %.1f", chi2);
         progress.update(done - start, extra);
-      });
+      };
+      CalibrationResult r = one_specimen_
+                                ? calibrate_one_specimen(ss.lab, model_of(base_), ss.free, tests, m.with_members(1), report)
+                                : calibrate(ss.lab, model_of(base_), ss.free, tests, m, 4, report);
       progress.finish("");
       require_a_result(r, what + " " + material, ss);
       return r;
@@ -281,6 +307,7 @@ class CalibrationWork : public MaterialWork {
  private:
   Session& ss_;
   const Config& base_;
+  bool one_specimen_;  ///< [calibrate] method "one_specimen"
   std::ostringstream table_;
 };
 
