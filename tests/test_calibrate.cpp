@@ -433,6 +433,34 @@ TEST(JobPlan, ADiagnosisCountsOnlyItsLawsExtensions) {
   EXPECT_NE(work(cfg).find("then " + std::to_string(all - 2) + " extensions"), std::string::npos) << work(cfg);
 }
 
+// One specimen a point ([calibrate] method) is priced as it runs: the design and its rounds on one specimen each, the
+// scatter runs at the answer beside them. Priced as the ensemble's search (planned_points on 1 to K specimens) the
+// search stage names other counts and fails.
+TEST(JobPlan, AOneSpecimenSearchIsPricedAtOneSpecimenAPoint) {
+  Config cfg = test::tiny_cell_config();
+  cfg.calibrate.scatter_specimens = 4;
+  TriaxialTest t;
+  t.material = "A";
+  t.sigma3 = 100e3;
+  t.specimen_balls = 100;
+  PlanInput in;
+  in.materials["A"] = {t, t, t};
+  in.free = {"mu_s", "mu_r"};
+  auto search = [&](const Config& c) {
+    in.cell = c;
+    for (const PlanStage& s : plan_job(in).stages)
+      if (s.name == "A: search") return s;
+    return PlanStage();
+  };
+  const PlanStage ensemble = search(cfg);
+  cfg.calibrate.method = "one_specimen";
+  const PlanStage one = search(cfg);
+  EXPECT_EQ(one.work.find(std::to_string(planned_one_specimen_points(2)) + " points x 3 tests x 1 specimens"), 0u)
+      << one.work;
+  EXPECT_EQ(one.setting, "[calibrate] method");
+  EXPECT_LT(one.particle_steps, ensemble.particle_steps) << ensemble.work;
+}
+
 // A job's plan counts a run's shear steps before it runs: the estimate is the stage's own count (the end strain at
 // the rate set from the inertial number at sigma3, with the time step of the cell's balls), at two pressures; the
 // probe measures a finite speed. A shear counted by engineering strain (0.01 / (rate dt)) is 0.5% short and fails.
