@@ -11,7 +11,6 @@
 #include "host/lab/periodic_lab.hpp"
 #include "host/lab/run_cost.hpp"
 #include "host/lab/state_match.hpp"
-#include "host/util/progress.hpp"
 #include "host/util/text_format.hpp"
 
 namespace dem {
@@ -21,34 +20,7 @@ namespace dem {
 /// seed and cached (.specimens), then tested at every pressure.
 constexpr Real kMembraneSpecimenOverTest = 1.3;
 
-double JobPlan::low() const {
-  double s = 0;
-  for (const PlanStage& p : stages) s += p.low;
-  return s;
-}
-
-double JobPlan::high() const {
-  double s = 0;
-  for (const PlanStage& p : stages) s += p.high;
-  return s;
-}
-
-double JobPlan::particle_steps() const {
-  double s = 0;
-  for (const PlanStage& p : stages) s += p.particle_steps;
-  return s;
-}
-
-const PlanStage& JobPlan::costliest() const {
-  return *std::max_element(stages.begin(), stages.end(),
-                           [](const PlanStage& a, const PlanStage& b) { return a.high < b.high; });
-}
-
 namespace {
-
-std::string span(double low, double high) {
-  return std::fabs(high - low) < 0.5 ? format_duration(high) : format_duration(low) + " to " + format_duration(high);
-}
 
 /// Mean of a cost over the tests' pressures.
 template <class F>
@@ -328,7 +300,7 @@ struct Planner {
                  " specimens x " + T + " tests)");
     bias_check(material, tests);
     const long tried = in.diagnose ? static_cast<long>(extensions_of(model_of(in.cell)).size()) : 0;
-    const bool one = cc.method == "one_specimen" && !in.diagnose && !in.two_fidelity;
+    const bool one = one_specimen();
     const long points = (one ? planned_one_specimen_points(static_cast<int>(in.free.size()))
                              : planned_points(static_cast<int>(in.free.size()))) + tried * 6;
     const std::string k = one ? "1" : auto_ensemble ? "1 to " + std::to_string(K) : std::to_string(K);
@@ -364,6 +336,10 @@ struct Planner {
                  std::to_string(std::max(0, P - shared)) + " packings");
   }
 
+  /// Whether the search runs one specimen a point ([calibrate] method; diagnose and two fidelities search with the
+  /// ensemble).
+  bool one_specimen() const { return cc.method == "one_specimen" && !in.diagnose && !in.two_fidelity; }
+
   /// What the counts rest on: the speed measured, a run's and a packing's steps, and the choices made on the way.
   void notes() {
     const auto probed = [](const CellCost& c) {
@@ -388,9 +364,15 @@ struct Planner {
                            " lets the balls slide on at sigma3: a run's consolidation settles its packing again, "
                            "counted as " + fmt("%g", static_cast<double>(ResettleCost::low)) +
                            fmt(" to %g packings' steps (measured 0.56 to 18.5: a frictionless packing is marginally rigid)", static_cast<double>(ResettleCost::high)));
-    plan.notes.push_back("a search counts its planned points on the whole ensemble: one whose optimum lies on the "
-                         "edge of a range searches again beyond it and runs more, and points far above the best run "
-                         "one specimen only (Table 6's S-1 once ran 636 runs where 264 were planned, now 200)");
+    if (one_specimen())
+      plan.notes.push_back("one specimen a point ([calibrate] method): the search runs its design and up to " +
+                           std::to_string(OneSpecimenSearch{}.rounds) + " rounds once each, on one specimen; the "
+                           "scatter runs at the base and at the answer are its points there; an optimum on the edge "
+                           "of a range searches again beyond it and runs more");
+    else
+      plan.notes.push_back("a search counts its planned points on the whole ensemble: one whose optimum lies on the "
+                           "edge of a range searches again beyond it and runs more, and points far above the best run "
+                           "one specimen only (Table 6's S-1 once ran 636 runs where 264 were planned, now 200)");
     if (auto_ensemble)
       plan.notes.push_back("ensemble \"auto\": the scatter runs choose 1 to " + std::to_string(S) +
                            " specimens a point (the fewest whose mean's standard error is half the data's noise): "
@@ -413,16 +395,6 @@ JobPlan plan_job(const PlanInput& in) {
   if (in.walls) p.walls_specimens();
   p.notes();
   return p.plan;
-}
-
-std::string JobPlan::text(const std::string& kind) const {
-  std::string s = kind + ": plan (before any packing):\n";
-  for (const PlanStage& p : stages)
-    s += "  " + p.name + ": " + p.work + fmt(", %.2g particle-steps, ", p.particle_steps) + span(p.low, p.high) + "\n";
-  s += kind + ": in all " + fmt("%.2g particle-steps, ", particle_steps()) + "about " + span(low(), high()) +
-       " on this machine\n";
-  for (const std::string& n : notes) s += "  " + n + "\n";
-  return s;
 }
 
 }  // namespace dem

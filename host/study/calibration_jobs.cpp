@@ -315,7 +315,11 @@ class CalibrationWork : public MaterialWork {
 class DiagnosisWork : public MaterialWork {
  public:
   DiagnosisWork(Session& ss, const Config& base, const CalibrationOptions& o)
-      : ss_(ss), base_(base), report_(ss, base, o) {}
+      : ss_(ss), base_(base), report_(ss, base, o) {
+    if (base.calibrate.method != "ensemble")
+      std::printf("diagnose: [calibrate] method \"%s\" is calibrate's: the diagnosis searches with the ensemble, "
+                  "every extension's fit on the same specimens as the base's\n", base.calibrate.method.c_str());
+  }
 
   Calibrated fit(const std::string& material, const std::vector<TriaxialTest>& tests, const Misfit& misfit) override {
     const Diagnosis dg = diagnose(ss_.lab, model_of(base_), ss_.free, tests, misfit, true);
