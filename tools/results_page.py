@@ -84,7 +84,8 @@ def coverage(root):
     out = io.StringIO()
     coverage_table.table(rows, out)
     return out.getvalue(), [folder], ('perf/coverage.sh (METHOD=ensemble with the binary of its commit; '
-                                      'METHOD=rescatter_max at 9827c3e; METHOD=specimens at 82f074b, cases 17-30 of 1x at ac9b891 and fb5505c, the same code as b79c38d), '
+                                      'METHOD=rescatter_max at 9827c3e; METHOD=specimens at 82f074b, cases 17-30 of 1x at ac9b891 and fb5505c, the same code as b79c38d; '
+                                      'METHOD=one_specimen SEARCH=one_specimen at 933e339 where no range was widened, the rest at 9286505), '
                                       'tools/coverage_table.py data/sweeps/coverage')
 
 
