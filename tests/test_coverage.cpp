@@ -14,6 +14,14 @@
 namespace dem {
 namespace {
 
+/// The base the bowls' free ranges centre on (free_param): mu_s 0.15, mu_r 0.015.
+Model bowl_base() {
+  Model base;
+  base.law.mu_s = 0.15;
+  base.law.mu_r = 0.015;
+  return base;
+}
+
 /// Residuals as the misfit whitens them: r_i = f_i(x, y) + c_i + chaos_i(x, y) - d_i in units of the total standard
 /// deviation, (x, y) the unit coordinates of (mu_s, mu_r). f rises with the friction as q does, most data along one
 /// combination of the two (they trade against each other, as on Table 6's S-1); d = f(truth) + the data's own noise;
@@ -75,9 +83,7 @@ struct NoisyBowl {
 // 2.2); at least 90 allows 2.3 sd of chance, and a method whose intervals hold it 85% of the time or less fails with
 // probability above 0.9 (binomial). The same for the joint 95% region (region_rise at most 1).
 TEST(Coverage, IntervalsAndTheJointRegionHoldTheTruthAtTheirLevel) {
-  Model base;
-  base.law.mu_s = 0.15;
-  base.law.mu_r = 0.015;
+  const Model base = bowl_base();
   constexpr int kCases = 100;
   std::mt19937_64 draw(2026);
   std::uniform_real_distribution<Real> inner(0.15, 0.85);
@@ -108,9 +114,7 @@ TEST(Coverage, IntervalsAndTheJointRegionHoldTheTruthAtTheirLevel) {
 // variance along the friction's combination, which the marginal profiles cross at a slant), below the 85 a test that
 // can fail needs; with them at least 90 each, as for a right noise.
 TEST(Coverage, ScatterSpecimensMeasureANoiseTheMisfitMisstates) {
-  Model base;
-  base.law.mu_s = 0.15;
-  base.law.mu_r = 0.015;
+  const Model base = bowl_base();
   constexpr int kCases = 100, kSpecimens = 8;
   std::mt19937_64 draw(2027);
   std::uniform_real_distribution<Real> inner(0.15, 0.85);
@@ -188,9 +192,7 @@ struct SpecimenBowl {
 // search runs at most its 3^2 design and 6 rounds besides the base's and the answer's points. Without the surfaces'
 // own scatter (calibration_uncertainty.cpp, surface_scatter) the joint region held it 87 times: the test fails.
 TEST(Coverage, OneSpecimenAPointHoldsTheTruthAtItsLevel) {
-  Model base;
-  base.law.mu_s = 0.15;
-  base.law.mu_r = 0.015;
+  const Model base = bowl_base();
   constexpr int kCases = 100;
   std::mt19937_64 draw(2028);
   std::uniform_real_distribution<Real> inner(0.15, 0.85);
@@ -249,9 +251,7 @@ TEST(Coverage, OneSpecimenAPointHoldsTheTruthAtItsLevel) {
 // best point where it was and widens the intervals about it (the chi2 falls by four, so the same rise lies twice as
 // far where the intervals end inside the box).
 TEST(Coverage, AWiderScatterWidensTheIntervalsAboutTheSameBest) {
-  Model base;
-  base.law.mu_s = 0.15;
-  base.law.mu_r = 0.015;
+  const Model base = bowl_base();
   const std::vector<FreeParam> free{free_param("mu_s", base), free_param("mu_r", base)};
   // q's level follows x, its early stiffness y; the data at (0.4, 0.6); eps_v the same at every point.
   auto curve_at = [](Real x, Real y, Real scale) {

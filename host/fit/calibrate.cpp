@@ -31,6 +31,13 @@ Real chi2_95(int d) {
 
 namespace {
 
+/// The chi2 the surfaces give at u: the sum of their squares.
+Real surfaces_chi2(const std::vector<QuadraticSurface>& s, const std::vector<Real>& u) {
+  Real c = 0;
+  for (const QuadraticSurface& q : s) c += q(u) * q(u);
+  return c;
+}
+
 /// One search over fixed ranges: every point run is kept in `res.design`, the best in `res.best`.
 class Search {
  public:
@@ -123,11 +130,7 @@ class Search {
     std::vector<Real> centre(d_, 0.5), was_at, was_wide;
     for (int round = 0;; ++round) {
       const std::vector<QuadraticSurface> s = response_surfaces(res.design, centre);
-      auto chi2 = [&](const std::vector<Real>& x) {
-        Real c = 0;
-        for (const QuadraticSurface& q : s) c += q(x) * q(x);
-        return c;
-      };
+      auto chi2 = [&](const std::vector<Real>& x) { return surfaces_chi2(s, x); };
       const std::vector<Real> u = minimise_unit_box(chi2, d_);
       const Real scale = std::max(Real(1), chi2(u) / std::max(1, res.data - d_));
       const std::vector<Real> wide = region_half_widths(s, u, chi2_95(d_) * scale);
@@ -143,11 +146,8 @@ class Search {
     // The answer: the surfaces' minimum, centred on itself; its curves the nearest run's (one specimen's) until the
     // job runs the scatter specimens there.
     Evaluation best;
-    best.u = minimise_unit_box([&, s = response_surfaces(res.design, centre)](const std::vector<Real>& x) {
-      Real c = 0;
-      for (const QuadraticSurface& q : s) c += q(x) * q(x);
-      return c;
-    }, d_);
+    const std::vector<QuadraticSurface> last = response_surfaces(res.design, centre);
+    best.u = minimise_unit_box([&](const std::vector<Real>& x) { return surfaces_chi2(last, x); }, d_);
     Real nearest = std::numeric_limits<Real>::infinity();
     for (const Evaluation& e : res.design) {
       Real d2 = 0;
@@ -207,11 +207,7 @@ class Search {
   /// Runs the surrogate's optimum, the surfaces centred on the best run; false when that point was run before.
   bool surrogate_step() {
     const std::vector<QuadraticSurface> s = response_surfaces(res.design, res.best.u);
-    const std::vector<Real> u = minimise_unit_box([&](const std::vector<Real>& x) {
-      Real c = 0;
-      for (const QuadraticSurface& q : s) c += q(x) * q(x);
-      return c;
-    }, d_);
+    const std::vector<Real> u = minimise_unit_box([&](const std::vector<Real>& x) { return surfaces_chi2(s, x); }, d_);
     if (run_before(u)) return false;
     evaluate(u);
     return true;
@@ -244,9 +240,7 @@ Real surfaces_inside(const CalibrationResult& r, std::size_t k) {
   const bool upper = r.best.u[k] > 0.5;
   auto chi2 = [&](std::vector<Real> x) {
     x[k] = upper ? 0.875 * x[k] : 0.125 + 0.875 * x[k];
-    Real c = 0;
-    for (const QuadraticSurface& q : s) c += q(x) * q(x);
-    return c;
+    return surfaces_chi2(s, x);
   };
   return chi2(minimise_unit_box(chi2, static_cast<int>(r.best.u.size())));
 }
