@@ -14,6 +14,9 @@
 #                      # the data's own: what matching the cells to one data set's void ratio costs the intervals)
 #                      # SEARCH=ensemble ([calibrate] method of the calibrations: ensemble or one_specimen; BASE's copy
 #                      # in WORK carries it)
+#                      # REUSE= (an earlier METHOD whose case folders in WORK are analysed again: their data and runs
+#                      # copied and the calibration resumed, so that only points the new code asks for run; the same
+#                      # data and specimens, what a change to the intervals alone does, case by case)
 # WORK holds each case's data and calibration folder; the script removes only case folders it made (a marker file:
 # scripts/script_folders.sh).
 set -euo pipefail
@@ -23,13 +26,15 @@ fail() { echo "coverage: $*" >&2; exit 2; }
 whole() { [[ "$2" =~ ^[0-9]+$ ]] || fail "$1=$2: a whole number"; }
 cases="${CASES:-30}"; first="${FIRST:-1}"; sizes="${SIZES:-1 4}"; jobs="${JOBS:-2}"; budget="${BUDGET:-3600}"
 case_s="${CASE_S:-300}"; plan="${PLAN:-0}"; state="${STATE:-1}"; method="${METHOD:-ensemble}"; cal_args="${CAL_ARGS:-}"
-search="${SEARCH:-ensemble}"
+search="${SEARCH:-ensemble}"; reuse="${REUSE:-}"
 mu_s_box="${MU_S:-0.06 0.40}"; mu_r_box="${MU_R:-0.005 0.055}"
 for v in cases first jobs budget case_s; do whole "${v^^}" "${!v}"; done
 for s in $sizes; do whole SIZES "$s"; [ "$s" -ge 1 ] && [ "$s" -le 64 ] || fail "SIZES: $s is not in 1..64"; done
 [[ "$state" =~ ^[01]$ ]] || fail "STATE=$state: 1 (the data's void ratio matched) or 0 (dropped)"
 [[ "$method" =~ ^[A-Za-z0-9_-]+$ ]] || fail "METHOD=$method: letters, digits, _ and - only (it names OUT/<METHOD>.csv)"
 [[ "$search" =~ ^(ensemble|one_specimen)$ ]] || fail "SEARCH=$search: ensemble or one_specimen"
+[[ "$reuse" =~ ^[A-Za-z0-9_-]*$ ]] || fail "REUSE=$reuse: letters, digits, _ and - only (an earlier METHOD)"
+[ "$reuse" != "$method" ] || [ -z "$reuse" ] || fail "REUSE=$reuse: the METHOD itself; name the new rows otherwise"
 build="$(build_folder coverage)"; tdem="$build/triaxdem"
 [ -x "$tdem" ] || fail "no triaxdem in BUILD=$build (build it first: cmake --build $build --target triaxdem)"
 base="$(realpath "${BASE:-$root/tests/data/hidden_effects.toml}")"
@@ -91,8 +96,15 @@ if [ "$plan" != 1 ]; then
       fail "BASE=$base: no [material] mu_s and mu_r lines to set the truth in"
     printf 'material,mu_s,mu_r\nsynthetic,%s,%s\n' "$mu_s" "$mu_r" > "$dir/truth.csv"
     t0=$SECONDS
+    earlier="$work/${reuse}_${s}x/case$c"; resume=()
+    if [ -n "$reuse" ]; then
+      [ -f "$earlier/data.csv" ] && ls -d "$earlier"/cal/calibrate_* > /dev/null 2>&1 ||
+        fail "REUSE=$reuse: no data and calibration of case $c in $earlier"
+      cp "$earlier/data.csv" "$dir/"; cp -r "$earlier/cal" "$dir/cal"
+      resume=(--resume "$(ls -d "$dir"/cal/calibrate_* | head -1)")
+    fi
     seed="$(sed -n 's/^seed = \([0-9]*\).*/\1/p' "$base" | head -1)"
-    "$tdem" synth --config "$dir/truth.toml" -o "$dir/data.csv" --extension none --seed "$((1000 + c))" \
+    [ -n "$reuse" ] || "$tdem" synth --config "$dir/truth.toml" -o "$dir/data.csv" --extension none --seed "$((1000 + c))" \
       --specimen-seed "$((${seed:-1} + 300000 + 10 * c))" --cell-factor "$s" > "$dir/synth.log" 2>&1 ||
       { tail -5 "$dir/synth.log"; fail "case $c: synth failed ($dir/synth.log)"; }
     if [ "$state" = 0 ]; then
@@ -109,7 +121,7 @@ PY
     fi
     # shellcheck disable=SC2086
     "$tdem" calibrate "$dir/data.csv" --config "$base" --reference "$dir/truth.csv" --predict none -j "$jobs" \
-      -o "$dir/cal" $cal_args > "$dir/calibrate.log" 2>&1 ||
+      -o "$dir/cal" "${resume[@]}" $cal_args > "$dir/calibrate.log" 2>&1 ||
       { tail -5 "$dir/calibrate.log"; fail "case $c: calibrate failed ($dir/calibrate.log)"; }
     secs=$((SECONDS - t0))
     cal="$(ls "$dir"/cal/calibrate_*/calibrated.csv)"

@@ -190,6 +190,13 @@ if [ "$part" != tools ]; then
     bash "$root/perf/coverage.sh" > "$work/coverage_again.log"
   grep -q ": 0 to run," "$work/coverage_again.log" && [ "$(wc -l < "$work/coverage/tiny.csv")" = 2 ] ||
     { cat "$work/coverage_again.log"; echo "scripts_smoke: coverage ran a case it had" >&2; exit 1; }
+  # The same case analysed again from its runs (REUSE): a row of its own, from the earlier case's data and runs.
+  env BUILD="$build" BASE="$base" OUT="$work/coverage" WORK="$work/coverage_runs" CASES=1 SIZES=1 METHOD=tiny_again \
+    REUSE=tiny JOBS=1 bash "$root/perf/coverage.sh" > "$work/coverage_reuse.log" 2>&1 &&
+    grep -q "^tiny_again,[0-9a-f+]*,1,1,$(cut -d, -f5,6 <<< "$(sed -n 2p "$work/coverage/tiny.csv")")," \
+      "$work/coverage/tiny_again.csv" && cmp -s "$work/coverage_runs/tiny_1x/case1/data.csv" \
+      "$work/coverage_runs/tiny_again_1x/case1/data.csv" ||
+    { cat "$work/coverage_reuse.log"; echo "scripts_smoke: coverage's REUSE gave no row from the case's data" >&2; exit 1; }
   ran+=(tools/coverage_table.py)
   # A folder the script did not make is never removed: refused, its file kept.
   mkdir -p "$work/coverage_user/tiny_1x/case2" && touch "$work/coverage_user/tiny_1x/case2/keep"

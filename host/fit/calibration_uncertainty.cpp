@@ -49,6 +49,12 @@ Eigen::MatrixXd surface_scatter(const CalibrationResult& r, int d) {
   const Eigen::VectorXd own = (basis * P).diagonal();                    // each point's share in its own value
   Eigen::MatrixXd departure = Y - fitted;
   for (int i = 0; i < n; ++i) departure.col(i) /= std::sqrt(std::max(Real(0.05), 1 - own(i)));
+  // The draws' minima are sought half a range beyond each edge: clamped to the box, the draws that would cross an
+  // edge the answer lies near pile up on it, and their spread understates the answer's scatter along that edge.
+  const auto widened = [](std::vector<Real> x) {
+    for (Real& v : x) v = 2 * v - Real(0.5);
+    return x;
+  };
   std::mt19937_64 rng(20261202);
   Eigen::MatrixXd moves(kDraws, d);
   for (int b = 0; b < kDraws; ++b) {
@@ -58,11 +64,12 @@ Eigen::MatrixXd surface_scatter(const CalibrationResult& r, int d) {
     for (int i = 0; i < n; ++i) drawn.col(i) += sign[static_cast<std::size_t>(specimen[static_cast<std::size_t>(i)])] * departure.col(i);
     const Eigen::MatrixXd C = drawn * P.transpose();  // m x nb: each residual's surface
     const Eigen::MatrixXd Q = C.transpose() * C;      // the chi2 as a quadratic form of the basis
-    const std::vector<Real> u = minimise_unit_box([&](const std::vector<Real>& x) {
-      const std::vector<Real> bx = QuadraticSurface::basis(x);
+    const std::vector<Real> x = minimise_unit_box([&](const std::vector<Real>& x) {
+      const std::vector<Real> bx = QuadraticSurface::basis(widened(x));
       const Eigen::Map<const Eigen::VectorXd> v(bx.data(), nb);
       return v.dot(Q * v);
     }, d);
+    const std::vector<Real> u = widened(x);
     for (int k = 0; k < d; ++k) moves(b, k) = u[static_cast<std::size_t>(k)];
   }
   auto covariance = [](Eigen::MatrixXd x) {
