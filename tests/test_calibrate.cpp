@@ -459,6 +459,11 @@ TEST(JobPlan, AOneSpecimenSearchIsPricedAtOneSpecimenAPoint) {
       << one.work;
   EXPECT_EQ(one.setting, "[calibrate] method");
   EXPECT_LT(one.particle_steps, ensemble.particle_steps) << ensemble.work;
+  // "auto" chooses no ensemble and grows no cell for it (decide_noise_budget): the plan says neither.
+  for (const std::string& note : plan_job(in).notes) {
+    EXPECT_EQ(note.find("ensemble \"auto\""), std::string::npos) << note;
+    EXPECT_EQ(note.find("cell \"auto\""), std::string::npos) << note;
+  }
 }
 
 // A job's plan counts a run's shear steps before it runs: the estimate is the stage's own count (the end strain at
@@ -800,7 +805,7 @@ TEST(Calibrate, AMatchNearAKnownFrictionBracketsItAndStoresItsPackings) {
 // The cell an "auto" [calibrate] cell_factor chooses (measure_misfit): where even all the scatter specimens leave the
 // simulator's standard error above half a lab's noise, the cell grows by the factor that makes up the rest, at most
 // kMaxCellFactor, and the scatter is measured again on it; a lab matched to the data's void ratio is matched again on
-// the grown cell. A fixed cell_factor, or a fixed ensemble, keeps the cell.
+// the grown cell. A fixed cell_factor, or a fixed ensemble, or one specimen a point keeps the cell.
 // Whether the grown cell then reaches the goal is not asserted: a variance from two specimens has one degree of
 // freedom (here 0.7 of the noise on 100 balls came out 1.2 on 200), which is why the default measures it on 16.
 // The cell's bias, which measure_misfit measures next on cells of four times the balls, is left out: it does not
@@ -853,6 +858,14 @@ TEST(Calibrate, AutoCellGrowsWhereAllScatterSpecimensFallShort) {
   PeriodicLab fixed_ensemble(cfg, false);
   measure_misfit(fixed_ensemble, m, data, noise, false);
   EXPECT_EQ(fixed_ensemble.cell_factor(), 1);
+
+  // One specimen a point runs each point once: an "auto" ensemble and cell choose nothing for it.
+  cfg.calibrate.ensemble = kAutoEnsemble;
+  cfg.calibrate.method = "one_specimen";
+  PeriodicLab one(cfg, false);
+  const NoiseBudget once = decide_noise_budget(one, m, data, noise, false, state);
+  EXPECT_EQ(one.cell_factor(), 1);
+  EXPECT_EQ(once.members, 1);
 }
 
 // measure_misfit measures the cell's bias on 4 cells of 4 times the balls and says so in the report's words; a data

@@ -373,11 +373,11 @@ struct Planner {
       plan.notes.push_back("a search counts its planned points on the whole ensemble: one whose optimum lies on the "
                            "edge of a range searches again beyond it and runs more, and points far above the best run "
                            "one specimen only (Table 6's S-1 once ran 636 runs where 264 were planned, now 200)");
-    if (auto_ensemble)
+    if (auto_ensemble && !one_specimen())
       plan.notes.push_back("ensemble \"auto\": the scatter runs choose 1 to " + std::to_string(S) +
                            " specimens a point (the fewest whose mean's standard error is half the data's noise): "
                            "the searches' times are that range");
-    if (cc.cell_factor == kAutoCell && auto_ensemble)
+    if (cc.cell_factor == kAutoCell && auto_ensemble && !one_specimen())
       plan.notes.push_back("cell \"auto\": where all " + std::to_string(S) + " scatter specimens fall short, the "
                            "cell grows (up to " + std::to_string(kMaxCellFactor) + " x its balls) and every later "
                            "stage costs about that factor more: the job says so when it happens");

@@ -323,13 +323,19 @@ Misfit Session::misfit_of(const Config& base, const std::string& material, const
     std::printf("%s: %s: FINDING: %s\n", folder.c_str(), material.c_str(), m.cell_bias_finding().c_str());
   for (const std::string& n : m.notes()) std::printf("  noise: %s\n", n.c_str());
   const Real ratio = m.ensemble_ratio();
-  const bool chosen = base.calibrate.ensemble == kAutoEnsemble;
+  const bool one_specimen = base.calibrate.method == "one_specimen";
+  const bool chosen = base.calibrate.ensemble == kAutoEnsemble && !one_specimen;
   // An "auto" cell grows only with an "auto" ensemble: a fixed ensemble fixes the cost per point.
   const bool cell_chosen = chosen && base.calibrate.cell_factor == kAutoCell;
   std::printf("  cell: %zu balls, %d x the config's (%s)%s\n", lab.balls(), lab.cell_factor(),
               base.calibrate.cell_factor != kAutoCell ? "[calibrate] cell_factor" : cell_chosen ? "chosen" : "kept",
               lab.cell_factor() > 1 && cell_chosen ? ": all the scatter specimens of the config's cell fell short"
                                                    : "");
+  if (one_specimen) {
+    std::printf("  ensemble: one specimen a point ([calibrate] method); the surfaces average the points' scatter, and "
+                "the answer's is measured on the %d scatter specimens\n", lab.specimens());
+    return m;
+  }
   std::printf("  ensemble: %d specimens per parameter point (%s); the simulator's standard error is %.2f of the "
               "data's noise (median)%s\n", lab.members(), chosen ? "chosen" : "[calibrate] ensemble", ratio,
               ratio > kEnsembleRatioGoal ? "" : ": below 1/2, enough");
