@@ -4,6 +4,8 @@
 # are taken on the same machine in the same state. Installs the peers from Debian when they are missing.
 #   perf/peer_benchmark.sh                    # STEPS=2000 REPS=3 NP=$(nproc) BUILD=build PEERS="liggghts lammps"
 # CONFIG: another packing config (default perf/configs/periodic_54k.toml); PEERS="": triaxdem alone (the CI's check).
+# CSV=FILE: one row a code appended (date, commit, machine, cores, balls, steps, code, the median and the runs), the
+# results page's file (data/results/peer_benchmark/rates.csv).
 # The packing: perf/configs/periodic_54k.toml (54,872 balls of 2 mm, a jittered cubic array at a pitch of
 # 0.995 d, periodic), written by triaxdem and read by the peers. The contact laws, as close as each code has:
 #   triaxdem  rrlinear: kn = pi r^2 E / (2 r), ks = kn / 1.5, Coulomb mu_s 0.3, rolling spring ks R^2 capped
@@ -18,6 +20,7 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 steps="${STEPS:-2000}"; reps="${REPS:-3}"; np="${NP:-$(nproc)}"
 build="$(build_folder peer_benchmark)"; work="$(realpath -m "${WORK:-$root/runs/peer_benchmark}")"
 peers="${PEERS-liggghts lammps}"
+csv="${CSV:+$(realpath -m "$CSV")}"  # the script may change folder
 tdem="$build/triaxdem"
 [ -x "$tdem" ] || { echo "peer_benchmark: build triaxdem first ($tdem)"; exit 1; }
 declare -A package=([liggghts]=liggghts [lammps]=lammps) command_of=([liggghts]=liggghts [lammps]=lmp)
@@ -119,3 +122,10 @@ for code in triaxdem $peers; do
   [ "$code" != triaxdem ] && best=$("$py" -c "print(max($best, $m))")
 done
 [ -z "$peers" ] || "$py" -c "print(f'  triaxdem / faster peer: {$mine / $best:.2f}')"
+if [ -n "$csv" ]; then
+  . "$root/scripts/provenance.sh"
+  [ -s "$csv" ] || echo "date,commit,machine,cores,balls,steps,code,median_psteps_per_s,runs" > "$csv"
+  for code in triaxdem $peers; do
+    echo "$(provenance_fields "$root"),$np,$balls,$steps,$code,$(echo "${rates[$code]}" | median),${rates[$code]% }" >> "$csv"
+  done
+fi

@@ -74,7 +74,11 @@ if [ "$part" != diagnoses ]; then
   ! "$py" "$root/tools/results_page.py" --root "$work/results" --check > "$work/results_changed.log" 2>&1 &&
     grep -q "is not what its artifacts give" "$work/results_changed.log" ||
     { cat "$work/results_changed.log"; echo "scripts_smoke: the results page passed with a changed artifact" >&2; exit 1; }
-  check perf/scaling.sh env BUILD="$build" WORK="$work/scaling" K=4 STEPS=20 bash "$root/perf/scaling.sh"
+  check perf/scaling.sh env BUILD="$build" WORK="$work/scaling" K=4 STEPS=20 CSV="$work/scaling.csv" \
+    bash "$root/perf/scaling.sh"
+  # The results page's row: its date, commit and machine, then the size's figures.
+  grep -Eq "^[0-9]{4}-[0-9]{2}-[0-9]{2},[0-9a-f+]+,[^,]+,[0-9]+,20,64,[0-9.e+]+," "$work/scaling.csv" ||
+    { cat "$work/scaling.csv"; echo "scripts_smoke: scaling wrote no CSV row" >&2; exit 1; }
   # The tiny calibration above, again from its packing store: the plan, a first and a second job, one row each.
   check perf/time_to_answer.sh env BUILD="$build" WORK="$work/answer" CASES=tiny JOBS=1 STORE="$work/cal" \
     bash "$root/perf/time_to_answer.sh"
@@ -133,8 +137,10 @@ if [ "$part" != diagnoses ]; then
   sed -e 's/^count = .*/count = 216/' -e 's/^size_mm = .*/size_mm = [11.94, 11.94, 11.94]/' \
       "$root/perf/configs/periodic_54k.toml" > "$work/packing.toml"
   check perf/peer_benchmark.sh env BUILD="$build" WORK="$work/peers" CONFIG="$work/packing.toml" PEERS= STEPS=20 REPS=1 \
-    NP=1 bash "$root/perf/peer_benchmark.sh"
+    NP=1 CSV="$work/peers.csv" bash "$root/perf/peer_benchmark.sh"
   exists "$work/peers/packing.data"
+  grep -Eq "^[0-9]{4}-[0-9]{2}-[0-9]{2},[0-9a-f+]+,[^,]+,1,216,20,triaxdem,[0-9.e+]+," "$work/peers.csv" ||
+    { cat "$work/peers.csv"; echo "scripts_smoke: peer_benchmark wrote no CSV row" >&2; exit 1; }
   # Valgrind (Debian 12's 3.19) cannot decode AVX-512: on a machine whose build chose x86-64-v4 the script must say
   # so and stop, which is this tiny case's outcome there.
   echo "== perf/instruction_count.sh"
