@@ -57,12 +57,13 @@ fi
 export OMP_NUM_THREADS=1  # -j runs at once, one thread each
 
 have() { awk -F, -v c="$1" -v s="$2" 'NR > 1 && $3 == c && $4 == s' "$csv" | grep -q .; }
-# SIZE: a case's seconds, the mean of this method's rows of that size, else of every method's in OUT (the same cells
-# and searches), else CASE_S.
+# SIZE: a case's seconds, the mean of this method's rows of that size, else of REUSE's (whose runs a case reads: an
+# upper bound, about 1.5 times what 30 such cases took), else of every method's in OUT (the same cells and searches),
+# else CASE_S.
 mean_case() {
-  awk -F, -v d="$case_s" -v z="$1" -v m="$method" 'FNR > 1 && $4 == z && $18 > 0 {
-      if ($1 == m) { s += $18; n++ } else { o += $18; k++ } }
-    END { printf "%d", n ? s / n : k ? o / k : d }' "$out"/*.csv
+  awk -F, -v d="$case_s" -v z="$1" -v m="$method" -v r="$reuse" 'FNR > 1 && $4 == z && $18 > 0 {
+      if ($1 == m) { s += $18; n++ } else if ($1 == r) { u += $18; j++ } else { o += $18; k++ } }
+    END { printf "%d", n ? s / n : j ? u / j : k ? o / k : d }' "$out"/*.csv
 }
 plan_s() { local t=0 i; for i in "$@"; do t=$((t + $(mean_case "${i##*:}"))); done; echo "$t"; }
 truth() {  # CASE: "mu_s mu_r", drawn from the case number (the same on every machine)
@@ -75,7 +76,7 @@ todo=()
 for ((c = first; c < first + cases; c++)); do for s in $sizes; do have "$c" "$s" || todo+=("$c:$s"); done; done
 total="$(plan_s "${todo[@]}")"
 echo "coverage: $method, cases $first..$((first + cases - 1)), data sizes ${sizes// /x, }x the cell's: ${#todo[@]} to run," \
-     "about $(( total / 60 )) min in all on this machine (-j $jobs; each case as the rows of its size took); this sitting's budget" \
+     "${reuse:+at most (the runs read from $reuse), }about $(( total / 60 )) min in all on this machine (-j $jobs; each case as the rows of its size took); this sitting's budget" \
      "$budget s"
 if [ "$plan" != 1 ]; then
   start=$SECONDS; done_here=0
