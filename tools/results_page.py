@@ -85,7 +85,8 @@ def coverage(root):
     coverage_table.table(rows, out)
     return out.getvalue(), [folder], ('perf/coverage.sh (METHOD=ensemble with the binary of its commit; '
                                       'METHOD=rescatter_max at 9827c3e; METHOD=specimens at 82f074b, cases 17-30 of 1x at ac9b891 and fb5505c, the same code as b79c38d; '
-                                      'METHOD=one_specimen SEARCH=one_specimen at 933e339 where no range was widened, the rest at 9286505), '
+                                      'METHOD=one_specimen SEARCH=one_specimen at 933e339 where no range was widened, the rest at 9286505; '
+                                      'METHOD=one_specimen_unclamped REUSE=one_specimen SIZES=1 at 777110e), '
                                       'tools/coverage_table.py data/sweeps/coverage')
 
 
@@ -187,20 +188,36 @@ def job_runs(path):
     return runs, plan
 
 
+# The coverage rows of the current code's one specimen a point (perf/coverage.sh METHOD): the bootstrap's minima
+# unclamped (777110e), the same cases' data and runs as `one_specimen` (REUSE).
+CURRENT_COVERAGE = "one_specimen_unclamped"
+
+
 def calibration_goals(root):
     """Issue 85's goals for one specimen a point (`[calibrate] method = "one_specimen"`) beside the ensemble: the
     runs a calibration takes, the particle-steps its plan counts, and how often its 95% intervals hold the truth.
     Runs in all are the calibration's (scatter runs at the base and at the answer, the search), not the cell's bias
-    check on larger cells. The coverage counts are of the 30 cases of the cell's size (perf/coverage.sh). A goal with no
+    check on larger cells. The coverage counts are of the 30 cases of the cell's size (perf/coverage.sh, the current
+    code's rows). A goal with no
     file behind it is marked not measured."""
     plans = os.path.join(root, "data/sweeps/plan/walled_4000")
     s1 = os.path.join(root, "data/runs/S1_one_specimen")
     cov = os.path.join(root, "data/sweeps/coverage")
     out = io.StringIO()
     out.write("| goal | measured | goal's bound | met |\n|---|---|---|---|\n")
-    runs, plan = job_runs(os.path.join(s1, "calibrate.log"))
-    out.write(f"| Table 6 S-1, simulator runs in all, one specimen a point | {runs} ({plan}) | <= 60 | "
-              f"{'yes' if runs <= 60 else 'no'} |\n")
+    for folder, words in ((s1, "one specimen a point"), (s1 + "_s4", "the same with 4 scatter specimens")):
+        runs, plan = job_runs(os.path.join(folder, "calibrate.log"))
+        out.write(f"| Table 6 S-1, simulator runs in all, {words} | {runs} ({plan}) | <= 60 | "
+                  f"{'yes' if runs <= 60 else 'no'} |\n")
+    one = {r["parameter"]: r for r in read_rows(os.path.join(s1, "calibrated.csv"))}
+    ens = {r["parameter"]: r for r in read_rows(os.path.join(root, "data/runs/S1_table6_periodic/calibrated.csv"))}
+    inside = lambda r, v: float(r["low95"]) <= float(v) <= float(r["high95"])
+    for p in one:
+        both = inside(ens[p], one[p]["value"]) and inside(one[p], ens[p]["value"])
+        out.write(f"| Table 6 S-1, {p}: each method's optimum inside the other's 95% interval (one specimen "
+                  f"{fmt(one[p]['value'])} [{fmt(one[p]['low95'])}, {fmt(one[p]['high95'])}], the ensemble "
+                  f"{fmt(ens[p]['value'])} [{fmt(ens[p]['low95'])}, {fmt(ens[p]['high95'])}]) | "
+                  f"{'both' if both else 'not both'} | both | {'yes' if both else 'no'} |\n")
     steps = {c: plan_particle_steps(os.path.join(plans, c + ".plan.txt"))
              for c in ("defaults", "ensemble2", "one_specimen", "one_specimen_s4")}
     words = {"defaults": "the defaults (ensemble auto)", "ensemble2": "ensemble 2",
@@ -208,7 +225,7 @@ def calibration_goals(root):
     for c, v in steps.items():
         out.write(f"| walled cell of 4,000 balls, particle-steps its plan counts: {words[c]} | {v:.2g} | <= 8e9 | "
                   f"{'yes' if v <= 8e9 else 'no'} |\n")
-    rows = [r for r in read_rows(os.path.join(cov, "one_specimen.csv")) if r["size"] == "1"]
+    rows = [r for r in read_rows(os.path.join(cov, CURRENT_COVERAGE + ".csv")) if r["size"] == "1"]
     held = lambda p: sum(coverage_table.num(r, p + "_lo") <= coverage_table.num(r, p + "_true") <=
                          coverage_table.num(r, p + "_hi") for r in rows)
     joint = sum(coverage_table.num(r, "region_rise") <= 1 for r in rows)
@@ -223,9 +240,53 @@ def calibration_goals(root):
     for goal in ("YADE's walled 1,000-ball file, simulator runs in all", "the default diagnosis of YADE's linear file, "
                  "minutes"):
         out.write(f"| {goal} | not measured | {'<= 60' if 'runs' in goal else '<= 2'} | - |\n")
-    return out.getvalue(), [s1, plans, cov], ("the S-1 command in data/runs/README.md; triaxdem calibrate "
+    return out.getvalue(), [s1, s1 + "_s4", os.path.join(root, "data/runs/S1_table6_periodic"), plans, cov], ("the S-1 commands in data/runs/README.md; triaxdem calibrate "
                                               "tests/data/crosscode/walled_seed1.csv --config "
                                               "data/sweeps/plan/walled_4000/<case>.toml --plan; perf/coverage.sh")
+
+
+def runs_of(rows, keys):
+    """Rows grouped by the values of `keys` (one benchmark run each), in file order."""
+    groups = {}
+    for r in rows:
+        groups.setdefault(tuple(r[k] for k in keys), []).append(r)
+    return groups
+
+
+def peer_benchmark(root):
+    """Throughput side by side with LIGGGHTS and LAMMPS (Debian's packages) on one packing of 54,872 balls, each code
+    on all cores, run one after the other by one script; particle-steps per second, the median of the runs. The runs
+    inside one benchmark spread by several %, so ratios are what compare, not one machine's rates with another's."""
+    path = os.path.join(root, "data/results/peer_benchmark/rates.csv")
+    out = io.StringIO()
+    out.write("| date | commit | machine | cores | triaxdem | LIGGGHTS | LAMMPS | triaxdem / faster peer |\n"
+              "|---|---|---|---|---|---|---|---|\n")
+    for (date, commit, machine, cores), g in runs_of(read_rows(path), ("date", "commit", "machine", "cores")).items():
+        rate = {r["code"]: float(r["median_psteps_per_s"]) for r in g}
+        peers = [v for k, v in rate.items() if k != "triaxdem"]
+        ratio = f"**{rate['triaxdem'] / max(peers):.2f}**" if peers else "-"
+        cell = lambda k: f"{rate[k] / 1e6:.3g} M" if k in rate else "-"
+        out.write(f"| {date} | {commit} | {machine} | {cores} | {cell('triaxdem')} | {cell('liggghts')} | "
+                  f"{cell('lammps')} | {ratio} |\n")
+    return out.getvalue(), [path], "STEPS=1000 REPS=5 CSV=data/results/peer_benchmark/rates.csv perf/peer_benchmark.sh"
+
+
+def scaling(root):
+    """The cost per particle-step against the ball count: the benchmark packing at k^3 balls, 300 steps on all cores;
+    stage seconds from the run's own timers, the peak resident memory over the balls (the program itself at small N).
+    The rise is the largest size's cost over the cheapest size's."""
+    path = os.path.join(root, "data/results/scaling/scaling.csv")
+    out = io.StringIO()
+    for (date, commit, machine, threads), g in runs_of(read_rows(path), ("date", "commit", "machine", "threads")).items():
+        out.write(f"{date}, {commit}, {machine}, {threads} threads:\n\n| balls | particle-steps/s | ns per particle-step | "
+                  "rebuild s | forces s | gather + integrate s | bytes/ball (peak RSS) |\n|---|---|---|---|---|---|---|\n")
+        for r in g:
+            out.write(f"| {int(r['balls']):,} | {float(r['psteps_per_s']) / 1e6:.3g} M | {float(r['ns_per_pstep']):.1f} | "
+                      f"{r['rebuild_s']} | {r['forces_s']} | {r['integrate_s']} | {float(r['bytes_per_ball']):,.0f} |\n")
+        cost = [float(r["ns_per_pstep"]) for r in g]
+        out.write(f"\nFrom the cheapest size to {int(g[-1]['balls']):,} balls the cost per particle-step rises by "
+                  f"**{100 * (cost[-1] / min(cost) - 1):.0f}%**.\n\n")
+    return out.getvalue().rstrip("\n") + "\n", [path], "STEPS=300 CSV=data/results/scaling/scaling.csv perf/scaling.sh"
 
 
 SECTIONS = [
@@ -235,6 +296,8 @@ SECTIONS = [
     ("Coverage of the 95% intervals", coverage),
     ("One specimen a point against its goals", calibration_goals),
     ("A frictionless base's consolidation against the plan", frictionless_plan),
+    ("Side by side with LIGGGHTS and LAMMPS", peer_benchmark),
+    ("Cost per particle-step against the ball count", scaling),
     ("An oedometer's K0 against Jaky's", k0_jaky),
     ("What a wider size distribution does", psd_width),
     ("A polydisperse calibration", polydisperse),
