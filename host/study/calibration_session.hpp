@@ -28,6 +28,9 @@ constexpr Real kStrainBeyondData = 1.1;
 /// asks for more (the shear's records up to there are the same bit for bit, and the misfit compares no strain beyond
 /// the data's). Summary data (a peak, an end value) keep the config's strain.
 Config sheared_for(Config cell, const MeasuredData& data);
+/// The reference test's cell, sheared as far as the data need, its packings kept in (and read from) the output
+/// folder's .specimens/cells, where a later job on the same base finds them.
+Config stored_cell(const Config& base, const CalibrationOptions& o, const MeasuredData& data);
 
 /// A material's calibration as the prediction needs it: its tests, the model, and the periodic cell's tests at it.
 struct Calibrated {
