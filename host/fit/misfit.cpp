@@ -278,10 +278,11 @@ NoiseBudget decide_noise_budget(PeriodicLab& lab, const Model& base, const std::
   b.sim_end = lab.config().periodic.triax.target_strain;
   b.scatter = lab.run_ensemble(base, measured, true);
   auto misfit = [&] { return Misfit(measured, noise, b.scatter, lab.members(), b.sim_end, Real(lab.balls())); };
-  const bool one_specimen = lab.config().calibrate.method == "one_specimen";
+  const bool chosen = lab.config().calibrate.ensemble == kAutoEnsemble;
   // One specimen a point runs each point once: "auto" neither chooses an ensemble nor grows the cell for one.
-  if (one_specimen && lab.config().calibrate.ensemble == kAutoEnsemble) lab.set_members(1);
-  if (!one_specimen && lab.config().calibrate.ensemble == kAutoEnsemble) {
+  if (chosen && lab.config().calibrate.method == "one_specimen") {
+    lab.set_members(1);
+  } else if (chosen) {
     lab.set_members(lab.specimens());
     const int wanted = misfit().members_for(kEnsembleRatioGoal);
     // The cap is on the cell, not on one step: a lab shared by several materials may have grown for an earlier one.

@@ -1,7 +1,5 @@
 #include "host/study/calibration_session.hpp"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
