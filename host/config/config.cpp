@@ -290,7 +290,7 @@ void read_calibrate(const Tables& read, Config& c) {
   cal.string("walled_match", c.calibrate.walled_match, {"interior", "whole"});
   cal.string("method", c.calibrate.method, {"ensemble", "one_specimen"});
   cal.finish();
-  if (c.calibrate.method == "one_specimen" && c.calibrate.reference_test == "two_fidelity")
+  if (c.calibrate.one_specimen() && c.calibrate.reference_test == "two_fidelity")
     throw ConfigError(read.path + ": [calibrate] method: \"one_specimen\" fits one cell; with reference_test = "
                       "\"two_fidelity\" the allowed value is \"ensemble\"");
 }

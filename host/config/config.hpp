@@ -206,6 +206,8 @@ struct CalibrateConfig {
   /// specimens) or "one_specimen" (every point one specimen, in turn from the scatter specimens, and the response
   /// surfaces carry their scatter: OneSpecimenSearch). `diagnose` and two fidelities search with the ensemble.
   std::string method = "ensemble";
+  /// method is "one_specimen".
+  bool one_specimen() const { return method == "one_specimen"; }
 };
 
 /// The [periodic] table: the periodic-cell triaxial test (host/triax/periodic_triaxial.hpp).

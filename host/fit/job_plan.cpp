@@ -338,7 +338,7 @@ struct Planner {
 
   /// Whether the search runs one specimen a point ([calibrate] method; diagnose and two fidelities search with the
   /// ensemble).
-  bool one_specimen() const { return cc.method == "one_specimen" && !in.diagnose && !in.two_fidelity; }
+  bool one_specimen() const { return cc.one_specimen() && !in.diagnose && !in.two_fidelity; }
 
   /// What the counts rest on: the speed measured, a run's and a packing's steps, and the choices made on the way.
   void notes() {

@@ -280,7 +280,7 @@ NoiseBudget decide_noise_budget(PeriodicLab& lab, const Model& base, const std::
   auto misfit = [&] { return Misfit(measured, noise, b.scatter, lab.members(), b.sim_end, Real(lab.balls())); };
   const bool chosen = lab.config().calibrate.ensemble == kAutoEnsemble;
   // One specimen a point runs each point once: "auto" neither chooses an ensemble nor grows the cell for one.
-  if (chosen && lab.config().calibrate.method == "one_specimen") {
+  if (chosen && lab.config().calibrate.one_specimen()) {
     lab.set_members(1);
   } else if (chosen) {
     lab.set_members(lab.specimens());

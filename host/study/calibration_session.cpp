@@ -152,7 +152,7 @@ Misfit Session::misfit_of(const Config& base, const std::string& material, const
     std::printf("%s: %s: FINDING: %s\n", folder.c_str(), material.c_str(), m.cell_bias_finding().c_str());
   for (const std::string& n : m.notes()) std::printf("  noise: %s\n", n.c_str());
   const Real ratio = m.ensemble_ratio();
-  const bool one_specimen = base.calibrate.method == "one_specimen";
+  const bool one_specimen = base.calibrate.one_specimen();
   const bool chosen = base.calibrate.ensemble == kAutoEnsemble && !one_specimen;
   // An "auto" cell grows only with an "auto" ensemble: a fixed ensemble fixes the cost per point.
   const bool cell_chosen = chosen && base.calibrate.cell_factor == kAutoCell;
