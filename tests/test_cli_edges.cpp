@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "host/data/compression_data.hpp"
 #include "host/util/folder_lock.hpp"
 #include "host/util/progress.hpp"
 #include "host/engine/simulation.hpp"
@@ -223,6 +224,21 @@ TEST(CliEdges, TheCompressionJobWritesARowPerIncrement) {
   int rows = 0;
   while (std::getline(series, line)) ++rows;
   EXPECT_EQ(rows, 3) << "the seating state and two increments";
+  // The record as compression data, which calibrate --compression reads: the increments from the seating state.
+  const std::vector<dem::CompressionTest> data = dem::load_compression((dir / "run" / "compression_data.csv").string());
+  ASSERT_EQ(data.size(), 1u);
+  EXPECT_EQ(data[0].material, "hidden-effect tests");
+  ASSERT_EQ(data[0].stress.size(), 2u);
+  EXPECT_DOUBLE_EQ(data[0].stress[1], 400e3);
+  EXPECT_GT(data[0].strain[1], data[0].strain[0]);
+  EXPECT_GT(data[0].strain[0], 0);
+  // Compression data of a material the triaxial data lack are refused before any work, naming both files.
+  const Outcome lone = triaxdem("calibrate " + std::string(TRIAXDEM_SOURCE_DIR) + "/data/tang2025_table6_peak.csv "
+                                "--config " + cell + " --compression " + (dir / "run" / "compression_data.csv").string() +
+                                " --plan -o " + (dir / "cal").string(), dir);
+  EXPECT_NE(lone.code, 0);
+  EXPECT_NE(lone.output.find("compression_data.csv:material: 'hidden-effect tests' has no triaxial tests in"),
+            std::string::npos) << lone.output;
   const Outcome bad = triaxdem("compression " + cell + " --test triaxial -o " + (dir / "bad").string(), dir);
   EXPECT_NE(bad.code, 0);
   EXPECT_NE(bad.output.find("oedometer"), std::string::npos) << bad.output;

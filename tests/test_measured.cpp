@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "host/fit/diagnose.hpp"
+#include "host/data/compression_data.hpp"
 #include "host/data/measured.hpp"
 #include "test_util.hpp"
 
@@ -604,4 +605,54 @@ TEST(Measured, ACurveOfMoreRowsThanTheCapIsRefused) {
   EXPECT_NE(e.find("bad.csv: A at 100 kPa: 100001 rows (allowed: at most 100000 per test"), std::string::npos) << e;
   EXPECT_NE(e.find("thin it, e.g. every 20th row"), std::string::npos) << e;
   EXPECT_EQ(error_of(curve(100000)), "");
+}
+
+// Compression files (host/data/compression_data.hpp): the test named by test_type, a test the rows of one material,
+// type and seating stress in file order, units to SI.
+TEST(Measured, CompressionFilesGroupTheirIncrementsByTest) {
+  const std::vector<CompressionTest> t = load_compression(write("oedometer.csv",
+      "# two tests\nmaterial,test_type,sigma3_kPa,stress_MPa,strain_pct,K0\n"
+      "S-1,oedometer,100,0.2,0.10,0.45\nS-1,oedometer,100,0.4,0.25,0.44\nS-1,oedometer,100,0.2,0.20,0.60\n"
+      "S-2,oedometer,50,0.2,0.30,0.41\n"));
+  ASSERT_EQ(t.size(), 2u);
+  EXPECT_EQ(t[0].material, "S-1");
+  EXPECT_EQ(t[0].path, CompressionPath::oedometer);
+  EXPECT_DOUBLE_EQ(t[0].sigma3, 100e3);
+  ASSERT_EQ(t[0].stress.size(), 3u);  // loading and unloading, as the lab went
+  EXPECT_DOUBLE_EQ(t[0].stress[1], 400e3);
+  EXPECT_DOUBLE_EQ(t[0].strain[1], 0.0025);
+  EXPECT_DOUBLE_EQ(t[0].k0[2], 0.60);
+  EXPECT_TRUE(t[0].strain_sd.empty());
+  EXPECT_DOUBLE_EQ(t[1].sigma3, 50e3);
+  const std::vector<CompressionTest> iso = load_compression(write("isotropic.csv",
+      "material,test_type,sigma3_Pa,stress_kPa,strain_frac,strain_sd_pct\nA,isotropic,1e5,200,0.004,0.05\n"));
+  ASSERT_EQ(iso.size(), 1u);
+  EXPECT_EQ(iso[0].path, CompressionPath::isotropic);
+  EXPECT_DOUBLE_EQ(iso[0].strain_sd[0], 5e-4);
+}
+
+TEST(Measured, BadCompressionFilesAreRefusedWithLineAndColumn) {
+  auto error = [](const std::string& text) {
+    try {
+      load_compression(write("bad_compression.csv", text));
+    } catch (const DataError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const std::string head = "material,test_type,sigma3_kPa,stress_kPa,strain_pct\n";
+  EXPECT_NE(error(head + "S-1,triaxial,100,200,0.1\n").find("bad_compression.csv:2:test_type: compression test "
+                                                             "'triaxial': allowed: oedometer, isotropic"),
+            std::string::npos);
+  EXPECT_NE(error(head + "S-1,oedometer,100,-200,0.1\n").find(":2:stress_kPa: '-200' is out of range"), std::string::npos);
+  EXPECT_NE(error(head + "S-1,oedometer,100,200,abc\n").find(":2:strain_pct: 'abc' is not a number"), std::string::npos);
+  EXPECT_NE(error("material,test_type,sigma3_kPa,stress_kPa\nS-1,oedometer,100,200\n").find("missing column 'strain'"),
+            std::string::npos);
+  EXPECT_NE(error("material,test_type,sigma3_kPa,stress_psi,strain_pct\n").find("stress_psi: unit 'psi'"),
+            std::string::npos);
+  EXPECT_NE(error("material,test_type,sigma3_kPa,stress_kPa,strain_pct,e\n").find("e: unknown column"),
+            std::string::npos);
+  EXPECT_NE(error("material,test_type,sigma3_kPa,stress_kPa,strain_pct,K0\nS-1,isotropic,100,200,0.1,0.5\n")
+                .find(":2:K0: an isotropic test has no K0"), std::string::npos);
+  EXPECT_NE(error(head).find("no rows"), std::string::npos);
 }

@@ -9,6 +9,7 @@
 
 #include "host/fit/calibration_report.hpp"
 #include "host/fit/cell_bias.hpp"
+#include "host/fit/compression_misfit.hpp"
 #include "host/fit/diagnose.hpp"
 #include "host/fit/generic_discrepancy.hpp"
 #include "host/config/config.hpp"
@@ -779,4 +780,38 @@ TEST(Misfit, OneMembersSpreadIsTheTraceOfItsScatterOverSigma) {
   ASSERT_EQ(with_scatter, 2) << "the peaks scatter, their strains do not";
   EXPECT_NEAR(m.member_spread(), expected, 1e-9 * expected);
   EXPECT_GT(expected, 0.1) << "a scatter the test can see";
+}
+
+// The compression misfit (host/fit/compression_misfit.hpp) compares the strain's increments, not the cumulative strain,
+// and whitens each by the data's standard deviation and the specimens' variance, (1 + 1/K) nu / (nu - 2) times it.
+// Five scatter specimens whose second increment is 0.003 + {-2, -1, 0, 1, 2} x 1e-4 have a sample variance of
+// 2.5e-8 (nu = 4: inflated by 2); with K = 2 and a datum sd of 1e-4 on each row (the increment's sqrt(2) x 1e-4),
+// the increment's sd is sqrt(2e-8 + 1.5 x 2 x 2.5e-8) = sqrt(9.5e-8).
+TEST(Misfit, ACompressionTestIsComparedByItsIncrements) {
+  CompressionTest measured{"A", CompressionPath::oedometer, 100e3, {200e3, 400e3}, {0.002, 0.005}, {}, {1e-4, 1e-4}, {}};
+  CompressionEnsemble scatter(1);
+  for (int s = -2; s <= 2; ++s) {
+    CompressionTest t = measured;
+    t.strain = {0.002 + 1e-5 * s, 0.005 + 1e-5 * s + 1e-4 * s};  // the first increment's scatter 1e-5 a step
+    scatter[0].push_back(t);
+  }
+  const CompressionMisfit m({measured}, scatter, 2);
+  ASSERT_EQ(m.data(), 2);
+  // The simulation: the same first increment, the second one sd larger, so its cumulative strain differs at the second
+  // row only: the residuals 0 and 1.
+  CompressionTest sim = measured;
+  sim.strain = {0.002, 0.005 + std::sqrt(9.5e-8)};
+  std::vector<Real> r = m.residuals({{sim, sim}});
+  EXPECT_NEAR(r[0], 0, 1e-9);
+  EXPECT_NEAR(r[1], 1, 1e-6);
+  // A member that gave no strain is left out of the mean; none at all is a missing datum.
+  CompressionTest failed = sim;
+  failed.strain = {std::nan(""), std::nan("")};
+  r = m.residuals({{sim, failed}});
+  EXPECT_NEAR(r[1], 1, 1e-6);
+  r = m.residuals({{failed, failed}});
+  EXPECT_EQ(r[0], kMissingResidual);
+  // Fewer than four specimens cannot measure the simulator's scatter.
+  scatter[0].resize(3);
+  EXPECT_THROW(CompressionMisfit({measured}, scatter, 2), std::invalid_argument);
 }

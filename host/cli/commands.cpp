@@ -186,6 +186,10 @@ void calibrate_options(CLI::App* cmd, Args& a) {
   cmd->add_option("--hold-out", a.cal.hold_out_kPa, "a confining pressure (kPa) of the data whose tests the fit "
                   "leaves out and the prediction predicts: the transfer to a pressure it never saw")
       ->check(pressure_kpa());
+  cmd->add_option("--compression", a.cal.compression, "a CSV of oedometer or isotropic compression tests (a test_type "
+                  "column; docs/calibration.md) fitted with the triaxial data of their material: the strain at each "
+                  "load pins the contact stiffness")
+      ->check(CLI::ExistingFile);
 }
 
 void synth_options(CLI::App* cmd, Args& a) {

@@ -36,11 +36,16 @@ int compression_job(const Config& cfg, const std::string& path_name_in, const st
       std::printf("  %10.4g %12.4g %12.4g %7.4g %6.3f %9.4f %9.4f %10.4f\n", 1e-3 * x.target, 1e-3 * x.sigma_v,
                   1e-3 * x.sigma_h, 1e-3 * x.p, x.k0, 100 * x.eps_a, 100 * x.eps_v, x.void_ratio);
     report_timings(out.folder(), r.stages);
+    // The record as data `calibrate --compression` reads, the material named by the run.
+    io::write_text_atomic(out.folder() + "/compression_data.csv",
+                          compression_csv({compression_data_of(r, cfg.run.name, tp.sigma3)}));
   } catch (const BlowUp& e) {
     return cell_blowup(out, sim.get(), "compression", cfg, e);
   }
-  std::printf("time loop: %s\noutput: %s/series.csv (a row per increment), timings.csv\n",
-              describe(sim->times(), sim->particles().n, sim->step_count()).c_str(), out.folder().c_str());
+  std::printf("time loop: %s\noutput: %s/series.csv (a row per increment), compression_data.csv (the same as "
+              "data for calibrate --compression, material \"%s\"), timings.csv\n",
+              describe(sim->times(), sim->particles().n, sim->step_count()).c_str(), out.folder().c_str(),
+              cfg.run.name.c_str());
   return 0;
 }
 

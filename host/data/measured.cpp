@@ -323,6 +323,12 @@ std::string describe_test(const TriaxialTest& t) {
   return t.material + " at " + str(t.sigma3 / 1e3) + " kPa" + (t.replicate.empty() ? "" : ", test " + t.replicate);
 }
 
+Real column_scale(const std::string& at, const std::string& column, bool stress) {
+  const auto cut = column.rfind('_');
+  const std::string unit = cut == std::string::npos ? "" : column.substr(cut + 1);
+  return unit_scale(at, column, column.substr(0, cut), stress ? kStressUnits : kStrainUnits, unit);
+}
+
 bool is_hdf5_path(const std::string& path) {
   const auto dot = path.rfind('.');
   const std::string ext = dot == std::string::npos ? "" : path.substr(dot);

@@ -107,6 +107,10 @@ std::vector<std::vector<std::size_t>> replicate_groups(const std::vector<Triaxia
 /// Throws DataError naming the file, the line (CSV) or group and row (HDF5), and the column.
 MeasuredData load_measured(const std::string& path);
 
+/// The factor to SI of a column named "<quantity>_<unit>": a stress's unit (Pa, kPa, MPa) or a strain's (pct, frac).
+/// Throws DataError naming `at`, the column and the allowed units.
+Real column_scale(const std::string& at, const std::string& column, bool stress);
+
 /// True for a path ending in .h5 or .hdf5: the HDF5 form of measured data.
 bool is_hdf5_path(const std::string& path);
 

@@ -239,10 +239,17 @@ CalibrationResult calibrate_one_specimen(PeriodicLab& lab, const Model& base, co
                                          const CalibrationProgress& progress = {}, int widen = 2);
 /// Points a one-specimen search of d free parameters runs at most before any widening, besides its points at the base.
 long planned_one_specimen_points(int d, int rounds = OneSpecimenSearch{}.rounds);
-/// The same on `measured` (one material, any number of pressures), simulated by the lab's ensemble.
+/// Residuals of other tests than the triaxial ones, fitted with them (host/fit/compression_misfit.hpp): `data` of them
+/// at a model, appended to the triaxial residuals at every point. Empty: none.
+struct JointTerm {
+  int data = 0;
+  std::function<std::vector<Real>(const Model&)> residuals;
+};
+/// The same on `measured` (one material, any number of pressures), simulated by the lab's ensemble, with `joint`'s
+/// tests fitted beside them.
 CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,
                             const std::vector<TriaxialTest>& measured, const Misfit& misfit, int rounds = 4,
-                            const CalibrationProgress& progress = {}, int widen = 2);
+                            const CalibrationProgress& progress = {}, int widen = 2, const JointTerm& joint = {});
 /// A run of the base model found after the calibration (a nested model's run at strength 0) that beats its best:
 /// it joins the design and becomes the best, and the values, the model (`base` with them) and the uncertainty are
 /// computed again at it, so that the intervals and correlation belong to the reported point.
@@ -260,7 +267,8 @@ void adopt_best(CalibrationResult& r, const Evaluation& better, const Model& bas
 /// best point.
 void measure_on_specimens(CalibrationResult& r, std::vector<SpecimenSpread> spreads);
 /// The spreads of `misfit` (Misfit::specimen_spreads) are kept in r, so that its intervals and region are measured
-/// on the specimens.
+/// on the specimens. A joint fit's residuals beyond the misfit's data (JointTerm: other tests') stay as they were, and
+/// its intervals then rest on the misfit's model alone (the spreads cover the triaxial tests only).
 void rewhiten(CalibrationResult& r, const Misfit& misfit, const Model& base);
 
 /// r's intervals, correlation, region and surfaces at its best point, measured on r.spreads where given

@@ -300,7 +300,9 @@ void rewhiten(CalibrationResult& r, const Misfit& misfit, const Model& base) {
   for (Evaluation& e : r.design) {
     Ensemble one;
     for (const TriaxialTest& t : e.sim) one.push_back({t});
-    e.r = misfit.residuals(one);
+    std::vector<Real> r_new = misfit.residuals(one);
+    if (e.r.size() > r_new.size()) r_new.insert(r_new.end(), e.r.begin() + r_new.size(), e.r.end());
+    e.r = std::move(r_new);
     e.chi2 = sum_sq(e.r);
     if (!r.surrogate_answer && !e.screened && (!best || e.chi2 < best->chi2)) best = &e;
   }

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "host/config/config.hpp"
+#include "host/data/compression_data.hpp"
 #include "host/engine/builder.hpp"
 #include "host/data/measured.hpp"
 #include "host/lab/packing_store.hpp"
@@ -61,6 +62,13 @@ class PeriodicLab {
                     std::size_t to);
   /// Test j of `like` (its material and pressure) on member j % members(): data made on a specimen per test.
   std::vector<TriaxialTest> run_each(const Model& m, const std::vector<TriaxialTest>& like);
+  /// A compression test as `like` (its path, seating stress and increments) on member's specimen, at model m: the strain
+  /// and K0 at each increment (host/triax/compression_test.hpp); a run that blew up or did not come to rest gives NaN
+  /// (missing data), counted in failed_runs().
+  CompressionTest run_compression(const Model& m, const CompressionTest& like, int member);
+  /// Every test of `like` on every member (every specimen with `all`), [test][member], up to workers() at once.
+  std::vector<std::vector<CompressionTest>> run_compressions(const Model& m, const std::vector<CompressionTest>& like,
+                                                             bool all = false);
   /// Runs at once: each in a child process (fork) with the same specimens; the results are the same as one at a
   /// time, bit for bit. Only where that is safe: a host backend on one thread (OMP_NUM_THREADS=1); otherwise
   /// the runs go one at a time with all threads. Returns the value in effect.

@@ -16,6 +16,7 @@
 #include "host/data/curve_reading.hpp"
 #include "host/fit/calibrate.hpp"
 #include "host/fit/calibration_report.hpp"
+#include "host/fit/compression_misfit.hpp"
 #include "host/fit/diagnose.hpp"
 #include "host/fit/prediction.hpp"
 #include "host/fit/two_fidelity.hpp"
@@ -229,13 +230,15 @@ int run_materials(const Config& base, const CalibrationOptions& o, Session& ss, 
 class CalibrationWork : public MaterialWork {
  public:
   CalibrationWork(Session& ss, const Config& base)
-      : ss_(ss), base_(base), one_specimen_(base.calibrate.method == "one_specimen") {
+      : ss_(ss), base_(base), one_specimen_(base.calibrate.one_specimen()) {
     table_ << "material,parameter,value,low95,high95,reference,chi2,data,runs,reference_rise,reference_chi2\n";
   }
 
   Calibrated fit(const std::string& material, const std::vector<TriaxialTest>& tests, const Misfit& misfit) override {
     Session& ss = ss_;
     const long runs0 = ss.lab.runs();
+    const std::optional<CompressionMisfit> compression = compression_misfit(material);
+    const JointTerm joint = compression ? compression->joint(ss.lab) : JointTerm{};
     auto fit = [&](const Misfit& m, const std::string& what) {
       const long start = ss.lab.runs();
       const int d = static_cast<int>(ss.free.size());
@@ -249,7 +252,7 @@ class CalibrationWork : public MaterialWork {
       };
       CalibrationResult r = one_specimen_
                                 ? calibrate_one_specimen(ss.lab, model_of(base_), ss.free, tests, m.with_members(1), report)
-                                : calibrate(ss.lab, model_of(base_), ss.free, tests, m, 4, report);
+                                : calibrate(ss.lab, model_of(base_), ss.free, tests, m, 4, report, 2, joint);
       progress.finish("");
       require_a_result(r, what + " " + material, ss);
       return r;
@@ -282,6 +285,7 @@ class CalibrationWork : public MaterialWork {
                   "outside)\n", material.c_str(), name.c_str());
     std::printf("calibrate: %s: chi2 %.1f on %d data after %ld runs\n", material.c_str(), r.best.chi2, r.data,
                 fit_runs);
+    if (compression) compression_fit(material, *compression, r.model);
     std::vector<TriaxialTest> held;
     for (const TriaxialTest& t : ss.held_out)
       if (t.material == material) held.push_back(t);
@@ -309,6 +313,37 @@ class CalibrationWork : public MaterialWork {
   const Config& base_;
   bool one_specimen_;  ///< [calibrate] method "one_specimen"
   std::ostringstream table_;
+  std::string compression_table_;  ///< compression_fit.csv: every material's compression tests at its answer
+
+  /// The misfit of the material's compression tests, their scatter run at the base on every scatter specimen; none
+  /// without such tests.
+  std::optional<CompressionMisfit> compression_misfit(const std::string& material) {
+    const std::vector<CompressionTest> tests = ss_.compression_of(material);
+    if (tests.empty()) return std::nullopt;
+    const long start = ss_.lab.runs();
+    Progress progress("calibrate " + material + ": the compression tests' scatter at the base",
+                      static_cast<long>(tests.size()) * ss_.lab.specimens());
+    CompressionMisfit m(tests, ss_.lab.run_compressions(model_of(base_), tests, true), ss_.lab.members());
+    progress.finish(std::to_string(ss_.lab.runs() - start) + " runs");
+    std::printf("calibrate: %s: %zu compression tests fitted with the triaxial ones: %d data (strain increments%s)\n",
+                material.c_str(), tests.size(), m.data(),
+                std::any_of(tests.begin(), tests.end(), [](const CompressionTest& t) { return !t.k0.empty(); })
+                    ? " and K0" : "");
+    return m;
+  }
+
+  /// The compression tests at the answer, printed and kept in compression_fit.csv.
+  void compression_fit(const std::string& material, const CompressionMisfit& m, const Model& at) {
+    const CompressionEnsemble sim = ss_.lab.run_compressions(at, m.measured());
+    const std::vector<Real> r = m.residuals(sim);
+    Real chi2 = 0;
+    for (Real x : r) chi2 += x * x;
+    const std::string table = m.table(sim);
+    std::printf("calibrate: %s: the compression tests at the answer: chi2 %.1f on %d data\n%s", material.c_str(), chi2,
+                m.data(), table.c_str());
+    compression_table_ += compression_table_.empty() ? table : table.substr(table.find('\n') + 1);
+    io::write_text_atomic(ss_.folder + "/compression_fit.csv", compression_table_);
+  }
 };
 
 /// The diagnosis of each material: the base model's fit, each extension's, the verdict; diagnosis.md.

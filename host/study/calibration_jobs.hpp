@@ -30,6 +30,9 @@ struct CalibrationOptions {
   /// --hold-out: the confining pressure (kPa) whose tests the calibration leaves out and the prediction predicts
   /// (NaN: none), a test of the transfer to a pressure the fit never saw.
   Real hold_out_kPa = std::numeric_limits<Real>::quiet_NaN();
+  /// --compression: a file of compression tests (host/data/compression_data.hpp) fitted beside the triaxial tests of
+  /// their material; "": none.
+  std::string compression;
 };
 
 /// Calibrates each material of the data; writes calibrate_<date>/ under options.output. Returns 0.

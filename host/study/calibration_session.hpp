@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "host/study/calibration_jobs.hpp"
+#include "host/data/compression_data.hpp"
 #include "host/fit/calibrate.hpp"
 #include "host/fit/job_plan.hpp"
 #include "host/fit/misfit.hpp"
@@ -65,6 +66,9 @@ struct JobInputs {
   bool two_fidelity = false;  ///< the reference test: the periodic cell corrected by the membrane test
   QMeasure cell_q = QMeasure::kAreaCorrected;  ///< the q the reference cell's tests carry (reference_q_measure)
   std::vector<TriaxialTest> held_out;  ///< the tests --hold-out took out of `data` (the fit never sees them)
+  std::vector<CompressionTest> compression;  ///< --compression's tests, each of a material of `data`
+  /// The compression tests of `material`.
+  std::vector<CompressionTest> compression_of(const std::string& material) const;
   JobInputs(const Config& base, const CalibrationOptions& o);
   /// The job's plan (host/fit/job_plan.hpp), printed. A plan above kPlanBoundSeconds without --yes is refused
   /// (ConfigError naming its costliest stage and the setting that sizes it).

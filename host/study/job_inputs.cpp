@@ -98,6 +98,25 @@ QMeasure reference_q_measure(const Config& base, const CalibrationOptions& o, co
   return data.q_measure;
 }
 
+/// --compression's tests, checked: each of a material the triaxial data hold, and a search that can fit them (the
+/// ensemble's: two fidelities correct the triaxial misfit alone, one specimen a point whitens a run of one specimen).
+std::vector<CompressionTest> compression_tests(const Config& base, const CalibrationOptions& o,
+                                               const MeasuredData& data, bool two_fidelity) {
+  if (o.compression.empty()) return {};
+  std::vector<CompressionTest> tests = load_compression(o.compression);
+  for (const CompressionTest& t : tests)
+    if (std::none_of(data.tests.begin(), data.tests.end(), [&](const TriaxialTest& x) { return x.material == t.material; }))
+      throw DataError(o.compression, "material", "'" + t.material + "' has no triaxial tests in " + o.data +
+                                                     " (allowed: a material of the triaxial data, fitted with them)");
+  if (two_fidelity)
+    throw ConfigError("--compression: two fidelities correct the triaxial misfit by the membrane test, which has no "
+                      "compression test (allowed: --reference-test periodic)");
+  if (base.calibrate.one_specimen())
+    throw ConfigError(base.path + ": [calibrate] method: \"" + base.calibrate.method + "\" with --compression "
+                      "(allowed: \"ensemble\", whose every point is its members' mean, as the compression misfit compares)");
+  return tests;
+}
+
 }  // namespace
 
 Config stored_cell(const Config& base, const CalibrationOptions& o, const MeasuredData& data) {
@@ -141,6 +160,14 @@ JobInputs::JobInputs(const Config& base, const CalibrationOptions& o)
   }
   held_out = hold_out(o, data);
   check_enough_data(o, data, free.size());
+  compression = compression_tests(base, o, data, two_fidelity);
+}
+
+std::vector<CompressionTest> JobInputs::compression_of(const std::string& material) const {
+  std::vector<CompressionTest> out;
+  for (const CompressionTest& t : compression)
+    if (t.material == material) out.push_back(t);
+  return out;
 }
 
 JobPlan JobInputs::announce_plan(const Config& base, const CalibrationOptions& o, const std::string& kind) const {
@@ -163,6 +190,10 @@ JobPlan JobInputs::announce_plan(const Config& base, const CalibrationOptions& o
   JobPlan plan = plan_job(in);
   for (const std::string& n : data.notes) std::printf("%s: note: %s\n", kind.c_str(), n.c_str());
   std::printf("%s", plan.text(kind).c_str());
+  if (!compression.empty())
+    std::printf("%s: plus %zu compression tests (--compression): each on every scatter specimen at the base, then on "
+                "the ensemble at every point, one consolidation an increment; not in the estimate above\n", kind.c_str(),
+                compression.size());
   const bool above_bound = plan.high() > kPlanBoundSeconds, above_ceiling = plan.high() > kPlanCeilingSeconds;
   if ((above_ceiling || (above_bound && !o.yes)) && !o.plan_only) {
     // The cause a user can change: the costliest stage's work and a run's length, beside the setting that sizes it.

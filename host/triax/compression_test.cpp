@@ -9,14 +9,6 @@
 
 namespace dem {
 
-const char* path_name(CompressionPath path) { return path == CompressionPath::oedometer ? "oedometer" : "isotropic"; }
-
-CompressionPath compression_path(const std::string& name) {
-  if (name == "oedometer") return CompressionPath::oedometer;
-  if (name == "isotropic") return CompressionPath::isotropic;
-  throw std::invalid_argument("compression test '" + name + "': allowed: oedometer, isotropic");
-}
-
 namespace {
 
 /// An increment's servo: the consolidation's gain and clamp without its gas phase (the cell is packed), the axial
@@ -49,6 +41,17 @@ CompressionRecord measure(CellControl& cell, Real target, Real h0, Real V0, Real
 }
 
 }  // namespace
+
+CompressionTest compression_data_of(const CompressionResult& r, const std::string& material, Real sigma3) {
+  CompressionTest t{material, r.path, sigma3, {}, {}, {}, {}, {}};
+  for (std::size_t k = 1; k < r.series.size(); ++k) {
+    const CompressionRecord& x = r.series[k];
+    t.stress.push_back(x.target);
+    t.strain.push_back(r.path == CompressionPath::oedometer ? x.eps_a : x.eps_v);
+    if (r.path == CompressionPath::oedometer) t.k0.push_back(x.k0);
+  }
+  return t;
+}
 
 const std::vector<std::string>& compression_columns() {
   static const std::vector<std::string> names = {

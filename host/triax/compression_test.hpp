@@ -10,18 +10,12 @@
 #include <string>
 #include <vector>
 
+#include "host/data/compression_data.hpp"
 #include "host/engine/stage_loop.hpp"
 #include "host/io/io_hdf5.hpp"
 #include "host/triax/periodic_triaxial.hpp"
 
 namespace dem {
-
-enum class CompressionPath { oedometer, isotropic };
-
-/// "oedometer" or "isotropic".
-const char* path_name(CompressionPath path);
-/// The path of a name; throws std::invalid_argument naming the allowed ones.
-CompressionPath compression_path(const std::string& name);
 
 /// One row: the cell at rest at an increment's target (SI; the first row at the seating stress).
 struct CompressionRecord {
@@ -47,6 +41,10 @@ struct CompressionResult {
 /// Throws as consolidate_isotropic does, naming the increment that did not converge.
 CompressionResult run_compression_test(Simulation& sim, const PeriodicTriaxialParams& prm, CompressionPath path,
                                        const std::vector<Real>& targets, io::Output* out = nullptr);
+
+/// A test's record as compression data (host/data/compression_data.hpp): each increment's target and strain (axial
+/// for the oedometer, volumetric for the isotropic path) and the oedometer's K0; the seating row is the origin.
+CompressionTest compression_data_of(const CompressionResult& r, const std::string& material, Real sigma3);
 
 /// The series' columns and a row in them (kPa, %).
 const std::vector<std::string>& compression_columns();
