@@ -18,8 +18,8 @@ namespace dem {
 namespace {
 
 /// A material's law ([material] law, kContactLawNames) and the keys of that law and of every law; a key of another
-/// law is refused, naming the keys this one takes. hertz_mindlin's constants have no default: they are given, or
-/// taken from `from` (the balls' material, for the walls) where it has that law.
+/// law is refused, naming the keys this one takes. A law's needed keys (hertz_mindlin's constants) have no default: they
+/// are given, or taken from `from` (the balls' material, for the walls) where it has that law.
 void read_contact(TableReader& r, ContactParams& c, const ContactParams* from = nullptr) {
   std::string law = kContactLawNames[static_cast<int>(c.law)];
   r.string("law", law, std::set<std::string>(std::begin(kContactLawNames), std::end(kContactLawNames)));
@@ -38,11 +38,16 @@ void read_contact(TableReader& r, ContactParams& c, const ContactParams* from = 
       }
     }
   }
-  if (c.law == kHertzMindlin && !(from && from->law == kHertzMindlin))
-    for (const char* key : {"shear_modulus_Pa", "poisson"})
-      if (!r.has(key))
-        r.fail(key, "law = \"hertz_mindlin\" needs the balls' shear modulus and Poisson ratio: shear_modulus_Pa "
-                    "(allowed: (0, 1e13] Pa) and poisson (allowed: [0, 0.5])");
+  // The keys a law's material must give (needed in model_keys: no default), unless `from` has that law and gives them.
+  if (!(from && from->law == c.law)) {
+    std::string needed;
+    for (const ModelKey& k : model_keys())
+      if (k.required && law == k.law)
+        needed += (needed.empty() ? "" : ", ") + std::string(k.key) + " (allowed: " + allowed_range(k) + ")";
+    for (const ModelKey& k : model_keys())
+      if (k.required && law == k.law && !r.has(k.key))
+        r.fail(k.key, "law = \"" + law + "\" needs its keys, which have no default: " + needed);
+  }
   r.finish();
 }
 

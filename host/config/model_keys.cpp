@@ -1,5 +1,6 @@
 #include "host/config/model_keys.hpp"
 
+#include <sstream>
 #include <stdexcept>
 
 namespace dem {
@@ -18,28 +19,36 @@ const std::vector<ModelKey>& model_keys() {
   // (host/fit/generic_discrepancy.hpp).
   using C = ContactParams;
   static const std::vector<ModelKey> keys = {
-      {"mu_s", &C::mu_s, "-", 0, 10, false, 1, true, 0.02, 1.0, true, "", {}, "", true},
-      {"mu_r", &C::mu_r, "-", 0, 10, false, 1, true, 0.0, 0.2, false, "", {}, "", true},
-      {"emod_Pa", &C::emod, "Pa", 0, 1e13, true, 1, true, 1e6, 1e10, true, "", {}, "", true, true, "rrlinear"},
-      {"kratio", &C::kratio, "-", 0, 1e3, true, 1, true, 1.0, 4.0, false, "", {}, "", true, true, "rrlinear"},
-      {"shear_modulus_Pa", &C::shear_modulus, "Pa", 0, 1e13, true, 1, true, 1e6, 1e11, true, "", {}, "", true, true,
-       "hertz_mindlin"},
-      {"poisson", &C::poisson, "-", 0, 0.5, false, 1, false, 0, 0.5, false, "", {}, "", true, true, "hertz_mindlin"},
-      {"beta_n", &C::beta_n, "-", 0, 1, false, 1, false, 0, 0, false, "", {}, "", true},
-      {"hertz_overlap", &C::hertz_overlap, "r", 0, 0.5, false, 1, true, 3e-4, 0.03, true, "hertz", {1e-3, 3e-3, 1e-2},
-       "initial stiffness that grows faster with confinement than the linear contacts give", false, true, "rrlinear"},
-      {"roughness", &C::roughness, "r", 0, 0.1, false, 1, true, 1e-4, 5e-2, true, "roughness", {1e-3, 3e-3, 1e-2},
-       "soft initial response, most at low confinement; peak and residual hardly change", true, true, "rrlinear"},
-      {"wear", &C::wear, "-", 0, 0.99, false, 1, true, 0.0, 0.9, false, "wear", {0.2, 0.4, 0.6},
-       "a residual strength that falls below the peak more than sliding alone explains", true},
-      {"wear_slip", &C::wear_slip, "r", 0, 10, true, 1, true, 0.005, 0.5, true, "", {}, "", true},
-      {"twist", &C::twist, "-", 0, 10, false, 1, true, 0.0, 0.5, false, "twist", {0.05, 0.1, 0.2},
-       "more strength and dilatancy at every confinement, as a larger mu_r gives; spin in the shear band held back",
-       true},
-      {"adhesion_kPa", &C::adhesion, "kPa", 0, 1e4, false, 1e3, true, 0.0, 3e5, false, "adhesion", {1e4, 3e4, 1e5},
-       "more strength and a stiffer start at low confinement than friction gives: an apparent cohesion", true},
-      {"membrane_kPa", nullptr, "kPa", 0, 1e5, false, 1e3, true, 0.0, 3e6, false, "membrane", {1e5, 3e5, 1e6},
-       "extra strength late in the test as the specimen bulges, largest relative to low sigma3", true},
+      key("mu_s", &C::mu_s, "-").in(0, 10).searched_log(0.02, 1.0),
+      key("mu_r", &C::mu_r, "-").in(0, 10).searched(0.0, 0.2),
+      key("emod_Pa", &C::emod, "Pa").above(0, 1e13).searched_log(1e6, 1e10).of("rrlinear"),
+      key("kratio", &C::kratio, "-").above(0, 1e3).searched(1.0, 4.0).of("rrlinear"),
+      key("shear_modulus_Pa", &C::shear_modulus, "Pa").above(0, 1e13).searched_log(1e6, 1e11).of("hertz_mindlin")
+          .needed(),
+      key("poisson", &C::poisson, "-").in(0, 0.5).of("hertz_mindlin").needed(),
+      key("beta_n", &C::beta_n, "-").in(0, 1),
+      key("hertz_overlap", &C::hertz_overlap, "r").in(0, 0.5).searched_log(3e-4, 0.03).of("rrlinear")
+          .extension_named("hertz", {1e-3, 3e-3, 1e-2},
+                           "initial stiffness that grows faster with confinement than the linear contacts give")
+          .not_from_off(),
+      key("roughness", &C::roughness, "r").in(0, 0.1).searched_log(1e-4, 5e-2).of("rrlinear")
+          .extension_named("roughness", {1e-3, 3e-3, 1e-2},
+                           "soft initial response, most at low confinement; peak and residual hardly change"),
+      key("wear", &C::wear, "-").in(0, 0.99).searched(0.0, 0.9)
+          .extension_named("wear", {0.2, 0.4, 0.6},
+                           "a residual strength that falls below the peak more than sliding alone explains"),
+      key("wear_slip", &C::wear_slip, "r").above(0, 10).searched_log(0.005, 0.5),
+      key("twist", &C::twist, "-").in(0, 10).searched(0.0, 0.5)
+          .extension_named("twist", {0.05, 0.1, 0.2},
+                           "more strength and dilatancy at every confinement, as a larger mu_r gives; spin in the "
+                           "shear band held back"),
+      key("adhesion_kPa", &C::adhesion, "kPa").in(0, 1e4).times(1e3).searched(0.0, 3e5)
+          .extension_named("adhesion", {1e4, 3e4, 1e5},
+                           "more strength and a stiffer start at low confinement than friction gives: an apparent "
+                           "cohesion"),
+      key("membrane_kPa", nullptr, "kPa").in(0, 1e5).times(1e3).searched(0.0, 3e6)
+          .extension_named("membrane", {1e5, 3e5, 1e6},
+                           "extra strength late in the test as the specimen bulges, largest relative to low sigma3"),
   };
   return keys;
 }
@@ -62,6 +71,13 @@ std::string free_key_names() {
   for (const ModelKey& k : model_keys())
     if (k.fit) names += (names.empty() ? "" : ", ") + std::string(k.key);
   return names;
+}
+
+std::string allowed_range(const ModelKey& k) {
+  std::ostringstream s;
+  s << (k.open_lo ? "(" : "[") << k.lo << ", " << k.hi << "]" << (std::string(k.unit) == "-" ? "" : " ") <<
+      (std::string(k.unit) == "-" ? "" : k.unit);
+  return s.str();
 }
 
 std::string law_key_names(const std::string& law) {
