@@ -94,6 +94,17 @@ TEST(Specimen, CacheRoundTripsBitForBitAndRefusesOtherKeys) {
   Config other = s1;
   other.run.seed = 2;
   EXPECT_NE(specimen_key(s1), specimen_key(other));
+  // The law's own keys (model_keys) enter it, for the balls and the walls alike; an extension does not (preparation
+  // runs the law without them).
+  auto changed = [&](const std::function<void(Config&)>& edit) {
+    Config c = s1;
+    edit(c);
+    return specimen_key(c) != specimen_key(s1);
+  };
+  EXPECT_TRUE(changed([](Config& c) { c.ball.emod *= 1.1; }));
+  EXPECT_TRUE(changed([](Config& c) { c.wall.kratio *= 1.1; }));
+  EXPECT_TRUE(changed([](Config& c) { c.ball.beta_n = 0.1; }));
+  EXPECT_FALSE(changed([](Config& c) { c.ball.hertz_overlap = 3e-3; }));
 }
 
 TEST(Specimen, SmallSpecimenReachesTheTargetVoidRatio) {

@@ -215,21 +215,22 @@ std::string specimen_key(const Config& cfg) {
   const SolverConfig& sv = cfg.solver;
   std::ostringstream k;
   k.precision(17);
-  k << "v2 d " << pc.diameter << " ratio " << pc.diameter_ratio << size_key(pc) << " rho " << pc.density << " D " << sc.diameter
+  k << "v3 d " << pc.diameter << " ratio " << pc.diameter_ratio << size_key(pc) << " rho " << pc.density << " D " << sc.diameter
     << " H " << sc.height << " n " << specimen_ball_count(cfg) << " layers " << sc.layers << " mu " << sc.compaction_mu_s
     << " settle " << sc.settle_mu_s
     << " v " << sc.platen_speed << " stop " << sc.stop_ratio << " max " << sc.max_steps_per_layer << " seed "
-    << cfg.run.seed << " E " << cfg.ball.emod << " kr " << cfg.ball.kratio << " bn " << cfg.ball.beta_n << " Ew "
-    << cfg.wall.emod << " krw " << cfg.wall.kratio << " bnw " << cfg.wall.beta_n << " damp " << sv.damping << " g "
+    << cfg.run.seed << " damp " << sv.damping << " g "
     << sv.gravity[0] << " " << sv.gravity[1] << " " << sv.gravity[2] << " dts " << sv.dt_safety << " dt " << sv.dt
     << " ms " << sv.mass_scale << " skin " << sv.skin;
   if (sc.layer_stop_ratio > 0) k << " lstop " << sc.layer_stop_ratio;  // absent: the keys of earlier specimens hold
-  for (const ContactParams* p : {&cfg.ball, &cfg.wall}) {  // another law: its name and own keys (model_keys)
-    if (p->law == kRRLinear) continue;
+  // The balls' and the walls' law with its own keys (model_keys) and the damping ratio: what the preparation's contacts
+  // follow. The friction (the compaction's own) and the extensions (preparation runs the law's base()) stay out.
+  for (const ContactParams* p : {&cfg.ball, &cfg.wall}) {
     const std::string law = kContactLawNames[static_cast<int>(p->law)];
-    k << " law " << law;
+    k << (p == &cfg.ball ? " ball " : " wall ") << law;
     for (const ModelKey& m : model_keys())
-      if (law == m.law) k << " " << m.key << " " << p->*m.field;
+      if (m.field && !*m.extension && law == m.law) k << " " << m.key << " " << p->*m.field;
+    k << " beta_n " << p->beta_n;
   }
   return k.str();
 }
