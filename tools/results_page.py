@@ -54,6 +54,43 @@ def table6_periodic(root):
                                                          "data/runs/S1_table6_periodic/base.toml --material S-1 -j 2")
 
 
+def table6_loop(root):
+    """Table 6 by the loop (perf/table6_loop.sh): each material calibrated on the periodic cell with two fidelities to
+    their fixed point (the small membrane specimen, an ensemble of 4) and its pressures predicted by the membrane test,
+    then each pressure held out in turn (fitted on the other two, predicted). A case not run yet says so; the loop goes on
+    across sittings."""
+    folder = os.path.join(root, "data/results/table6_loop")
+    out = io.StringIO()
+    out.write("| material | fitted | sigma3 kPa: error (held out in bold) | calibrated (95% intervals) | runs | time | "
+              "commit |\n|---|---|---|---|---|---|---|\n")
+    fitted_errors = []
+    for m in ("S-1", "S-2", "S-3"):
+        for c in ("all", "100", "200", "300"):
+            case = os.path.join(folder, f"{m}_{'all' if c == 'all' else 'hold' + c}")
+            label = "all" if c == "all" else f"all but {c} kPa"
+            if not os.path.isfile(os.path.join(case, "prediction.csv")):
+                out.write(f"| {m} | {label} | not run yet | | | | |\n")
+                continue
+            pred = read_rows(os.path.join(case, "prediction.csv"))
+            cal = read_rows(os.path.join(case, "calibrated.csv"))
+            run = read_rows(os.path.join(case, "run.csv"))[0]
+            errors = []
+            for r in pred:
+                held = r.get("held_out") == "1"
+                e = f"{r['sigma3_kPa']}: {float(r['error_pct']):+.1f}%"
+                errors.append(f"**{e}**" if held else e)
+                if c == "all":
+                    fitted_errors.append(abs(float(r["error_pct"])))
+            values = "; ".join(f"{x['parameter']} {fmt(x['value'])} [{fmt(x['low95'])}, {fmt(x['high95'])}]" for x in cal)
+            secs = int(run["seconds"])
+            out.write(f"| {m} | {label} | {', '.join(errors)} | {values} | {cal[0]['runs']} | "
+                      f"{secs // 3600}h{secs % 3600 // 60:02d}m | {run['commit']} |\n")
+    if len(fitted_errors) == 9:
+        out.write(f"\nThe nine tests with all pressures fitted: mean |error| **{statistics.fmean(fitted_errors):.1f}%**, at "
+                  f"most {max(fitted_errors):.1f}%.\n")
+    return out.getvalue(), [folder], "perf/table6_loop.sh (each case's files copied as data/results/table6_loop/README.md says)"
+
+
 def walled_on_periodic(root):
     """Another code's walled data (YADE, 4,000 balls) calibrated on the periodic cell, predicted by the walled cell."""
     folder = os.path.join(root, "data/runs/walled_periodic_predict_walls")
@@ -165,6 +202,34 @@ def polydisperse(root):
     out.write(f"\nchi2 {fmt(rows[0]['chi2'])} on {rows[0]['data']} data, {rows[0]['runs']} runs.\n")
     return out.getvalue(), [folder], ("triaxdem calibrate data/runs/polydisperse/data.csv --config "
                                       "data/runs/polydisperse/base.toml --predict none -j 2 (data: data/runs/README.md)")
+
+
+def joint_compression(root):
+    """Compression tests calibrated with triaxial peaks: data made at emod 2e8 Pa, mu_s 0.25 (the hidden-effect cell,
+    whose base is 1e8 and 0.15) on specimens no calibration runs: the peak deviator of three drained tests (100-300
+    kPa), an oedometer and an isotropic compression from 100 to 800 kPa; emod and mu_s calibrated from the base on the
+    peaks alone, with the oedometer (`--compression`), with both compression tests, and with the oedometer on peaks that
+    give their void ratio after consolidation (which the cells are then prepared to, at the base's stiffness)."""
+    folder = os.path.join(root, "data/sweeps/joint")
+    rows = read_rows(os.path.join(folder, "joint.csv"))
+    names = {"peaks_alone": "peaks alone", "peaks_oedometer": "peaks and the oedometer",
+             "peaks_both": "peaks, the oedometer and the isotropic test",
+             "peaks_state_oedometer": "peaks with their void ratio, and the oedometer"}
+    out = io.StringIO()
+    out.write("| data | emod Pa (95% interval) | holds 2e8 | mu_s (95% interval) | holds 0.25 | chi2 / data | runs | "
+              "time |\n|---|---|---|---|---|---|---|---|\n")
+    for case in dict.fromkeys(r["case"] for r in rows):
+        by = {r["parameter"]: r for r in rows if r["case"] == case}
+        cells = []
+        for p in ("emod_Pa", "mu_s"):
+            r = by[p]
+            inside = float(r["low95"]) <= float(r["truth"]) <= float(r["high95"])
+            cells.append(f"{fmt(r['value'])} [{fmt(r['low95'])}, {fmt(r['high95'])}] | {'yes' if inside else 'NO'}")
+        r = by["emod_Pa"]
+        secs = int(r["seconds"])
+        out.write(f"| {names.get(case, case)} | {' | '.join(cells)} | {fmt(r['chi2'])} / {r['data']} | {r['runs']} | "
+                  f"{secs // 60}m{secs % 60:02d}s |\n")
+    return out.getvalue(), [folder], "BUILD=build SRC=. bash data/sweeps/joint/run.sh > joint.csv (from a scratch folder)"
 
 
 def plan_particle_steps(path):
@@ -308,6 +373,7 @@ def scaling(root):
 
 SECTIONS = [
     ("Table 6, S-1, calibrated on the periodic cell and predicted by the membrane test", table6_periodic),
+    ("Table 6 by the loop: fitted, and each pressure held out", table6_loop),
     ("Another code's walled data, calibrated on the periodic cell and predicted between walls", walled_on_periodic),
     ("The diagnosis: hidden effects named, and false alarms", identification),
     ("Coverage of the 95% intervals", coverage),
@@ -316,6 +382,7 @@ SECTIONS = [
     ("Side by side with LIGGGHTS and LAMMPS", peer_benchmark),
     ("Cost per particle-step against the ball count", scaling),
     ("An oedometer's K0 against Jaky's", k0_jaky),
+    ("Compression tests with the triaxial ones", joint_compression),
     ("What a wider size distribution does", psd_width),
     ("A polydisperse calibration", polydisperse),
 ]

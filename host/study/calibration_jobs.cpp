@@ -325,8 +325,8 @@ class CalibrationWork : public MaterialWork {
                       static_cast<long>(tests.size()) * ss_.lab.specimens());
     CompressionMisfit m(tests, ss_.lab.run_compressions(model_of(base_), tests, true), ss_.lab.members());
     progress.finish(std::to_string(ss_.lab.runs() - start) + " runs");
-    std::printf("calibrate: %s: %zu compression tests fitted with the triaxial ones: %d data (strain increments%s)\n",
-                material.c_str(), tests.size(), m.data(),
+    std::printf("calibrate: %s: %zu compression test%s fitted with the triaxial ones: %d data (strain increments%s)\n",
+                material.c_str(), tests.size(), tests.size() == 1 ? "" : "s", m.data(),
                 std::any_of(tests.begin(), tests.end(), [](const CompressionTest& t) { return !t.k0.empty(); })
                     ? " and K0" : "");
     return m;

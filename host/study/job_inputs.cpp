@@ -191,9 +191,9 @@ JobPlan JobInputs::announce_plan(const Config& base, const CalibrationOptions& o
   for (const std::string& n : data.notes) std::printf("%s: note: %s\n", kind.c_str(), n.c_str());
   std::printf("%s", plan.text(kind).c_str());
   if (!compression.empty())
-    std::printf("%s: plus %zu compression tests (--compression): each on every scatter specimen at the base, then on "
+    std::printf("%s: plus %zu compression test%s (--compression): each on every scatter specimen at the base, then on "
                 "the ensemble at every point, one consolidation an increment; not in the estimate above\n", kind.c_str(),
-                compression.size());
+                compression.size(), compression.size() == 1 ? "" : "s");
   const bool above_bound = plan.high() > kPlanBoundSeconds, above_ceiling = plan.high() > kPlanCeilingSeconds;
   if ((above_ceiling || (above_bound && !o.yes)) && !o.plan_only) {
     // The cause a user can change: the costliest stage's work and a run's length, beside the setting that sizes it.
