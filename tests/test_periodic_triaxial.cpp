@@ -219,6 +219,11 @@ TEST(PeriodicTriaxial, MembraneConfinesWhenTheCellBulges) {
     EXPECT_NEAR(row.membrane, 1e6 * std::max(eps_lat, Real(0)), 2e-4 * 1e6) << "eps_a " << row.eps_a;
     const Real target = kSigma3 + row.membrane;
     EXPECT_NEAR(0.5 * (row.sigma2 + row.sigma3), target, 0.01 * target) << "eps_a " << row.eps_a;
+    // The mobilised angle is the lab's, of q against the confinement q is measured from (the lateral stress less the
+    // membrane's share): sin phi = q / (q + 2 sigma3'), a definition, so to rounding.
+    const Real confinement = 0.5 * (row.sigma2 + row.sigma3) - row.membrane;
+    if (row.q > 0)
+      EXPECT_NEAR(std::sin(row.phi_mob_deg * M_PI / 180), row.q / (row.q + 2 * confinement), 1e-9) << row.eps_a;
     last_membrane = row.membrane;
   }
   EXPECT_GT(last_membrane, 0.05 * kSigma3);  // the dense specimen dilates: the membrane is stretched

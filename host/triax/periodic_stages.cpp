@@ -9,6 +9,7 @@
 #include "host/data/measured.hpp"
 #include "host/engine/micro.hpp"
 #include "host/engine/setup.hpp"
+#include "host/engine/stress.hpp"
 
 namespace dem {
 
@@ -56,9 +57,10 @@ PeriodicTriaxialRecord measure_row(CellControl& cell, const PeriodicTriaxialPara
   r.membrane = 0.5 * (target[0] + target[1]) - prm.sigma3;
   r.q = r.sigma1 - (lateral - r.membrane);
   r.q_fixed_area = r.q * (lengths[0] * lengths[1]) / (L0[0] * L0[1]);
-  r.p = (r.sigma1 + r.sigma2 + r.sigma3) / 3;
-  const Real sum = r.sigma1 + lateral;
-  r.phi_mob_deg = sum > 0 ? std::asin(std::clamp(r.q / sum, Real(-1), Real(1))) * 180 / kPi : 0;
+  r.p = mean_stress(s);
+  // The lab's angle of q against the confinement it is measured from: the lateral stress less the membrane's share.
+  const Real confinement = lateral - r.membrane;
+  r.phi_mob_deg = confinement > 0 && r.q > -confinement ? friction_angle_deg(r.q, confinement) : 0;
   r.void_ratio = V / g.v_solid - 1;
   const int n = cell.balls();
   r.coordination = n > 0 ? 2.0 * static_cast<Real>(cell.touching()) / n : 0;

@@ -16,7 +16,8 @@
 ///   q = sigma1 - (sigma2 + sigma3) / 2 + membrane   (measured lateral stresses, not the applied sigma3; the
 ///                                membrane extension's confinement is counted in q, as in a lab's sigma1 - cell)
 ///   p = (sigma1 + sigma2 + sigma3) / 3
-///   phi_mob = asin(q / (sigma1 + (sigma2 + sigma3) / 2))   mobilised friction angle
+///   phi_mob = asin(q / (q + 2 sigma3'))   mobilised friction angle (friction_angle_deg), sigma3' = (sigma2 + sigma3)
+///                                / 2 - membrane: the confinement q is measured from
 ///   I = axial_rate d sqrt(rho_eff / p)   inertial number, d = mean diameter, rho_eff = density x mass_scale
 /// Axial kinematics: the cell's axial velocity gradient is constant (-axial_rate, a constant true strain
 /// rate, as YADE's goal strain rate), so eps_a = 1 - exp(-axial_rate t) and I stays constant at fixed p.
