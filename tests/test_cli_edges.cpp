@@ -673,6 +673,10 @@ TEST(CliEdges, AResumeWithOtherInputsIsRefused) {
   EXPECT_NE(o.output.find("ran with another --material ('S-1', now 'S-2')"), std::string::npos) << o.output;
   o = triaxdem(job + " --material S-1", dir);
   EXPECT_EQ(o.code, 0) << o.output;
+  std::ofstream(folder / "job_inputs.txt") << "--compression 0\n";  // the first job fitted compression tests too
+  o = triaxdem(job + " --material S-1", dir);
+  EXPECT_NE(o.output.find("ran with another --compression file (its bytes differ from none)"), std::string::npos)
+      << o.output;
 }
 
 // --hold-out leaves a pressure out of the fit and predicts it: the plan fits the other two tests and predicts all three;

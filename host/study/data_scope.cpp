@@ -107,11 +107,15 @@ namespace {
 /// The inputs that decide a job's results, a line each ("data <hash of the file's bytes>"): a resumed folder's runs
 /// belong to the same lines.
 std::vector<std::pair<std::string, std::string>> job_inputs(const Config& base, const CalibrationOptions& o) {
-  std::ifstream in(o.data, std::ios::binary);
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto bytes_hash = [](const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    return std::to_string(std::hash<std::string>{}(bytes));
+  };
   std::string free;
   for (const std::string& f : o.free) free += f + " ";
-  return {{"data", std::to_string(std::hash<std::string>{}(bytes))},
+  return {{"data", bytes_hash(o.data)},
+          {"--compression", o.compression.empty() ? "" : bytes_hash(o.compression)},
           {"config", std::to_string(std::hash<std::string>{}(base.fingerprint))},
           {"--free", free},
           {"--material", o.material},
@@ -144,6 +148,8 @@ void check_resumed_inputs(const Config& base, const CalibrationOptions& o, const
     if (was.count(key) && was[key] != value)
       throw std::invalid_argument("--resume " + o.resume + ": the " + kind + " there ran with another " +
                                   (key == "data" ? "data file (its bytes differ from " + o.data + ")"
+                                   : key == "--compression" ? "--compression file (its bytes differ from " +
+                                                                   (o.compression.empty() ? "none" : o.compression) + ")"
                                    : key == "config" ? "config (" + base.path + " differs in a key that decides runs)"
                                                      : key + " ('" + was[key] + "', now '" + value + "')") +
                                   ": a resume continues the same job; start a new folder with -o");
