@@ -21,23 +21,8 @@ using Arg = typename Same<T>::type;
 /// The parameters of W material pairs as lanes: pair(k) gives lane k's.
 template <class T, class Pair>
 KOKKOS_INLINE_FUNCTION ContactParamsT<T> params_of_lanes(const Pair& pair) {
-  static_assert(sizeof(ContactParams) == 14 * sizeof(Real), "a new ContactParams field must be copied here");
-  const auto field = [&](Real ContactParams::*m) { return from_lanes<T>([&](int k) { return pair(k).*m; }); };
   ContactParamsT<T> P;
-  P.law = field(&ContactParams::law);
-  P.emod = field(&ContactParams::emod);
-  P.kratio = field(&ContactParams::kratio);
-  P.shear_modulus = field(&ContactParams::shear_modulus);
-  P.poisson = field(&ContactParams::poisson);
-  P.mu_s = field(&ContactParams::mu_s);
-  P.mu_r = field(&ContactParams::mu_r);
-  P.beta_n = field(&ContactParams::beta_n);
-  P.hertz_overlap = field(&ContactParams::hertz_overlap);
-  P.roughness = field(&ContactParams::roughness);
-  P.wear = field(&ContactParams::wear);
-  P.wear_slip = field(&ContactParams::wear_slip);
-  P.twist = field(&ContactParams::twist);
-  P.adhesion = field(&ContactParams::adhesion);
+  P.each_field([&](T& out, Real ContactParams::*m) { out = from_lanes<T>([&](int k) { return pair(k).*m; }); });
   return P;
 }
 

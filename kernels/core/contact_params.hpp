@@ -3,6 +3,14 @@
 /// which a CUDA build compiles with the host compiler (CMakeLists.txt), can fill them.
 #include "kernels/core/real.hpp"
 
+// Device-callable where a CUDA compiler builds the file (the kernels), a plain function where the host compiler does
+// (the config reader): this header is free of Kokkos and its KOKKOS_INLINE_FUNCTION.
+#if defined(__CUDACC__)
+#define DEM_HOST_DEVICE __host__ __device__
+#else
+#define DEM_HOST_DEVICE
+#endif
+
 namespace dem {
 
 /// The contact laws a material pair may choose ([material] law), by the value of ContactParams::law; each is a
@@ -29,6 +37,28 @@ struct ContactParamsT {
   T twist = 0.0;          ///< twisting resistance: the spin moment's cap over Rbar Fn (the spin analogue of mu_r)
   T adhesion = 0.0;       ///< adhesion between touching balls: pull-off force over (2 r)^2 (Pa)
 
+  /// Every field in one list, in order: f(this pair's field, the same field of ContactParams). The lanes' copy
+  /// (law_table.hpp) goes through it, and a field missing here fails the check below: a new field is two lines of
+  /// this file.
+  template <class F>
+  constexpr DEM_HOST_DEVICE void each_field(F&& f) {
+    using P = ContactParamsT<Real>;
+    f(law, &P::law);
+    f(emod, &P::emod);
+    f(kratio, &P::kratio);
+    f(shear_modulus, &P::shear_modulus);
+    f(poisson, &P::poisson);
+    f(mu_s, &P::mu_s);
+    f(mu_r, &P::mu_r);
+    f(beta_n, &P::beta_n);
+    f(hertz_overlap, &P::hertz_overlap);
+    f(roughness, &P::roughness);
+    f(wear, &P::wear);
+    f(wear_slip, &P::wear_slip);
+    f(twist, &P::twist);
+    f(adhesion, &P::adhesion);
+  }
+
   /// The same pair without the extensions (specimen preparation, which must not depend on them).
   ContactParamsT base() const {
     ContactParamsT b = *this;
@@ -37,6 +67,16 @@ struct ContactParamsT {
   }
 };
 using ContactParams = ContactParamsT<Real>;
+
+/// The fields each_field lists.
+constexpr int contact_field_count() {
+  ContactParams p{};
+  int n = 0;
+  p.each_field([&n](Real&, Real ContactParams::*) { ++n; });
+  return n;
+}
+static_assert(sizeof(ContactParams) == contact_field_count() * sizeof(Real),
+              "ContactParams::each_field must list every field");
 
 /// The scalar history the extensions keep per contact, by name (units: slip m, twist N m). Storage
 /// (ContactList::slot), the rebuild's remap, the saved state and the checkpoint loop over this list, so an
