@@ -6,7 +6,9 @@
 # so a study too long for one sitting goes on where it stopped. Then the table, one row per case and pressure, from
 # the prediction.csv files (Markdown on stdout), with each case's wall time and its calibrated values.
 #   perf/table6_loop.sh        # MATERIALS="S-1 S-2 S-3" CASES="all 100 200 300" JOBS=2 BUILD=build
-#                              # WORK=runs/table6_loop ENSEMBLE=4 PLAN=0
+#                              # WORK=runs/table6_loop ENSEMBLE=4 PLAN=0 KEEP=
+# KEEP=DIR (the results page's is data/results/table6_loop): each case done, now or before, is kept there as
+# DIR/<case>/prediction.csv, calibrated.csv and run.csv (the command, its seconds, the commit, the machine, the date).
 # On 2 cores a case takes about 30-60 minutes (the plan of each says so before it runs); PLAN=1 prints each case's
 # plan and runs nothing, then the table of what is done (the scripts' check).
 set -euo pipefail
@@ -14,7 +16,7 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 . "$root/scripts/script_folders.sh"
 build="$(build_folder table6_loop)"; work="$(realpath -m "${WORK:-$root/runs/table6_loop}")"
 materials="${MATERIALS:-S-1 S-2 S-3}"; cases="${CASES:-all 100 200 300}"; jobs="${JOBS:-2}"
-ensemble="${ENSEMBLE:-4}"; plan="${PLAN:-0}"
+ensemble="${ENSEMBLE:-4}"; plan="${PLAN:-0}"; keep="${KEEP:-}"
 tdem="$build/triaxdem"
 [ -x "$tdem" ] || { echo "table6_loop: build triaxdem first ($tdem)"; exit 1; }
 mkdir -p "$work"
@@ -30,6 +32,17 @@ base() {  # MATERIAL: the base config for it
       "$ensemble" "$ensemble" "$root/configs/small/${m}_100kPa.toml"; } > "$work/base_$m.toml"
   echo "$work/base_$m.toml"
 }
+. "$root/scripts/provenance.sh"
+keep_case() {  # OUT: a finished case's files into KEEP, with the run's provenance (its commit: this checkout's now)
+  [ -n "$keep" ] || return 0
+  local name folder
+  name="$(basename "$1")"; folder="$(ls -d "$1"/calibrate_*/ | tail -1)"
+  mkdir -p "$keep/$name"
+  cp "$folder/prediction.csv" "$folder/calibrated.csv" "$keep/$name/"
+  IFS=, read -r day commit machine <<< "$(provenance_fields "$root")"
+  printf 'command,seconds,commit,machine,date\nperf/table6_loop.sh %s,%s,%s,%s,%s\n' "$name" \
+    "$(cat "$1.seconds" 2>/dev/null || echo 0)" "$commit" "$machine" "$day" > "$keep/$name/run.csv"
+}
 for m in $materials; do
   cfg="$(base "$m")"
   for c in $cases; do
@@ -41,12 +54,15 @@ for m in $materials; do
       grep -E ': in all ' "$out.plan.log" | sed "s|^|$m $c: |"
       continue
     fi
-    if ls "$out"/calibrate_*/prediction.csv > /dev/null 2>&1; then echo "table6_loop: $m $c: done before, kept"; continue; fi
+    if ls "$out"/calibrate_*/prediction.csv > /dev/null 2>&1; then
+      echo "table6_loop: $m $c: done before, kept"; keep_case "$out"; continue
+    fi
     echo "table6_loop: $m $c: running (log $out.log)"
     start=$SECONDS
     "$tdem" calibrate data/tang2025_table6_peak.csv --config "$cfg" --material "$m" "${hold[@]}" -j "$jobs" -o "$out" \
         > "$out.log" 2>&1 || { tail -20 "$out.log"; echo "table6_loop: $m $c failed" >&2; exit 1; }
     echo "$((SECONDS - start))" > "$out.seconds"
+    keep_case "$out"
   done
 done
 # The table: every case's predictions (a case not run yet, as with PLAN=1, is a row that says so), the held-out pressure marked, with the case's rounds, values and time.

@@ -186,6 +186,15 @@ if [ "$part" != tools ]; then
     bash "$root/perf/table6_loop.sh"
   [ "$(grep -c '^| S-1 | .* | not run |' "$work/table6_loop.sh.log")" = 2 ] ||
     { cat "$work/table6_loop.sh.log"; echo "scripts_smoke: table6_loop gave no row per case" >&2; exit 1; }
+  # A case done before is kept (KEEP) with its files and run.csv, and run no more: the committed S-1 case stands in.
+  mkdir -p "$work/table6/S-1_all/calibrate_x" && echo 4470 > "$work/table6/S-1_all.seconds" &&
+    cp "$root/data/results/table6_loop/S-1_all/prediction.csv" "$root/data/results/table6_loop/S-1_all/calibrated.csv" \
+      "$work/table6/S-1_all/calibrate_x/"
+  BUILD="$build" WORK="$work/table6" MATERIALS=S-1 CASES=all KEEP="$work/kept" bash "$root/perf/table6_loop.sh" \
+    > "$work/table6_keep.log" 2>&1 && grep -q "done before, kept" "$work/table6_keep.log" &&
+    [ "$(tail -1 "$work/kept/S-1_all/run.csv" | cut -d, -f1,2)" = "perf/table6_loop.sh S-1_all,4470" ] &&
+    cmp -s "$work/kept/S-1_all/prediction.csv" "$root/data/results/table6_loop/S-1_all/prediction.csv" ||
+    { cat "$work/table6_keep.log"; echo "scripts_smoke: table6_loop did not keep a case done before" >&2; exit 1; }
   # The coverage study on one tiny case (the tiny base, data of the cell's size), then again: the case is not run twice;
   # its row holds the truth, the intervals, the region's rise and the truth's own run.
   check perf/coverage.sh env BUILD="$build" BASE="$base" OUT="$work/coverage" WORK="$work/coverage_runs" CASES=1 SIZES=1 \
