@@ -1,8 +1,6 @@
 #include "host/data/compression_data.hpp"
 
-#include <cerrno>
 #include <cmath>
-#include <cstdlib>
 #include <map>
 #include <sstream>
 #include <stdexcept>
@@ -86,12 +84,9 @@ Real number(const Header& h, const MeasuredTextTable::Row& row, const std::strin
             const std::string& what) {
   const std::size_t c = h.index.at(q);
   const std::string& cell = row.cells[c];
-  char* end = nullptr;
-  errno = 0;
-  const double v = std::strtod(cell.c_str(), &end);
-  if (cell.empty() || end != cell.c_str() + cell.size() || errno != 0 || !std::isfinite(v))
-    throw DataError(row.at, h.names[c], "'" + cell + "' is not a number");
-  const Real si = v * h.scale[c];
+  const std::optional<double> v = parse_number(cell);
+  if (!v || !std::isfinite(*v)) throw DataError(row.at, h.names[c], "'" + cell + "' is not a number");
+  const Real si = *v * h.scale[c];
   if (!(si > low && si <= high)) throw DataError(row.at, h.names[c], "'" + cell + "' is out of range (allowed: " +
                                                                          what + ")");
   return si;

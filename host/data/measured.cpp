@@ -2,9 +2,7 @@
 #include "host/util/text_format.hpp"
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -141,15 +139,6 @@ void check_columns(const Columns& c, bool curves, const std::string& at) {
     if (is_sd(s.quantity)) check_sd_column(c, curves, at, s.quantity);
 }
 
-/// The cell as written (inf and nan included); nothing when it is not a number.
-std::optional<double> parse(const std::string& c) {
-  char* end = nullptr;
-  errno = 0;
-  const double v = std::strtod(c.c_str(), &end);
-  if (c.empty() || end != c.c_str() + c.size() || errno != 0) return std::nullopt;
-  return v;
-}
-
 /// One row's cells by quantity; its refusals name the row and the column.
 struct RowReader {
   const Columns& cols;
@@ -162,7 +151,7 @@ struct RowReader {
   /// In SI; NaN when the file has no such column.
   Real number(const std::string& q) const {
     if (!has(q)) return kNaN;
-    const std::optional<double> v = parse(cell(q));
+    const std::optional<double> v = parse_number(cell(q));
     if (!v || !std::isfinite(*v)) refuse(q, "'" + cell(q) + "' is not a number");
     return *v * cols.specs[cols.index.at(q)].scale;
   }
@@ -172,7 +161,7 @@ struct RowReader {
     const std::string c = q + "_sd";
     if (!has(c)) return kNaN;
     if (cell(c).empty()) refuse(c, "missing for part of a test: give it on every row or on none");
-    const std::optional<double> v = parse(cell(c));
+    const std::optional<double> v = parse_number(cell(c));
     if (!v) refuse(c, "'" + cell(c) + "' is not a number");
     const Real s = *v * cols.specs[cols.index.at(c)].scale;
     if (!(std::isfinite(s) && s > 0)) refuse(c, "standard deviation must be > 0 and finite, not '" + cell(c) + "'");

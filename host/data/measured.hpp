@@ -28,6 +28,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -124,6 +125,9 @@ struct MeasuredTextTable {
   std::vector<std::string> header;
   std::vector<Row> rows;
 };
+
+/// A cell as written (inf and nan included); nothing when it is not a number.
+std::optional<double> parse_number(const std::string& cell);
 
 /// The lines of a CSV file as a table, cells trimmed; comment ('#') and blank lines skipped. Throws DataError
 /// when the file cannot be read.

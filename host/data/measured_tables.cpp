@@ -1,5 +1,6 @@
 /// The text tables of measured data (host/data/measured.hpp): a CSV file's lines as cells, and reference parameter
 /// values (a paper's own calibration, set beside a calibrated one).
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -31,6 +32,14 @@ void check_is_text(const std::string& path, std::ifstream& f) {
 }
 
 }  // namespace
+
+std::optional<double> parse_number(const std::string& cell) {
+  char* end = nullptr;
+  errno = 0;
+  const double v = std::strtod(cell.c_str(), &end);
+  if (cell.empty() || end != cell.c_str() + cell.size() || errno != 0) return std::nullopt;
+  return v;
+}
 
 MeasuredTextTable read_csv_table(const std::string& path) {
   std::error_code ec;

@@ -144,4 +144,14 @@ struct Session : JobInputs {
               const std::string& what) const;
 };
 
+/// The misfit with the simulator's scatter measured at the calibrated point r.model too (the scatter specimens run
+/// there; each datum takes the larger), and r whitened again by it; the change of the simulator's scatter is said. One
+/// specimen a point: those runs join the design at the answer, and the misfit counts the ensemble the surfaces are worth.
+Misfit rescattered(Session& ss, const std::string& material, const std::vector<TriaxialTest>& tests,
+                   const Misfit& misfit, CalibrationResult& r, const Model& base);
+/// Where the reference gives every free parameter: its rise over the joint 95% region of r, and its chi2 run on the
+/// ensemble against `misfit` where the job runs it (runs_reference); NaN where not, and the line said.
+std::pair<Real, Real> place_reference(Session& ss, const std::string& material, const std::vector<TriaxialTest>& tests,
+                                      const Misfit& misfit, const CalibrationResult& r);
+
 }  // namespace dem
