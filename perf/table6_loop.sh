@@ -33,14 +33,16 @@ base() {  # MATERIAL: the base config for it
   echo "$work/base_$m.toml"
 }
 . "$root/scripts/provenance.sh"
-keep_case() {  # OUT: a finished case's files into KEEP, with the run's provenance (its commit: this checkout's now);
-  [ -n "$keep" ] || return 0  # a case kept before keeps its first record
+keep_case() {  # OUT: a finished case's files into KEEP, with the run's provenance (its commit: the binary's, which
+  [ -n "$keep" ] || return 0  # --version names); a case kept before keeps its first record
   local name folder
   name="$(basename "$1")"; folder="$(ls -d "$1"/calibrate_*/ | tail -1)"
   [ -f "$keep/$name/run.csv" ] && return 0
   mkdir -p "$keep/$name"
   cp "$folder/prediction.csv" "$folder/calibrated.csv" "$keep/$name/"
   IFS=, read -r day commit machine <<< "$(provenance_fields "$root")"
+  built="$("$tdem" --version | sed -n 's/^triaxdem [^+]*+\([0-9a-f]\{7\}\).*/\1/p')"
+  commit="${built:-$commit}"
   printf 'command,seconds,commit,machine,date\nperf/table6_loop.sh %s,%s,%s,%s,%s\n' "$name" \
     "$(cat "$1.seconds" 2>/dev/null || echo 0)" "$commit" "$machine" "$day" > "$keep/$name/run.csv"
 }
