@@ -3,9 +3,12 @@
 
 #include <filesystem>
 #include <fstream>
+#include <set>
+#include <sstream>
 
 #include "host/engine/builder.hpp"
 #include "host/config/config.hpp"
+#include "host/config/model_keys.hpp"
 #include "host/cli/job.hpp"
 #include "host/engine/setup.hpp"
 #include "host/fit/calibrate.hpp"
@@ -69,7 +72,7 @@ TEST(Config, TheContactLawIsChosenByNameAndTakesItsOwnKeys) {
   EXPECT_EQ(dem::load_config(write_config("hm_walls.toml", hm + "[wall_material]\nlaw = \"rrlinear\"\n")).wall.law,
             dem::kRRLinear);
   std::string e = error_of(hm + "emod_Pa = 1e8\n");
-  EXPECT_NE(e.find("[material] emod_Pa: emod_Pa belongs to law \"rrlinear\"; law = \"hertz_mindlin\" takes "
+  EXPECT_NE(e.find("[material] emod_Pa: emod_Pa belongs to laws \"rrlinear\", \"rrlinear_kr\"; law = \"hertz_mindlin\" takes "
                    "shear_modulus_Pa, poisson instead"), std::string::npos) << e;
   e = error_of("[material]\nshear_modulus_Pa = 25e9\n");
   EXPECT_NE(e.find("[material] shear_modulus_Pa: shear_modulus_Pa belongs to law \"hertz_mindlin\"; law = "
@@ -88,13 +91,37 @@ TEST(Config, TheContactLawIsChosenByNameAndTakesItsOwnKeys) {
     dem::free_param("emod_Pa", base);
     ADD_FAILURE() << "emod_Pa freed on a hertz_mindlin material";
   } catch (const std::invalid_argument& x) {
-    EXPECT_NE(std::string(x.what()).find("emod_Pa belongs to law \"rrlinear\""), std::string::npos) << x.what();
+    EXPECT_NE(std::string(x.what()).find("emod_Pa belongs to laws \"rrlinear\", \"rrlinear_kr\""), std::string::npos)
+        << x.what();
   }
   EXPECT_THROW(dem::free_param("roughness", base), std::invalid_argument);
   EXPECT_EQ(dem::free_param("shear_modulus_Pa", base).lo, 25e9 / 3);
   e = error_of("[material]\nlaw = \"hertz\"\n");
-  EXPECT_NE(e.find("[material] law: 'hertz' is not allowed (allowed: hertz_mindlin, rrlinear)"), std::string::npos)
+  EXPECT_NE(e.find("[material] law: 'hertz' is not allowed (allowed: hertz_mindlin, rrlinear, rrlinear_kr)"), std::string::npos)
       << e;
+}
+
+// rrlinear_kr is rrlinear's keys and its rolling spring's coefficient, which it needs; rrlinear refuses that key. Every
+// row's laws are laws (a misspelt one would leave its key to no law).
+TEST(Config, TheLawWithItsOwnRollingStiffnessTakesRRLinearsKeysAndItsCoefficient) {
+  const dem::Config c =
+      dem::load_config(write_config("kr.toml", "[material]\nlaw = \"rrlinear_kr\"\nkr_ratio = 2.5\nemod_Pa = 3e8\n"));
+  EXPECT_EQ(c.ball.law, dem::kRRLinearKr);
+  EXPECT_EQ(c.ball.kr_ratio, 2.5);
+  EXPECT_EQ(c.ball.emod, 3e8);
+  std::string e = error_of("[material]\nlaw = \"rrlinear_kr\"\n");
+  EXPECT_NE(e.find("[material] kr_ratio: law = \"rrlinear_kr\" needs its keys, which have no default: kr_ratio "
+                   "(allowed: (0, 100])"), std::string::npos) << e;
+  e = error_of("[material]\nkr_ratio = 2\n");
+  EXPECT_NE(e.find("[material] kr_ratio: kr_ratio belongs to law \"rrlinear_kr\"; law = \"rrlinear\" takes emod_Pa, "
+                   "kratio, hertz_overlap, roughness instead"), std::string::npos) << e;
+  const std::set<std::string> laws(std::begin(dem::kContactLawNames), std::end(dem::kContactLawNames));
+  for (const dem::ModelKey& k : dem::model_keys()) {
+    std::istringstream list(k.law);
+    std::string name;
+    while (std::getline(list >> std::ws, name, ','))
+      EXPECT_TRUE(laws.count(name) && dem::own_key_of(k, name)) << k.key << ": law \"" << name << "\" is no law";
+  }
 }
 
 TEST(Config, WrongTypeUnknownTableAndSyntaxError) {

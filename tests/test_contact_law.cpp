@@ -159,16 +159,19 @@ TEST(ContactLaw, CoulombCapUsesLinearNormalForce) {
 }
 
 // ---------------------------------------------------------------------------------------------------
-// Rolling: relative bend rotation accumulates M = kr * theta with kr = ks Rbar^2 until mu_r Rbar Fn.
-// Same rounding argument as for the shear spring: 1e-12 relative.
+// Rolling: relative bend rotation accumulates M = kr * theta with kr = ks Rbar^2 (rrlinear_kr: kr_ratio ks Rbar^2)
+// until mu_r Rbar Fn, through the table of laws as the kernels call it. Same rounding argument as for the shear
+// spring: 1e-12 relative.
 namespace {
-void check_rolling(double R1, double R2, double rbar_expect) {
-  const ContactParams p = test::law(1e8, 2.0, 0.5, 0.3);
+void check_rolling(double R1, double R2, double rbar_expect, ContactLawId law = kRRLinear, double kr_ratio = 1) {
+  ContactParams p = test::law(1e8, 2.0, 0.5, 0.3);
+  p.law = law;
+  p.kr_ratio = kr_ratio;
   const double dt = 1e-7, d = 2e-6;
   const Vec3 n = unit(Vec3(-0.2, 0.5, 1.0));
   const Vec3 t = unit(cross(n, Vec3(1, 0, 0)));
   const double kn = R2 > 0 ? kPi * std::min(R1, R2) * std::min(R1, R2) * p.emod / (R1 + R2) : kPi * R1 * p.emod;
-  const double kr = kn / p.kratio * rbar_expect * rbar_expect;
+  const double kr = kr_ratio * kn / p.kratio * rbar_expect * rbar_expect;
   const double cap = p.mu_r * rbar_expect * kn * d;
   const double wrel = 20.0;  // rad/s, (w2 - w1) along t, plus a twist about n that must be ignored
   ContactKinematics k = kin(p, n, d, R1, R2, dt);
@@ -180,7 +183,7 @@ void check_rolling(double R1, double R2, double rbar_expect) {
   ContactHistory h;
   bool saturated = false;
   for (int s = 1; s <= nsat + 30; ++s) {
-    const ContactOutput out = RRLinear::eval(p, k, h);
+    const ContactOutput out = ContactLaws::eval(p, k, h);
     const double mag = norm(out.moment);
     const double elastic = s * inc;
     if (elastic <= cap * (1 - 1e-9)) {
@@ -209,6 +212,21 @@ TEST(ContactLaw, RollingMomentCapBallBall) {
 }
 
 TEST(ContactLaw, RollingMomentCapWall) { check_rolling(1e-3, 0, 1e-3); }  // Rbar = R1 at walls
+
+// rrlinear_kr's rolling spring is kr_ratio times rrlinear's, stiffer and softer, at the same cap (the cap is reached
+// after 1/kr_ratio of the steps); rrlinear ignores the field.
+TEST(ContactLaw, TheRollingStiffnessLawScalesTheRollingSpringByItsCoefficient) {
+  check_rolling(1e-3, 1e-3, 0.5e-3, kRRLinearKr, 2.5);
+  check_rolling(0.8e-3, 1.2e-3, 0.8e-3 * 1.2e-3 / 2.0e-3, kRRLinearKr, 0.4);
+  check_rolling(1e-3, 0, 1e-3, kRRLinearKr, 3.0);
+  ContactParams p = test::law(1e8, 2.0, 0.5, 0.3);
+  p.kr_ratio = 7;  // rrlinear's own rolling spring
+  ContactKinematics k = kin(p, Vec3(0, 0, 1), 2e-6, 1e-3, 1e-3, 1e-7);
+  k.dtheta = Vec3(1e-6, 0, 0);
+  ContactHistory h;
+  const double ks = kPi * 1e-6 * p.emod / 2e-3 / p.kratio;
+  EXPECT_NEAR(norm(ContactLaws::eval(p, k, h).moment), ks * 0.25e-6 * 1e-6, 1e-12 * ks * 0.25e-12);
+}
 
 // Without twisting resistance (twist = 0, the default) a twist (relative rotation about n) is not resisted: no moment however long it lasts, and no shear.
 TEST(ContactLaw, TwistProducesNoMoment) {

@@ -41,8 +41,9 @@ std::vector<const ModelKey*> law_extensions() {
 
 /// A random touching contact: in turn the base law, the dashpot and each extension of the table at the strongest
 /// strength the diagnosis tries; every seventh is a wall, every third starts with no history and some have history
-/// along n (it must vanish) or loads past the caps. Of each three packs of lanes one is of rrlinear contacts, one of
-/// hertz_mindlin and one of both laws in turn (ContactLaws runs both and keeps each lane's).
+/// along n (it must vanish) or loads past the caps. Of each kContactLaws + 1 packs of lanes one is of each law's
+/// contacts and one of all laws in turn (ContactLaws runs each and keeps each lane's); a law's needed keys (its
+/// constants, model_keys) drawn in their search range, or their allowed range where a calibration does not free them.
 LawCase random_case(std::mt19937_64& rng, int t) {
   static const std::vector<const ModelKey*> extensions = law_extensions();
   std::uniform_real_distribution<double> u(-1, 1);
@@ -61,12 +62,15 @@ LawCase random_case(std::mt19937_64& rng, int t) {
   c.k.r2 = t % 7 == 0 ? 0 : 1e-3 * (1 + 0.2 * u(rng));
   c.k.m1 = 1e-5;
   c.k.m2 = c.k.r2 > 0 ? 1.2e-5 : 0;
-  const int pack = t / kContactLanes;
-  if (pack % 3 == 1 || (pack % 3 == 2 && t % 2 == 1)) {
-    c.p.law = kHertzMindlin;
-    c.p.shear_modulus = 1e9 * (1.5 + u(rng));
-    c.p.poisson = 0.25 * (1 + u(rng));
-  }
+  const int pack = t / kContactLanes, laws = kContactLaws;
+  c.p.law = static_cast<ContactLawId>(pack % (laws + 1) < laws ? pack % (laws + 1) : t % laws);
+  for (const ModelKey& key : model_keys())
+    if (key.required && own_key_of(key, kContactLawNames[c.p.law])) {
+      const double a = 0.5 * (1 + u(rng));
+      c.p.*key.field = !key.fit ? key.lo + a * (key.hi - key.lo)
+                       : key.fit_log ? key.fit_lo * std::pow(key.fit_hi / key.fit_lo, a)
+                                     : key.fit_lo + a * (key.fit_hi - key.fit_lo);
+    }
   c.k.kn = ContactLaws::stiffness(c.p, c.k.r1, c.k.r2);
   c.k.vrel = Vec3(u(rng), u(rng), u(rng));
   c.k.dtheta = 1e-3 * Vec3(u(rng), u(rng), u(rng));

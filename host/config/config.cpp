@@ -23,12 +23,12 @@ namespace {
 void read_contact(TableReader& r, ContactParams& c, const ContactParams* from = nullptr) {
   std::string law = kContactLawNames[static_cast<int>(c.law)];
   r.string("law", law, std::set<std::string>(std::begin(kContactLawNames), std::end(kContactLawNames)));
-  c.law = static_cast<Real>(std::find(std::begin(kContactLawNames), std::end(kContactLawNames), law) -
-                            std::begin(kContactLawNames));
+  c.law = static_cast<ContactLawId>(std::find(std::begin(kContactLawNames), std::end(kContactLawNames), law) -
+                                    std::begin(kContactLawNames));
   for (const ModelKey& k : model_keys()) {
     if (!k.field) continue;
     Real other = 0;  // a key of another law: read (and listed by config_keys) only to be refused
-    const bool mine = !*k.law || law == k.law;
+    const bool mine = law_takes(k.law, law);
     r.number(k.key, mine ? c.*k.field : other, k.lo, k.hi, k.scale, k.open_lo);
     if (!mine && r.has(k.key)) {
       try {
@@ -42,10 +42,10 @@ void read_contact(TableReader& r, ContactParams& c, const ContactParams* from = 
   if (!(from && from->law == c.law)) {
     std::string needed;
     for (const ModelKey& k : model_keys())
-      if (k.required && law == k.law)
+      if (k.required && own_key_of(k, law))
         needed += (needed.empty() ? "" : ", ") + std::string(k.key) + " (allowed: " + allowed_range(k) + ")";
     for (const ModelKey& k : model_keys())
-      if (k.required && law == k.law && !r.has(k.key))
+      if (k.required && own_key_of(k, law) && !r.has(k.key))
         r.fail(k.key, "law = \"" + law + "\" needs its keys, which have no default: " + needed);
   }
   r.finish();

@@ -7,6 +7,8 @@
 
 #include "host/config/config.hpp"
 #include "host/config/config_checks.hpp"
+
+#include "host/config/model_keys.hpp"
 #include "host/util/text_format.hpp"
 
 namespace dem {
@@ -51,7 +53,8 @@ void check_cell_physics(const Config& c) {
                       fmt("%.4g mm a side", 1e3 * std::cbrt(static_cast<Real>(c.particles.count) * M_PI / 6 * d * d * d /
                                                                kMinSolidFraction)) +
                       " for these balls, or more or larger balls: [particles] count, diameter_mm)");
-  if (static_cast<int>(c.ball.law) == kRRLinear && c.ball.emod < kMinStiffnessOverPressure * c.periodic.triax.sigma3)
+  if (own_key_of(model_key("emod_Pa"), kContactLawNames[c.ball.law]) &&
+      c.ball.emod < kMinStiffnessOverPressure * c.periodic.triax.sigma3)
     throw ConfigError(c.path + ": [material] emod_Pa: " + fmt("%g Pa", c.ball.emod) + " under sigma3 = " +
                       fmt("%g kPa", 1e-3 * c.periodic.triax.sigma3) + " overlaps the contacts by about " +
                       fmt("%.3g", c.periodic.triax.sigma3 / c.ball.emod) + " of a diameter (allowed: emod_Pa at least " +

@@ -1,5 +1,6 @@
 #include "host/config/model_keys.hpp"
 
+#include <cstring>
 #include <sstream>
 #include <stdexcept>
 
@@ -21,17 +22,18 @@ const std::vector<ModelKey>& model_keys() {
   static const std::vector<ModelKey> keys = {
       key("mu_s", &C::mu_s, "-").in(0, 10).searched_log(0.02, 1.0),
       key("mu_r", &C::mu_r, "-").in(0, 10).searched(0.0, 0.2),
-      key("emod_Pa", &C::emod, "Pa").above(0, 1e13).searched_log(1e6, 1e10).of("rrlinear"),
-      key("kratio", &C::kratio, "-").above(0, 1e3).searched(1.0, 4.0).of("rrlinear"),
+      key("emod_Pa", &C::emod, "Pa").above(0, 1e13).searched_log(1e6, 1e10).of("rrlinear, rrlinear_kr"),
+      key("kratio", &C::kratio, "-").above(0, 1e3).searched(1.0, 4.0).of("rrlinear, rrlinear_kr"),
       key("shear_modulus_Pa", &C::shear_modulus, "Pa").above(0, 1e13).searched_log(1e6, 1e11).of("hertz_mindlin")
           .needed(),
       key("poisson", &C::poisson, "-").in(0, 0.5).of("hertz_mindlin").needed(),
+      key("kr_ratio", &C::kr_ratio, "-").above(0, 100).searched_log(0.1, 10).of("rrlinear_kr").needed(),
       key("beta_n", &C::beta_n, "-").in(0, 1),
-      key("hertz_overlap", &C::hertz_overlap, "r").in(0, 0.5).searched_log(3e-4, 0.03).of("rrlinear")
+      key("hertz_overlap", &C::hertz_overlap, "r").in(0, 0.5).searched_log(3e-4, 0.03).of("rrlinear, rrlinear_kr")
           .extension_named("hertz", {1e-3, 3e-3, 1e-2},
                            "initial stiffness that grows faster with confinement than the linear contacts give")
           .not_from_off(),
-      key("roughness", &C::roughness, "r").in(0, 0.1).searched_log(1e-4, 5e-2).of("rrlinear")
+      key("roughness", &C::roughness, "r").in(0, 0.1).searched_log(1e-4, 5e-2).of("rrlinear, rrlinear_kr")
           .extension_named("roughness", {1e-3, 3e-3, 1e-2},
                            "soft initial response, most at low confinement; peak and residual hardly change"),
       key("wear", &C::wear, "-").in(0, 0.99).searched(0.0, 0.9)
@@ -83,14 +85,29 @@ std::string allowed_range(const ModelKey& k) {
 std::string law_key_names(const std::string& law) {
   std::string names;
   for (const ModelKey& k : model_keys())
-    if (law == k.law) names += (names.empty() ? "" : ", ") + std::string(k.key);
+    if (own_key_of(k, law)) names += (names.empty() ? "" : ", ") + std::string(k.key);
   return names;
 }
 
-void require_law_of(const ModelKey& k, Real law) {
-  const std::string mine = kContactLawNames[static_cast<int>(law)];
-  if (!*k.law || mine == k.law) return;
-  throw std::invalid_argument(std::string(k.key) + " belongs to law \"" + k.law + "\"; law = \"" + mine +
+bool law_takes(const std::string& laws, const std::string& law) {
+  if (laws.empty()) return true;
+  std::istringstream list(laws);
+  std::string name;
+  while (std::getline(list >> std::ws, name, ','))
+    if (name == law) return true;
+  return false;
+}
+
+bool own_key_of(const ModelKey& k, const std::string& law) { return *k.law && law_takes(k.law, law); }
+
+void require_law_of(const ModelKey& k, ContactLawId law) {
+  const std::string mine = kContactLawNames[law];
+  if (law_takes(k.law, mine)) return;
+  std::string owners;  // "law \"a\"" or "laws \"a\", \"b\""
+  for (const char* name : kContactLawNames)
+    if (own_key_of(k, name)) owners += (owners.empty() ? "\"" : ", \"") + std::string(name) + "\"";
+  throw std::invalid_argument(std::string(k.key) + " belongs to law" + (std::strchr(k.law, ',') ? "s " : " ") + owners +
+                              "; law = \"" + mine +
                               "\" takes " + law_key_names(mine) + " instead");
 }
 

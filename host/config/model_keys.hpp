@@ -34,7 +34,7 @@ struct ModelKey {
   /// The diagnosis tries it (and synth makes data with it). An extension that names another code's data, which lack
   /// it, is a parameter to calibrate, not a verdict to offer.
   bool diagnosed = true;
-  /// The contact law it belongs to (kContactLawNames); "" for every law's.
+  /// The contact laws it belongs to (kContactLawNames, comma-separated: "rrlinear, rrlinear_kr"); "" for every law's.
   const char* law = "";
   /// The law's materials must give it: it has no default (hertz_mindlin's constants).
   bool required = false;
@@ -53,7 +53,7 @@ struct ModelKey {
   }
   ModelKey& not_from_off() { return from_off = false, *this; }
   ModelKey& not_diagnosed() { return diagnosed = false, *this; }
-  ModelKey& of(const char* law_name) { return law = law_name, *this; }
+  ModelKey& of(const char* law_names) { return law = law_names, *this; }
   ModelKey& needed() { return required = true, *this; }
 };
 
@@ -79,8 +79,13 @@ std::string allowed_range(const ModelKey& k);
 /// The keys of law `law` alone ("shear_modulus_Pa, poisson"), for messages.
 std::string law_key_names(const std::string& law);
 
+/// Whether law `law` takes a key of `laws` (a row's `law`: "" for every law's, or a comma-separated list).
+bool law_takes(const std::string& laws, const std::string& law);
+/// Whether `law` has the key as its own, not every law's (the keys that name a law's stiffness in a specimen's key).
+bool own_key_of(const ModelKey& k, const std::string& law);
+
 /// A key of another law than the pair's ([material] law) is refused: throws std::invalid_argument naming the key's
-/// law and the keys the pair's law takes. Does nothing for a key of every law.
-void require_law_of(const ModelKey& k, Real law);
+/// laws and the keys the pair's law takes. Does nothing for a key of every law.
+void require_law_of(const ModelKey& k, ContactLawId law);
 
 }  // namespace dem

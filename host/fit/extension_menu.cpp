@@ -32,7 +32,7 @@ namespace {
 /// Whether extension e extends the base's law (the menu tries only those); says so where it does not.
 bool extends_law_of(const Extension& e, const Model& base, bool verbose) {
   const std::string law = kContactLawNames[static_cast<int>(base.law.law)];
-  if (e.law.empty() || e.law == law) return true;
+  if (law_takes(e.law, law)) return true;
   if (verbose)
     std::printf("diagnose: %-9s extends law %s, not this material's %s: not tried\n", e.name.c_str(), e.law.c_str(),
                 law.c_str());

@@ -229,7 +229,7 @@ std::string specimen_key(const Config& cfg) {
     const std::string law = kContactLawNames[static_cast<int>(p->law)];
     k << (p == &cfg.ball ? " ball " : " wall ") << law;
     for (const ModelKey& m : model_keys())
-      if (m.field && !*m.extension && law == m.law) k << " " << m.key << " " << p->*m.field;
+      if (m.field && !*m.extension && own_key_of(m, law)) k << " " << m.key << " " << p->*m.field;
     k << " beta_n " << p->beta_n;
   }
   return k.str();

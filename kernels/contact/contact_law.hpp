@@ -18,6 +18,9 @@
 ///   ks = 8 G* a = kn 2 (1 - nu) / (2 - nu) (Mindlin's no-slip stiffness, G* = G / (2 (2 - nu))),
 /// and keeps the tangential, rolling and twisting parts (kr = ks Rbar^2 follows the load; YADE's krot is constant).
 ///
+/// A third, `rrlinear_kr`, is rrlinear with the rolling spring's stiffness set by a coefficient of its own:
+///   kr = kr_ratio ks Rbar^2 (kr_ratio = 1 is rrlinear), the cap mu_r Rbar Fn as before.
+///
 /// Model extensions (what a mu_s + mu_r linear law misses, each with its signature in triaxial data:
 /// docs/calibration.md, Diagnosis), each off by default and set per material pair; with
 /// all of them off the arithmetic is the rrlinear model's, bit for bit:
@@ -76,7 +79,44 @@ KOKKOS_INLINE_FUNCTION T effective_radius(const T& r1, const Arg<T>& r2) {
   return select(r2 > T(0), r1 * r2 / (r1 + r2), r1);
 }
 
-/// Elastic normal spring: linear with the deformability method's kn, optionally Hertzian and rough.
+/// The rough-surface extension (roughness = sigma / r > 0, the top of the file): the bulk's overlap d and its derivative
+/// dd over the contact's overlap, taken where `on`.
+struct RoughLayer {
+  template <class T>
+  KOKKOS_INLINE_FUNCTION static auto on(const ContactParamsT<T>& p) {
+    return p.roughness > T(0);
+  }
+  template <class M, class T>
+  KOKKOS_FORCEINLINE_FUNCTION static void bulk(const ContactParamsT<T>& p, const M& on, const T& overlap, const T& r,
+                                               T& d, T& dd) {
+    const T c = 2 * p.roughness * r, s = overlap + c;
+    d = select(on, overlap * overlap / s, d);
+    dd = select(on, overlap * (overlap + 2 * c) / (s * s), dd);
+  }
+};
+
+/// The Hertz extension of a linear normal spring (hertz_overlap = delta_ref / r > 0, the top of the file): the force
+/// on the bulk's overlap d, kn the secant stiffness at delta_ref, where `on`; the linear spring's elsewhere.
+struct HertzOverlap {
+  template <class T>
+  KOKKOS_INLINE_FUNCTION static auto on(const ContactParamsT<T>& p) {
+    return p.hertz_overlap > T(0);
+  }
+  /// The largest tangent stiffness up to an overlap of overlap_max (m), from the linear spring's kn.
+  KOKKOS_INLINE_FUNCTION static Real max_stiffness(const ContactParams& p, Real kn, Real r, Real overlap_max) {
+    return kc::max(kn, Real(1.5) * kn * kc::sqrt(overlap_max / (p.hertz_overlap * r)));
+  }
+  template <class M, class T>
+  KOKKOS_FORCEINLINE_FUNCTION static NormalResponseT<T> response(const ContactParamsT<T>& p, const M& on, const T& kn,
+                                                                 const T& r, const T& d, const T& dd) {
+    const T root = kc::sqrt(d / (p.hertz_overlap * r));
+    const T kt = select(on, Real(1.5) * kn * root * dd, kn * dd);
+    return {select(on, kn * d * root, kn * d), kt, kt / p.kratio};
+  }
+};
+
+/// Elastic normal spring: linear with the deformability method's kn, optionally rough (RoughLayer) and Hertzian
+/// (HertzOverlap).
 struct NormalElastic {
   template <class T>
   KOKKOS_INLINE_FUNCTION static T stiffness(const ContactParamsT<T>& p, const Arg<T>& r1, const Arg<T>& r2) {
@@ -93,27 +133,19 @@ struct NormalElastic {
                                                            Real overlap_max) {
     Real kn = stiffness(p, r1, r2);
     if (p.hertz_overlap != Real(0))  // roughness only softens
-      kn = kc::max(kn, Real(1.5) * kn * kc::sqrt(overlap_max / (p.hertz_overlap * contact_radius(r1, r2))));
+      kn = HertzOverlap::max_stiffness(p, kn, contact_radius(r1, r2), overlap_max);
     return {kn, kn / p.kratio};
   }
   /// Elastic normal force (>= 0) and tangent stiffness of a touching contact (k.overlap > 0, k.kn set).
   template <class T>
   KOKKOS_FORCEINLINE_FUNCTION static NormalResponseT<T> response(const ContactParamsT<T>& p,
                                                                  const ContactKinematicsT<T>& k) {
-    const auto rough = p.roughness > T(0), hertz = p.hertz_overlap > T(0);
+    const auto rough = RoughLayer::on(p), hertz = HertzOverlap::on(p);
     if (!any(rough | hertz)) return {k.kn * k.overlap, k.kn, k.kn / p.kratio};
     const T r = contact_radius(k.r1, k.r2);
     T d = k.overlap, dd = 1;  // bulk overlap and d(bulk overlap)/d(overlap)
-    if (any(rough)) {
-      const T c = 2 * p.roughness * r, s = k.overlap + c;
-      d = select(rough, k.overlap * k.overlap / s, d);
-      dd = select(rough, k.overlap * (k.overlap + 2 * c) / (s * s), dd);
-    }
-    if (any(hertz)) {
-      const T root = kc::sqrt(d / (p.hertz_overlap * r));
-      const T kt = select(hertz, Real(1.5) * k.kn * root * dd, k.kn * dd);
-      return {select(hertz, k.kn * d * root, k.kn * d), kt, kt / p.kratio};
-    }
+    if (any(rough)) RoughLayer::bulk(p, rough, k.overlap, r, d, dd);
+    if (any(hertz)) return HertzOverlap::response(p, hertz, k.kn, r, d, dd);
     return {k.kn * d, k.kn * dd, k.kn * dd / p.kratio};
   }
   /// The adhesive pull of a touching pair of balls (N, >= 0; 0 at walls), subtracted from the normal force.
@@ -197,14 +229,31 @@ struct TangentialCoulomb {
   }
 };
 
-/// Rolling resistance linear (Iwashita and Oda): bend rotation only, kr = ks Rbar^2 (ks from the normal part),
-/// cap mu_r Rbar Fn.
-struct RollingLinear {
+/// The rolling spring's stiffness from ks Rbar^2: PFC's rrlinear takes it as it is.
+struct RollingStiffnessOfShear {
+  template <class T>
+  KOKKOS_FORCEINLINE_FUNCTION static T of(const ContactParamsT<T>&, const T& ks_rbar2) {
+    return ks_rbar2;
+  }
+};
+/// ... or scaled by a coefficient of its own, kr_ratio (as YADE's alphaKr and other codes' rolling stiffness
+/// coefficients): a rolling spring stiffer or softer than the shear spring's, at the same cap.
+struct RollingStiffnessScaled {
+  template <class T>
+  KOKKOS_FORCEINLINE_FUNCTION static T of(const ContactParamsT<T>& p, const T& ks_rbar2) {
+    return p.kr_ratio * ks_rbar2;
+  }
+};
+
+/// Rolling resistance linear (Iwashita and Oda): bend rotation only, kr = ks Rbar^2 (ks from the normal part) as
+/// Stiffness makes it, cap mu_r Rbar Fn.
+template <class Stiffness>
+struct RollingSpring {
   template <class T>
   KOKKOS_FORCEINLINE_FUNCTION static Vec3T<T> update(const ContactParamsT<T>& p, const ContactKinematicsT<T>& k,
                                                 const NormalResponseT<T>& nr, ContactHistoryT<T>& h) {
     const T rb = effective_radius(k.r1, k.r2);
-    const T kr = nr.ks * rb * rb;
+    const T kr = Stiffness::of(p, nr.ks * rb * rb);
     Vec3T<T> mr = rotate_into_plane(h.mr, k.n) + kr * tangential(k.dtheta, k.n);
     set_flag(h.flags, cap_to(mr, p.mu_r * rb * nr.fn), kRolling);
     h.mr = mr;
@@ -267,11 +316,14 @@ struct ContactLaw {
   }
 };
 
+using RollingLinear = RollingSpring<RollingStiffnessOfShear>;
 using RRLinear = ContactLaw<NormalElastic, TangentialCoulomb, RollingLinear, TwistingLinear>;
 using HertzMindlin = ContactLaw<NormalHertzMindlin, TangentialCoulomb, RollingLinear, TwistingLinear>;
+/// rrlinear with the rolling spring's own coefficient: kr = kr_ratio ks Rbar^2.
+using RRLinearKr = ContactLaw<NormalElastic, TangentialCoulomb, RollingSpring<RollingStiffnessScaled>, TwistingLinear>;
 
 /// The laws, in ContactLawId's order (law_table.hpp: LawTable).
-static_assert(kContactLaws == 2, "each ContactLawId needs its law in ContactLaws, in the enum's order");
-using ContactLaws = LawTable<RRLinear, HertzMindlin>;
+static_assert(kContactLaws == 3, "each ContactLawId needs its law in ContactLaws, in the enum's order");
+using ContactLaws = LawTable<RRLinear, HertzMindlin, RRLinearKr>;
 
 }  // namespace dem

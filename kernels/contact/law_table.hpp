@@ -2,6 +2,7 @@
 /// What a contact law works on and how a table of laws sends a call to each pair's: a contact's kinematics, history
 /// and output (for one pair, or W pairs as SIMD lanes), the parameters of lanes, and LawTable, which contact_law.hpp
 /// fills with its laws (ContactLaws).
+#include <cstdint>
 #include <tuple>
 #include <type_traits>
 
@@ -22,7 +23,14 @@ using Arg = typename Same<T>::type;
 template <class T, class Pair>
 KOKKOS_INLINE_FUNCTION ContactParamsT<T> params_of_lanes(const Pair& pair) {
   ContactParamsT<T> P;
-  P.each_field([&](T& out, Real ContactParams::*m) { out = from_lanes<T>([&](int k) { return pair(k).*m; }); });
+  P.each_field([&](auto& out, auto m) {
+    using F = std::decay_t<decltype(out)>;  // T, or the law's id for one pair
+    const T v = from_lanes<T>([&](int k) { return static_cast<Real>(pair(k).*m); });
+    if constexpr (std::is_enum<F>::value)
+      out = static_cast<F>(static_cast<std::int64_t>(v));
+    else
+      out = v;
+  });
   return P;
 }
 
@@ -117,7 +125,7 @@ struct LawTable {
     // copies and selects below cost 14% of the force kernel's instructions when always taken).
     ContactOutputT<T> out;
     bool done = false;
-    ((!done && all(p.law == T(index_of<Laws>())) ? (out = Laws::eval(p, k, h), done = true) : false), ...);
+    ((!done && all(is<Laws>(p.law)) ? (out = Laws::eval(p, k, h), done = true) : false), ...);
     return done ? out : eval_mixed(p, k, h);
   }
   /// For one pair (scalar parameters): a servo's spring and the critical time step's largest stiffness.
@@ -142,12 +150,17 @@ struct LawTable {
     const ContactOutputT<T> out = each_law(p, [&](auto law) {
       ContactHistoryT<T> mine = h;
       const ContactOutputT<T> o = decltype(law)::eval(p, k, mine);
-      const auto own = p.law == T(index_of<decltype(law)>());
+      const auto own = is<decltype(law)>(p.law);
       out_h = all(own) ? mine : select(own, mine, out_h);
       return o;
     });
     h = out_h;
     return out;
+  }
+  /// Whether a pair's law (each lane's, for lanes) is Law.
+  template <class Law, class L>
+  KOKKOS_INLINE_FUNCTION static auto is(const L& law) {
+    return law == L(index_of<Law>());
   }
   template <class Law>
   KOKKOS_INLINE_FUNCTION static constexpr int index_of() {
@@ -162,10 +175,10 @@ struct LawTable {
     using R = decltype(f(first_law()));
     R out{};
     bool set = false;
-    ((!set && all(p.law == decltype(p.law)(index_of<Laws>())) ? (out = f(Laws{}), set = true) : false), ...);
+    ((!set && all(is<Laws>(p.law)) ? (out = f(Laws{}), set = true) : false), ...);
     if (set) return out;
-    ((any(p.law == decltype(p.law)(index_of<Laws>()))
-          ? (out = set ? select(p.law == decltype(p.law)(index_of<Laws>()), f(Laws{}), out) : f(Laws{}), set = true)
+    ((any(is<Laws>(p.law))
+          ? (out = set ? select(is<Laws>(p.law), f(Laws{}), out) : f(Laws{}), set = true)
           : false),
      ...);
     return out;

@@ -1,6 +1,8 @@
 #pragma once
 /// The parameters of a material pair's contact law (contact_law.hpp). Free of Kokkos, so that the config reader,
 /// which a CUDA build compiles with the host compiler (CMakeLists.txt), can fill them.
+#include <cstdint>
+
 #include "kernels/core/real.hpp"
 
 // Device-callable where a CUDA compiler builds the file (the kernels), a plain function where the host compiler does
@@ -14,18 +16,31 @@
 namespace dem {
 
 /// The contact laws a material pair may choose ([material] law), by the value of ContactParams::law; each is a
-/// composition of sub-models in contact_law.hpp (ContactLaws lists them in this order).
-enum ContactLawId : int { kRRLinear, kHertzMindlin, kContactLaws };
-inline constexpr const char* kContactLawNames[kContactLaws] = {"rrlinear", "hertz_mindlin"};
+/// composition of sub-models in contact_law.hpp (ContactLaws lists them in this order). As wide as a Real, so that the
+/// pair table, which its hashes read byte by byte, has no padding.
+enum ContactLawId : std::int64_t { kRRLinear, kHertzMindlin, kRRLinearKr, kContactLaws };
+inline constexpr const char* kContactLawNames[kContactLaws] = {"rrlinear", "hertz_mindlin", "rrlinear_kr"};
+
+/// The type of the law field: the id for one pair; for W pairs as SIMD lanes (simd.hpp), each lane's id as a T, which
+/// the lanes compare at once.
+template <class T>
+struct LawField {
+  using type = T;
+};
+template <>
+struct LawField<Real> {
+  using type = ContactLawId;
+};
 
 /// Parameters of one material pair. Units: Pa, -, -, -, -, then as each field says. T is Real, or a pack of W pairs' values (simd.hpp).
 template <class T>
 struct ContactParamsT {
-  T law = kRRLinear;  ///< the ContactLawId, as a Real: the pair table and its hashes hold Reals only (no padding)
+  typename LawField<T>::type law = kRRLinear;  ///< the pair's law
   T emod = 1e8;     ///< rrlinear: effective modulus E* of the deformability method (Pa)
   T kratio = 1.5;   ///< rrlinear: kappa* = kn / ks
   T shear_modulus = 0;  ///< hertz_mindlin: the balls' shear modulus G (Pa)
   T poisson = 0;        ///< hertz_mindlin: the balls' Poisson ratio nu
+  T kr_ratio = 1;       ///< rrlinear_kr: the rolling spring's stiffness over ks Rbar^2
   T mu_s = 0.5;     ///< sliding friction coefficient
   T mu_r = 0.0;     ///< rolling friction coefficient
   T beta_n = 0.0;   ///< normal viscous damping ratio (PFC dp_nratio); 0 = off, force never tensile
@@ -48,6 +63,7 @@ struct ContactParamsT {
     f(kratio, &P::kratio);
     f(shear_modulus, &P::shear_modulus);
     f(poisson, &P::poisson);
+    f(kr_ratio, &P::kr_ratio);
     f(mu_s, &P::mu_s);
     f(mu_r, &P::mu_r);
     f(beta_n, &P::beta_n);
@@ -72,10 +88,10 @@ using ContactParams = ContactParamsT<Real>;
 constexpr int contact_field_count() {
   ContactParams p{};
   int n = 0;
-  p.each_field([&n](Real&, Real ContactParams::*) { ++n; });
+  p.each_field([&n](auto&, auto) { ++n; });
   return n;
 }
-static_assert(sizeof(ContactParams) == contact_field_count() * sizeof(Real),
+static_assert(sizeof(ContactParams) == contact_field_count() * sizeof(Real) && sizeof(ContactLawId) == sizeof(Real),
               "ContactParams::each_field must list every field");
 
 /// The scalar history the extensions keep per contact, by name (units: slip m, twist N m). Storage
