@@ -19,17 +19,23 @@ struct Same {
 template <class T>
 using Arg = typename Same<T>::type;
 
+/// A field of the parameters from its lanes' value: T, or the law's id for one pair. A function template of its own
+/// so that the id's branch is discarded for lanes (clang checks a generic lambda's non-dependent branches).
+template <class F, class T>
+KOKKOS_INLINE_FUNCTION F field_of_lanes(const T& v) {
+  if constexpr (std::is_enum<F>::value)
+    return static_cast<F>(static_cast<std::int64_t>(v));
+  else
+    return v;
+}
+
 /// The parameters of W material pairs as lanes: pair(k) gives lane k's.
 template <class T, class Pair>
 KOKKOS_INLINE_FUNCTION ContactParamsT<T> params_of_lanes(const Pair& pair) {
   ContactParamsT<T> P;
   P.each_field([&](auto& out, auto m) {
-    using F = std::decay_t<decltype(out)>;  // T, or the law's id for one pair
     const T v = from_lanes<T>([&](int k) { return static_cast<Real>(pair(k).*m); });
-    if constexpr (std::is_enum<F>::value)
-      out = static_cast<F>(static_cast<std::int64_t>(v));
-    else
-      out = v;
+    out = field_of_lanes<std::decay_t<decltype(out)>>(v);
   });
   return P;
 }
