@@ -27,7 +27,7 @@ std::string Session::plan_text() const {
 
 Session::Session(const Config& base, const CalibrationOptions& o, const std::string& kind)
     : JobInputs(base, o), plan(announce_plan(base, o, kind)),
-      lab(matched(stored_cell(base, o, data), o.workers), true, o.workers),
+      lab(matched(stored_cell(cell, o, data), o.workers), true, o.workers),
       folder(o.resume.empty() ? new_dated_folder(o.output, kind) : resumed_folder(o.resume, kind)),
       output(o.resume.empty() ? o.output : resumed_parent(o.resume)) {
   ranks::check_shared_folder(folder);  // every rank reads the run store there
@@ -201,9 +201,9 @@ std::string Session::predict_boundary(const Config& base, const std::map<std::st
   std::optional<Config> walls;
   if (walls_prediction) {
     StateMatch walls_state;  // the walled cell's own preparation to the data's state
-    Config cell = reference_cell(base, kPredictWalls);
-    cell.packing_store = lab.config().packing_store;
-    walls = matched_state(cell, data.tests, walls_state, true, match_plan(cell, workers));
+    Config walled = reference_cell(base, kPredictWalls);
+    walled.packing_store = lab.config().packing_store;
+    walls = matched_state(walled, data.tests, walls_state, true, match_plan(walled, workers));
   }
   const std::string test = walls ? walled_cell_text(*walls) : membrane_test_text(*predict_template);
   const int specimens = static_cast<int>(base.calibrate.predict_specimens);

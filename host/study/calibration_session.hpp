@@ -29,9 +29,9 @@ constexpr Real kStrainBeyondData = 1.1;
 /// asks for more (the shear's records up to there are the same bit for bit, and the misfit compares no strain beyond
 /// the data's). Summary data (a peak, an end value) keep the config's strain.
 Config sheared_for(Config cell, const MeasuredData& data);
-/// The reference test's cell, sheared as far as the data need, its packings kept in (and read from) the output
-/// folder's .specimens/cells, where a later job on the same base finds them.
-Config stored_cell(const Config& base, const CalibrationOptions& o, const MeasuredData& data);
+/// The reference test's cell (JobInputs::cell), sheared as far as the data need, its packings kept in (and read from)
+/// the output folder's .specimens/cells, where a later job on the same base finds them.
+Config stored_cell(const Config& cell, const CalibrationOptions& o, const MeasuredData& data);
 
 /// A material's calibration as the prediction needs it: its tests, the model, and the periodic cell's tests at it.
 struct Calibrated {
@@ -57,6 +57,7 @@ struct EmptyFolderRemover {
 /// parameters, the noise, the prediction; and the plan of the work (--plan stops after it).
 struct JobInputs {
   MeasuredData data;
+  Config cell;  ///< the reference test's cell (reference_cell of --reference-test), read once for the whole job
   ReferenceValues ref;
   std::vector<FreeParam> free;
   NoiseOptions noise;
@@ -85,12 +86,12 @@ struct JobInputs {
 /// smaller than the data's specimen is said. hold_out: the tests at --hold-out's pressure out of `data`, returned;
 /// DataError where no test has it or a material the job calibrates would keep none. check_enough_data: DataError where
 /// a material's summary values are fewer than the free parameters (a ridge of fits, each with chi2 0).
-void take_walled_size(const Config& base, const CalibrationOptions& o, MeasuredData& data);
+void take_walled_size(const Config& cell, MeasuredData& data);
 std::vector<TriaxialTest> hold_out(const CalibrationOptions& o, MeasuredData& data);
 void check_enough_data(const CalibrationOptions& o, const MeasuredData& data, std::size_t free);
 /// DataError where a test's specimen_balls lie below the simulator cell's balls: the cell's bias check extrapolates
 /// toward larger specimens only (a 10-ball specimen against a 120-ball cell was extrapolated to q -45%).
-void check_specimen_sizes(const Config& base, const CalibrationOptions& o, const MeasuredData& data);
+void check_specimen_sizes(const Config& base, const Config& cell, const MeasuredData& data);
 /// The inputs that decide a job's runs (the data's bytes, the config's keys, the options), in the result folder's
 /// job_inputs.txt; a --resume with other inputs is refused before any work, naming what differs.
 void record_job_inputs(const Config& base, const CalibrationOptions& o, const std::string& folder);

@@ -21,8 +21,7 @@ namespace dem {
 /// Between walls the specimen's size is part of the test (the walls' looser layer falls as N^-1/3): tests that give
 /// no specimen_balls are taken to be of the walled cell's balls, with a note, where the cell's bias check would have
 /// extrapolated the cell to an infinite specimen and counted the walls' share as the simulator's bias.
-void take_walled_size(const Config& base, const CalibrationOptions& o, MeasuredData& data) {
-  const Config cell = reference_cell(base, o.reference_test);
+void take_walled_size(const Config& cell, MeasuredData& data) {
   if (cell.periodic.boundary != CellBoundary::walls) return;
   const Real balls = static_cast<Real>(cell.particles.count * std::max(cell.calibrate.cell_factor, 1L));
   bool took = false;
@@ -51,8 +50,7 @@ void take_walled_size(const Config& base, const CalibrationOptions& o, MeasuredD
                          "differs");
 }
 
-void check_specimen_sizes(const Config& base, const CalibrationOptions& o, const MeasuredData& data) {
-  const Config cell = reference_cell(base, o.reference_test);
+void check_specimen_sizes(const Config& base, const Config& cell, const MeasuredData& data) {
   const Real balls = static_cast<Real>(cell.particles.count * std::max(cell.calibrate.cell_factor, 1L));
   for (const TriaxialTest& t : data.tests)
     if (std::isfinite(t.specimen_balls) && t.specimen_balls < balls)

@@ -76,9 +76,9 @@ NoiseOptions noise_options(const std::string& name) {
 }
 
 /// --predict walls, checked: the reference test must not be the walled cell already.
-bool walls_prediction_wanted(const Config& base, const CalibrationOptions& o) {
+bool walls_prediction_wanted(const Config& base, const CalibrationOptions& o, const Config& cell) {
   if (!predicts_walls(base, o.predict)) return false;
-  if (reference_cell(base, o.reference_test).periodic.boundary == CellBoundary::walls)
+  if (cell.periodic.boundary == CellBoundary::walls)
     throw ConfigError((o.predict.empty() ? base.path + ": [calibrate] predict" : std::string("--predict")) +
                       ": walls: the reference test is the cell between six walls already; predict a membrane test "
                       "(a config of configs/small/) or none");
@@ -88,8 +88,8 @@ bool walls_prediction_wanted(const Config& base, const CalibrationOptions& o) {
 /// The q the reference cell's tests carry: the walled cell's walls measure the deviator force over the cross-section
 /// at the start of shear and over the current one, and give the one the data name; the periodic cell gives its
 /// contacts' stress (area_corrected), whatever the data name (two fidelities take the measure up in the membrane test).
-QMeasure reference_q_measure(const Config& base, const CalibrationOptions& o, const MeasuredData& data) {
-  if (reference_cell(base, o.reference_test).periodic.boundary != CellBoundary::walls) return QMeasure::kAreaCorrected;
+QMeasure reference_q_measure(const Config& cell, const MeasuredData& data) {
+  if (cell.periodic.boundary != CellBoundary::walls) return QMeasure::kAreaCorrected;
   if (data.q_measure != QMeasure::kFixedArea && data.q_measure != QMeasure::kAreaCorrected)
     throw DataError(data.path, "q_measure",
                     std::string("'") + name_of(data.q_measure) + "' is not a q the cell between walls measures "
@@ -119,8 +119,8 @@ std::vector<CompressionTest> compression_tests(const Config& base, const Calibra
 
 }  // namespace
 
-Config stored_cell(const Config& base, const CalibrationOptions& o, const MeasuredData& data) {
-  Config c = sheared_for(reference_cell(base, o.reference_test), data);
+Config stored_cell(const Config& cell, const CalibrationOptions& o, const MeasuredData& data) {
+  Config c = sheared_for(cell, data);
   c.packing_store = (o.resume.empty() ? o.output : resumed_parent(o.resume)) + "/.specimens/cells";
   return c;
 }
@@ -145,14 +145,15 @@ std::map<std::string, std::vector<TriaxialTest>> by_material(const MeasuredData&
 
 JobInputs::JobInputs(const Config& base, const CalibrationOptions& o)
     : data(load_measured(o.data)),
+      cell(reference_cell(base, o.reference_test)),
       ref(o.reference.empty() ? ReferenceValues{}
                               : load_reference(o.reference, [](const std::string& n) { free_param(n); })),
       free(free_params(base, o.free)), noise(noise_options(o.noise)), predict_template(prediction_template(base, o.predict)),
-      walls_prediction(walls_prediction_wanted(base, o)), workers(o.workers),
+      walls_prediction(walls_prediction_wanted(base, o, cell)), workers(o.workers),
       two_fidelity(two_fidelity_wanted(base, o.reference_test, predict_template.has_value())),
-      cell_q(reference_q_measure(base, o, data)) {
-  check_specimen_sizes(base, o, data);
-  take_walled_size(base, o, data);
+      cell_q(reference_q_measure(cell, data)) {
+  check_specimen_sizes(base, cell, data);
+  take_walled_size(cell, data);
   if (two_fidelity) {
     const std::string key = o.predict.empty() ? base.path + ": [calibrate] predict" : "--predict";
     check_template_size(*predict_template, data.tests, key);
@@ -174,7 +175,7 @@ JobPlan JobInputs::announce_plan(const Config& base, const CalibrationOptions& o
   check_folders(o, kind);
   check_resumed_inputs(base, o, kind);
   PlanInput in;
-  in.cell = stored_cell(base, o, data);
+  in.cell = stored_cell(cell, o, data);
   in.materials = by_material(data, o.material);
   in.state_tests = data.tests;
   for (const FreeParam& f : free) in.free.push_back(f.name);
