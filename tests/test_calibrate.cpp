@@ -23,6 +23,7 @@
 #include "host/lab/run_store.hpp"
 #include "host/lab/wall_layer.hpp"
 #include "host/util/forked_runs.hpp"
+#include "host/triax/compression_test.hpp"
 #include "host/triax/periodic_triaxial.hpp"
 #include "test_util.hpp"
 
@@ -402,6 +403,68 @@ TEST(JobPlan, PackingsInTheStoreAreNotCounted) {
   EXPECT_TRUE(said);
   // The work, not the time: the times rest on the probe's speed, which a busy machine moves between the two plans.
   EXPECT_LT(after.particle_steps(), before.particle_steps());
+}
+
+// A compression test's holds (its consolidation and each increment held to rest) take HoldChecks' range of
+// convergence checks, measured on the cells run_cost.hpp names; here the tiny cell, none of those, on three seeds and
+// both paths, loading and unloading as the compression command's default targets. A test whose holds take more
+// checks than the plan's upper end, or fewer than its lower, fails.
+TEST(RunCost, ACompressionTestsHoldsTakeThePlansRange) {
+  Config cfg = test::tiny_cell_config();
+  const CellCost cost = measure_cell_cost(cfg, 0.01);
+  const Real s = cfg.periodic.triax.sigma3;
+  const std::vector<Real> targets = {2 * s, 4 * s, 8 * s, 4 * s, 2 * s};
+  for (const CompressionPath path : {CompressionPath::oedometer, CompressionPath::isotropic})
+    for (unsigned seed = 1; seed <= 3; ++seed) {
+      cfg.run.seed = seed;
+      std::vector<BallSpec> balls;
+      std::array<Real, 3> cell{};
+      prepare_periodic_specimen(cfg, balls, cell, false);
+      auto sim = make_periodic_simulation(balls, cell, cfg.ball, cfg.solver, CellBoundary::periodic);
+      PeriodicTriaxialParams p = cfg.periodic.triax;
+      p.verbose = false;
+      long steps = 0;
+      for (const StageTiming& t : run_compression_test(*sim, p, path, targets).stages) steps += t.steps;
+      EXPECT_GE(steps, cost.compression_steps(targets.size(), false)) << path_name(path) << ", seed " << seed;
+      EXPECT_LE(steps, cost.compression_steps(targets.size())) << path_name(path) << ", seed " << seed;
+    }
+}
+
+// A calibration with compression tests (--compression) prices them with their material: each test on every scatter
+// specimen at the base, then on the ensemble at each point and at the answer, at the compression test's own steps.
+// Left out (as the plan once did, saying so in a line of its own), the stage is missing and the total is the same.
+TEST(JobPlan, ACalibrationsCompressionTestsArePricedWithTheirMaterial) {
+  Config cfg = test::tiny_cell_config();
+  cfg.calibrate.scatter_specimens = 4;
+  cfg.calibrate.ensemble = 2;
+  TriaxialTest t;
+  t.sigma3 = 100e3;
+  t.specimen_balls = 100;  // the cell's own: no check cells to plan
+  PlanInput in;
+  in.cell = cfg;
+  t.material = "A";
+  in.materials["A"] = {t};
+  t.material = "B";
+  in.materials["B"] = {t};
+  in.free = {"mu_s", "emod_Pa"};
+  const JobPlan without = plan_job(in);
+  CompressionTest oedometer{"A", CompressionPath::oedometer, 100e3, {200e3, 400e3, 800e3}, {}, {}, {}, {}};
+  in.compression = {oedometer, oedometer};
+  const JobPlan with = plan_job(in);
+  const auto stage = [&](const std::string& name) {
+    for (const PlanStage& p : with.stages)
+      if (p.name == name) return p;
+    return PlanStage();
+  };
+  const PlanStage a = stage("A: compression tests");
+  EXPECT_EQ(stage("B: compression tests").name, "") << "B has no compression tests";
+  const long points = planned_points(2);
+  EXPECT_EQ(a.work.find("2 tests x (4 specimens at the base + " + std::to_string(points) +
+                        " points and the answer x 2 specimens) of 100 balls"), 0u) << a.work;
+  const CellCost cost = measure_cell_cost(cfg, 0.01);
+  EXPECT_DOUBLE_EQ(a.particle_steps, 2.0 * (4 + (points + 1) * 2) * static_cast<double>(cost.compression_steps(3)) * 100);
+  EXPECT_NEAR(with.particle_steps() - without.particle_steps(), a.particle_steps, 1e-6 * a.particle_steps);
+  EXPECT_GT(a.high, 0);
 }
 
 // A diagnosis plans the runs of the extensions it will try, which are its law's: hertz_overlap and roughness extend

@@ -3,6 +3,7 @@
 
 #include "host/cli/job.hpp"
 #include "host/io/io_hdf5.hpp"
+#include "host/lab/run_cost.hpp"
 #include "host/triax/compression_test.hpp"
 #include "host/triax/periodic_triaxial.hpp"
 #include "host/util/progress.hpp"
@@ -18,10 +19,10 @@ int compression_job(const Config& cfg, const std::string& path_name_in, const st
   for (double k : targets_kpa) targets.push_back(1e3 * k);
   if (targets.empty())
     for (Real f : {2, 4, 8, 4, 2}) targets.push_back(f * tp.sigma3);
-  std::printf("compression: plan: %ld balls in %s, a packing, consolidation to %.4g kPa, then %zu %s increments to "
-              "rest (each about a consolidation's steps; progress lines to each one's step cap)\n",
-              cfg.particles.count, cell_name(cfg.periodic.boundary), 1e-3 * tp.sigma3, targets.size(),
-              dem::path_name(path));
+  const CellCost cost = measure_cell_cost(cfg);
+  print_cell_plan(cfg, "compression", std::to_string(targets.size()) + " " + dem::path_name(path) +
+                  " increments in " + cell_name(cfg.periodic.boundary) + ", each held to rest", cost,
+                  cost.compression_steps(targets.size(), false), cost.compression_steps(targets.size()));
   std::vector<BallSpec> balls;
   std::array<Real, 3> cell{};
   prepare_periodic_specimen(cfg, balls, cell, true);

@@ -45,6 +45,13 @@ namespace io {
 class Output;
 }
 
+struct CellCost;
+/// A cell job's plan before its packing: `command`'s cell packed (at its preparation friction's cost,
+/// packing_cost_at), consolidated to sigma3 and then `test`, which takes low_steps to high_steps (its consolidation
+/// included), at the speed of `cost`'s probe; the particle-steps and the time on this machine.
+void print_cell_plan(const Config& cfg, const std::string& command, const std::string& test, const CellCost& cost,
+                     long low_steps, long high_steps);
+
 /// A cell job's blow-up: the series so far written, the state saved in the output folder as a snapshot and a
 /// checkpoint of `kind`, and the error with where it was saved on stderr. Returns 2, the jobs' status for it.
 int cell_blowup(io::Output& out, Simulation* sim, const std::string& kind, const Config& cfg, const BlowUp& e);

@@ -15,6 +15,7 @@
 #include "host/triax/summary.hpp"
 #include "host/triax/triaxial.hpp"
 #include "host/util/progress.hpp"
+#include "host/util/text_format.hpp"
 
 namespace dem {
 
@@ -31,26 +32,35 @@ void print_triaxial_plan(const Config& cfg) {
               cost.steps(sigma3) * static_cast<double>(cost.cell.balls), format_duration(cost.seconds(sigma3)).c_str());
 }
 
+}  // namespace
+
+void print_cell_plan(const Config& cfg, const std::string& command, const std::string& test, const CellCost& cost,
+                     long low_steps, long high_steps) {
+  const Real prep = cfg.periodic.prep_mu_s >= 0 ? cfg.periodic.prep_mu_s : cfg.ball.mu_s;
+  const PackingCost at = packing_cost_at(prep);
+  const double packing = static_cast<double>(cost.packing_steps), balls = static_cast<double>(cost.balls);
+  const double step_s = 1e-9 * cost.ns_per_particle_step * balls;
+  const double low = at.low * packing + static_cast<double>(low_steps),
+               high = at.high * packing + static_cast<double>(high_steps);
+  std::printf("%s: plan: %ld balls, a packing (preparation friction %.3g: %.3g to %.3g steps), consolidation to %.0f "
+              "kPa and %s (%ld to %ld steps%s): %.2g to %.2g particle-steps, about %s to %s on this machine\n",
+              command.c_str(), cost.balls, prep, at.low * packing, at.high * packing,
+              cfg.periodic.triax.sigma3 / 1e3, test.c_str(), low_steps, high_steps,
+              cost.resettles() ? ", the balls sliding on without friction: the consolidation settles them again" : "",
+              low * balls, high * balls, format_duration(low * step_s).c_str(), format_duration(high * step_s).c_str());
+}
+
+namespace {
+
 /// The same for a cell's test: its packing (at its preparation friction's cost, packing_cost_at), consolidation and
 /// shear, from a probe of its balls. A config the cell test refuses is refused first, with its own words.
 void print_periodic_plan(const Config& cfg) {
   check_periodic_config(cfg);
   const CellCost cost = measure_cell_cost(cfg);
-  const Real prep = cfg.periodic.prep_mu_s >= 0 ? cfg.periodic.prep_mu_s : cfg.ball.mu_s;
-  const PackingCost at = packing_cost_at(prep);
   const Real sigma3 = cfg.periodic.triax.sigma3;
-  const double run_low = static_cast<double>(cost.run_steps(sigma3, false)),
-               run = static_cast<double>(cost.run_steps(sigma3)), packing = static_cast<double>(cost.packing_steps);
-  std::printf("%s: plan: %ld balls, a packing (preparation friction %.3g: %.3g to %.3g steps), consolidation to %.0f "
-              "kPa and shear to %.1f%% axial strain (%.3g to %.3g steps%s): %.2g to %.2g particle-steps, about %s to "
-              "%s on this machine\n",
-              cfg.periodic.boundary == CellBoundary::walls ? "walls" : "periodic", cost.balls, prep, at.low * packing,
-              at.high * packing, sigma3 / 1e3, 100 * cfg.periodic.triax.target_strain, run_low, run,
-              cost.resettles() ? ", the balls sliding on without friction: the consolidation settles them again" : "",
-              (at.low * packing + run_low) * static_cast<double>(cost.balls),
-              (at.high * packing + run) * static_cast<double>(cost.balls),
-              format_duration(at.low * cost.packing_seconds() + cost.run_seconds(sigma3, false)).c_str(),
-              format_duration(at.high * cost.packing_seconds() + cost.run_seconds(sigma3)).c_str());
+  print_cell_plan(cfg, cfg.periodic.boundary == CellBoundary::walls ? "walls" : "periodic",
+                  fmt("shear to %.1f%% axial strain", 100 * cfg.periodic.triax.target_strain), cost,
+                  cost.run_steps(sigma3, false), cost.run_steps(sigma3));
 }
 
 }  // namespace

@@ -292,6 +292,34 @@ struct Planner {
                            predict, predict});
   }
 
+  /// A material's compression tests (--compression), each on every scatter specimen at the base, then on the
+  /// ensemble at every point of the search and at the answer (host/study/calibration_jobs.cpp).
+  void compressions(const std::string& material, long points) {
+    std::vector<CompressionTest> tests;
+    for (const CompressionTest& t : in.compression)
+      if (t.material == material) tests.push_back(t);
+    if (tests.empty()) return;
+    const double T = static_cast<double>(tests.size());
+    double low = 0, high = 0;  // a test's mean steps
+    for (const CompressionTest& t : tests) {
+      low += static_cast<double>(searched.compression_steps(t.stress.size(), false)) / T;
+      high += static_cast<double>(searched.compression_steps(t.stress.size())) / T;
+    }
+    const double step_s = 1e-9 * searched.ns_per_particle_step * static_cast<double>(searched.balls);
+    const auto seconds = [&](double points_n, int k, double steps) {
+      return points_n * searched.seconds_of(T * k, steps * step_s, in.at_once);
+    };
+    const double at = static_cast<double>(points + 1);  // the search's points and the answer
+    plan.stages.push_back(
+        {material + ": compression tests",
+         std::to_string(tests.size()) + " tests x (" + std::to_string(S) + " specimens at the base + " +
+             std::to_string(points) +
+             " points and the answer x " + (auto_ensemble ? "1 to " + std::to_string(K) : std::to_string(K)) +
+             " specimens) of " + n + " balls, a hold a load step",
+         "--compression", T * (S + at * K) * high * static_cast<double>(searched.balls),
+         seconds(1, S, low) + seconds(at, K_low, low), seconds(1, S, high) + seconds(at, K, high)});
+  }
+
   /// A material's stages: its scatter runs, the cell's bias check, the search, and what predicts.
   void material(const std::string& material, const std::vector<TriaxialTest>& tests) {
     const std::string T = std::to_string(tests.size());
@@ -312,6 +340,7 @@ struct Planner {
              one ? "[calibrate] method" : auto_ensemble ? "[calibrate] ensemble (auto)" : "[calibrate] ensemble",
              searched, tests, static_cast<double>(points - tried * 6), one ? 1 : K_low, one ? 1 : K, search_what);
     if (in.diagnose) extension_points(tests);
+    if (!in.diagnose) compressions(material, points);
     if (!in.diagnose && !in.two_fidelity)
       add.runs(material + ": scatter at the calibrated point", "[calibrate] scatter_specimens", searched, tests, 1, S, S,
                std::to_string(S * static_cast<int>(tests.size())) + " runs of " + n + " balls (" + std::to_string(S) +

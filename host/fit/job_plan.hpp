@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "host/config/config.hpp"
+#include "host/data/compression_data.hpp"
 #include "host/data/measured.hpp"
 
 namespace dem {
@@ -51,6 +52,7 @@ struct PlanInput {
   int at_once = 1;                   ///< simulator runs at once
   std::vector<TriaxialTest> held_out;  ///< tests left out of the fit and predicted (--hold-out)
   std::vector<std::string> reference_runs;  ///< materials whose reference point (--reference) is run after the fit
+  std::vector<CompressionTest> compression;  ///< --compression's tests, fitted with their material's triaxial tests
 };
 
 /// The plan of a job; measures the engine's speed on the cells it will run (about a second).

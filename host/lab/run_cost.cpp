@@ -25,10 +25,18 @@ long CellCost::shear_steps(Real sigma3) const {
   return shear_step_count(triax.target_strain, axial_rate(triax, d, rho_eff, sigma3), dt);
 }
 
+long CellCost::settling_steps(bool high) const {
+  return resettles() ? static_cast<long>((high ? ResettleCost::high : ResettleCost::low) * packing_steps) : 0;
+}
+
 long CellCost::consolidation_steps(Real sigma3, bool high) const {
-  const Real share = kConsolidationShare * static_cast<Real>(shear_steps(sigma3));
-  const Real settle = resettles() ? (high ? ResettleCost::high : ResettleCost::low) * packing_steps : 0;
-  return static_cast<long>(share + settle);
+  return static_cast<long>(kConsolidationShare * static_cast<Real>(shear_steps(sigma3))) + settling_steps(high);
+}
+
+long CellCost::compression_steps(std::size_t increments, bool high) const {
+  const Real holds = static_cast<Real>(increments + 1) * (high ? HoldChecks::high : HoldChecks::low) *
+                     static_cast<Real>(triax.check_every);
+  return static_cast<long>(holds) + settling_steps(high);
 }
 
 namespace {

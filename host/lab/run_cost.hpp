@@ -42,6 +42,15 @@ constexpr Real kSlidingFriction = 0.0075;
 struct ResettleCost {
   static constexpr Real low = 0.5, high = 20.0;
 };
+/// A compression test's holds (its consolidation to the seating stress and each increment, host/triax/
+/// compression_test.hpp) in the cell's convergence checks ([periodic] check_every steps apart), the range of the cells
+/// measured: each hold converges in 2 to 7 checks (3 December, oedometer and isotropic, sigma3 2, 4, 8, 4, 2 times 100
+/// kPa: the 120-ball hidden-effect cell at emod 1e8, 1e9 and 1e10, the 200-ball calibration base and the 1,000-ball S-1
+/// cell; a test's six holds 17 to 25 checks, 2.8 to 4.2 a hold). A plan counts a test's mean hold at the ends below.
+struct HoldChecks {
+  static constexpr Real low = 2, high = 5;
+};
+
 /// Contact pairs a ball of a random packing has (4.5, docs/performance.md) over the probe lattice's 3: the probe's
 /// speed is scaled by it.
 constexpr Real kPairsOverLattice = 1.5;
@@ -70,6 +79,11 @@ struct CellCost {
   double run_seconds(Real sigma3, bool high = true) const {
     return 1e-9 * ns_per_particle_step * balls * run_steps(sigma3, high);
   }
+  /// Steps of a packing's settling again in a run's consolidation (below kSlidingFriction; else 0).
+  long settling_steps(bool high = true) const;
+  /// Steps of one compression test with `increments` increments: a hold each and the consolidation's (HoldChecks),
+  /// and below kSlidingFriction a packing's settling again.
+  long compression_steps(std::size_t increments, bool high = true) const;
   /// Whether a run's consolidation settles its packing again (mu_s below kSlidingFriction): its steps are a range.
   bool resettles() const { return mu_s < kSlidingFriction; }
   double packing_seconds() const { return 1e-9 * ns_per_particle_step * balls * packing_steps; }

@@ -185,16 +185,13 @@ JobPlan JobInputs::announce_plan(const Config& base, const CalibrationOptions& o
   in.walls = walls_prediction;
   in.at_once = runs_at_once(o.workers);
   in.held_out = held_out;
+  in.compression = compression;
   if (kind == "calibrate")
     for (const auto& m : in.materials)
       if (runs_reference(m.first)) in.reference_runs.push_back(m.first);
   JobPlan plan = plan_job(in);
   for (const std::string& n : data.notes) std::printf("%s: note: %s\n", kind.c_str(), n.c_str());
   std::printf("%s", plan.text(kind).c_str());
-  if (!compression.empty())
-    std::printf("%s: plus %zu compression test%s (--compression): each on every scatter specimen at the base, then on "
-                "the ensemble at every point, one consolidation an increment; not in the estimate above\n", kind.c_str(),
-                compression.size(), compression.size() == 1 ? "" : "s");
   const bool above_bound = plan.high() > kPlanBoundSeconds, above_ceiling = plan.high() > kPlanCeilingSeconds;
   if ((above_ceiling || (above_bound && !o.yes)) && !o.plan_only) {
     // The cause a user can change: the costliest stage's work and a run's length, beside the setting that sizes it.
