@@ -1,10 +1,8 @@
 #include "host/fit/calibration_report.hpp"
 
-#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <map>
 #include <sstream>
 
 #include "host/util/text_format.hpp"
@@ -99,94 +97,6 @@ std::string reference_text(const CalibrationResult& r, const std::vector<Real>& 
     o += fmt("; run: chi2 %.1f", run_chi2) + fmt(" against the best's %.1f", r.best.chi2) +
          fmt(" (the region's rise: %.1f)", chi2_95(static_cast<int>(r.free.size())) * r.scale * r.region_factor);
   return o + "\n";
-}
-
-/// The noise used, per test and quantity: the median over the test's features of each part.
-std::string noise_table(const Misfit& mf, const std::vector<TriaxialTest>& tests) {
-  std::ostringstream md;
-  md << "Noise (" << mf.source() << "; median standard deviation over each test's data; the simulator's is that of "
-     << "the mean of " << mf.members() << " specimens"
-     << (mf.sim_balls() > 0 ? fmt(" of %.0f balls", mf.sim_balls()) : std::string())
-     << "; correlation length along strain " << fmt("%.2f", mf.correlation_length()) << " in ln strain):\n\n| sigma3 kPa | quantity | data | measured specimen | "
-        "simulator mean | simulator cell |\n|---|---|---|---|---|---|\n";
-  for (std::size_t k = 0; k < mf.tests(); ++k) {
-    std::map<std::string, std::vector<std::array<Real, 4>>> by;
-    for (const Feature& f : mf.features(k)) {
-      const std::string q = f.strain > 0 ? quantity_group(f) + (f.quantity == 0 ? " (kPa)" : " (%)") : f.name;
-      const Real u = feature_unit(f, 1).first;
-      by[q].push_back({u * f.data_sd, u * f.specimen_sd, u * f.ensemble_sd / std::sqrt(Real(mf.members())), u * f.cell_sd});
-    }
-    for (auto& [q, v] : by) {
-      md << "| " << fmt("%g", 1e-3 * tests[k].sigma3) << " | " << q;
-      for (int c = 0; c < 4; ++c) {
-        std::vector<Real> x;
-        for (const auto& a : v) x.push_back(a[c]);
-        std::nth_element(x.begin(), x.begin() + x.size() / 2, x.end());
-        md << " | " << fmt("%.3g", x[x.size() / 2]);
-      }
-      md << " |\n";
-    }
-  }
-  md << "\n";
-  for (const std::string& n : mf.notes()) md << "- " << n << "\n";
-  return md.str() + "\n";
-}
-
-/// The gain in markdown: chi2 of the base and the extended model by pressure, by strain range and by quantity,
-/// then every datum. Strain ranges: small (up to 0.2%), hardening (to 3%), large (beyond); summary data: E_ini
-/// and q at 1% small, q at 3%, the peak and its strain hardening, q_end and dilatancy large.
-std::string gain_tables(const Misfit& mf, const std::vector<TriaxialTest>& tests, const Evaluation& base,
-                        const Evaluation& ext, const std::string& name) {
-  static const char* range_of[kQuantities] = {"small strain", "small strain", "hardening", "hardening",
-                                              "hardening", "large strain", "large strain"};
-  using Groups = std::vector<std::pair<std::string, std::pair<Real, Real>>>;  // in the order first met
-  Groups by_pressure, by_range, by_quantity;
-  auto at = [](Groups& g, const std::string& key) -> std::pair<Real, Real>& {
-    for (auto& [k, v] : g)
-      if (k == key) return v;
-    return g.emplace_back(key, std::pair<Real, Real>{0, 0}).second;
-  };
-  std::ostringstream rows;
-  std::size_t first = 0;
-  for (std::size_t k = 0; k < mf.tests(); ++k) {
-    const std::vector<Real> b = mf.mean_values(k, {base.sim[k]}), e = mf.mean_values(k, {ext.sim[k]});
-    const std::string p = fmt("%g kPa", 1e-3 * tests[k].sigma3);
-    for (std::size_t i = 0; i < mf.features(k).size(); ++i) {
-      const Feature& f = mf.features(k)[i];
-      const Real cb = base.r[first + i] * base.r[first + i], ce = ext.r[first + i] * ext.r[first + i];
-      const bool summary = f.strain == 0;
-      const std::string range = summary ? range_of[f.quantity]
-                                        : f.strain <= 0.002 ? "small strain" : f.strain <= 0.03 ? "hardening"
-                                                                                                 : "large strain";
-      const std::string quantity = summary ? f.name : f.quantity == 0 ? "q" : "eps_v";
-      for (auto* t : {&by_pressure, &by_range, &by_quantity}) {
-        const std::string key = t == &by_pressure ? p : t == &by_range ? range : quantity;
-        at(*t, key).first += cb;
-        at(*t, key).second += ce;
-      }
-      const Real s = mf.sd(k, i);
-      const auto u = feature_unit(f, f.measured);
-      rows << "| " << fmt("%g", 1e-3 * tests[k].sigma3) << " | " << f.name << " | " << u.second << " | "
-           << fmt("%.4g", u.first) << " | " << fmt("%.4g", feature_unit(f, b[i]).first) << " | "
-           << fmt("%+.1f", (b[i] - f.measured) / s) << " | " << fmt("%.4g", feature_unit(f, e[i]).first) << " | "
-           << fmt("%+.1f", (e[i] - f.measured) / s) << " |\n";
-    }
-    first += mf.features(k).size();
-  }
-  std::ostringstream md;
-  md << "\nMisfit (chi2) of the base model and of the base + " << name
-     << " model, from the whitened residuals (each datum counts what it says beyond those before it in the "
-        "test, q before eps_v, small strain first), so that the groups add up to chi2:\n\n"
-        "| by | group | base | + " << name
-     << " |\n|---|---|---|---|\n";
-  for (const auto& [what, table] : {std::make_pair("pressure", &by_pressure), std::make_pair("strain range", &by_range),
-                                    std::make_pair("quantity", &by_quantity)})
-    for (const auto& [key, c] : *table)
-      md << "| " << what << " | " << key << " | " << fmt("%.1f", c.first) << " | " << fmt("%.1f", c.second) << " |\n";
-  md << "\nEvery datum (plain residual in units of its whole noise, (simulated - measured) / s):\n\n| sigma3 kPa | "
-        "datum | unit | measured | base | residual | + " << name << " | residual |\n|---|---|---|---|---|---|---|---|\n"
-     << rows.str();
-  return md.str();
 }
 
 }  // namespace dem

@@ -1,6 +1,7 @@
 #pragma once
 /// The tables of `triaxdem calibrate` and `diagnose`: errors per test (like the paper's Table 6), calibrated values
-/// with their intervals, the noise used, and the gain of an extension. They read only the results they are handed.
+/// with their intervals and a reference point's place. They read only the results they are handed; the diagnosis's
+/// own tables (the noise used, an extension's gain) are its report's (host/study/diagnosis_report.cpp).
 #include <string>
 #include <vector>
 
@@ -21,10 +22,5 @@ std::string uncertainty_text(const CalibrationResult& r, const std::string& mate
 /// region's (at most 1 inside), and, where the point was run (`run_chi2` finite), its chi2 beside the best's.
 std::string reference_text(const CalibrationResult& r, const std::vector<Real>& reference, Real run_chi2,
                            const std::string& material, const std::string& job);
-/// The noise used, per test and quantity (markdown).
-std::string noise_table(const Misfit& mf, const std::vector<TriaxialTest>& tests);
-/// The gain of an extension over the base by pressure, strain range and quantity, then every datum (markdown).
-std::string gain_tables(const Misfit& mf, const std::vector<TriaxialTest>& tests, const Evaluation& base,
-                        const Evaluation& ext, const std::string& name);
 
 }  // namespace dem

@@ -123,23 +123,6 @@ Config Session::matched(const Config& base, int workers) {
   return matched_state(base, data.tests, state, true, match_plan(base, workers));
 }
 
-std::string Session::state_text(const Misfit& m, const std::vector<TriaxialTest>& tests) const {
-  if (state.tests == 0)
-    return "The data give no void ratio: the simulator's specimens have the density their preparation gives (" +
-           fmt("e = %.3f", lab.prepared_void_ratio(0)) + " for the first), and the calibrated friction absorbs "
-           "any difference in density.\n";
-  std::string s = "The simulator's specimens were prepared to the data's void ratio " + fmt("%.4f", state.target) +
-                  " (preparation friction " + fmt("%.4g", state.prep_mu_s) + ", which packs " +
-                  fmt("%.4f", state.reached) +
-                  fmt(" on the mean of its first %.0f", static_cast<double>(state.specimens)) +
-                  "). At the start of shear, measured and simulated (mean of the scatter specimens at the base "
-                  "model):";
-  for (std::size_t k = 0; k < tests.size(); ++k)
-    s += fmt(" %g kPa", 1e-3 * tests[k].sigma3) + fmt(" %.4f", tests[k].void_ratio) +
-         fmt(" against %.4f;", m.reached_void_ratio(k));
-  return s + "\n";
-}
-
 Misfit Session::misfit_of(const Config& base, const std::string& material, const std::vector<TriaxialTest>& tests) {
   std::printf("%s: %s: measuring the simulator's scatter: %d specimens of %zu balls at the base model\n",
               folder.c_str(), material.c_str(), lab.specimens(), lab.balls());

@@ -130,8 +130,6 @@ struct Session : JobInputs {
   /// The membrane runs made, by the free parameters' values and the test (material, sigma3).
   mutable std::map<std::string, Prediction> membrane_runs;
   Config matched(const Config& base, int workers);
-  /// The report's line on the specimens' state.
-  std::string state_text(const Misfit& m, const std::vector<TriaxialTest>& tests) const;
   /// The misfit of a material's tests: the ensemble run at the base model, its scatter beside the data's noise.
   Misfit misfit_of(const Config& base, const std::string& material, const std::vector<TriaxialTest>& tests);
   /// The reference value of a parameter for a material, in the key's unit; NaN when there is none.
