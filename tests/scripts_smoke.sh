@@ -227,6 +227,10 @@ if [ "$part" != tools ]; then
   check perf/inertial_scan "$build/perf/inertial_scan" --config "$base" --specimens 2 --pressures 100 \
     --inertial 1e-3,4e-3 -j 1 -o "$work/inertial.csv"
   exists "$work/inertial.csv"
+  check perf/inertial_scan_preparation "$build/perf/inertial_scan" --config "$base" --specimens 2 --pressures 100 \
+    --preparation-emod 1e8,2e8 -j 1 -o "$work/preparation.csv"
+  grep -q "^2e+08,100,q,0," "$work/preparation.csv" ||
+    { cat "$work/preparation.csv"; echo "scripts_smoke: the preparation scan has no peak row" >&2; exit 1; }
 fi
 
 # Every script and perf program has its line above, in one part or the other.
