@@ -242,6 +242,15 @@ TEST(CliEdges, TheCompressionJobWritesARowPerIncrement) {
   const Outcome bad = triaxdem("compression " + cell + " --test triaxial -o " + (dir / "bad").string(), dir);
   EXPECT_NE(bad.code, 0);
   EXPECT_NE(bad.output.find("oedometer"), std::string::npos) << bad.output;
+  // diagnose takes them beside the material's triaxial tests (here three peaks), and its plan prices them.
+  std::ofstream(dir / "peaks.csv") << "material,sigma3_kPa,q_peak_kPa\nhidden-effect tests,100,150\n"
+                                      "hidden-effect tests,200,290\nhidden-effect tests,300,420\n";
+  const Outcome diagnosis = triaxdem("diagnose " + (dir / "peaks.csv").string() + " --config " + cell +
+                                     " --free emod_Pa,mu_s --predict none --compression " +
+                                     (dir / "run" / "compression_data.csv").string() + " --plan -o " +
+                                     (dir / "diagnose").string(), dir);
+  EXPECT_EQ(diagnosis.code, 0) << diagnosis.output;
+  EXPECT_NE(diagnosis.output.find("hidden-effect tests: compression tests"), std::string::npos) << diagnosis.output;
 }
 
 // A specimen whose layer the step cap stopped before it came to rest warned and went on (exit 0): it is refused,

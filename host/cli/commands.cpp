@@ -179,6 +179,10 @@ void calibration_options(CLI::App* cmd, Args& a) {
                 "how long on this machine) and stop before any packing");
   cmd->add_flag("--yes", a.cal.yes, "run a plan longer than 4 hours (without it such a job is refused, naming the "
                 "setting that costs most)");
+  cmd->add_option("--compression", a.cal.compression, "a CSV of oedometer or isotropic compression tests (a test_type "
+                  "column; docs/calibration.md) fitted with the triaxial data of their material: the strain at each "
+                  "load pins the contact stiffness")
+      ->check(CLI::ExistingFile);
 }
 
 void calibrate_options(CLI::App* cmd, Args& a) {
@@ -186,10 +190,6 @@ void calibrate_options(CLI::App* cmd, Args& a) {
   cmd->add_option("--hold-out", a.cal.hold_out_kPa, "a confining pressure (kPa) of the data whose tests the fit "
                   "leaves out and the prediction predicts: the transfer to a pressure it never saw")
       ->check(pressure_kpa());
-  cmd->add_option("--compression", a.cal.compression, "a CSV of oedometer or isotropic compression tests (a test_type "
-                  "column; docs/calibration.md) fitted with the triaxial data of their material: the strain at each "
-                  "load pins the contact stiffness")
-      ->check(CLI::ExistingFile);
 }
 
 void synth_options(CLI::App* cmd, Args& a) {

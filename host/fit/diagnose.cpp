@@ -74,6 +74,16 @@ struct FitContext {
   const std::vector<TriaxialTest>& measured;
   const Misfit& misfit;
   const std::function<void()>& report;  ///< a progress line after each batch of runs
+  const JointTerm& joint;               ///< the material's other tests, fitted beside the triaxial ones
+  /// The residuals of an ensemble run at m: the triaxial tests', then the joint tests' at m.
+  std::vector<Real> residuals(const Model& m, const Ensemble& e) const {
+    std::vector<Real> r = misfit.residuals(e);
+    if (joint.residuals) {
+      const std::vector<Real> more = joint.residuals(m);
+      r.insert(r.end(), more.begin(), more.end());
+    }
+    return r;
+  }
 };
 
 /// One extension fitted jointly with the base parameters: its effect measured at the base optimum strength by
@@ -91,7 +101,7 @@ ExtensionFit fit_extension(const Extension& e, const FitContext& cx, Evaluation&
   for (Real level : e.levels) {
     Model m = cx.base.model;
     set_param(m, e.param, level);
-    const std::vector<Real> r = cx.misfit.residuals(lab.run_ensemble(m, cx.measured));
+    const std::vector<Real> r = cx.residuals(m, lab.run_ensemble(m, cx.measured));
     cx.report();
     std::vector<Real> diff(r.size());
     for (std::size_t i = 0; i < r.size(); ++i) diff[i] = r[i] - cx.base.best.r[i];
@@ -125,9 +135,10 @@ ExtensionFit fit_extension(const Extension& e, const FitContext& cx, Evaluation&
     const std::vector<Real> predicted = joint(u);
     Evaluation ev;
     ev.u.assign(u.begin(), u.begin() + d);
-    const Ensemble ens = lab.run_ensemble(model_at(u), cx.measured);
+    const Model at = model_at(u);
+    const Ensemble ens = lab.run_ensemble(at, cx.measured);
     for (const auto& members : ens) ev.sim.push_back(mean_curve(members));
-    ev.r = cx.misfit.residuals(ens);
+    ev.r = cx.residuals(at, ens);
     ev.chi2 = sum_sq(ev.r);
     cx.report();
     if (strength_at(e, strength_coordinate(e, u[d])) == 0 && ev.chi2 < base_runs.chi2) base_runs = ev;
@@ -163,7 +174,8 @@ void fall_back_to_base(Diagnosis& dg, int d, int n) {
 }  // namespace
 
 Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free0,
-                   const std::vector<TriaxialTest>& measured, const Misfit& misfit, bool verbose) {
+                   const std::vector<TriaxialTest>& measured, const Misfit& misfit, bool verbose,
+                   const JointTerm& joint) {
   Diagnosis dg;
   const int d = static_cast<int>(free0.size());
   auto say = [&](const char* fmt, auto... a) {
@@ -184,7 +196,8 @@ Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreePa
     std::snprintf(extra, sizeof extra, "runs, best base chi2 %.1f", chi2);
     progress.update(std::min(lab.runs() - runs0, planned), extra);
   };
-  dg.base = calibrate(lab, base, free0, measured, misfit, 4, [&](long, long, Real chi2) { report(best_chi2 = chi2); });
+  dg.base = calibrate(lab, base, free0, measured, misfit, 4, [&](long, long, Real chi2) { report(best_chi2 = chi2); },
+                      2, joint);
   const std::vector<FreeParam>& free = dg.base.free;  // the ranges as the calibration left them
   const int n = dg.base.data;
   dg.chi2_limit = n > d ? chi2_quantile(n - d, kZ99) : 0;  // no degrees of freedom: any misfit is too much
@@ -210,7 +223,7 @@ Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreePa
 
   Evaluation base_runs = dg.base.best;  // the best run of the base model, also among the extension fits' runs
   const std::function<void()> report_runs = [&] { report(best_chi2); };
-  const FitContext cx{lab, dg.base, base_model, base_at, measured, misfit, report_runs};
+  const FitContext cx{lab, dg.base, base_model, base_at, measured, misfit, report_runs, joint};
   for (const Extension& e : menu) {
     dg.fits.push_back(fit_extension(e, cx, base_runs));
     const ExtensionFit& f = dg.fits.back();

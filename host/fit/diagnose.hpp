@@ -80,9 +80,12 @@ struct Diagnosis {
 /// extension's accepted, specific and reason, and the verdict and explanation; n data, d base parameters.
 void give_verdict(Diagnosis& dg, int n, int d);
 
-/// Runs the diagnosis of `measured` (one material) from `base` with base parameters `free`.
+/// Runs the diagnosis of `measured` (one material) from `base` with base parameters `free`; `joint`'s tests (compression
+/// tests of the material) join every fit's residuals after the triaxial ones, the base's and each extension's, and
+/// count in its data. The held-out check and the generic discrepancies hold out and shape the triaxial tests alone.
 Diagnosis diagnose(PeriodicLab& lab, const Model& base, const std::vector<FreeParam>& free,
-                   const std::vector<TriaxialTest>& measured, const Misfit& misfit, bool verbose);
+                   const std::vector<TriaxialTest>& measured, const Misfit& misfit, bool verbose,
+                   const JointTerm& joint = {});
 
 /// A hidden strength drawn from `seed`: log-uniform between the extension's lowest and highest level.
 Real draw_strength(const Extension& e, unsigned seed);

@@ -55,6 +55,8 @@ class ShapedPoint {
       plain_.push_back(misfit.test_residuals(k, {e.sim[k]}));
       at += n;
     }
+    // Residuals beyond the triaxial tests' (a joint fit's other tests, JointTerm) are no shape's: they count as run.
+    tail_ = sum_sq(e.r, std::min(at, e.r.size()), e.r.size());
   }
   /// Test k's residuals at c: the run's, plus the change the shape makes to its curve.
   std::vector<Real> residuals(std::size_t k, Real c) const {
@@ -68,7 +70,7 @@ class ShapedPoint {
   }
   /// chi2 over the data but the held-out part `skip` (none: all), at c.
   Real chi2(Real c, const HeldOutPart* skip) const {
-    Real s = 0;
+    Real s = tail_;
     for (std::size_t k = 0; k < run_.size(); ++k) {
       const bool held = skip && skip->test == k;
       if (held && skip->local.size() == run_[k].size()) continue;  // a whole test held out
@@ -93,6 +95,7 @@ class ShapedPoint {
   const Misfit& misfit_;
   const GenericShape& shape_;
   std::vector<std::vector<Real>> run_, plain_;
+  Real tail_ = 0;
 };
 
 }  // namespace

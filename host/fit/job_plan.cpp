@@ -293,7 +293,8 @@ struct Planner {
   }
 
   /// A material's compression tests (--compression), each on every scatter specimen at the base, then on the
-  /// ensemble at every point of the search and at the answer (host/study/calibration_jobs.cpp).
+  /// ensemble at every point of the search and at a calibration's answer (host/study/calibration_jobs.cpp); a
+  /// diagnosis's points are its base fit's and its extension fits' (host/fit/diagnose.cpp).
   void compressions(const std::string& material, long points) {
     std::vector<CompressionTest> tests;
     for (const CompressionTest& t : in.compression)
@@ -309,12 +310,12 @@ struct Planner {
     const auto seconds = [&](double points_n, int k, double steps) {
       return points_n * searched.seconds_of(T * k, steps * step_s, in.at_once);
     };
-    const double at = static_cast<double>(points + 1);  // the search's points and the answer
+    const double at = static_cast<double>(points + (in.diagnose ? 0 : 1));  // the points, and a calibration's answer
     plan.stages.push_back(
         {material + ": compression tests",
          std::to_string(tests.size()) + " tests x (" + std::to_string(S) + " specimens at the base + " +
-             std::to_string(points) +
-             " points and the answer x " + (auto_ensemble ? "1 to " + std::to_string(K) : std::to_string(K)) +
+             std::to_string(points) + (in.diagnose ? " points x " : " points and the answer x ") +
+             (auto_ensemble ? "1 to " + std::to_string(K) : std::to_string(K)) +
              " specimens) of " + n + " balls, a hold a load step",
          "--compression", T * (S + at * K) * high * static_cast<double>(searched.balls),
          seconds(1, S, low) + seconds(at, K_low, low), seconds(1, S, high) + seconds(at, K, high)});
@@ -340,7 +341,7 @@ struct Planner {
              one ? "[calibrate] method" : auto_ensemble ? "[calibrate] ensemble (auto)" : "[calibrate] ensemble",
              searched, tests, static_cast<double>(points - tried * 6), one ? 1 : K_low, one ? 1 : K, search_what);
     if (in.diagnose) extension_points(tests);
-    if (!in.diagnose) compressions(material, points);
+    compressions(material, points);
     if (!in.diagnose && !in.two_fidelity)
       add.runs(material + ": scatter at the calibrated point", "[calibrate] scatter_specimens", searched, tests, 1, S, S,
                std::to_string(S * static_cast<int>(tests.size())) + " runs of " + n + " balls (" + std::to_string(S) +

@@ -112,6 +112,24 @@ CalibrationResult two_fidelity_fit(Session& ss, const Config& base, const std::s
   return rounds.last();
 }
 
+/// The misfit of the material's compression tests (--compression), their scatter run at the base on every scatter
+/// specimen; none without such tests. `kind`: the job, for its lines.
+std::optional<CompressionMisfit> compression_misfit(Session& ss, const Config& base, const std::string& material,
+                                                    const std::string& kind) {
+  const std::vector<CompressionTest> tests = ss.compression_of(material);
+  if (tests.empty()) return std::nullopt;
+  const long start = ss.lab.runs();
+  Progress progress(kind + " " + material + ": the compression tests' scatter at the base",
+                    static_cast<long>(tests.size()) * ss.lab.specimens());
+  CompressionMisfit m(tests, ss.lab.run_compressions(model_of(base), tests, true), ss.lab.members());
+  progress.finish(std::to_string(ss.lab.runs() - start) + " runs");
+  std::printf("%s: %s: %zu compression test%s fitted with the triaxial ones: %d data (strain increments%s)\n",
+              kind.c_str(), material.c_str(), tests.size(), tests.size() == 1 ? "" : "s", m.data(),
+              std::any_of(tests.begin(), tests.end(), [](const CompressionTest& t) { return !t.k0.empty(); })
+                  ? " and K0" : "");
+  return m;
+}
+
 /// What a job does with each material's tests: the calibration's fit, or the diagnosis. The loop over the
 /// materials, the account of the runs, the prediction and the pools are the job's (run_materials), one for both.
 class MaterialWork {
@@ -165,7 +183,7 @@ class CalibrationWork : public MaterialWork {
   Calibrated fit(const std::string& material, const std::vector<TriaxialTest>& tests, const Misfit& misfit) override {
     Session& ss = ss_;
     const long runs0 = ss.lab.runs();
-    const std::optional<CompressionMisfit> compression = compression_misfit(material);
+    const std::optional<CompressionMisfit> compression = compression_misfit(ss, base_, material, "calibrate");
     const JointTerm joint = compression ? compression->joint(ss.lab) : JointTerm{};
     auto fit = [&](const Misfit& m, const std::string& what) {
       const long start = ss.lab.runs();
@@ -243,23 +261,6 @@ class CalibrationWork : public MaterialWork {
   std::ostringstream table_;
   std::string compression_table_;  ///< compression_fit.csv: every material's compression tests at its answer
 
-  /// The misfit of the material's compression tests, their scatter run at the base on every scatter specimen; none
-  /// without such tests.
-  std::optional<CompressionMisfit> compression_misfit(const std::string& material) {
-    const std::vector<CompressionTest> tests = ss_.compression_of(material);
-    if (tests.empty()) return std::nullopt;
-    const long start = ss_.lab.runs();
-    Progress progress("calibrate " + material + ": the compression tests' scatter at the base",
-                      static_cast<long>(tests.size()) * ss_.lab.specimens());
-    CompressionMisfit m(tests, ss_.lab.run_compressions(model_of(base_), tests, true), ss_.lab.members());
-    progress.finish(std::to_string(ss_.lab.runs() - start) + " runs");
-    std::printf("calibrate: %s: %zu compression test%s fitted with the triaxial ones: %d data (strain increments%s)\n",
-                material.c_str(), tests.size(), tests.size() == 1 ? "" : "s", m.data(),
-                std::any_of(tests.begin(), tests.end(), [](const CompressionTest& t) { return !t.k0.empty(); })
-                    ? " and K0" : "");
-    return m;
-  }
-
   /// The compression tests at the answer, printed and kept in compression_fit.csv.
   void compression_fit(const std::string& material, const CompressionMisfit& m, const Model& at) {
     const CompressionEnsemble sim = ss_.lab.run_compressions(at, m.measured());
@@ -285,7 +286,9 @@ class DiagnosisWork : public MaterialWork {
   }
 
   Calibrated fit(const std::string& material, const std::vector<TriaxialTest>& tests, const Misfit& misfit) override {
-    const Diagnosis dg = diagnose(ss_.lab, model_of(base_), ss_.free, tests, misfit, true);
+    const std::optional<CompressionMisfit> compression = compression_misfit(ss_, base_, material, "diagnose");
+    const Diagnosis dg = diagnose(ss_.lab, model_of(base_), ss_.free, tests, misfit, true,
+                                  compression ? compression->joint(ss_.lab) : JointTerm{});
     require_a_result(dg.base, "diagnose " + material + " (the base model's search)", ss_);
     std::printf("diagnose: %s: verdict: %s\n  %s\n", material.c_str(), dg.verdict.c_str(), dg.explanation.c_str());
     std::printf("%s", uncertainty_text(dg.base, material, "diagnose").c_str());

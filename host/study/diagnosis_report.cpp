@@ -100,6 +100,10 @@ std::string gain_tables(const Misfit& mf, const std::vector<TriaxialTest>& tests
     }
     first += mf.features(k).size();
   }
+  if (base.r.size() > first) {  // a joint fit's compression tests (JointTerm), after the triaxial data
+    const std::pair<Real, Real> c{sum_sq(base.r, first, base.r.size()), sum_sq(ext.r, first, ext.r.size())};
+    for (auto* t : {&by_pressure, &by_range, &by_quantity}) at(*t, "compression tests") = c;
+  }
   std::ostringstream md;
   md << "\nMisfit (chi2) of the base model and of the base + " << name
      << " model, from the whitened residuals (each datum counts what it says beyond those before it in the "
