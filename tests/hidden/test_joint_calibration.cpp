@@ -21,6 +21,42 @@ void print(const char* what, const CalibrationResult& r) {
               r.best.chi2, r.data);
 }
 
+/// The data of the tests below: the generator (the hidden-effect cell at emod 2e8 Pa, mu_s 0.25) on four foreign
+/// specimens packed from `first_seed`: three triaxial tests (100-300 kPa, lab-like noise drawn from `noise_seed`) on
+/// the first three, an oedometer from 100 to 800 kPa on the fourth.
+struct JointData {
+  std::vector<TriaxialTest> triaxial;
+  std::vector<CompressionTest> oedometer;
+};
+
+JointData joint_data(const Config& cfg, unsigned first_seed, unsigned noise_seed) {
+  Model truth = model_of(cfg);
+  set_param(truth, "emod_Pa", 2e8);
+  set_param(truth, "mu_s", 0.25);
+  PeriodicLab generator(cfg, false, 4, first_seed, 0, 2);
+  JointData d;
+  d.triaxial = synthetic_tests(generator, truth, {100e3, 200e3, 300e3}, "joint", noise_seed, 1);
+  const CompressionTest like{"joint", CompressionPath::oedometer, 100e3, {200e3, 400e3, 800e3}, {}, {}, {}, {}};
+  d.oedometer.push_back(generator.run_compression(truth, like, 3));
+  return d;
+}
+
+/// The analyser of such data: the base's lab (its own specimens), emod and mu_s free, the misfit of the triaxial tests
+/// and the oedometer's, each scatter measured at the base.
+struct JointAnalysis {
+  JointAnalysis(const Config& cfg, const JointData& d)
+      : lab(cfg, false, 2),
+        base(model_of(cfg)),
+        free{free_param("emod_Pa", base), free_param("mu_s", base)},
+        misfit(measure_misfit(lab, base, d.triaxial, NoiseOptions(), false)),
+        compression(d.oedometer, lab.run_compressions(base, d.oedometer, true), lab.members()) {}
+  PeriodicLab lab;
+  Model base;
+  std::vector<FreeParam> free;
+  Misfit misfit;
+  CompressionMisfit compression;
+};
+
 }  // namespace
 
 // The generator: tests/data/hidden_effects.toml's cell (120 balls) at emod 2e8 Pa and mu_s 0.25, twice the base's
@@ -38,30 +74,21 @@ void print(const char* what, const CalibrationResult& r) {
 // peaks of specimens this small; this test asks for the oedometer's pin and an answer at one fixed draw.
 TEST(JointCalibration, AnOedometerWithTriaxialPeaksRecoversTheStiffnessAndTheFriction) {
   const Config cfg = load_config(std::string(TRIAXDEM_SOURCE_DIR) + "/tests/data/hidden_effects.toml");
-  Model truth = model_of(cfg);
-  set_param(truth, "emod_Pa", 2e8);
-  set_param(truth, "mu_s", 0.25);
-  std::vector<TriaxialTest> peaks;
-  std::vector<CompressionTest> oedometer;
-  {  // Four foreign specimens: the triaxial tests on the first three, the oedometer on the fourth.
-    PeriodicLab generator(cfg, false, 4, cfg.run.seed + kForeignSeedOffset, 0, 2);
-    for (const TriaxialTest& t : synthetic_tests(generator, truth, {100e3, 200e3, 300e3}, "joint", 1, 1)) {
-      TriaxialTest p;
-      p.material = t.material, p.sigma3 = t.sigma3, p.q_peak = t.q_peak;
-      p.eps_a_peak = p.q_end = p.max_dilatancy = p.e_ini = p.q_1pct = p.q_3pct = std::nan("");
-      peaks.push_back(p);
-    }
-    const CompressionTest like{"joint", CompressionPath::oedometer, 100e3, {200e3, 400e3, 800e3}, {}, {}, {}, {}};
-    oedometer.push_back(generator.run_compression(truth, like, 3));
+  JointData data = joint_data(cfg, cfg.run.seed + kForeignSeedOffset, 1);
+  ASSERT_TRUE(std::isfinite(data.oedometer.front().strain.back()));
+  for (TriaxialTest& t : data.triaxial) {  // the peak deviator alone
+    TriaxialTest p;
+    p.material = t.material, p.sigma3 = t.sigma3, p.q_peak = t.q_peak;
+    p.eps_a_peak = p.q_end = p.max_dilatancy = p.e_ini = p.q_1pct = p.q_3pct = std::nan("");
+    t = p;
   }
-  ASSERT_TRUE(std::isfinite(oedometer.front().strain.back()));
-  PeriodicLab lab(cfg, false, 2);
-  const Model base = model_of(cfg);
-  const std::vector<FreeParam> free{free_param("emod_Pa", base), free_param("mu_s", base)};
-  const Misfit misfit = measure_misfit(lab, base, peaks, NoiseOptions(), false);
-  const CompressionMisfit compression(oedometer, lab.run_compressions(base, oedometer, true), lab.members());
-  const CalibrationResult joint = calibrate(lab, base, free, peaks, misfit, 4, {}, 2, compression.joint(lab));
-  const CalibrationResult alone = calibrate(lab, base, free, peaks, misfit);
+  JointAnalysis a(cfg, data);
+  const std::vector<TriaxialTest>& peaks = data.triaxial;
+  const std::vector<FreeParam>& free = a.free;
+  const Misfit& misfit = a.misfit;
+  const CompressionMisfit& compression = a.compression;
+  const CalibrationResult joint = calibrate(a.lab, a.base, free, peaks, misfit, 4, {}, 2, compression.joint(a.lab));
+  const CalibrationResult alone = calibrate(a.lab, a.base, free, peaks, misfit);
   print("peaks and oedometer", joint);
   print("peaks alone", alone);
   EXPECT_EQ(joint.data, misfit.data() + compression.data());
@@ -83,24 +110,12 @@ TEST(JointCalibration, AnOedometerWithTriaxialPeaksRecoversTheStiffnessAndTheFri
 // data in cells four times larger for that). About 4 minutes on 2 cores.
 TEST(JointCalibration, ADiagnosisFitsTheOedometerInEveryFit) {
   const Config cfg = load_config(std::string(TRIAXDEM_SOURCE_DIR) + "/tests/data/hidden_effects.toml");
-  Model truth = model_of(cfg);
-  set_param(truth, "emod_Pa", 2e8);
-  set_param(truth, "mu_s", 0.25);
-  std::vector<TriaxialTest> curves;
-  std::vector<CompressionTest> oedometer;
-  {
-    PeriodicLab generator(cfg, false, 4, cfg.run.seed + kForeignSeedOffset + 10, 0, 2);
-    curves = synthetic_tests(generator, truth, {100e3, 200e3, 300e3}, "joint", 2, 1);
-    const CompressionTest like{"joint", CompressionPath::oedometer, 100e3, {200e3, 400e3, 800e3}, {}, {}, {}, {}};
-    oedometer.push_back(generator.run_compression(truth, like, 3));
-  }
-  ASSERT_TRUE(std::isfinite(oedometer.front().strain.back()));
-  PeriodicLab lab(cfg, false, 2);
-  const Model base = model_of(cfg);
-  const std::vector<FreeParam> free{free_param("emod_Pa", base), free_param("mu_s", base)};
-  const Misfit misfit = measure_misfit(lab, base, curves, NoiseOptions(), false);
-  const CompressionMisfit compression(oedometer, lab.run_compressions(base, oedometer, true), lab.members());
-  const Diagnosis dg = diagnose(lab, base, free, curves, misfit, false, compression.joint(lab));
+  const JointData data = joint_data(cfg, cfg.run.seed + kForeignSeedOffset + 10, 2);
+  ASSERT_TRUE(std::isfinite(data.oedometer.front().strain.back()));
+  JointAnalysis a(cfg, data);
+  const Misfit& misfit = a.misfit;
+  const CompressionMisfit& compression = a.compression;
+  const Diagnosis dg = diagnose(a.lab, a.base, a.free, data.triaxial, misfit, false, compression.joint(a.lab));
   print("diagnosis's base fit", dg.base);
   std::printf("verdict %s: %s\n", dg.verdict.c_str(), dg.explanation.c_str());
   const std::size_t n = static_cast<std::size_t>(misfit.data() + compression.data());
