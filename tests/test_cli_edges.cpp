@@ -251,6 +251,19 @@ TEST(CliEdges, TheCompressionJobWritesARowPerIncrement) {
                                      (dir / "diagnose").string(), dir);
   EXPECT_EQ(diagnosis.code, 0) << diagnosis.output;
   EXPECT_NE(diagnosis.output.find("hidden-effect tests: compression tests"), std::string::npos) << diagnosis.output;
+  // One specimen a point cannot fit them (it whitens a run of one specimen): calibrate refuses the config's method
+  // with them, naming it; a diagnosis searches with the ensemble whatever the method says, and takes them.
+  const std::string one = (dir / "one_specimen.toml").string();
+  write_edited("tests/data/hidden_effects.toml", "free = [\"mu_s\", \"mu_r\"]",
+               "free = [\"mu_s\", \"mu_r\"]\nmethod = \"one_specimen\"", one);
+  const std::string with = " --free emod_Pa,mu_s --predict none --compression " +
+                           (dir / "run" / "compression_data.csv").string() + " --plan -o " + (dir / "one").string();
+  const Outcome refused = triaxdem("calibrate " + (dir / "peaks.csv").string() + " --config " + one + with, dir);
+  EXPECT_NE(refused.code, 0);
+  EXPECT_NE(refused.output.find("[calibrate] method: \"one_specimen\" with --compression"), std::string::npos)
+      << refused.output;
+  const Outcome taken = triaxdem("diagnose " + (dir / "peaks.csv").string() + " --config " + one + with, dir);
+  EXPECT_EQ(taken.code, 0) << taken.output;
 }
 
 // A specimen whose layer the step cap stopped before it came to rest warned and went on (exit 0): it is refused,

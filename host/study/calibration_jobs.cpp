@@ -328,14 +328,14 @@ class DiagnosisWork : public MaterialWork {
 }  // namespace
 
 int calibrate_job(const Config& base, const CalibrationOptions& o) {
-  if (o.plan_only) return JobInputs(base, o).announce_plan(base, o, "calibrate"), 0;
+  if (o.plan_only) return JobInputs(base, o, "calibrate").announce_plan(base, o, "calibrate"), 0;
   Session ss(base, o, "calibrate");
   CalibrationWork work(ss, base);
   return run_materials(base, o, ss, "calibrate", work);
 }
 
 int diagnose_job(const Config& base, const CalibrationOptions& o) {
-  if (o.plan_only) return JobInputs(base, o).announce_plan(base, o, "diagnose"), 0;
+  if (o.plan_only) return JobInputs(base, o, "diagnose").announce_plan(base, o, "diagnose"), 0;
   Session ss(base, o, "diagnose");
   if (ss.two_fidelity)
     std::printf("diagnose: note: the diagnosis fits the periodic cell; two fidelities apply to calibrate (the "

@@ -26,7 +26,7 @@ std::string Session::plan_text() const {
 }
 
 Session::Session(const Config& base, const CalibrationOptions& o, const std::string& kind)
-    : JobInputs(base, o), plan(announce_plan(base, o, kind)),
+    : JobInputs(base, o, kind), plan(announce_plan(base, o, kind)),
       lab(matched(stored_cell(cell, o, data), o.workers), true, o.workers),
       folder(o.resume.empty() ? new_dated_folder(o.output, kind) : resumed_folder(o.resume, kind)),
       output(o.resume.empty() ? o.output : resumed_parent(o.resume)) {

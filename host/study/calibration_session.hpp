@@ -70,7 +70,8 @@ struct JobInputs {
   std::vector<CompressionTest> compression;  ///< --compression's tests, each of a material of `data`
   /// The compression tests of `material`.
   std::vector<CompressionTest> compression_of(const std::string& material) const;
-  JobInputs(const Config& base, const CalibrationOptions& o);
+  /// `kind`: the job ("calibrate" or "diagnose"), whose search decides what --compression may go with.
+  JobInputs(const Config& base, const CalibrationOptions& o, const std::string& kind);
   /// The job's plan (host/fit/job_plan.hpp), printed. A plan above kPlanBoundSeconds without --yes is refused
   /// (ConfigError naming its costliest stage and the setting that sizes it).
   JobPlan announce_plan(const Config& base, const CalibrationOptions& o, const std::string& kind) const;

@@ -100,8 +100,10 @@ QMeasure reference_q_measure(const Config& cell, const MeasuredData& data) {
 
 /// --compression's tests, checked: each of a material the triaxial data hold, and a search that can fit them (the
 /// ensemble's: two fidelities correct the triaxial misfit alone, one specimen a point whitens a run of one specimen).
+/// `two_fidelity` and `searched_by_method`: whether the job's search is the two fidelities' or the config's [calibrate]
+/// method (a calibration's; a diagnosis fits the periodic cell with the ensemble whatever the config says).
 std::vector<CompressionTest> compression_tests(const Config& base, const CalibrationOptions& o,
-                                               const MeasuredData& data, bool two_fidelity) {
+                                               const MeasuredData& data, bool two_fidelity, bool searched_by_method) {
   if (o.compression.empty()) return {};
   std::vector<CompressionTest> tests = load_compression(o.compression);
   for (const CompressionTest& t : tests)
@@ -111,7 +113,7 @@ std::vector<CompressionTest> compression_tests(const Config& base, const Calibra
   if (two_fidelity)
     throw ConfigError("--compression: two fidelities correct the triaxial misfit by the membrane test, which has no "
                       "compression test (allowed: --reference-test periodic)");
-  if (base.calibrate.one_specimen())
+  if (searched_by_method && base.calibrate.one_specimen())
     throw ConfigError(base.path + ": [calibrate] method: \"" + base.calibrate.method + "\" with --compression "
                       "(allowed: \"ensemble\", whose every point is its members' mean, as the compression misfit compares)");
   return tests;
@@ -143,7 +145,7 @@ std::map<std::string, std::vector<TriaxialTest>> by_material(const MeasuredData&
   return out;
 }
 
-JobInputs::JobInputs(const Config& base, const CalibrationOptions& o)
+JobInputs::JobInputs(const Config& base, const CalibrationOptions& o, const std::string& kind)
     : data(load_measured(o.data)),
       cell(reference_cell(base, o.reference_test)),
       ref(o.reference.empty() ? ReferenceValues{}
@@ -161,7 +163,7 @@ JobInputs::JobInputs(const Config& base, const CalibrationOptions& o)
   }
   held_out = hold_out(o, data);
   check_enough_data(o, data, free.size());
-  compression = compression_tests(base, o, data, two_fidelity);
+  compression = compression_tests(base, o, data, two_fidelity && kind == "calibrate", kind == "calibrate");
 }
 
 std::vector<CompressionTest> JobInputs::compression_of(const std::string& material) const {
