@@ -100,20 +100,20 @@ QMeasure reference_q_measure(const Config& cell, const MeasuredData& data) {
 
 /// --compression's tests, checked: each of a material the triaxial data hold, and a search that can fit them (the
 /// ensemble's: two fidelities correct the triaxial misfit alone, one specimen a point whitens a run of one specimen).
-/// `two_fidelity` and `searched_by_method`: whether the job's search is the two fidelities' or the config's [calibrate]
-/// method (a calibration's; a diagnosis fits the periodic cell with the ensemble whatever the config says).
+/// Only a calibration searches as two fidelities or the config's [calibrate] method say (`calibrating`); a diagnosis
+/// fits the periodic cell with the ensemble whatever the config says.
 std::vector<CompressionTest> compression_tests(const Config& base, const CalibrationOptions& o,
-                                               const MeasuredData& data, bool two_fidelity, bool searched_by_method) {
+                                               const MeasuredData& data, bool two_fidelity, bool calibrating) {
   if (o.compression.empty()) return {};
   std::vector<CompressionTest> tests = load_compression(o.compression);
   for (const CompressionTest& t : tests)
     if (std::none_of(data.tests.begin(), data.tests.end(), [&](const TriaxialTest& x) { return x.material == t.material; }))
       throw DataError(o.compression, "material", "'" + t.material + "' has no triaxial tests in " + o.data +
                                                      " (allowed: a material of the triaxial data, fitted with them)");
-  if (two_fidelity)
+  if (calibrating && two_fidelity)
     throw ConfigError("--compression: two fidelities correct the triaxial misfit by the membrane test, which has no "
                       "compression test (allowed: --reference-test periodic)");
-  if (searched_by_method && base.calibrate.one_specimen())
+  if (calibrating && base.calibrate.one_specimen())
     throw ConfigError(base.path + ": [calibrate] method: \"" + base.calibrate.method + "\" with --compression "
                       "(allowed: \"ensemble\", whose every point is its members' mean, as the compression misfit compares)");
   return tests;
@@ -163,7 +163,7 @@ JobInputs::JobInputs(const Config& base, const CalibrationOptions& o, const std:
   }
   held_out = hold_out(o, data);
   check_enough_data(o, data, free.size());
-  compression = compression_tests(base, o, data, two_fidelity && kind == "calibrate", kind == "calibrate");
+  compression = compression_tests(base, o, data, two_fidelity, kind == "calibrate");
 }
 
 std::vector<CompressionTest> JobInputs::compression_of(const std::string& material) const {
