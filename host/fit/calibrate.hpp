@@ -244,6 +244,14 @@ long planned_one_specimen_points(int d, int rounds = OneSpecimenSearch{}.rounds)
 struct JointTerm {
   int data = 0;
   std::function<std::vector<Real>(const Model&)> residuals;
+  /// The triaxial residuals `r` of a run at m with the joint tests' at m after them: the order every fit's chi2,
+  /// surfaces and data count assume.
+  std::vector<Real> appended(const Model& m, std::vector<Real> r) const {
+    if (!residuals) return r;
+    const std::vector<Real> more = residuals(m);
+    r.insert(r.end(), more.begin(), more.end());
+    return r;
+  }
 };
 /// The same on `measured` (one material, any number of pressures), simulated by the lab's ensemble, with `joint`'s
 /// tests fitted beside them.

@@ -75,15 +75,6 @@ struct FitContext {
   const Misfit& misfit;
   const std::function<void()>& report;  ///< a progress line after each batch of runs
   const JointTerm& joint;               ///< the material's other tests, fitted beside the triaxial ones
-  /// The residuals of an ensemble run at m: the triaxial tests', then the joint tests' at m.
-  std::vector<Real> residuals(const Model& m, const Ensemble& e) const {
-    std::vector<Real> r = misfit.residuals(e);
-    if (joint.residuals) {
-      const std::vector<Real> more = joint.residuals(m);
-      r.insert(r.end(), more.begin(), more.end());
-    }
-    return r;
-  }
 };
 
 /// One extension fitted jointly with the base parameters: its effect measured at the base optimum strength by
@@ -101,7 +92,7 @@ ExtensionFit fit_extension(const Extension& e, const FitContext& cx, Evaluation&
   for (Real level : e.levels) {
     Model m = cx.base.model;
     set_param(m, e.param, level);
-    const std::vector<Real> r = cx.residuals(m, lab.run_ensemble(m, cx.measured));
+    const std::vector<Real> r = cx.joint.appended(m, cx.misfit.residuals(lab.run_ensemble(m, cx.measured)));
     cx.report();
     std::vector<Real> diff(r.size());
     for (std::size_t i = 0; i < r.size(); ++i) diff[i] = r[i] - cx.base.best.r[i];
@@ -138,7 +129,7 @@ ExtensionFit fit_extension(const Extension& e, const FitContext& cx, Evaluation&
     const Model at = model_at(u);
     const Ensemble ens = lab.run_ensemble(at, cx.measured);
     for (const auto& members : ens) ev.sim.push_back(mean_curve(members));
-    ev.r = cx.residuals(at, ens);
+    ev.r = cx.joint.appended(at, cx.misfit.residuals(ens));
     ev.chi2 = sum_sq(ev.r);
     cx.report();
     if (strength_at(e, strength_coordinate(e, u[d])) == 0 && ev.chi2 < base_runs.chi2) base_runs = ev;

@@ -35,14 +35,13 @@ CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vect
   const Real spread = misfit.member_spread();
   // The first parts that probes ran, each taken up by its point's next call.
   std::vector<std::pair<Model, Ensemble>> probed;
-  // The joint tests' residuals of each model run (a probe's point is called twice).
+  // The joint tests' residuals of each model, run once: a probe's point is called twice.
   std::vector<std::pair<Model, std::vector<Real>>> joint_done;
-  auto with_joint = [&](const Model& m, std::vector<Real> r) {
-    if (!joint.residuals) return r;
+  JointTerm once = joint;
+  if (joint.residuals) once.residuals = [&](const Model& m) {
     auto was = std::find_if(joint_done.begin(), joint_done.end(), [&](const auto& p) { return same_model(p.first, m); });
     if (was == joint_done.end()) was = joint_done.insert(joint_done.end(), {m, joint.residuals(m)});
-    r.insert(r.end(), was->second.begin(), was->second.end());
-    return r;
+    return was->second;
   };
   auto simulate = [&](const Model& m, Real screen_above) {
     SimulatedPoint s;
@@ -63,7 +62,7 @@ CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vect
     if (ens.back().size() < K) {  // the first part: the last test has its first member only
       Ensemble one(T);
       for (std::size_t k = 0; k < T; ++k) one[k].push_back(ens[k].front());
-      s.r = with_joint(m, misfit.residuals(one));
+      s.r = once.appended(m, misfit.residuals(one));
       s.screened = screen_above == kProbe || clearly_above(s.r, spread, screen_above);
       if (s.screened) {
         if (screen_above == kProbe) probed.emplace_back(m, ens);
@@ -74,7 +73,7 @@ CalibrationResult calibrate(PeriodicLab& lab, const Model& base, const std::vect
       }
     }
     for (const auto& one : ens) s.sim.push_back(mean_curve(one));
-    s.r = with_joint(m, misfit.residuals(ens));
+    s.r = once.appended(m, misfit.residuals(ens));
     if (!s.screened) best = std::min(best, sum_sq(s.r));
     if (progress) progress(lab.runs(), planned, best);
     return s;
