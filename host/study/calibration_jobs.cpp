@@ -88,7 +88,7 @@ CalibrationResult two_fidelity_fit(Session& ss, const Config& base, const std::s
   int round = 0;
   const FidelityRounds rounds = two_fidelity_rounds(r, misfit, tests, [&](const Model& at) {
     std::string where;
-    for (const FreeParam& f : ss.free)
+    for (const FreeParam& f : ss.in.free)
       where += (where.empty() ? " " : ", ") + f.name + fmt(" = %.4g", f.shown * get_param(at, f.name));
     std::printf("calibrate: %s: two fidelities, membrane test %d: it and every periodic specimen at%s\n",
                 material.c_str(), ++round, where.c_str());
@@ -98,7 +98,7 @@ CalibrationResult two_fidelity_fit(Session& ss, const Config& base, const std::s
     return d;
   }, [&](const Misfit& corrected) {
     return fit(corrected, "calibrate (corrected, round " + std::to_string(round) + ")");
-  }, ss.predict_template->path, kFidelityRounds, [&](const Model& at, const Misfit& corrected) {
+  }, ss.in.predict_template->path, kFidelityRounds, [&](const Model& at, const Misfit& corrected) {
     const Ensemble e = ss.lab.run_ensemble(at, tests, true);
     Evaluation ev;
     for (const std::vector<TriaxialTest>& members : e) ev.sim.push_back(mean_curve(members));
@@ -108,7 +108,7 @@ CalibrationResult two_fidelity_fit(Session& ss, const Config& base, const std::s
   });
   const std::string text = rounds.text();
   std::printf("calibrate: %s: two fidelities:\n%s", material.c_str(), text.c_str());
-  ss.discrepancy += "### " + material + "\n\n" + text + "\n";
+  ss.report.discrepancy += "### " + material + "\n\n" + text + "\n";
   return rounds.last();
 }
 
@@ -116,7 +116,7 @@ CalibrationResult two_fidelity_fit(Session& ss, const Config& base, const std::s
 /// specimen; none without such tests. `kind`: the job, for its lines.
 std::optional<CompressionMisfit> compression_misfit(Session& ss, const Config& base, const std::string& material,
                                                     const std::string& kind) {
-  const std::vector<CompressionTest> tests = ss.compression_of(material);
+  const std::vector<CompressionTest> tests = ss.in.compression_of(material);
   if (tests.empty()) return std::nullopt;
   const long start = ss.lab.runs();
   Progress progress(kind + " " + material + ": the compression tests' scatter at the base",
@@ -150,9 +150,9 @@ int run_materials(const Config& base, const CalibrationOptions& o, Session& ss, 
                   MaterialWork& work) {
   std::vector<TriaxialTest> all_meas, all_sim;
   std::map<std::string, Calibrated> models;
-  for (const auto& [material, tests] : by_material(ss.data, o.material)) {
+  for (const auto& [material, tests] : by_material(ss.in.data, o.material)) {
     std::printf("%s: %s, %zu tests, free %zu parameters, %zu balls in %s\n", kind.c_str(), material.c_str(),
-                tests.size(), ss.free.size(), ss.lab.balls(), ss.cell_text().c_str());
+                tests.size(), ss.in.free.size(), ss.lab.balls(), ss.cell_text().c_str());
     const Misfit misfit = ss.misfit_of(base, material, tests);  // sets the ensemble ("auto": from the scatter)
     Calibrated c = work.fit(material, tests, misfit);
     all_meas.insert(all_meas.end(), tests.begin(), tests.end());
@@ -162,12 +162,12 @@ int run_materials(const Config& base, const CalibrationOptions& o, Session& ss, 
   const std::string where = work.close(all_meas, all_sim);
   std::printf("%s: %s in %s; %s\n", kind.c_str(), ss.runs_text().c_str(), format_duration(ss.lab.seconds()).c_str(),
               where.c_str());
-  if (const std::string w = ss.workers_text(); !w.empty()) std::printf("%s: %s\n", kind.c_str(), w.c_str());
-  ss.finish(all_meas, all_sim, work.fitted());
+  if (const std::string w = ss.report.workers_text(); !w.empty()) std::printf("%s: %s\n", kind.c_str(), w.c_str());
+  ss.report.finish(ss.in.data, all_meas, all_sim, work.fitted());
   const std::string prediction = ss.predict_boundary(base, models);
   if (!prediction.empty()) work.predicted(prediction);
-  ss.write_pools();
-  std::printf("%s: %s\n", kind.c_str(), ss.plan_text().c_str());
+  ss.report.write_pools();
+  std::printf("%s: %s\n", kind.c_str(), ss.report.plan_text().c_str());
   return 0;
 }
 
@@ -187,7 +187,7 @@ class CalibrationWork : public MaterialWork {
     const JointTerm joint = compression ? compression->joint(ss.lab) : JointTerm{};
     auto fit = [&](const Misfit& m, const std::string& what) {
       const long start = ss.lab.runs();
-      const int d = static_cast<int>(ss.free.size());
+      const int d = static_cast<int>(ss.in.free.size());
       const long planned = static_cast<long>(tests.size()) *
                            (one_specimen_ ? planned_one_specimen_points(d) : planned_points(d) * ss.lab.members());
       Progress progress(what + " " + material, planned);
@@ -197,24 +197,24 @@ class CalibrationWork : public MaterialWork {
         progress.update(done - start, extra);
       };
       CalibrationResult r = one_specimen_
-                                ? calibrate_one_specimen(ss.lab, model_of(base_), ss.free, tests, m.with_members(1), report)
-                                : calibrate(ss.lab, model_of(base_), ss.free, tests, m, 4, report, 2, joint);
+                                ? calibrate_one_specimen(ss.lab, model_of(base_), ss.in.free, tests, m.with_members(1), report)
+                                : calibrate(ss.lab, model_of(base_), ss.in.free, tests, m, 4, report, 2, joint);
       progress.finish("");
       require_a_result(r, what + " " + material, ss);
       return r;
     };
     CalibrationResult r = fit(misfit, "calibrate");
-    if (ss.two_fidelity) r = two_fidelity_fit(ss, base_, material, tests, misfit, r, fit);
+    if (ss.in.two_fidelity) r = two_fidelity_fit(ss, base_, material, tests, misfit, r, fit);
     // The noise at the answer: the scatter specimens run again at the calibrated point, and the design whitened by it
     // (rewhiten). Two fidelities fit a misfit corrected by the membrane test, which is measured at its own points.
-    const Misfit there = ss.two_fidelity ? misfit : rescattered(ss, material, tests, misfit, r, model_of(base_));
+    const Misfit there = ss.in.two_fidelity ? misfit : rescattered(ss, material, tests, misfit, r, model_of(base_));
     // A reference that gives every free parameter is placed against the joint region, and run (runs_reference): is
     // it consistent with these data?
     const long fit_runs = ss.lab.runs() - runs0;  // the reference point's runs are not the calibration's
     const auto [reference_rise, reference_chi2] = place_reference(ss, material, tests, there, r);
     const bool whole_reference = !std::isnan(reference_rise);  // inf: outside the searched ranges
-    for (std::size_t k = 0; k < ss.free.size(); ++k) {
-      const FreeParam& f = ss.free[k];
+    for (std::size_t k = 0; k < ss.in.free.size(); ++k) {
+      const FreeParam& f = ss.in.free[k];
       const Real ref = ss.reference(material, f.name);
       std::printf("calibrate: %s: %s = %.4g%s\n", material.c_str(), f.name.c_str(), f.shown * r.values[k],
                   std::isfinite(ref) ? fmt(" (reference %g)", ref).c_str() : "");
@@ -233,23 +233,23 @@ class CalibrationWork : public MaterialWork {
                 fit_runs);
     if (compression) compression_fit(material, *compression, r.model);
     std::vector<TriaxialTest> held;
-    for (const TriaxialTest& t : ss.held_out)
+    for (const TriaxialTest& t : ss.in.held_out)
       if (t.material == material) held.push_back(t);
     return Calibrated{tests, r.model, r.best.sim, held};
   }
 
   std::string close(const std::vector<TriaxialTest>& meas, const std::vector<TriaxialTest>& sim) override {
-    if (ss_.two_fidelity)
+    if (ss_.in.two_fidelity)
       std::printf("calibrate: two fidelities: the table sets the periodic cell against the data as measured; it was "
                   "fitted to them less the boundary's discrepancy, and the membrane prediction below is the test "
                   "that compares with the lab\n");
     print_errors(meas, sim);
-    io::write_text_atomic(ss_.folder + "/calibrated.csv", table_.str());
-    return "results in " + ss_.folder + " (calibrated.csv, errors.csv, simulated_curves.csv)";
+    io::write_text_atomic(ss_.report.folder + "/calibrated.csv", table_.str());
+    return "results in " + ss_.report.folder + " (calibrated.csv, errors.csv, simulated_curves.csv)";
   }
 
   void predicted(const std::string& prediction) override {
-    io::write_text_atomic(ss_.folder + "/prediction.md", prediction);
+    io::write_text_atomic(ss_.report.folder + "/prediction.md", prediction);
   }
 
   const char* fitted() const override { return "the calibrated parameters"; }
@@ -271,7 +271,7 @@ class CalibrationWork : public MaterialWork {
     std::printf("calibrate: %s: the compression tests at the answer: chi2 %.1f on %d data\n%s", material.c_str(), chi2,
                 m.data(), table.c_str());
     compression_table_ += compression_table_.empty() ? table : table.substr(table.find('\n') + 1);
-    io::write_text_atomic(ss_.folder + "/compression_fit.csv", compression_table_);
+    io::write_text_atomic(ss_.report.folder + "/compression_fit.csv", compression_table_);
   }
 };
 
@@ -287,7 +287,7 @@ class DiagnosisWork : public MaterialWork {
 
   Calibrated fit(const std::string& material, const std::vector<TriaxialTest>& tests, const Misfit& misfit) override {
     const std::optional<CompressionMisfit> compression = compression_misfit(ss_, base_, material, "diagnose");
-    const Diagnosis dg = diagnose(ss_.lab, model_of(base_), ss_.free, tests, misfit, true,
+    const Diagnosis dg = diagnose(ss_.lab, model_of(base_), ss_.in.free, tests, misfit, true,
                                   compression ? compression->joint(ss_.lab) : JointTerm{});
     require_a_result(dg.base, "diagnose " + material + " (the base model's search)", ss_);
     std::printf("diagnose: %s: verdict: %s\n  %s\n", material.c_str(), dg.verdict.c_str(), dg.explanation.c_str());
@@ -307,10 +307,10 @@ class DiagnosisWork : public MaterialWork {
   std::string close(const std::vector<TriaxialTest>& meas, const std::vector<TriaxialTest>&) override {
     report_.close();
     if (extended_.size() == meas.size())
-      write_measured_curves(ss_.folder + "/extended_curves.csv", extended_,
+      write_measured_curves(ss_.report.folder + "/extended_curves.csv", extended_,
                             "simulated by the extended model of each material");
     report_.write();
-    return "report in " + ss_.folder + "/diagnosis.md";
+    return "report in " + ss_.report.folder + "/diagnosis.md";
   }
 
   // The report stands before the membrane tests run; their section is added when they end.
@@ -337,7 +337,7 @@ int calibrate_job(const Config& base, const CalibrationOptions& o) {
 int diagnose_job(const Config& base, const CalibrationOptions& o) {
   if (o.plan_only) return JobInputs(base, o, "diagnose").announce_plan(base, o, "diagnose"), 0;
   Session ss(base, o, "diagnose");
-  if (ss.two_fidelity)
+  if (ss.in.two_fidelity)
     std::printf("diagnose: note: the diagnosis fits the periodic cell; two fidelities apply to calibrate (the "
                 "membrane prediction at the end shows what the boundary adds)\n");
   DiagnosisWork work(ss, base, o);

@@ -18,23 +18,27 @@ namespace dem {
 
 namespace fs = std::filesystem;
 
-std::string Session::plan_text() const {
+std::string JobReport::plan_text() const {
   return "the plan said about " +
          (plan.high() - plan.low() < 0.5 ? format_duration(plan.high())
                                          : format_duration(plan.low()) + " to " + format_duration(plan.high())) +
          "; the job took " + format_duration(seconds_since(started));
 }
 
-Session::Session(const Config& base, const CalibrationOptions& o, const std::string& kind)
-    : JobInputs(base, o, kind), plan(announce_plan(base, o, kind)),
-      lab(matched(stored_cell(cell, o, data), o.workers), true, o.workers),
+JobReport::JobReport(JobPlan announced, const CalibrationOptions& o, const std::string& kind)
+    : plan(std::move(announced)),
       folder(o.resume.empty() ? new_dated_folder(o.output, kind) : resumed_folder(o.resume, kind)),
-      output(o.resume.empty() ? o.output : resumed_parent(o.resume)) {
+      output(o.resume.empty() ? o.output : resumed_parent(o.resume)) {}
+
+Session::Session(const Config& base, const CalibrationOptions& o, const std::string& kind)
+    : in(base, o, kind), report(in.announce_plan(base, o, kind), o, kind),
+      lab(matched(stored_cell(in.cell, o, in.data), o.workers), true, o.workers) {
+  const std::string& folder = report.folder;
   ranks::check_shared_folder(folder);  // every rank reads the run store there
   lab.set_run_store(folder + "/runs");
   set_stop_note("the runs so far are kept in " + folder + "/runs: the same command with --resume " + folder +
                 " continues");
-  lab.set_q_measure(cell_q);
+  lab.set_q_measure(in.cell_q);
   if (!o.resume.empty())
     std::printf("%s: resuming in %s: the runs stored there are read, not run again%s\n", kind.c_str(), folder.c_str(),
                 fs::exists(folder + "/job_inputs.txt") ? " (same data, config and options)"
@@ -42,10 +46,10 @@ Session::Session(const Config& base, const CalibrationOptions& o, const std::str
                                                          "checked against this job's");
   record_job_inputs(base, o, folder);
   if (lab.config().periodic.boundary == CellBoundary::walls) {
-    const bool fixed = cell_q == QMeasure::kFixedArea;
+    const bool fixed = in.cell_q == QMeasure::kFixedArea;
     std::printf("%s: note: the walled cell compares its q over the %s cross-section (%s%s); its walls also give q "
-                "over the %s one (%s)\n", kind.c_str(), fixed ? "initial" : "current", name_of(cell_q),
-                data.q_measure_given ? ", the data's q_measure"
+                "over the %s one (%s)\n", kind.c_str(), fixed ? "initial" : "current", name_of(in.cell_q),
+                in.data.q_measure_given ? ", the data's q_measure"
                                      : ", taken where the data say no q_measure: name yours in a q_measure column",
                 fixed ? "current" : "initial", name_of(fixed ? QMeasure::kAreaCorrected : QMeasure::kFixedArea));
   }
@@ -68,7 +72,7 @@ std::string Session::runs_text() const {
          (lab.failed_runs() > 0 ? "; WARNING: " + failed_text() : "");
 }
 
-std::string Session::workers_text() const {
+std::string JobReport::workers_text() const {
   const PoolUse use = pool_use();
   const double job = seconds_since(started);
   const LabTime t = lab_time();
@@ -83,7 +87,7 @@ std::string Session::workers_text() const {
          fmt(" (idle %.0f worker-seconds, waiting for the longest piece of a batch)", use.idle());
 }
 
-void Session::write_pools() const { io::write_text_atomic(folder + "/pools.csv", pools_csv(seconds_since(started))); }
+void JobReport::write_pools() const { io::write_text_atomic(folder + "/pools.csv", pools_csv(seconds_since(started))); }
 
 std::string Session::failed_text() const {
   return std::to_string(lab.failed_runs()) + " of the runs stopped at a blow-up" +
@@ -94,7 +98,7 @@ std::string Session::failed_text() const {
 
 std::vector<std::string> Session::free_names() const {
   std::vector<std::string> names;
-  for (const FreeParam& f : free) names.push_back(f.name);
+  for (const FreeParam& f : in.free) names.push_back(f.name);
   return names;
 }
 
@@ -104,35 +108,35 @@ std::vector<Prediction> Session::predict_at(const Config& base, const Model& mod
   auto key = [&](const TriaxialTest& t) { return at + t.material + fmt(",%.17g", t.sigma3); };
   std::vector<TriaxialTest> missing;
   for (const TriaxialTest& t : tests)
-    if (!membrane_runs.count(key(t))) missing.push_back(t);
+    if (!membrane_runs_.count(key(t))) missing.push_back(t);
   if (missing.size() < tests.size())
     std::printf("prediction: %zu of %zu membrane tests at this point were run before in this job: taken, not run "
                 "again\n", tests.size() - missing.size(), tests.size());
   if (!missing.empty()) {
-    const std::vector<Prediction> ran = predict(*predict_template, model, free_names(), missing, data.q_measure,
+    const std::vector<Prediction> ran = predict(*in.predict_template, model, free_names(), missing, in.data.q_measure,
                                                 static_cast<int>(base.calibrate.predict_specimens),
-                                                output + "/.specimens", true, workers);
-    for (std::size_t k = 0; k < ran.size(); ++k) membrane_runs[key(missing[k])] = ran[k];
+                                                report.output + "/.specimens", true, in.workers);
+    for (std::size_t k = 0; k < ran.size(); ++k) membrane_runs_[key(missing[k])] = ran[k];
   }
   std::vector<Prediction> out;
-  for (const TriaxialTest& t : tests) out.push_back(membrane_runs.at(key(t)));
+  for (const TriaxialTest& t : tests) out.push_back(membrane_runs_.at(key(t)));
   return out;
 }
 
 Config Session::matched(const Config& base, int workers) {
-  return matched_state(base, data.tests, state, true, match_plan(base, workers));
+  return matched_state(base, in.data.tests, state, true, match_plan(base, workers));
 }
 
 Misfit Session::misfit_of(const Config& base, const std::string& material, const std::vector<TriaxialTest>& tests) {
   std::printf("%s: %s: measuring the simulator's scatter: %d specimens of %zu balls at the base model\n",
-              folder.c_str(), material.c_str(), lab.specimens(), lab.balls());
+              report.folder.c_str(), material.c_str(), lab.specimens(), lab.balls());
   lab.set_progress("  " + material + ": scatter");
-  const NoiseBudget budget = decide_noise_budget(lab, model_of(base), tests, noise, true, state);
+  const NoiseBudget budget = decide_noise_budget(lab, model_of(base), tests, in.noise, true, state);
   lab.set_progress("");
   state = budget.state;  // a grown cell was matched again: the next material's budget starts from it
-  const Misfit m(tests, noise, budget);
+  const Misfit m(tests, in.noise, budget);
   if (!m.cell_bias_finding().empty())
-    std::printf("%s: %s: FINDING: %s\n", folder.c_str(), material.c_str(), m.cell_bias_finding().c_str());
+    std::printf("%s: %s: FINDING: %s\n", report.folder.c_str(), material.c_str(), m.cell_bias_finding().c_str());
   for (const std::string& n : m.notes()) std::printf("  noise: %s\n", n.c_str());
   const Real ratio = m.ensemble_ratio();
   const bool one_specimen = base.calibrate.one_specimen();
@@ -169,26 +173,26 @@ Misfit Session::misfit_of(const Config& base, const std::string& material, const
 }
 
 Real Session::reference(const std::string& material, const std::string& name) const {
-  auto m = ref.values.find(material);
-  if (m == ref.values.end()) return std::nan("");
+  auto m = in.ref.values.find(material);
+  if (m == in.ref.values.end()) return std::nan("");
   auto v = m->second.find(name);
   return v == m->second.end() ? std::nan("") : v->second;
 }
 
 std::string Session::predict_boundary(const Config& base, const std::map<std::string, Calibrated>& models) const {
-  if (!predict_template && !walls_prediction) {
+  if (!in.predict_template && !in.walls_prediction) {
     std::printf("%s: no prediction ([calibrate] predict or --predict names a membrane test, or walls)\n",
-                folder.c_str());
+                report.folder.c_str());
     return "";
   }
   std::optional<Config> walls;
-  if (walls_prediction) {
+  if (in.walls_prediction) {
     StateMatch walls_state;  // the walled cell's own preparation to the data's state
     Config walled = reference_cell(base, kPredictWalls);
     walled.packing_store = lab.config().packing_store;
-    walls = matched_state(walled, data.tests, walls_state, true, match_plan(walled, workers));
+    walls = matched_state(walled, in.data.tests, walls_state, true, match_plan(walled, in.workers));
   }
-  const std::string test = walls ? walled_cell_text(*walls) : membrane_test_text(*predict_template);
+  const std::string test = walls ? walled_cell_text(*walls) : membrane_test_text(*in.predict_template);
   const int specimens = static_cast<int>(base.calibrate.predict_specimens);
   std::vector<Prediction> all;
   std::vector<TriaxialTest> curves;
@@ -196,9 +200,9 @@ std::string Session::predict_boundary(const Config& base, const std::map<std::st
     std::vector<TriaxialTest> tests = cal.tests;
     tests.insert(tests.end(), cal.held_out.begin(), cal.held_out.end());
     std::printf("%s: %s: predicting %s at the calibrated parameters: %zu pressures x %d specimens\n",
-                folder.c_str(), material.c_str(), walls ? "the walled cell" : predict_template->path.c_str(),
+                report.folder.c_str(), material.c_str(), walls ? "the walled cell" : in.predict_template->path.c_str(),
                 tests.size(), specimens);
-    std::vector<Prediction> p = walls ? predict_walls(*walls, cal.model, tests, specimens, workers)
+    std::vector<Prediction> p = walls ? predict_walls(*walls, cal.model, tests, specimens, in.workers)
                                       : predict_at(base, cal.model, tests);
     for (std::size_t k = 0; k < p.size() && k < cal.sim.size(); ++k) p[k].periodic_q_peak = cal.sim[k].q_peak;
     for (std::size_t k = cal.tests.size(); k < p.size(); ++k) p[k].held_out = true;
@@ -207,17 +211,17 @@ std::string Session::predict_boundary(const Config& base, const std::map<std::st
       all.push_back(std::move(x));
     }
   }
-  const std::string md = prediction_markdown(all, data.q_measure);
-  io::write_text_atomic(folder + "/prediction.csv", prediction_csv(all, data.q_measure));
-  write_measured_curves(folder + "/prediction_curves.csv", curves, test + " at the calibrated parameters",
-                        name_of(data.q_measure));
+  const std::string md = prediction_markdown(all, in.data.q_measure);
+  io::write_text_atomic(report.folder + "/prediction.csv", prediction_csv(all, in.data.q_measure));
+  write_measured_curves(report.folder + "/prediction_curves.csv", curves, test + " at the calibrated parameters",
+                        name_of(in.data.q_measure));
   std::printf("\nprediction (%s at the calibrated parameters):\n%s", test.c_str(), md.c_str());
-  run_plot_script("plot_prediction.py", {folder});
-  return prediction_section(test, specimens, data.q_measure, md, discrepancy);
+  run_plot_script("plot_prediction.py", {report.folder});
+  return prediction_section(test, specimens, in.data.q_measure, md, report.discrepancy);
 }
 
-void Session::finish(const std::vector<TriaxialTest>& meas, const std::vector<TriaxialTest>& sim,
-            const std::string& what) const {
+void JobReport::finish(const MeasuredData& data, const std::vector<TriaxialTest>& meas,
+                       const std::vector<TriaxialTest>& sim, const std::string& what) const {
   io::write_text_atomic(folder + "/errors.csv", errors_csv(meas, sim));
   write_measured_curves(folder + "/simulated_curves.csv", sim, "simulated by " + what);
   if (data.curves) write_measured_curves(folder + "/measured_curves.csv", meas, "measured: " + data.path);

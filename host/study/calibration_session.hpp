@@ -98,39 +98,49 @@ void check_specimen_sizes(const Config& base, const Config& cell, const Measured
 void record_job_inputs(const Config& base, const CalibrationOptions& o, const std::string& folder);
 void check_resumed_inputs(const Config& base, const CalibrationOptions& o, const std::string& kind);
 
-/// What calibrate and diagnose share: the job's inputs, the simulator and a new result folder.
-struct Session : JobInputs {
+/// Where a job writes and what it says at its end: a new result folder (or the one resumed), its plan beside the time
+/// taken, how the runs used the workers, and the two fidelities' account for the prediction's section.
+struct JobReport {
   std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();
   JobPlan plan;
-  StateMatch state;  ///< the data's void ratio and the preparation that packs it, on the lab's present cell
-  std::string discrepancy;    ///< what the two fidelities measured, for the report
-  PeriodicLab lab;
   std::string folder, output;
   EmptyFolderRemover remover{folder};
-  Session(const Config& base, const CalibrationOptions& o, const std::string& kind);
+  std::string discrepancy;  ///< what the two fidelities measured, for the report
+  JobReport(JobPlan announced, const CalibrationOptions& o, const std::string& kind);
   /// The plan's estimate beside the job's time so far, for the job's last lines.
   std::string plan_text() const;
-  /// The reference test's cell, for the report.
-  std::string cell_text() const;
-  /// "N runs", how many of them a resumed session read from its store, and how many a blow-up stopped: their data
-  /// count as missing (kMissingResidual), which pushes the fit away from where they happen.
-  std::string runs_text() const;
   /// How the runs used the workers: their mean length, the workers' busy share while the pools ran (the rest
   /// they waited for a batch's longest run) and the pools' share of the job's time (the rest the fits took).
   std::string workers_text() const;
   /// pools.csv in the result folder: each pool's pieces and their run times, and the job's wall time so far
   /// (tools/schedule_projection.py projects the job on more ranks from it).
   void write_pools() const;
+  /// The errors table, the curves in the measured-data format and the figure.
+  void finish(const MeasuredData& data, const std::vector<TriaxialTest>& meas, const std::vector<TriaxialTest>& sim,
+              const std::string& what) const;
+};
+
+/// What calibrate and diagnose share: the job's inputs, read and checked before any work and not changed after; its
+/// report; and its lab, the simulator of the reference test on specimens matched to the data's state, with what the
+/// lab measures once for the job (the state, the scatter, the membrane runs).
+struct Session {
+  const JobInputs in;
+  JobReport report;
+  StateMatch state;  ///< the data's void ratio and the preparation that packs it, on the lab's present cell
+  PeriodicLab lab;
+  Session(const Config& base, const CalibrationOptions& o, const std::string& kind);
+  /// The reference test's cell, for the report.
+  std::string cell_text() const;
+  /// "N runs", how many of them a resumed session read from its store, and how many a blow-up stopped: their data
+  /// count as missing (kMissingResidual), which pushes the fit away from where they happen.
+  std::string runs_text() const;
   std::string failed_text() const;
   std::vector<std::string> free_names() const;
   /// The membrane test at `model` on every test of `tests`, q in the data's measure (a template must be set).
   /// Each (point, test) runs once per job: a membrane run the two fidelities made is the prediction's where the
-  /// answer lies at a point they ran (membrane_runs).
+  /// answer lies at a point they ran (membrane_runs_).
   std::vector<Prediction> predict_at(const Config& base, const Model& model,
                                      const std::vector<TriaxialTest>& tests) const;
-  /// The membrane runs made, by the free parameters' values and the test (material, sigma3).
-  mutable std::map<std::string, Prediction> membrane_runs;
-  Config matched(const Config& base, int workers);
   /// The misfit of a material's tests: the ensemble run at the base model, its scatter beside the data's noise.
   Misfit misfit_of(const Config& base, const std::string& material, const std::vector<TriaxialTest>& tests);
   /// The reference value of a parameter for a material, in the key's unit; NaN when there is none.
@@ -139,9 +149,11 @@ struct Session : JobInputs {
   /// membrane test of the template or the walled cell. Writes prediction.csv, prediction_curves.csv and
   /// prediction.png, prints the table, and returns it as Markdown ("" when there is no prediction).
   std::string predict_boundary(const Config& base, const std::map<std::string, Calibrated>& models) const;
-  /// The errors table, the curves in the measured-data format and the figure.
-  void finish(const std::vector<TriaxialTest>& meas, const std::vector<TriaxialTest>& sim,
-              const std::string& what) const;
+
+ private:
+  /// The membrane runs made, by the free parameters' values and the test (material, sigma3).
+  mutable std::map<std::string, Prediction> membrane_runs_;
+  Config matched(const Config& base, int workers);
 };
 
 /// The misfit with the simulator's scatter measured at the calibrated point r.model too (the scatter specimens run

@@ -57,17 +57,17 @@ Misfit rescattered(Session& ss, const std::string& material, const std::vector<T
 
 std::pair<Real, Real> place_reference(Session& ss, const std::string& material, const std::vector<TriaxialTest>& tests,
                                       const Misfit& misfit, const CalibrationResult& r) {
-  const std::vector<Real> reference = ss.reference_point(material);
+  const std::vector<Real> reference = ss.in.reference_point(material);
   Real rise = std::nan(""), chi2 = std::nan("");
   if (!std::all_of(reference.begin(), reference.end(), [](Real v) { return std::isfinite(v); })) return {rise, chi2};
   Model at = r.model;
   std::vector<Real> si;
-  for (std::size_t k = 0; k < ss.free.size(); ++k) {
-    si.push_back(reference[k] / ss.free[k].shown);
-    set_param(at, ss.free[k].name, si.back());
+  for (std::size_t k = 0; k < ss.in.free.size(); ++k) {
+    si.push_back(reference[k] / ss.in.free[k].shown);
+    set_param(at, ss.in.free[k].name, si.back());
   }
   rise = r.region_rise(si);
-  if (ss.runs_reference(material)) {
+  if (ss.in.runs_reference(material)) {
     const long start = ss.lab.runs();
     Progress progress("calibrate " + material + ": the reference point", static_cast<long>(tests.size()) *
                       ss.lab.members());

@@ -153,17 +153,17 @@ DiagnosisReport::DiagnosisReport(const Session& ss, const Config& base, const Ca
      << "Simulator: the cell triaxial test in " << ss.cell_text() << ", an ensemble of " << ss.lab.members()
      << " specimens of " << ss.lab.balls() << " balls (packing seeds from " << base.run.seed
      << "), each prepared once; every parameter point runs them all and compares their mean. Free base parameters:";
-  for (const FreeParam& f : ss.free) md << " " << f.name;
-  md << ". Misfit: chi2 over " << (ss.data.curves ? "q and eps_v at fixed axial strains (0.02% to 15%)"
+  for (const FreeParam& f : ss.in.free) md << " " << f.name;
+  md << ". Misfit: chi2 over " << (ss.in.data.curves ? "q and eps_v at fixed axial strains (0.02% to 15%)"
                                                   : "the summary quantities given")
      << ", with the data's noise, the measured specimen's own scatter and the simulator's standard error "
-        "(host/fit/misfit.hpp); noise: " << (ss.noise.mode == "lab" ? ss.noise.lab_name : "the data's") << ".\n\n";
-  if (!ss.ref.values.empty())
-    md << "Reference values: " << ss.ref.path << (ss.ref.comment.empty() ? "" : ": " + ss.ref.comment)
+        "(host/fit/misfit.hpp); noise: " << (ss.in.noise.mode == "lab" ? ss.in.noise.lab_name : "the data's") << ".\n\n";
+  if (!ss.in.ref.values.empty())
+    md << "Reference values: " << ss.in.ref.path << (ss.in.ref.comment.empty() ? "" : ": " + ss.in.ref.comment)
        << " The calibrated values belong to this simulator (its cell, density and boundary), the reference values to "
           "the model they were calibrated with: a difference between them measures the two simulators as much as "
           "the data.\n\n";
-  for (const std::string& n : ss.data.notes) md << "Note on the data: " << n << "\n\n";
+  for (const std::string& n : ss.in.data.notes) md << "Note on the data: " << n << "\n\n";
   csv_ << "material,model,parameter,value,chi2,bic,heldout_chi2,runs\n";
 }
 
@@ -174,9 +174,9 @@ void DiagnosisReport::models_table(const std::string& material, const Diagnosis&
   std::ostream& md = md_;
   std::ostream& csv = csv_;
   md << "| model | parameters | chi2 | BIC | held-out chi2 | runs |\n|---|---|---|---|---|---|\n| base | ";
-  for (std::size_t k = 0; k < ss.free.size(); ++k) {
-    md << ss.free[k].name << " = " << fmt("%.4g", ss.free[k].shown * dg.base.values[k]) << " ";
-    csv << material << ",base," << ss.free[k].name << "," << fmt("%.6g", ss.free[k].shown * dg.base.values[k]) << ","
+  for (std::size_t k = 0; k < ss.in.free.size(); ++k) {
+    md << ss.in.free[k].name << " = " << fmt("%.4g", ss.in.free[k].shown * dg.base.values[k]) << " ";
+    csv << material << ",base," << ss.in.free[k].name << "," << fmt("%.6g", ss.in.free[k].shown * dg.base.values[k]) << ","
         << fmt("%.3f", dg.base.best.chi2) << "," << fmt("%.3f", dg.base_bic) << "," << fmt("%.3f", dg.base_heldout)
         << "," << dg.base.design.size() * tests << "\n";
   }
@@ -184,8 +184,8 @@ void DiagnosisReport::models_table(const std::string& material, const Diagnosis&
      << fmt("%.1f", dg.base_heldout) << " | " << dg.base.design.size() * tests * ss.lab.members() << " |\n";
   for (const ExtensionFit& f : dg.fits) {
     md << "| " << f.ext.name << " | ";
-    for (std::size_t k = 0; k < ss.free.size(); ++k)
-      md << ss.free[k].name << " = " << fmt("%.4g", ss.free[k].shown * f.values[k]) << " ";
+    for (std::size_t k = 0; k < ss.in.free.size(); ++k)
+      md << ss.in.free[k].name << " = " << fmt("%.4g", ss.in.free[k].shown * f.values[k]) << " ";
     const Real shown = free_param(f.ext.param).shown;
     md << f.ext.param << " = " << fmt("%.3g", shown * f.strength) << " | " << fmt("%.1f", f.best.chi2) << " | "
        << fmt("%.1f", f.bic) << " | " << fmt("%.1f", f.heldout) << " | " << f.runs << " |\n";
@@ -196,8 +196,8 @@ void DiagnosisReport::models_table(const std::string& material, const Diagnosis&
   // The generic discrepancies, each extension's rival: fitted over the base's runs, no runs of their own.
   for (const GenericFit& g : dg.generic) {
     md << "| generic: " << g.shape.name << " | ";
-    for (std::size_t k = 0; k < ss.free.size(); ++k)
-      md << ss.free[k].name << " = " << fmt("%.4g", ss.free[k].shown * g.values[k]) << " ";
+    for (std::size_t k = 0; k < ss.in.free.size(); ++k)
+      md << ss.in.free[k].name << " = " << fmt("%.4g", ss.in.free[k].shown * g.values[k]) << " ";
     md << "c = " << fmt("%.3g", g.c) << " in " << g.shape.formula << " | " << fmt("%.1f", g.chi2) << " | "
        << fmt("%.1f", g.bic) << " | " << fmt("%.1f", g.heldout) << " | 0 |\n";
     csv << material << ",generic: " << g.shape.name << ",c," << fmt("%.6g", g.c) << "," << fmt("%.3f", g.chi2) << ","
@@ -208,18 +208,18 @@ void DiagnosisReport::models_table(const std::string& material, const Diagnosis&
 /// The calibrated values beside the reference values, for the base model and the extension the verdict names.
 std::string DiagnosisReport::reference_table(const std::string& material, const Diagnosis& dg) const {
   const Session& ss = ss_;
-  if (ss.ref.values.empty()) return "";
+  if (ss.in.ref.values.empty()) return "";
   std::ostringstream md;
   const ExtensionFit* named = nullptr;  // the extension the verdict names first, if any
   for (const ExtensionFit& f : dg.fits)
     if (dg.verdict.rfind(f.ext.name, 0) == 0) named = &f;
-  md << "\nCalibrated values beside the reference (" << ss.ref.path << "):\n\n| parameter | base model | "
+  md << "\nCalibrated values beside the reference (" << ss.in.ref.path << "):\n\n| parameter | base model | "
      << (named ? "base + " + named->ext.name + " | " : "") << "reference |\n|---|---|" << (named ? "---|" : "")
      << "---|\n";
-  for (std::size_t k = 0; k < ss.free.size(); ++k) {
-    const Real ref = ss.reference(material, ss.free[k].name);
-    md << "| " << ss.free[k].name << " | " << fmt("%.4g", ss.free[k].shown * dg.base.values[k]) << " | "
-       << (named ? fmt("%.4g", ss.free[k].shown * named->values[k]) + " | " : "")
+  for (std::size_t k = 0; k < ss.in.free.size(); ++k) {
+    const Real ref = ss.reference(material, ss.in.free[k].name);
+    md << "| " << ss.in.free[k].name << " | " << fmt("%.4g", ss.in.free[k].shown * dg.base.values[k]) << " | "
+       << (named ? fmt("%.4g", ss.in.free[k].shown * named->values[k]) + " | " : "")
        << (std::isfinite(ref) ? fmt("%g", ref) : std::string("-")) << " |\n";
   }
   return md.str();
@@ -262,8 +262,8 @@ void DiagnosisReport::close() {
 }
 
 void DiagnosisReport::write(const std::string& prediction) const {
-  io::write_text_atomic(ss_.folder + "/diagnosis.md", md_.str() + (prediction.empty() ? "" : "\n" + prediction));
-  io::write_text_atomic(ss_.folder + "/models.csv", csv_.str());
+  io::write_text_atomic(ss_.report.folder + "/diagnosis.md", md_.str() + (prediction.empty() ? "" : "\n" + prediction));
+  io::write_text_atomic(ss_.report.folder + "/models.csv", csv_.str());
 }
 
 }  // namespace dem
