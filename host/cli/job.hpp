@@ -39,23 +39,6 @@ int triaxial_job(const Config& cfg, bool resume = false, long stop_at_step = -1)
 /// Returns 0, or 2 on a blow-up (state saved).
 int run_periodic_job(const Config& cfg);
 
-class Simulation;
-struct BlowUp;
-namespace io {
-class Output;
-}
-
-struct CellCost;
-/// A cell job's plan before its packing: `command`'s cell packed (at its preparation friction's cost,
-/// packing_cost_at), consolidated to sigma3 and then `test`, which takes low_steps to high_steps (its consolidation
-/// included), at the speed of `cost`'s probe; the particle-steps and the time on this machine.
-void print_cell_plan(const Config& cfg, const std::string& command, const std::string& test, const CellCost& cost,
-                     long low_steps, long high_steps);
-
-/// A cell job's blow-up: the series so far written, the state saved in the output folder as a snapshot and a
-/// checkpoint of `kind`, and the error with where it was saved on stderr. Returns 2, the jobs' status for it.
-int cell_blowup(io::Output& out, Simulation* sim, const std::string& kind, const Config& cfg, const BlowUp& e);
-
 /// The `compression` job: the cell of a periodic job's config (fully periodic or [periodic] boundary = "walls"),
 /// consolidated to [periodic] sigma3, then loaded in increments to `targets_kpa` (kPa; empty: 2, 4, 8, 4 and 2 times
 /// sigma3) along `path` ("oedometer" or "isotropic", host/triax/compression_test.hpp), a row per increment in

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "host/cli/cell_job.hpp"
 #include "host/cli/job.hpp"
 #include "host/engine/checkpoint.hpp"
 #include "host/engine/setup.hpp"
@@ -30,37 +31,6 @@ void print_triaxial_plan(const Config& cfg) {
               "%.2g particle-steps, about %s on this machine (the specimen's layers first, unless cached)\n",
               cost.cell.balls, sigma3 / 1e3, 100 * cfg.triaxial.axial_strain_end, cost.steps(sigma3),
               cost.steps(sigma3) * static_cast<double>(cost.cell.balls), format_duration(cost.seconds(sigma3)).c_str());
-}
-
-}  // namespace
-
-void print_cell_plan(const Config& cfg, const std::string& command, const std::string& test, const CellCost& cost,
-                     long low_steps, long high_steps) {
-  const Real prep = cfg.periodic.prep_mu_s >= 0 ? cfg.periodic.prep_mu_s : cfg.ball.mu_s;
-  const PackingCost at = packing_cost_at(prep);
-  const double packing = static_cast<double>(cost.packing_steps), balls = static_cast<double>(cost.balls);
-  const double step_s = 1e-9 * cost.ns_per_particle_step * balls;
-  const double low = at.low * packing + static_cast<double>(low_steps),
-               high = at.high * packing + static_cast<double>(high_steps);
-  std::printf("%s: plan: %ld balls, a packing (preparation friction %.3g: %.3g to %.3g steps), consolidation to %.0f "
-              "kPa and %s (%ld to %ld steps%s): %.2g to %.2g particle-steps, about %s to %s on this machine\n",
-              command.c_str(), cost.balls, prep, at.low * packing, at.high * packing,
-              cfg.periodic.triax.sigma3 / 1e3, test.c_str(), low_steps, high_steps,
-              cost.resettles() ? ", the balls sliding on without friction: the consolidation settles them again" : "",
-              low * balls, high * balls, format_duration(low * step_s).c_str(), format_duration(high * step_s).c_str());
-}
-
-namespace {
-
-/// The same for a cell's test: its packing (at its preparation friction's cost, packing_cost_at), consolidation and
-/// shear, from a probe of its balls. A config the cell test refuses is refused first, with its own words.
-void print_periodic_plan(const Config& cfg) {
-  check_periodic_config(cfg);
-  const CellCost cost = measure_cell_cost(cfg);
-  const Real sigma3 = cfg.periodic.triax.sigma3;
-  print_cell_plan(cfg, cfg.periodic.boundary == CellBoundary::walls ? "walls" : "periodic",
-                  fmt("shear to %.1f%% axial strain", 100 * cfg.periodic.triax.target_strain), cost,
-                  cost.run_steps(sigma3, false), cost.run_steps(sigma3));
 }
 
 }  // namespace
@@ -124,50 +94,40 @@ int triaxial_job(const Config& cfg, bool resume, long stop_at_step) {
   return 0;
 }
 
-int cell_blowup(io::Output& out, Simulation* sim, const std::string& kind, const Config& cfg, const BlowUp& e) {
-  out.flush_series();
-  if (sim) {
-    out.write_snapshot(take_snapshot(*sim, "blow-up"));
-    write_checkpoint(blowup_path(out.folder()), checkpoint_of(kind, *sim, &out, cfg.fingerprint));
-  }
-  std::fprintf(stderr, "\ntriaxdem: %s\n  state at the blow-up saved in %s (snapshot and %s)\n", e.what(),
-               out.folder().c_str(), blowup_path(out.folder()).c_str());
-  return 2;
-}
+namespace {
 
-int run_periodic_job(const Config& cfg) {
-  std::vector<BallSpec> balls;
-  std::array<Real, 3> cell{};
-  print_periodic_plan(cfg);
-  prepare_periodic_specimen(cfg, balls, cell, true);
-  PeriodicTriaxialParams tp = cfg.periodic.triax;
-  tp.name = cfg.run.name;
-  io::Output out(cfg.run.output);
-  std::unique_ptr<Simulation> sim;
-  std::vector<StageTiming> timings;
-  auto announce = [&](const char* what) {
-    const std::array<Real, 3> l = cell_lengths(*sim);
-    std::printf("triaxdem: %s: %zu balls in %s %.2f x %.2f x %.2f mm; critical dt %.3e s, dt %.3e s\n", what,
-                balls.size(), cell_name(cfg.periodic.boundary), 1e3 * l[0], 1e3 * l[1], 1e3 * l[2],
-                sim->critical_dt(), sim->params().integ.dt);
-    if (cfg.solver.mass_scale != 1)
-      std::printf("triaxdem: DENSITY SCALING x%g is on: inertia is not physical (quasi-static runs only)\n",
-                  cfg.solver.mass_scale);
-  };
-  try {
-    sim = make_periodic_simulation(balls, cell, cfg.ball, cfg.solver, cfg.periodic.boundary);
-    announce("test");
-    const PeriodicTriaxialResult r = run_periodic_triaxial(*sim, tp, &out);
-    timings = r.stages;
-    write_summary(out.folder(), summary_of(cfg, r, static_cast<long>(balls.size())));
-  } catch (const BlowUp& e) {
-    return cell_blowup(out, sim.get(), "periodic", cfg, e);
+/// The drained triaxial test of the cell (host/triax/periodic_triaxial.hpp): consolidation and shear, its summary.
+class CellTriaxial : public CellTest {
+ public:
+  explicit CellTriaxial(const Config& cfg) : cfg_(cfg) {}
+  std::string kind() const override {
+    return cfg_.periodic.boundary == CellBoundary::walls ? "walls" : "periodic";
   }
-  std::printf("time loop (test): %s\n", describe(sim->times(), sim->particles().n, sim->step_count()).c_str());
-  report_timings(out.folder(), timings);
-  std::printf("output: %s/series.csv, summary.csv, snapshots.xdmf\n", out.folder().c_str());
-  run_plot_script("plot_triaxial.py", {out.folder(), "--title", cfg.run.name});
-  return 0;
-}
+  std::string plan_words() const override {
+    return fmt("shear to %.1f%% axial strain", 100 * cfg_.periodic.triax.target_strain);
+  }
+  std::pair<long, long> steps(const CellCost& cost) const override {
+    const Real sigma3 = cfg_.periodic.triax.sigma3;
+    return {cost.run_steps(sigma3, false), cost.run_steps(sigma3)};
+  }
+  std::vector<StageTiming> run(Simulation& sim, io::Output& out) const override {
+    PeriodicTriaxialParams tp = cfg_.periodic.triax;
+    tp.name = cfg_.run.name;
+    const PeriodicTriaxialResult r = run_periodic_triaxial(sim, tp, &out);
+    write_summary(out.folder(), summary_of(cfg_, r, static_cast<long>(sim.particles().n)));
+    return r.stages;
+  }
+  void finish(const std::string& folder) const override {
+    std::printf("output: %s/series.csv, summary.csv, snapshots.xdmf\n", folder.c_str());
+    run_plot_script("plot_triaxial.py", {folder, "--title", cfg_.run.name});
+  }
+
+ private:
+  const Config& cfg_;
+};
+
+}  // namespace
+
+int run_periodic_job(const Config& cfg) { return run_cell_job(cfg, CellTriaxial(cfg)); }
 
 }  // namespace dem
