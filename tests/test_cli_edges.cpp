@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "host/data/compression_data.hpp"
+#include "host/engine/checkpoint.hpp"
 #include "host/util/folder_lock.hpp"
 #include "host/util/progress.hpp"
 #include "host/engine/simulation.hpp"
@@ -264,6 +265,29 @@ TEST(CliEdges, TheCompressionJobWritesARowPerIncrement) {
       << refused.output;
   const Outcome taken = triaxdem("diagnose " + (dir / "peaks.csv").string() + " --config " + one + with, dir);
   EXPECT_EQ(taken.code, 0) << taken.output;
+}
+
+// A cell test that blows up (a shear at inertial number 1, far past what its contacts' stiffness holds at 300 kPa)
+// stops with the jobs' status for it, 2, its state saved beside the series for inspection. Saving it read the
+// blown-up step's statistics again and threw a second time, so the job ended with status 1 and no checkpoint.
+TEST(CliEdges, ACellsBlowUpSavesItsState) {
+  const fs::path dir = dem::test::scratch_dir("cli_cell_blowup");
+  std::string text = text_of(fs::path(TRIAXDEM_SOURCE_DIR) / "tests/data/hidden_effects.toml");
+  for (const auto& [from, to] : {std::pair<std::string, std::string>{"sigma3_kPa = 100.0", "sigma3_kPa = 300.0"},
+                                 {"target_inertial = 3e-3", "target_inertial = 1.0"}}) {
+    ASSERT_NE(text.find(from), std::string::npos) << from;
+    text.replace(text.find(from), from.size(), to);
+  }
+  std::ofstream(dir / "cell.toml") << text;
+  const Outcome o = triaxdem("periodic " + (dir / "cell.toml").string() + " -o " + (dir / "run").string(), dir);
+  EXPECT_EQ(o.code, 2) << o.output;
+  EXPECT_NE(o.output.find("blow-up at step"), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("state at the blow-up saved in"), std::string::npos) << o.output;
+  const std::string saved = dem::blowup_path((dir / "run").string());
+  ASSERT_TRUE(fs::exists(saved)) << o.output;
+  const dem::Checkpoint c = dem::read_checkpoint(saved);
+  EXPECT_EQ(c.job, "periodic");
+  EXPECT_GT(c.sim.step, 0);
 }
 
 // A specimen whose layer the step cap stopped before it came to rest warned and went on (exit 0): it is refused,

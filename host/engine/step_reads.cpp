@@ -63,7 +63,14 @@ void Simulation::read_rows() const {
     const Real* row = rows_.host_row(s);
     StepStats st = step_stats(row + StepRows::kLeapfrog);
     if (row[StepRows::kLeapfrog + 2] > 0) st.bad = non_finite_particle(p_);
-    check_blowup(s, st, rows_.host_overlap(s, StepRows::kBalls), rows_.host_overlap(s, StepRows::kWalls));
+    try {
+      check_blowup(s, st, rows_.host_overlap(s, StepRows::kBalls), rows_.host_overlap(s, StepRows::kWalls));
+    } catch (const BlowUp&) {
+      // Reported once: saving the blown-up state for inspection (state(), a snapshot) reads no row again, where it
+      // threw a second time and the job ended without its checkpoint.
+      read_to_ = step_;
+      throw;
+    }
     const BoundaryStep& b = boundary_steps_[static_cast<std::size_t>(StepRows::slot(s))];
     Real speed = b.speed;
     if (b.cell) speed = std::max(speed, row[StepRows::kCellSpeed]);
