@@ -25,7 +25,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 
 
 def fmt(v, digits=3):
-    return f"{float(v):.{digits}g}"
+    v = float(v)
+    return f"{0.0 if abs(v) < 1e-12 else v:.{digits}g}"  # a bound's rounding (mu_r 1e-19) reads as the 0 it is
 
 
 def prediction_section(folder, periodic_column):
