@@ -15,6 +15,7 @@
 #include "host/config/config.hpp"
 #include "host/io/io_hdf5.hpp"
 #include "host/triax/periodic_triaxial.hpp"
+#include "host/triax/q_columns.hpp"
 #include "host/triax/triaxial.hpp"
 #include "host/util/ranks.hpp"
 #include "host/util/text_format.hpp"
@@ -44,12 +45,6 @@ const Column kColumns[] = {
     {"q_peak_membrane_kPa", &TestSummary::q_peak_membrane, 1e-3, true},
     {"q_peak_lw_kPa", &TestSummary::q_peak_lw, 1e-3, true},
 };
-/// The series column of each measure's q whose peak a summary holds (beside q_kPa's, q_peak).
-const std::pair<const char*, Real TestSummary::*> kMeasurePeaks[] = {{"q_area_kPa", &TestSummary::q_peak_area},
-                                                                     {"q_parabolic_kPa", &TestSummary::q_peak_parabolic},
-                                                                     {"q_membrane_kPa", &TestSummary::q_peak_membrane},
-                                                                     {"q_lw_kPa", &TestSummary::q_peak_lw}};
-
 // Provenance, after the numbers: text columns, optional for the reader (older summaries lack them).
 const std::pair<const char*, std::string Provenance::*> kProvenanceColumns[] = {
     {"version", &Provenance::version}, {"backend", &Provenance::backend}, {"config", &Provenance::config},
@@ -124,12 +119,8 @@ TestSummary summary_of(const Config& cfg, const TriaxialResult& r, long balls) {
   TestSummary s = curve_summary(cfg, r, balls, "membrane");
   s.sigma3 = cfg.triaxial.sigma3;
   s.void_ratio0 = r.void_ratio_consolidated;
-  if (!r.records.empty()) {
-    s.q_peak_area = curves_of(r, q_field(QMeasure::kAreaCorrected), s.sigma3).q_peak;
-    s.q_peak_parabolic = curves_of(r, q_field(QMeasure::kParabolic), s.sigma3).q_peak;
-    s.q_peak_membrane = curves_of(r, q_field(QMeasure::kMembraneCorrected), s.sigma3).q_peak;
-    s.q_peak_lw = curves_of(r, &TriaxialRecord::q_lw, s.sigma3).q_peak;
-  }
+  if (!r.records.empty())
+    for (const QColumn& c : kQColumns) s.*c.peak = curves_of(r, c.record, s.sigma3).q_peak;
   s.eps_a_end = r.records.empty() ? 0 : r.records.back().eps_a;
   s.inertial_number = r.inertial_number;
   return s;
@@ -139,7 +130,7 @@ TestSummary summary_of(const Config& cfg, const PeriodicTriaxialResult& r, long 
   TestSummary s = curve_summary(cfg, r, balls, cfg.periodic.boundary == CellBoundary::walls ? "walls" : "periodic");
   s.sigma3 = r.params.sigma3;
   s.void_ratio0 = r.void_ratio0;
-  s.q_peak_area = s.q_peak_parabolic = s.q_peak_membrane = s.q_peak_lw = r.q_peak;
+  for (const QColumn& c : kQColumns) s.*c.peak = r.q_peak;  // one q: every measure's
   s.eps_a_end = r.series.empty() ? 0 : r.series.back().eps_a;
   s.inertial_number = r.inertial;
   return s;
@@ -174,14 +165,8 @@ TestSummary read_summary(const std::string& path) {
 }
 
 Real q_peak_as(const TestSummary& s, QMeasure m) {
-  if (s.kind == "periodic") return s.q_peak;  // no boundary: its one q is every measure's
-  switch (m) {
-    case QMeasure::kFixedArea: return s.q_peak;
-    case QMeasure::kAreaCorrected: return s.q_peak_area;
-    case QMeasure::kParabolic: return s.q_peak_parabolic;
-    case QMeasure::kMembraneCorrected: return s.q_peak_membrane;
-  }
-  return kNaN;
+  const QColumn* c = s.kind == "periodic" ? nullptr : q_column(m);  // no boundary: its one q is every measure's
+  return c ? s.*c->peak : s.q_peak;
 }
 
 bool summarise_series(const std::string& folder, TestSummary& s) {
@@ -212,10 +197,10 @@ bool summarise_series(const std::string& folder, TestSummary& s) {
   const auto rows = rows_of(kq);
   if (!rows) return false;
   take_curve_values(s, summarised(*rows, s.sigma3));
-  for (const auto& [name, field] : kMeasurePeaks) {
-    const auto k = column(name);
+  for (const QColumn& c : kQColumns) {
+    const auto k = column(c.series_column);
     const auto measured = k == n ? std::nullopt : rows_of(k);
-    if (measured) s.*field = summarised(*measured, s.sigma3).q_peak;
+    if (measured) s.*c.peak = summarised(*measured, s.sigma3).q_peak;
   }
   return true;
 }

@@ -14,6 +14,7 @@
 #include "host/engine/stage_loop.hpp"
 #include "host/engine/stress.hpp"
 #include "host/data/measured.hpp"
+#include "host/triax/q_columns.hpp"
 #include "host/triax/shear_record.hpp"
 #include "host/triax/micro_report.hpp"
 #include "host/util/progress.hpp"
@@ -151,13 +152,8 @@ ShearPlan shear_plan(const Config& cfg, Real dt) {
 }
 
 Real TriaxialRecord::*q_field(QMeasure m) {
-  switch (m) {
-    case QMeasure::kAreaCorrected: return &TriaxialRecord::q_area;
-    case QMeasure::kParabolic: return &TriaxialRecord::q_parabolic;
-    case QMeasure::kMembraneCorrected: return &TriaxialRecord::q_membrane;
-    case QMeasure::kFixedArea: break;
-  }
-  return &TriaxialRecord::q;
+  const QColumn* c = q_column(m);
+  return c ? c->record : &TriaxialRecord::q;
 }
 
 TriaxialTest curves_of(const TriaxialResult& r, Real TriaxialRecord::*q, Real sigma3) {
