@@ -267,27 +267,35 @@ TEST(CliEdges, TheCompressionJobWritesARowPerIncrement) {
   EXPECT_EQ(taken.code, 0) << taken.output;
 }
 
-// A cell test that blows up (a shear at inertial number 1, far past what its contacts' stiffness holds at 300 kPa)
-// stops with the jobs' status for it, 2, its state saved beside the series for inspection. Saving it read the
-// blown-up step's statistics again and threw a second time, so the job ended with status 1 and no checkpoint.
+// A cell test that blows up stops with the jobs' status for it, 2, its state saved beside the series for
+// inspection, in its shear (inertial number 1, far past what the contacts' stiffness holds at 300 kPa) and in its
+// preparation (an overlap limit of 1% of the radius, which a packing at 100 kPa of these balls passes). The shear's
+// saving read the blown-up step's statistics again and threw a second time (status 1, no checkpoint); the
+// preparation's ran outside the job's blow-up handling (status 1, nothing saved).
 TEST(CliEdges, ACellsBlowUpSavesItsState) {
   const fs::path dir = dem::test::scratch_dir("cli_cell_blowup");
-  std::string text = text_of(fs::path(TRIAXDEM_SOURCE_DIR) / "tests/data/hidden_effects.toml");
-  for (const auto& [from, to] : {std::pair<std::string, std::string>{"sigma3_kPa = 100.0", "sigma3_kPa = 300.0"},
-                                 {"target_inertial = 3e-3", "target_inertial = 1.0"}}) {
-    ASSERT_NE(text.find(from), std::string::npos) << from;
-    text.replace(text.find(from), from.size(), to);
+  const std::vector<std::pair<std::string, std::string>> shear = {{"sigma3_kPa = 100.0", "sigma3_kPa = 300.0"},
+                                                                  {"target_inertial = 3e-3", "target_inertial = 1.0"}},
+                                                         preparation = {{"dt_safety = 0.2",
+                                                                         "dt_safety = 0.2\noverlap_limit = 0.01"}};
+  for (const auto& [name, edits] : {std::pair{std::string("shear"), shear}, {"preparation", preparation}}) {
+    std::string text = text_of(fs::path(TRIAXDEM_SOURCE_DIR) / "tests/data/hidden_effects.toml");
+    for (const auto& [from, to] : edits) {
+      ASSERT_NE(text.find(from), std::string::npos) << from;
+      text.replace(text.find(from), from.size(), to);
+    }
+    const fs::path config = dir / (name + ".toml"), run = dir / name;
+    std::ofstream(config) << text;
+    const Outcome o = triaxdem("periodic " + config.string() + " -o " + run.string(), dir);
+    EXPECT_EQ(o.code, 2) << name << "\n" << o.output;
+    EXPECT_NE(o.output.find("blow-up at step"), std::string::npos) << name << "\n" << o.output;
+    EXPECT_NE(o.output.find("state at the blow-up saved in"), std::string::npos) << name << "\n" << o.output;
+    const std::string saved = dem::blowup_path(run.string());
+    ASSERT_TRUE(fs::exists(saved)) << name << "\n" << o.output;
+    const dem::Checkpoint c = dem::read_checkpoint(saved);
+    EXPECT_EQ(c.job, "periodic") << name;
+    EXPECT_GT(c.sim.step, 0) << name;
   }
-  std::ofstream(dir / "cell.toml") << text;
-  const Outcome o = triaxdem("periodic " + (dir / "cell.toml").string() + " -o " + (dir / "run").string(), dir);
-  EXPECT_EQ(o.code, 2) << o.output;
-  EXPECT_NE(o.output.find("blow-up at step"), std::string::npos) << o.output;
-  EXPECT_NE(o.output.find("state at the blow-up saved in"), std::string::npos) << o.output;
-  const std::string saved = dem::blowup_path((dir / "run").string());
-  ASSERT_TRUE(fs::exists(saved)) << o.output;
-  const dem::Checkpoint c = dem::read_checkpoint(saved);
-  EXPECT_EQ(c.job, "periodic");
-  EXPECT_GT(c.sim.step, 0);
 }
 
 // A specimen whose layer the step cap stopped before it came to rest warned and went on (exit 0): it is refused,

@@ -58,11 +58,11 @@ int run_cell_job(const Config& cfg, const CellTest& test) {
   print_cell_plan(cfg, test.kind(), test.plan_words(), cost, low, high);
   std::vector<BallSpec> balls;
   std::array<Real, 3> cell{};
-  prepare_periodic_specimen(cfg, balls, cell, true);
   io::Output out(cfg.run.output);
-  std::unique_ptr<Simulation> sim;
+  std::unique_ptr<Simulation> sim;  // the preparation's, then the test's: a blow-up in either is saved
   std::vector<StageTiming> timings;
   try {
+    prepare_periodic_specimen(cfg, balls, cell, true, &sim);
     sim = make_periodic_simulation(balls, cell, cfg.ball, cfg.solver, cfg.periodic.boundary);
     const std::array<Real, 3> l = cell_lengths(*sim);
     std::printf("triaxdem: test: %zu balls in %s %.2f x %.2f x %.2f mm; critical dt %.3e s, dt %.3e s\n",

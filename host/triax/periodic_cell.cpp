@@ -166,9 +166,11 @@ std::unique_ptr<Simulation> packing_of(const Config& cfg, std::vector<BallSpec>&
 }  // namespace
 
 long prepare_periodic_specimen(const Config& cfg, std::vector<BallSpec>& balls, std::array<Real, 3>& cell,
-                               bool verbose) {
+                               bool verbose, std::unique_ptr<Simulation>* keep) {
   PeriodicTriaxialParams pp;
-  auto sim = packing_of(cfg, balls, cell, pp, verbose);
+  std::unique_ptr<Simulation> own;
+  std::unique_ptr<Simulation>& sim = keep ? *keep : own;
+  sim = packing_of(cfg, balls, cell, pp, verbose);
   if (!sim) return 0;
   const long steps = consolidate_isotropic(*sim, pp).timing.steps;
   balls = extract_balls(*sim, cell);

@@ -145,8 +145,9 @@ void check_periodic_config(const Config& cfg);
 /// The specimen of a periodic job: the packing of [particles]/[box], consolidated to [periodic] sigma3_kPa
 /// with the preparation friction (prep_mu_s, prep_mu_r) when that differs from the material's, without the
 /// model extensions. `balls` and `cell` receive it; returns the preparation's steps (0 where there was none).
+/// `keep`, where given, holds the preparation's simulation, so that a blow-up's state can be saved for inspection.
 long prepare_periodic_specimen(const Config& cfg, std::vector<BallSpec>& balls, std::array<Real, 3>& cell,
-                               bool verbose);
+                               bool verbose, std::unique_ptr<Simulation>* keep = nullptr);
 
 /// A specimen prepared: its balls in their cell.
 struct PreparedCell {
