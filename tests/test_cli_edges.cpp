@@ -298,6 +298,25 @@ TEST(CliEdges, ACellsBlowUpSavesItsState) {
   }
 }
 
+// A membrane specimen's layer that blows up (an overlap limit of 3% of the radius, which the compaction of these
+// beads passes) stops the specimen and triaxial commands with status 2, the layer's state saved for inspection, where
+// the blow-up was said and nothing saved.
+TEST(CliEdges, ASpecimenLayersBlowUpSavesItsState) {
+  const fs::path dir = dem::test::scratch_dir("cli_layer_blowup");
+  write_edited("tests/data/tiny_triaxial.toml", "overlap_limit = 0.25", "overlap_limit = 0.03", dir / "tiny.toml");
+  for (const std::string job : {"specimen", "triaxial"}) {
+    const fs::path run = dir / job;
+    const Outcome o = triaxdem(job + " " + (dir / "tiny.toml").string() + " -o " + run.string(), dir);
+    EXPECT_EQ(o.code, 2) << job << "\n" << o.output;
+    EXPECT_NE(o.output.find("blow-up at step"), std::string::npos) << job << "\n" << o.output;
+    EXPECT_NE(o.output.find("the specimen layer's state at the blow-up saved in"), std::string::npos)
+        << job << "\n" << o.output;
+    const std::string saved = dem::blowup_path(run.string());
+    ASSERT_TRUE(fs::exists(saved)) << job << "\n" << o.output;
+    EXPECT_EQ(dem::read_checkpoint(saved).job, "specimen") << job;
+  }
+}
+
 // A specimen whose layer the step cap stopped before it came to rest warned and went on (exit 0): it is refused,
 // naming the keys, unless accepted; the refused specimen is kept, so the rerun that accepts it does not build it
 // again; and a resume reads the run's own copy, so clearing the shared cache costs nothing.

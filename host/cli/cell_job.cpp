@@ -39,11 +39,7 @@ void print_cell_plan(const Config& cfg, const std::string& command, const std::s
 /// The series so far written, the state saved in the output folder as a snapshot and a checkpoint of `kind`, and the
 /// error with where it was saved on stderr. Returns 2, the jobs' status for a blow-up.
 int cell_blowup(io::Output& out, Simulation* sim, const std::string& kind, const Config& cfg, const BlowUp& e) {
-  out.flush_series();
-  if (sim) {
-    out.write_snapshot(take_snapshot(*sim, "blow-up"));
-    write_checkpoint(blowup_path(out.folder()), checkpoint_of(kind, *sim, &out, cfg.fingerprint));
-  }
+  if (sim) save_blowup_state(out, *sim, kind, cfg.fingerprint);
   std::fprintf(stderr, "\ntriaxdem: %s\n  state at the blow-up saved in %s (snapshot and %s)\n", e.what(),
                out.folder().c_str(), blowup_path(out.folder()).c_str());
   return 2;

@@ -85,11 +85,7 @@ int run_job(const Config& cfg, bool resume, long stop_at_step) {
     out.flush_series();
     write_checkpoint(ckpt, checkpoint_of("run", *sim, &out, cfg.fingerprint));
   };
-  run.save_blowup = [&] {
-    out.flush_series();
-    out.write_snapshot(take_snapshot(*sim, "blow-up"));
-    write_checkpoint(blowup_path(out.folder()), checkpoint_of("run", *sim, &out, cfg.fingerprint));
-  };
+  run.save_blowup = [&] { save_blowup_state(out, *sim, "run", cfg.fingerprint); };
   try {
     timing = run_stage(*sim, run, &plan).timing;
     timing.name = "run";
@@ -113,6 +109,14 @@ int run_job(const Config& cfg, bool resume, long stop_at_step) {
   return 0;
 }
 
+LayerBlowUp layer_blowup(io::Output& out, const Config& cfg) {
+  return [&out, &cfg](Simulation& sim) {
+    save_blowup_state(out, sim, "specimen", cfg.fingerprint);
+    std::fprintf(stderr, "\ntriaxdem: the specimen layer's state at the blow-up saved in %s (snapshot and %s)\n",
+                 out.folder().c_str(), blowup_path(out.folder()).c_str());
+  };
+}
+
 void report_timings(const std::string& folder, const std::vector<StageTiming>& stages) {
   if (stages.empty()) return;
   io::write_text_atomic(folder + "/timings.csv", timings_csv(stages));
@@ -128,9 +132,9 @@ int specimen_job(const Config& cfg) {
   Specimen sp;
   StopSignals signals;
   try {
-    sp = build_specimen(cfg, true);
+    sp = build_specimen(cfg, true, layer_blowup(out, cfg));
   } catch (const BlowUp& e) {
-    std::fprintf(stderr, "triaxdem: %s\n", e.what());
+    std::fprintf(stderr, "\ntriaxdem: %s\n", e.what());
     return 2;
   } catch (const RunStopped& e) {
     std::fprintf(stderr, "\ntriaxdem: %s\n", e.what());

@@ -6,6 +6,7 @@
 #include "host/config/config.hpp"
 #include "host/engine/stage_loop.hpp"
 #include "host/study/study.hpp"
+#include "host/triax/specimen.hpp"
 
 namespace dem {
 
@@ -19,6 +20,10 @@ int run_job(const Config& cfg, bool resume = false, long stop_at_step = -1);
 /// What each stage of a job cost, stage by stage and part by part of the step: printed, and written to
 /// `folder`/timings.csv (nothing where no stage ran in this process).
 void report_timings(const std::string& folder, const std::vector<StageTiming>& stages);
+
+/// What the membrane jobs do with a specimen layer that blows up: its state saved in `out`'s folder for inspection
+/// (save_blowup_state, a checkpoint of kind "specimen") and said.
+LayerBlowUp layer_blowup(io::Output& out, const Config& cfg);
 
 /// `triaxdem check`: validates the config and describes the job it is for (a membrane triaxial test when it has
 /// [specimen], a periodic cell when it has [periodic], else the `run` job's box): balls, geometry, stages, the time

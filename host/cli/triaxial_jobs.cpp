@@ -50,7 +50,7 @@ int triaxial_job(const Config& cfg, bool resume, long stop_at_step) {
     print_triaxial_plan(cfg);
     // Specimens are shared through a cache beside the output folder; each run keeps a copy, which a resume reads first.
     const Specimen sp = cached_specimen(cfg, (std::filesystem::path(out.folder()).parent_path() / ".specimens").string(),
-                                        true, out.folder() + "/specimen.csv");
+                                        true, out.folder() + "/specimen.csv", layer_blowup(out, cfg));
     std::printf("specimen: %zu balls, e = %.4f, height %.3f mm (layers.csv, porosity_profile.csv)\n",
                 sp.balls.size(), sp.void_ratio, sp.height * 1e3);
     write_specimen_report(out.folder(), cfg, sp);

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <sstream>
 
+#include "host/engine/setup.hpp"
 #include "host/util/fnv1a.hpp"
 #include "host/io/h5_file.hpp"
 #include "host/util/text_format.hpp"
@@ -294,6 +295,12 @@ void resume_from(const Checkpoint& c, Simulation& sim, io::Output* out) {
 
 std::string checkpoint_path(const std::string& folder) { return folder + "/checkpoint.h5"; }
 std::string blowup_path(const std::string& folder) { return folder + "/blowup_state.h5"; }
+
+void save_blowup_state(io::Output& out, Simulation& sim, const std::string& job, const std::string& config) {
+  out.flush_series();
+  out.write_snapshot(take_snapshot(sim, "blow-up"));
+  write_checkpoint(blowup_path(out.folder()), checkpoint_of(job, sim, &out, config));
+}
 
 // ---------------------------------------------------------------------------------------------------
 

@@ -52,6 +52,9 @@ Checkpoint read_checkpoint(const std::string& path);
 /// from by default: the last good checkpoint stays).
 std::string checkpoint_path(const std::string& folder);
 std::string blowup_path(const std::string& folder);
+/// What a blow-up of `job` leaves in `out`'s folder for inspection: the series so far, a snapshot of the balls, and the
+/// state at blowup_path (a checkpoint of `job`, written with `config`'s fingerprint).
+void save_blowup_state(io::Output& out, Simulation& sim, const std::string& job, const std::string& config);
 
 /// When to write the next checkpoint: every `every_steps` steps (0: never by count) or `minutes` of wall
 /// time (0: never by time), whichever comes first.

@@ -11,6 +11,7 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <tuple>
 
 #include "host/config/model_keys.hpp"
 #include "host/engine/checkpoint.hpp"
@@ -132,7 +133,7 @@ long specimen_ball_count(const Config& cfg) {
   return std::lround(v / ((1 + sc.void_ratio) * M_PI / 6 * SizeDistribution(cfg.particles).mean_cube()));
 }
 
-Specimen build_specimen(const Config& cfg, bool verbose) {
+Specimen build_specimen(const Config& cfg, bool verbose, const LayerBlowUp& on_blowup) {
   const SpecimenConfig& sc = cfg.specimen;
   const Real R = sc.diameter / 2, h_layer = sc.height / sc.layers;
   const long total = specimen_ball_count(cfg);
@@ -175,8 +176,15 @@ Specimen build_specimen(const Config& cfg, bool verbose) {
     ContactParams settle_law = ball_law;
     settle_law.mu_s = sc.settle_mu_s;
     const std::vector<ContactParams> settle_table{settle_law, wall_law, wall_law, wall_law};
-    const auto [end, ratio] = compact(sim, z1, sc, layer_stop_ratio(sc, k), f_limit, verbose ? &progress : nullptr,
-                                      sc.settle_mu_s >= 0 ? &settle_table : nullptr);
+    StageEnd end;
+    Real ratio = 0;
+    try {
+      std::tie(end, ratio) = compact(sim, z1, sc, layer_stop_ratio(sc, k), f_limit, verbose ? &progress : nullptr,
+                                     sc.settle_mu_s >= 0 ? &settle_table : nullptr);
+    } catch (const BlowUp&) {
+      if (on_blowup) on_blowup(sim);
+      throw;
+    }
     const long steps = end.step;
     out.stages.push_back(end.timing);
     out.stages.back().name = "specimen layer " + std::to_string(k + 1);
@@ -317,7 +325,8 @@ bool load_specimen(const std::string& path, const std::string& key, Specimen& sp
   return true;
 }
 
-Specimen cached_specimen(const Config& cfg, const std::string& cache, bool verbose, const std::string& own) {
+Specimen cached_specimen(const Config& cfg, const std::string& cache, bool verbose, const std::string& own,
+                         const LayerBlowUp& on_blowup) {
   const std::string key = specimen_key(cfg);
   char name[32];
   std::snprintf(name, sizeof name, "%016zx.csv", std::hash<std::string>{}(key));
@@ -332,7 +341,7 @@ Specimen cached_specimen(const Config& cfg, const std::string& cache, bool verbo
       std::printf("specimen: reusing %s (%zu balls, e = %.4f; same beads, mould, seed and compaction)\n", path.c_str(),
                   sp.balls.size(), sp.void_ratio);
   } else {
-    sp = build_specimen(cfg, verbose);
+    sp = build_specimen(cfg, verbose, on_blowup);
     std::filesystem::create_directories(cache);
     save_specimen(path, sp, key);
     if (verbose) std::printf("specimen: stored in %s for later runs\n", path.c_str());

@@ -3,6 +3,7 @@
 /// split into equal layers; each layer's share of balls (count from the target void ratio) is poured at
 /// random above the previous layers inside a rigid cylinder and pressed by the top platen to the layer's
 /// target height, then left to settle until the unbalanced-force ratio is below the threshold.
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -38,9 +39,12 @@ Real layer_stop_ratio(const SpecimenConfig& sc, long k);
 /// Balls needed for the target void ratio: V / ((1 + e) V_ball), V_ball of the mean diameter.
 long specimen_ball_count(const Config& cfg);
 
+/// What a caller does with a layer's simulation that blew up, before the BlowUp goes on (save its state).
+using LayerBlowUp = std::function<void(Simulation&)>;
+
 /// Builds the specimen of cfg.specimen with cfg.particles sizes and the cfg.ball / cfg.wall laws.
-/// Throws ConfigError when a layer cannot be placed or compacted.
-Specimen build_specimen(const Config& cfg, bool verbose);
+/// Throws ConfigError when a layer cannot be placed or compacted, BlowUp (after `on_blowup`) when one blows up.
+Specimen build_specimen(const Config& cfg, bool verbose, const LayerBlowUp& on_blowup = {});
 
 /// Text key of everything that decides the specimen (particles, [specimen], seed, compaction laws, solver):
 /// equal keys build identical specimens, so a study's cases can share one.
@@ -57,7 +61,8 @@ bool load_specimen(const std::string& path, const std::string& key, Specimen& sp
 /// otherwise builds the specimen and stores it there. With `own` (a run folder's specimen.csv), that file is
 /// looked at first and written when it does not hold the specimen: a run resumed elsewhere, or after the cache
 /// was cleared, does not build it again. Then require_settled: an unsettled specimen is kept and refused.
-Specimen cached_specimen(const Config& cfg, const std::string& cache, bool verbose, const std::string& own = "");
+Specimen cached_specimen(const Config& cfg, const std::string& cache, bool verbose, const std::string& own = "",
+                         const LayerBlowUp& on_blowup = {});
 
 /// Throws ConfigError naming the first layer that max_steps_per_layer stopped above stop_ratio, the keys to
 /// change, and accept_unsettled, unless [specimen] accept_unsettled.
