@@ -98,6 +98,62 @@ TEST(Compression, AnElasticPackingUnloadsAlongItsLoadingPath) {
   EXPECT_NEAR(r.series[2].eps_a, 0, 0.02 * loaded);
 }
 
+// Between walls: a simple cubic lattice of n^3 balls of radius r (WalledCell.ServoHoldsALatticeAtItsAnalyticSize's
+// lattice), whose every column carries F = sigma L_a L_b / n^2 through n - 1 ball-ball springs of kn = pi r E / 2 and
+// two ball-wall springs of kw = pi r E, so that its side along an axis is L = 2 n r - F ((n - 1) / kn + 2 / kw). Its
+// contacts lie along the axes: an axial load moves no lateral contact.
+//   oedometer:  the lateral sides held at the seating L0, the axial side from its column's F = sigma_v L0^2 / n^2, so
+//               d sigma_v / d eps_a = n^2 / (L0 ((n - 1) / kn + 2 / kw)); the lateral forces stay the seating ones,
+//               so sigma_h times the axial side is unchanged;
+//   isotropic:  every side at the fixed point of L(sigma) (the one WalledCell solves), eps_v = 1 - (L / L0)^3.
+// Tolerances: the servo holds each stress within stress_tolerance (0.5%) of its target, which moves each side by 0.5%
+// of its compression; the moduli come from the stresses measured, so 1% covers the change of the sides (0.3%) and the
+// walls' resting drift; the isotropic strain from the targets, 0.5% of a squeeze at each end of a difference of about
+// half the larger: 2%.
+TEST(Compression, ALatticeBetweenWallsFollowsItsColumns) {
+  constexpr int n = 4;
+  constexpr Real r = 1e-3, E = 1e8, gap = 1.01;
+  std::vector<BallSpec> balls;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      for (int k = 0; k < n; ++k) {
+        BallSpec b;
+        b.radius = r;
+        b.density = 2500;
+        b.x = gap * Vec3((2 * i + 1) * r, (2 * j + 1) * r, (2 * k + 1) * r);
+        balls.push_back(b);
+      }
+  const Real kn = M_PI * r * E / 2, kw = M_PI * r * E, compliance = (n - 1) / kn + 2 / kw;
+  auto side_at = [&](Real sigma) {  // an isotropic stress's side
+    Real L = 2 * n * r;
+    for (int it = 0; it < 50; ++it) L = 2 * n * r - sigma * L * L / (n * n) * compliance;
+    return L;
+  };
+  for (const CompressionPath path : {CompressionPath::oedometer, CompressionPath::isotropic}) {
+    const Real side = gap * 2 * n * r;
+    auto sim = make_periodic_simulation(balls, {side, side, side}, test::law(E, 1.5, 0.3, 0), test::cell_solver(),
+                                        CellBoundary::walls);
+    PeriodicTriaxialParams p = seated_at(100e3);
+    p.consolidation_rate = 20;  // from a lattice 1% short of its walls
+    const CompressionResult res = run_compression_test(*sim, p, path, {200e3, 300e3});
+    ASSERT_EQ(res.series.size(), 3u) << path_name(path);
+    const CompressionRecord& a = res.series[1];
+    const CompressionRecord& b = res.series[2];
+    const Real L0 = side_at(100e3);
+    if (path == CompressionPath::oedometer) {
+      const Real modulus = (b.sigma_v - a.sigma_v) / (b.eps_a - a.eps_a);
+      EXPECT_NEAR(modulus, n * n / (L0 * compliance), 0.01 * modulus);
+      EXPECT_NEAR(b.sigma_h * (1 - b.eps_a), res.series[0].sigma_h, 1e-3 * res.series[0].sigma_h)
+          << "the lateral contacts carry the seating forces";
+    } else {
+      for (const CompressionRecord* x : {&a, &b}) {
+        const Real eps_v = 1 - std::pow(side_at(x->target) / L0, 3);
+        EXPECT_NEAR(x->eps_v, eps_v, 0.02 * eps_v) << x->target;
+      }
+    }
+  }
+}
+
 TEST(Compression, AnUnknownPathOrABadTargetIsRefused) {
   EXPECT_THROW(compression_path("triaxial"), std::invalid_argument);
   EXPECT_EQ(compression_path("isotropic"), CompressionPath::isotropic);
