@@ -113,16 +113,7 @@ TEST(Compression, AnElasticPackingUnloadsAlongItsLoadingPath) {
 TEST(Compression, ALatticeBetweenWallsFollowsItsColumns) {
   constexpr int n = 4;
   constexpr Real r = 1e-3, E = 1e8, gap = 1.01;
-  std::vector<BallSpec> balls;
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j)
-      for (int k = 0; k < n; ++k) {
-        BallSpec b;
-        b.radius = r;
-        b.density = 2500;
-        b.x = gap * Vec3((2 * i + 1) * r, (2 * j + 1) * r, (2 * k + 1) * r);
-        balls.push_back(b);
-      }
+  const std::vector<BallSpec> balls = test::cubic_lattice(n, r, gap);
   const Real kn = M_PI * r * E / 2, kw = M_PI * r * E, compliance = (n - 1) / kn + 2 / kw;
   auto side_at = [&](Real sigma) {  // an isotropic stress's side
     Real L = 2 * n * r;

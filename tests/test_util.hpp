@@ -6,8 +6,10 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "host/config/config.hpp"
+#include "host/engine/builder.hpp"
 #include "kernels/contact/contact_law.hpp"
 
 namespace dem::test {
@@ -40,7 +42,6 @@ inline std::filesystem::path scratch_dir(const std::string& name) {
   return dir;
 }
 
-/// Contact parameters in one line: E* (Pa), kn/ks, mu_s, mu_r, normal damping ratio.
 /// The cell tests' solver: no gravity, local damping 0.7, dt a fifth of the critical step.
 inline SolverConfig cell_solver() {
   SolverConfig s;
@@ -50,6 +51,7 @@ inline SolverConfig cell_solver() {
   return s;
 }
 
+/// Contact parameters in one line: E* (Pa), kn/ks, mu_s, mu_r, normal damping ratio.
 inline ContactParams law(double emod, double kratio, double mu_s, double mu_r, double beta_n = 0) {
   ContactParams p;
   p.emod = emod;
@@ -58,6 +60,22 @@ inline ContactParams law(double emod, double kratio, double mu_s, double mu_r, d
   p.mu_r = mu_r;
   p.beta_n = beta_n;
   return p;
+}
+
+/// A simple cubic lattice of n^3 glass balls of radius r, their centres 2 r `gap` apart from (r gap, r gap, r gap):
+/// gap 1 touching, above 1 apart, in a cube of side 2 n r gap.
+inline std::vector<BallSpec> cubic_lattice(int n, double r, double gap) {
+  std::vector<BallSpec> balls;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      for (int k = 0; k < n; ++k) {
+        BallSpec b;
+        b.radius = r;
+        b.density = 2500;
+        b.x = gap * Vec3((2 * i + 1) * r, (2 * j + 1) * r, (2 * k + 1) * r);
+        balls.push_back(b);
+      }
+  return balls;
 }
 
 /// A cylindrical specimen of 2 mm beads (diameter = height = size, m) for the quick tests: density scaling

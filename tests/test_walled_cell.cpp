@@ -40,16 +40,7 @@ PeriodicTriaxialParams quiet() {
 TEST(WalledCell, ServoHoldsALatticeAtItsAnalyticSize) {
   const int n = 4;
   const Real gap = 1.01;  // the lattice starts unloaded, the walls 1% beyond it
-  std::vector<BallSpec> balls;
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j)
-      for (int k = 0; k < n; ++k) {
-        BallSpec b;
-        b.radius = kR;
-        b.density = 2500;
-        b.x = gap * Vec3((2 * i + 1) * kR, (2 * j + 1) * kR, (2 * k + 1) * kR);
-        balls.push_back(b);
-      }
+  const std::vector<BallSpec> balls = test::cubic_lattice(n, kR, gap);
   const Real side = gap * 2 * n * kR;
   auto sim = make_periodic_simulation(balls, {side, side, side}, test::law(kE, 1.5, 0.3, 0), test::cell_solver(),
                                       CellBoundary::walls);
