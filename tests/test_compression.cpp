@@ -8,6 +8,7 @@
 #include "host/triax/compression_test.hpp"
 #include "host/triax/periodic_triaxial.hpp"
 #include "kernels/contact/contact_law.hpp"
+#include "test_lattice.hpp"
 #include "test_util.hpp"
 
 using namespace dem;

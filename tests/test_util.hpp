@@ -6,10 +6,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
-#include <vector>
 
 #include "host/config/config.hpp"
-#include "host/engine/builder.hpp"
 #include "kernels/contact/contact_law.hpp"
 
 namespace dem::test {
@@ -60,22 +58,6 @@ inline ContactParams law(double emod, double kratio, double mu_s, double mu_r, d
   p.mu_r = mu_r;
   p.beta_n = beta_n;
   return p;
-}
-
-/// A simple cubic lattice of n^3 glass balls of radius r, their centres 2 r `gap` apart from (r gap, r gap, r gap):
-/// gap 1 touching, above 1 apart, in a cube of side 2 n r gap.
-inline std::vector<BallSpec> cubic_lattice(int n, double r, double gap) {
-  std::vector<BallSpec> balls;
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j)
-      for (int k = 0; k < n; ++k) {
-        BallSpec b;
-        b.radius = r;
-        b.density = 2500;
-        b.x = gap * Vec3((2 * i + 1) * r, (2 * j + 1) * r, (2 * k + 1) * r);
-        balls.push_back(b);
-      }
-  return balls;
 }
 
 /// A cylindrical specimen of 2 mm beads (diameter = height = size, m) for the quick tests: density scaling

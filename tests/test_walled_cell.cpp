@@ -11,6 +11,7 @@
 #include "host/triax/periodic_triaxial.hpp"
 #include "host/engine/simulation.hpp"
 #include "host/triax/triaxial_measure.hpp"
+#include "test_lattice.hpp"
 #include "test_util.hpp"
 
 using namespace dem;
