@@ -67,7 +67,9 @@ int run_cell_job(const Config& cfg, const CellTest& test) {
     if (cfg.solver.mass_scale != 1)
       std::printf("triaxdem: DENSITY SCALING x%g is on: inertia is not physical (quasi-static runs only)\n",
                   cfg.solver.mass_scale);
-    timings = test.run(*sim, out);
+    PeriodicTriaxialParams tp = cfg.periodic.triax;
+    tp.name = cfg.run.name;
+    timings = test.run(*sim, tp, out);
   } catch (const BlowUp& e) {
     return cell_blowup(out, sim.get(), test.kind(), cfg, e);
   }

@@ -27,8 +27,9 @@ class CellTest {
   /// included; low and high) at `cost`.
   virtual std::string plan_words() const = 0;
   virtual std::pair<long, long> steps(const CellCost& cost) const = 0;
-  /// The test on the packed cell into `out` (its record, summary or data, and its own lines): its stages' timings.
-  virtual std::vector<StageTiming> run(Simulation& sim, io::Output& out) const = 0;
+  /// The test on the packed cell at `tp` (the config's [periodic] test, named by the run) into `out` (its record,
+  /// summary or data, and its own lines): its stages' timings.
+  virtual std::vector<StageTiming> run(Simulation& sim, const PeriodicTriaxialParams& tp, io::Output& out) const = 0;
   /// The files it left in `folder` said, and its plots made.
   virtual void finish(const std::string& folder) const = 0;
 };

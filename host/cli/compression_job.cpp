@@ -26,9 +26,7 @@ class CellCompression : public CellTest {
   std::pair<long, long> steps(const CellCost& cost) const override {
     return {cost.compression_steps(targets_.size(), false), cost.compression_steps(targets_.size())};
   }
-  std::vector<StageTiming> run(Simulation& sim, io::Output& out) const override {
-    PeriodicTriaxialParams tp = cfg_.periodic.triax;
-    tp.name = cfg_.run.name;
+  std::vector<StageTiming> run(Simulation& sim, const PeriodicTriaxialParams& tp, io::Output& out) const override {
     const CompressionResult r = run_compression_test(sim, tp, path_, targets_, &out);
     std::printf("%s: target_kPa  sigma_v_kPa  sigma_h_kPa  p_kPa  K0  eps_a_pct  eps_v_pct  void_ratio\n",
                 path_name(path_));

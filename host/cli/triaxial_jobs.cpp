@@ -110,9 +110,7 @@ class CellTriaxial : public CellTest {
     const Real sigma3 = cfg_.periodic.triax.sigma3;
     return {cost.run_steps(sigma3, false), cost.run_steps(sigma3)};
   }
-  std::vector<StageTiming> run(Simulation& sim, io::Output& out) const override {
-    PeriodicTriaxialParams tp = cfg_.periodic.triax;
-    tp.name = cfg_.run.name;
+  std::vector<StageTiming> run(Simulation& sim, const PeriodicTriaxialParams& tp, io::Output& out) const override {
     const PeriodicTriaxialResult r = run_periodic_triaxial(sim, tp, &out);
     write_summary(out.folder(), summary_of(cfg_, r, static_cast<long>(sim.particles().n)));
     return r.stages;
