@@ -70,8 +70,8 @@ if [ "$part" != diagnoses ]; then
   mkdir -p "$work/results/data/sweeps" "$work/results/docs"
   cp -r "$root/data/runs" "$root/data/results" "$work/results/data/" && cp -r "$root/data/sweeps/identification" "$root/data/sweeps/coverage" \
     "$root/data/sweeps/plan" "$root/data/sweeps/compression" "$root/data/sweeps/psd" \
-    "$root/data/sweeps/joint" "$root/data/sweeps/preparation" "$work/results/data/sweeps/" &&
-    cp "$root/docs/results.md" "$work/results/docs/"
+    "$root/data/sweeps/joint" "$root/data/sweeps/preparation" "$root/data/sweeps/inertial_scan_base_8specimens.csv" \
+    "$work/results/data/sweeps/" && cp -r "$root/docs/results.md" "$root/docs/device_runs" "$work/results/docs/"
   sed -i "s/,31.348,/,41.348,/" "$work/results/data/runs/S1_table6_periodic/prediction.csv"  # the error at 100 kPa
   ! "$py" "$root/tools/results_page.py" --root "$work/results" --check > "$work/results_changed.log" 2>&1 &&
     grep -q "is not what its artifacts give" "$work/results_changed.log" ||

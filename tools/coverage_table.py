@@ -62,8 +62,8 @@ def table(rows, out, reference="ensemble"):
         groups.setdefault((r["method"], int(r["size"])), []).append(r)
     out.write("| method | data size | cases | mu_s interval holds | mu_r interval holds | joint region holds | "
               "P(so few) joint | median width mu_s | median width mu_r | widths over " + reference + "'s, same cases "
-              "(mu_s / mu_r) | mu_s misses (below/above) | truth run inside the model region's rise | commits |\n"
-              "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n")
+              "(mu_s / mu_r) | mu_s misses (below/above) | truth run inside the model region's rise | median runs a fit | "
+              "commits |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n")
     for (method, size), g in sorted(groups.items()):
         n = len(g)
         held = {}
@@ -82,9 +82,10 @@ def table(rows, out, reference="ensemble"):
         w_r = statistics.median(width(r, "mu_r") for r in g)
         ratio = against(g, groups.get((reference, size), []))
         commits = ", ".join(sorted({r["commit"] for r in g}))
+        runs = statistics.median(num(r, "runs") for r in g)
         out.write(f"| {method} | {size}x the cell's balls | {n} | {held['mu_s']} of {n} | {held['mu_r']} of {n} | "
                   f"{joint} of {n} | {binom_cdf(joint, n, 0.95):.2g} | {w_s:.3g} | {w_r:.3g} | {ratio} | {below}/{above} | "
-                  f"{run_in} of {run_n} | {commits} |\n")
+                  f"{run_in} of {run_n} | {runs:.0f} | {commits} |\n")
     out.write("\nA true 95% interval holds the truth in 27 to 30 of 30 cases (it misses about 1.5 times in 30); "
               "P(so few) is the chance of at most the joint count under a true 95%. The truth's run is set against the "
               "region the misfit's model gives (chi2_95(2) x max(1, chi2 / (data - 2))), not the one measured on the "

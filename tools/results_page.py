@@ -114,7 +114,10 @@ def identification(root):
                           check=True, capture_output=True, text=True).stdout
     # The sweep's own title is this section's.
     text = "\n".join(l for l in text.splitlines() if not l.startswith("## The identification rate"))
-    return text.strip() + "\n", [folder], "perf/identification_table.sh (tools/sweep_table.py for the table)"
+    rows = [r for level in ("lab", "precise") for r in read_rows(os.path.join(folder, level + ".csv"))]
+    cost = (f"\n\nThe two levels: {len(rows)} cases, {sum(float(r['seconds']) for r in rows) / 3600:.1f} hours of runs in "
+            "all (each case's seconds).")
+    return text.strip() + cost + "\n", [folder], "perf/identification_table.sh (tools/sweep_table.py for the table)"
 
 
 def coverage(root):
@@ -160,14 +163,15 @@ def k0_jaky(root):
     rows = read_rows(os.path.join(folder, "k0_jaky.csv"))
     out = io.StringIO()
     out.write("| emod Pa | K0 (each seed) | peak phi deg | K0 - Jaky with the peak angle | mean | K0 - Jaky with the end-of-test "
-              "angle, mean |\n|---|---|---|---|---|---|\n")
+              "angle | mean |\n|---|---|---|---|---|---|---|\n")
     for emod in dict.fromkeys(r["emod_Pa"] for r in rows):
         sel = [r for r in rows if r["emod_Pa"] == emod]
         d_peak = [float(r["K0_at_1600kPa"]) - float(r["jaky_peak"]) for r in sel]
         d_end = [float(r["K0_at_1600kPa"]) - float(r["jaky_end"]) for r in sel]
         out.write(f"| {emod} | {', '.join(fmt(r['K0_at_1600kPa']) for r in sel)} | "
                   f"{', '.join(fmt(r['phi_peak_deg_400kPa']) for r in sel)} | {', '.join(f'{v:+.3f}' for v in d_peak)} | "
-                  f"**{statistics.fmean(d_peak):+.3f}** | {statistics.fmean(d_end):+.3f} |\n")
+                  f"**{statistics.fmean(d_peak):+.3f}** | {', '.join(f'{v:+.3f}' for v in d_end)} | "
+                  f"{statistics.fmean(d_end):+.3f} |\n")
     return out.getvalue(), [folder], "BUILD=build SRC=. bash data/sweeps/compression/run.sh (from a scratch folder)"
 
 
@@ -356,6 +360,87 @@ def calibration_goals(root):
                                               "data/sweeps/plan/walled_4000/<case>.toml --plan; perf/coverage.sh")
 
 
+def inertial_scan(root):
+    """How fast a calibration cell may shear: the same 8 specimens of configs/calibration/base.toml (200 balls, to 10%)
+    sheared at 100 and 300 kPa at each inertial number, each curve feature's mean shift from the slowest rate over the
+    specimens' own scatter (SD); the largest over the features, strains and pressures."""
+    path = os.path.join(root, "data/sweeps/inertial_scan_base_8specimens.csv")
+    rows = read_rows(path)
+    out = io.StringIO()
+    out.write("| inertial number | largest shift (specimen SDs) | where |\n|---|---|---|\n")
+    for inertial in dict.fromkeys(r["inertial"] for r in rows):
+        worst = max((r for r in rows if r["inertial"] == inertial), key=lambda r: abs(float(r["shift_over_scatter"])))
+        shift = abs(float(worst["shift_over_scatter"]))
+        where = f"{worst['feature']} at {worst['strain_pct']}%, {worst['sigma3_kPa']} kPa" if shift > 0 else "the reference"
+        out.write(f"| {inertial} | {shift:.2f} | {where} |\n")
+    return out.getvalue(), [path], "perf/inertial_scan --specimens 8 --pressures 100,300 -j 2 -o runs/inertial_scan.csv"
+
+
+def device_blocks(path):
+    """A device log's blocks: each "== title" line and the lines under it, in order."""
+    blocks, title = [], ""
+    for line in open(path):
+        if line.startswith("== "):
+            title = line[3:].strip()
+            blocks.append((title, []))
+        elif blocks:
+            blocks[-1][1].append(line.rstrip("\n"))
+    return blocks
+
+
+def device_run(root):
+    """The latest device run, on an H200 (perf/device_check.sh with three full-scale runs of the paper's S-1 test
+    after it; the log keeps what each part printed), and one figure from the third run, on an H100: calibration cells
+    as processes sharing one device. The shear's host work is `host_control_ns` of the shear's row in timings.csv,
+    over the particle-step's time at its rate."""
+    fifth = os.path.join(root, "docs/device_runs/2026-11-30_h200_fifth.log")
+    third = os.path.join(root, "docs/device_runs/2026-11-27_h100_third.log")
+    blocks = device_blocks(fifth)
+    part = lambda start: next(body for title, body in blocks if title.startswith(start))
+    first = lambda body, word: next(l for l in body if l.split()[:1] == [word])
+    field = lambda text, key: float(text.split(key, 1)[1].split()[0].rstrip("M/s"))
+    tests = next(l for l in part("the suite's kernels tests") if l.startswith("passed "))
+    packing = first(part("particle-steps/s at 1000000 balls"), "1000000")
+    launch = first(part("launch overhead (64 balls"), "64")
+    bench = {l.split("/")[1] if l.startswith("BM_CellBatch") else "alone": field(l, "particle_steps/s=")
+             for l in part("calibration cells as one batch")
+             if l.startswith(("BM_CellBatch/64/", "BM_CellBatch/512/", "BM_TimeLoop/9/1/"))}
+    compared = [l for l in part("periodic cell against the CPU's") + part("membrane triaxial test against the CPU's")
+                if l.startswith("| ") and l.split("|")[2].strip().isdigit()]
+    same = sum(l.split("|")[4].strip() == "identical" for l in compared)
+    walls, peaks, host = [], set(), []
+    for title, body in blocks:
+        if "20 records" in title or "overlap off" in title:
+            continue  # the other settings, not the default run's
+        for l in body:
+            if l.startswith("result: q_peak"):
+                peaks.add(l.split()[2])
+                minutes, seconds = l.rsplit("wall time ", 1)[1].rstrip("s").split("m")
+                walls.append(60 * int(minutes) + int(seconds))
+            if l.startswith("shear,53704,"):
+                c = l.split(",")
+                host.append((float(c[-3]), float(c[-3]) * float(c[4]) / 1e9))  # and over a particle-step's ns
+    alone, *shared = [field(l, "; ") for l in open(third) if l.startswith("time loop (test)")][-5:]
+    out = io.StringIO()
+    out.write("| case | measured |\n|---|---|\n")
+    out.write(f"| the suite's kernel and reference tests | {tests} |\n")
+    out.write(f"| the benchmark packing, 10^6 balls | {float(packing.split()[1]):.3g} particle-steps/s |\n")
+    out.write(f"| 64 balls, a step (the launches' overhead) | {64 * float(launch.split()[2]) / 1000:.0f} us |\n")
+    out.write(f"| calibration cells of 729 balls: one alone, a batch of 64, of 512 (particle-steps/s) | "
+              f"{bench['alone'] * 1e6:.3g}; {bench['64'] * 1e6:.3g} ({bench['64'] / bench['alone']:.0f}x); "
+              f"{bench['512'] * 1e6:.3g} ({bench['512'] / bench['alone']:.0f}x) |\n")
+    out.write(f"| the periodic cell's and the membrane test's files against the CPU build's | {same} of {len(compared)} "
+              "identical |\n")
+    out.write(f"| S-1 at full scale (53,704 beads), consolidation and shear to 15%, the specimen made | "
+              f"{min(walls)}-{max(walls)} s in {len(walls)} runs, q_peak {', '.join(sorted(peaks))} kPa |\n")
+    ns, share = zip(*host)
+    out.write(f"| the shear's host work a particle-step in those runs | {min(ns):.2f}-{max(ns):.2f} ns, "
+              f"{min(share):.1%} to {max(share):.1%} of the particle-step |\n")
+    out.write(f"| H100: 4 cells as 4 processes at once against one alone (particle-steps/s) | {alone:.3g} alone; "
+              f"{sum(shared):.3g} for the four together: **{alone / sum(shared):.1f} times slower** |\n")
+    return out.getvalue(), [fifth, third], "perf/device_check.sh and the full-scale runs (each log's command at its top)"
+
+
 def runs_of(rows, keys):
     """Rows grouped by the values of `keys` (one benchmark run each), in file order."""
     groups = {}
@@ -410,6 +495,8 @@ SECTIONS = [
     ("A frictionless base's consolidation against the plan", frictionless_plan),
     ("Side by side with LIGGGHTS and LAMMPS", peer_benchmark),
     ("Cost per particle-step against the ball count", scaling),
+    ("The latest device run (H200)", device_run),
+    ("How fast a calibration cell may shear", inertial_scan),
     ("An oedometer's K0 against Jaky's", k0_jaky),
     ("Compression tests with the triaxial ones", joint_compression),
     ("The preparation's stiffness against the test", preparation_stiffness),
