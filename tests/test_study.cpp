@@ -261,8 +261,8 @@ TEST(Study, KeptCasesAreSummarisedAfreshFromTheirSeries) {
 
 // The study starts its longest cases first (process_pool.hpp's start_order, by study_case_cost). At one inertial
 // number a case's shear takes steps as 1/sqrt(sigma3): the paper's S-1 cases took 65 min at 100 kPa and 34 at
-// 300 kPa on 2 threads (docs/performance.md), so a 100 kPa case must come before any 300 kPa case, and the estimate's
-// ratio is sqrt(3) for the same specimen. Without a cost the pieces start in index order.
+// 300 kPa on 2 threads (docs/history/performance.md), so a 100 kPa case must come before any 300 kPa case, and the
+// estimate's ratio is sqrt(3) for the same specimen. Without a cost the pieces start in index order.
 TEST(Study, LongestCasesStartFirst) {
   const auto cases = study_cases({std::string(TRIAXDEM_SOURCE_DIR) + "/configs/paper"});
   PoolWork w;
