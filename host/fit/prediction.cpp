@@ -120,7 +120,11 @@ std::vector<Prediction> predict(const Config& membrane, const Model& calibrated,
           }
           return true;
         },
-        "membrane test");
+        "membrane test",
+        // A specimen's build and its tests take minutes before its first result: the line says they run.
+        [&](std::size_t) {
+          if (verbose) progress.update(done, "running: each specimen's build, then its tests");
+        });
   }
   if (verbose) progress.finish("");
   return predictions_of(tests, std::move(runs));

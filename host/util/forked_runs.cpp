@@ -28,7 +28,8 @@ bool get_bytes(int fd, void* p, std::size_t n) {
 }
 
 void forked_runs(std::size_t n, int workers, const std::function<void(std::size_t, int)>& task,
-                 const std::function<bool(std::size_t, int)>& collect, const char* what) {
+                 const std::function<bool(std::size_t, int)>& collect, const char* what,
+                 const std::function<void(std::size_t)>& waiting, int waiting_seconds) {
   if (workers <= 1) return;
   bool ok = true;
   PoolWork w;
@@ -38,6 +39,8 @@ void forked_runs(std::size_t n, int workers, const std::function<void(std::size_
   w.child = task;
   w.collect = collect;
   w.after = [&](std::size_t, int status) { ok = ok && status == 0; };
+  w.waiting = waiting;
+  w.waiting_seconds = waiting_seconds;
   run_pool(w, what);
   if (!ok)
     throw std::runtime_error(std::string(what) + ": a parallel run failed (set OMP_NUM_THREADS=1 and -j 1 to see it)");
