@@ -162,6 +162,8 @@ int run_materials(const Config& base, const CalibrationOptions& o, Session& ss, 
   const std::string where = work.close(all_meas, all_sim);
   std::printf("%s: %s in %s; %s\n", kind.c_str(), ss.runs_text().c_str(), format_duration(ss.lab.seconds()).c_str(),
               where.c_str());
+  // A line of its own: inside the runs' line the job's time read as part of the fix ("raise overlap_limit in 11m48s").
+  if (ss.lab.failed_runs() > 0) std::printf("%s: WARNING: %s\n", kind.c_str(), ss.failed_text().c_str());
   if (const std::string w = ss.report.workers_text(); !w.empty()) std::printf("%s: %s\n", kind.c_str(), w.c_str());
   ss.report.finish(ss.in.data, all_meas, all_sim, work.fitted());
   const std::string prediction = ss.predict_boundary(base, models);

@@ -68,8 +68,7 @@ std::string Session::cell_text() const {
 std::string Session::runs_text() const {
   const long read = lab.stored_runs_read();
   return std::to_string(lab.runs()) + " runs" +
-         (read > 0 ? " (" + std::to_string(read) + " of them read from the run store)" : "") +
-         (lab.failed_runs() > 0 ? "; WARNING: " + failed_text() : "");
+         (read > 0 ? " (" + std::to_string(read) + " of them read from the run store)" : "");
 }
 
 std::string JobReport::workers_text() const {

@@ -131,9 +131,10 @@ struct Session {
   Session(const Config& base, const CalibrationOptions& o, const std::string& kind);
   /// The reference test's cell, for the report.
   std::string cell_text() const;
-  /// "N runs", how many of them a resumed session read from its store, and how many a blow-up stopped: their data
-  /// count as missing (kMissingResidual), which pushes the fit away from where they happen.
+  /// "N runs" and how many of them a resumed session read from its store.
   std::string runs_text() const;
+  /// How many runs a blow-up stopped, at up to which pressure, and the fix: their data count as missing
+  /// (kMissingResidual), which pushes the fit away from where they happen.
   std::string failed_text() const;
   std::vector<std::string> free_names() const;
   /// The membrane test at `model` on every test of `tests`, q in the data's measure (a template must be set).
