@@ -266,7 +266,8 @@ Real time_step(const SolverConfig& solver, Real critical, const std::string& pat
 
 /// Memory a run of `balls` balls needs at its peak (bytes): 667 bytes per ball in steady state
 /// (perf/bench_engine: particle arrays and contact lists at 6-7 contacts per ball), doubled for the rebuild,
-/// when the old and the new contact lists live side by side (perf/scaling.sh measured 1,259 at 10^6 balls).
+/// when the old and the new contact lists live side by side. perf/scaling.sh's peak resident memory at 10^6 balls
+/// (docs/results.md, Cost per particle-step against the ball count) is some 15% above this, the program included.
 constexpr double kBytesPerBall = 2 * 667;
 /// Upper bound of a membrane node's memory, its triangles and facet contacts included (the config check).
 constexpr double kBytesPerMembraneNode = 1000;
