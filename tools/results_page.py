@@ -408,6 +408,7 @@ def device_run(root):
     compared = [l for l in part("periodic cell against the CPU's") + part("membrane triaxial test against the CPU's")
                 if l.startswith("| ") and l.split("|")[2].strip().isdigit()]
     same = sum(l.split("|")[4].strip() == "identical" for l in compared)
+    columns = next(l for _, body in blocks for l in body if l.startswith("stage,balls,")).split(",")  # timings.csv's
     walls, peaks, host = [], set(), []
     for title, body in blocks:
         if "20 records" in title or "overlap off" in title:
@@ -418,8 +419,9 @@ def device_run(root):
                 minutes, seconds = l.rsplit("wall time ", 1)[1].rstrip("s").split("m")
                 walls.append(60 * int(minutes) + int(seconds))
             if l.startswith("shear,53704,"):
-                c = l.split(",")
-                host.append((float(c[-3]), float(c[-3]) * float(c[4]) / 1e9))  # and over a particle-step's ns
+                row = dict(zip(columns, l.split(",")))
+                ns = float(row["host_control_ns"])
+                host.append((ns, ns * float(row["particle_steps_per_s"]) / 1e9))  # and over a particle-step's ns
     alone, *shared = [field(l, "; ") for l in open(third) if l.startswith("time loop (test)")][-5:]
     out = io.StringIO()
     out.write("| case | measured |\n|---|---|\n")
